@@ -1,0 +1,680 @@
+//! The independent checker: recomputes every limit of a profile from the
+//! profile alone (its bins and its declared `limits`), trusting nothing a
+//! planner or solver said.
+//!
+//! [`CertifiedProfile`] can only be built by [`certify`], so every profile
+//! the library hands out has passed this check.
+//!
+//! Tolerances: relative [`REL_TOL`] on physical quantities and
+//! [`ANGLE_TOL_DEG`] on bin edges — far below any hardware resolution, large
+//! enough for `f64` sums over 36,000 bins.
+
+use serde::Serialize;
+use std::fmt;
+use thiserror::Error;
+
+use crate::eye_safety::{self, ExposureReport};
+use crate::model::angle::{next_index, FULL_TURN_DEG};
+use crate::model::lidar::PowerAccounting;
+use crate::profile::{Profile, Region, Summary, PROFILE_FORMAT};
+
+/// Relative tolerance on power, spin, time and acceleration comparisons.
+pub const REL_TOL: f64 = 1e-9;
+/// Absolute tolerance on bin edges, degrees.
+pub const ANGLE_TOL_DEG: f64 = 1e-9;
+/// Largest number of bins the checker accepts.
+pub const MAX_PROFILE_BINS: usize = 1_000_000;
+
+/// `value <= limit` with the relative tolerance.
+fn le_tol(value: f64, limit: f64) -> bool {
+    value <= limit + REL_TOL * limit.abs().max(f64::MIN_POSITIVE)
+}
+
+/// `value >= limit` with the relative tolerance.
+fn ge_tol(value: f64, limit: f64) -> bool {
+    value >= limit - REL_TOL * limit.abs().max(f64::MIN_POSITIVE)
+}
+
+/// One violated requirement: where, the value found and the limit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Violation {
+    /// `format` is not profile@1.
+    Format {
+        /// What the file said.
+        found: String,
+    },
+    /// A top-level number is invalid.
+    Header {
+        /// Field name.
+        field: &'static str,
+        /// Value.
+        value: f64,
+        /// Why.
+        reason: &'static str,
+    },
+    /// A limit is itself invalid (NaN, negative, min above max …).
+    BadLimit {
+        /// Key in `limits`.
+        field: &'static str,
+        /// Value.
+        value: f64,
+        /// Why.
+        reason: &'static str,
+    },
+    /// No bins, or too many.
+    BinCount {
+        /// Number of bins.
+        count: usize,
+    },
+    /// A per-bin number is invalid.
+    BinField {
+        /// Bin index.
+        bin: usize,
+        /// Field name.
+        field: &'static str,
+        /// Value.
+        value: f64,
+        /// Why.
+        reason: &'static str,
+    },
+    /// A bin does not start where the previous one ended (gap or overlap).
+    Coverage {
+        /// Bin index.
+        bin: usize,
+        /// Where it should start, degrees.
+        expected_start_deg: f64,
+        /// Where it starts, degrees.
+        start_deg: f64,
+    },
+    /// The bins do not end at 360°.
+    CoverageEnd {
+        /// Where the last bin ends, degrees.
+        end_deg: f64,
+    },
+    /// Σ dwell ≠ 1 / frame_rate_hz.
+    FramePeriod {
+        /// Σ dwell, s.
+        period_s: f64,
+        /// 1 / frame_rate_hz, s.
+        expected_s: f64,
+    },
+    /// Average power over budget.
+    AveragePower {
+        /// Declared accounting.
+        accounting: PowerAccounting,
+        /// Average found, W.
+        average_w: f64,
+        /// `average_power_w`, W.
+        budget_w: f64,
+    },
+    /// Power below `power_w_min`.
+    PowerMin {
+        /// Bin.
+        bin: usize,
+        /// Power, W.
+        power_w: f64,
+        /// Limit, W.
+        limit_w: f64,
+    },
+    /// Power above `power_w_max`.
+    PowerMax {
+        /// Bin.
+        bin: usize,
+        /// Power, W.
+        power_w: f64,
+        /// Limit, W.
+        limit_w: f64,
+    },
+    /// Spin below `spin_rad_s_min`.
+    SpinMin {
+        /// Bin.
+        bin: usize,
+        /// Spin, rad/s.
+        spin_rad_s: f64,
+        /// Limit, rad/s.
+        limit_rad_s: f64,
+    },
+    /// Spin above `spin_rad_s_max`.
+    SpinMax {
+        /// Bin.
+        bin: usize,
+        /// Spin, rad/s.
+        spin_rad_s: f64,
+        /// Limit, rad/s.
+        limit_rad_s: f64,
+    },
+    /// Spin jumps at a bin edge while the acceleration limit is finite.
+    SpinStep {
+        /// Bin whose end is compared.
+        bin: usize,
+        /// Its `spin_end_rad_s`.
+        end_rad_s: f64,
+        /// The next bin's `spin_start_rad_s`.
+        next_start_rad_s: f64,
+        /// The acceleration limit, rad/s².
+        limit_rad_s2: f64,
+    },
+    /// |angular acceleration| above `spin_accel_rad_s2_max`.
+    SpinAccel {
+        /// Bin.
+        bin: usize,
+        /// |a|, rad/s².
+        accel_rad_s2: f64,
+        /// Limit.
+        limit_rad_s2: f64,
+    },
+    /// Power slew between neighbouring bin centres above its limit.
+    PowerSlew {
+        /// First bin of the pair (the other is the next, cyclically).
+        bin: usize,
+        /// Slew, W/deg.
+        slew_w_per_deg: f64,
+        /// Limit.
+        limit_w_per_deg: f64,
+    },
+    /// An eye-safety rule fails at some azimuth.
+    EyeSafety {
+        /// Azimuth of the worst aperture position, degrees.
+        azimuth_deg: f64,
+        /// Which rule binds.
+        rule: String,
+        /// Exposure / limit (> 1 fails).
+        ratio: f64,
+    },
+    /// Eye-safety parameters unusable (wavelength out of band …).
+    EyeSafetyParams {
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+impl Violation {
+    /// The profile key or limit this violation is about.
+    #[must_use]
+    pub fn limit_key(&self) -> &'static str {
+        match self {
+            Self::Format { .. } => "format",
+            Self::Header { field, .. } | Self::BinField { field, .. } => field,
+            Self::BadLimit { field, .. } => field,
+            Self::BinCount { .. } | Self::Coverage { .. } | Self::CoverageEnd { .. } => "bins",
+            Self::FramePeriod { .. } => "frame_rate_hz",
+            Self::AveragePower { .. } => "average_power_w",
+            Self::PowerMin { .. } => "power_w_min",
+            Self::PowerMax { .. } => "power_w_max",
+            Self::SpinMin { .. } => "spin_rad_s_min",
+            Self::SpinMax { .. } => "spin_rad_s_max",
+            Self::SpinStep { .. } | Self::SpinAccel { .. } => "spin_accel_rad_s2_max",
+            Self::PowerSlew { .. } => "power_slew_w_per_deg_max",
+            Self::EyeSafety { .. } | Self::EyeSafetyParams { .. } => "eye_safety",
+        }
+    }
+}
+
+impl fmt::Display for Violation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Format { found } => write!(f, "format: '{found}' is not '{PROFILE_FORMAT}'"),
+            Self::Header {
+                field,
+                value,
+                reason,
+            } => write!(f, "{field} = {value}: {reason}"),
+            Self::BadLimit {
+                field,
+                value,
+                reason,
+            } => write!(f, "limits.{field} = {value}: {reason}"),
+            Self::BinCount { count } => write!(
+                f,
+                "bins: {count} bins; a profile needs 1 to {MAX_PROFILE_BINS}"
+            ),
+            Self::BinField {
+                bin,
+                field,
+                value,
+                reason,
+            } => write!(f, "bins[{bin}].{field} = {value}: {reason}"),
+            Self::Coverage {
+                bin,
+                expected_start_deg,
+                start_deg,
+            } => write!(
+                f,
+                "bins[{bin}].start_deg = {start_deg}: bins must cover [0, 360) contiguously, expected {expected_start_deg}"
+            ),
+            Self::CoverageEnd { end_deg } => {
+                write!(f, "bins: the last bin ends at {end_deg}°, not 360°")
+            }
+            Self::FramePeriod {
+                period_s,
+                expected_s,
+            } => write!(
+                f,
+                "frame period: the bins' dwell times sum to {period_s} s, but 1/frame_rate_hz = {expected_s} s"
+            ),
+            Self::AveragePower {
+                accounting,
+                average_w,
+                budget_w,
+            } => write!(
+                f,
+                "average_power_w: {accounting}-averaged power {average_w} W exceeds the budget {budget_w} W"
+            ),
+            Self::PowerMin {
+                bin,
+                power_w,
+                limit_w,
+            } => write!(
+                f,
+                "bins[{bin}].power_w = {power_w} W is below limits.power_w_min {limit_w} W"
+            ),
+            Self::PowerMax {
+                bin,
+                power_w,
+                limit_w,
+            } => write!(
+                f,
+                "bins[{bin}].power_w = {power_w} W exceeds limits.power_w_max {limit_w} W"
+            ),
+            Self::SpinMin {
+                bin,
+                spin_rad_s,
+                limit_rad_s,
+            } => write!(
+                f,
+                "bins[{bin}] spin {spin_rad_s} rad/s is below limits.spin_rad_s_min {limit_rad_s} rad/s"
+            ),
+            Self::SpinMax {
+                bin,
+                spin_rad_s,
+                limit_rad_s,
+            } => write!(
+                f,
+                "bins[{bin}] spin {spin_rad_s} rad/s exceeds limits.spin_rad_s_max {limit_rad_s} rad/s"
+            ),
+            Self::SpinStep {
+                bin,
+                end_rad_s,
+                next_start_rad_s,
+                limit_rad_s2,
+            } => write!(
+                f,
+                "bins[{bin}] spin steps from {end_rad_s} to {next_start_rad_s} rad/s at its end edge: a step is an infinite acceleration, limits.spin_accel_rad_s2_max is {limit_rad_s2} rad/s²"
+            ),
+            Self::SpinAccel {
+                bin,
+                accel_rad_s2,
+                limit_rad_s2,
+            } => write!(
+                f,
+                "bins[{bin}] needs |acceleration| {accel_rad_s2} rad/s², above limits.spin_accel_rad_s2_max {limit_rad_s2} rad/s²"
+            ),
+            Self::PowerSlew {
+                bin,
+                slew_w_per_deg,
+                limit_w_per_deg,
+            } => write!(
+                f,
+                "bins[{bin}]→next power slew {slew_w_per_deg} W/deg exceeds limits.power_slew_w_per_deg_max {limit_w_per_deg} W/deg"
+            ),
+            Self::EyeSafety {
+                azimuth_deg,
+                rule,
+                ratio,
+            } => write!(
+                f,
+                "eye_safety: at azimuth {azimuth_deg:.3}° the {rule} is {:.1} % of the Class 1 limit (margin {:.3}×)",
+                ratio * 100.0,
+                1.0 / ratio
+            ),
+            Self::EyeSafetyParams { reason } => write!(f, "limits.eye_safety: {reason}"),
+        }
+    }
+}
+
+/// A profile failed the checker; every violation is listed.
+#[derive(Debug, Clone, Error, PartialEq)]
+#[error("profile rejected: {} violation(s); first: {}", violations.len(), violations.first().map(ToString::to_string).unwrap_or_default())]
+pub struct Rejected {
+    /// Every violation found, in the order checked.
+    pub violations: Vec<Violation>,
+}
+
+/// A profile that has passed [`certify`]. Only the checker can build one.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct CertifiedProfile {
+    profile: Profile,
+}
+
+impl CertifiedProfile {
+    /// The certified profile (its `summary` is the checker's).
+    #[must_use]
+    pub fn profile(&self) -> &Profile {
+        &self.profile
+    }
+
+    /// The checker's summary.
+    #[must_use]
+    pub fn summary(&self) -> &Summary {
+        // certify() always sets the summary before constructing Self.
+        self.profile
+            .summary
+            .as_ref()
+            .expect("certify() sets the summary")
+    }
+
+    /// Gives the profile back (it stays certified only as long as unchanged).
+    #[must_use]
+    pub fn into_inner(self) -> Profile {
+        self.profile
+    }
+}
+
+/// Derived figures of a structurally valid profile.
+#[must_use]
+pub fn summarize(profile: &Profile) -> Summary {
+    let n = profile.bins.len();
+    let mut energy = 0.0;
+    let mut power_angle = 0.0;
+    let mut period = 0.0;
+    let mut max_accel: f64 = 0.0;
+    let mut rof = 0.0;
+    let mut p_range = [f64::INFINITY, f64::NEG_INFINITY];
+    let mut s_range = [f64::INFINITY, f64::NEG_INFINITY];
+    for (i, b) in profile.bins.iter().enumerate() {
+        let t = b.dwell_time_s();
+        energy += b.power_w * t;
+        power_angle += b.power_w * b.width_deg;
+        period += t;
+        max_accel = max_accel.max(b.spin_accel_rad_s2().abs());
+        let next = &profile.bins[next_index(i, n)];
+        if n > 1 && b.spin_end_rad_s != next.spin_start_rad_s {
+            max_accel = f64::INFINITY;
+        }
+        if b.region == Some(Region::Rof) {
+            rof += b.width_deg;
+        }
+        p_range = [p_range[0].min(b.power_w), p_range[1].max(b.power_w)];
+        let lo = b.spin_start_rad_s.min(b.spin_end_rad_s);
+        let hi = b.spin_start_rad_s.max(b.spin_end_rad_s);
+        s_range = [s_range[0].min(lo), s_range[1].max(hi)];
+    }
+    Summary {
+        average_power_angle_w: power_angle / FULL_TURN_DEG,
+        average_power_time_w: energy / period,
+        energy_per_frame_j: energy,
+        frame_period_s: period,
+        max_spin_accel_rad_s2: max_accel.is_finite().then_some(max_accel),
+        rof_width_deg: rof,
+        power_w_range: p_range,
+        spin_rad_s_range: s_range,
+    }
+}
+
+fn check_header(p: &Profile, v: &mut Vec<Violation>) {
+    if p.format != PROFILE_FORMAT {
+        v.push(Violation::Format {
+            found: p.format.clone(),
+        });
+    }
+    let pos = |field, value: f64, v: &mut Vec<Violation>| {
+        if !(value.is_finite() && value > 0.0) {
+            v.push(Violation::Header {
+                field,
+                value,
+                reason: "must be finite and > 0",
+            });
+        }
+    };
+    pos("frame_rate_hz", p.frame_rate_hz, v);
+    pos("pulse_rate_hz", p.pulse_rate_hz, v);
+    if !(p.average_power_w.is_finite() && p.average_power_w >= 0.0) {
+        v.push(Violation::Header {
+            field: "average_power_w",
+            value: p.average_power_w,
+            reason: "must be finite and >= 0",
+        });
+    }
+    if let Some(g) = p.gaze_deg {
+        if !g.is_finite() {
+            v.push(Violation::Header {
+                field: "gaze_deg",
+                value: g,
+                reason: "must be finite or null",
+            });
+        }
+    }
+    let l = &p.limits;
+    let mut nonneg = |field, value: f64| {
+        if !(value.is_finite() && value >= 0.0) {
+            v.push(Violation::BadLimit {
+                field,
+                value,
+                reason: "must be finite and >= 0",
+            });
+        }
+    };
+    nonneg("power_w_min", l.power_w_min);
+    nonneg("power_w_max", l.power_w_max);
+    nonneg("spin_rad_s_min", l.spin_rad_s_min);
+    nonneg("spin_rad_s_max", l.spin_rad_s_max);
+    if let Some(a) = l.spin_accel_rad_s2_max {
+        nonneg("spin_accel_rad_s2_max", a);
+    }
+    if let Some(s) = l.power_slew_w_per_deg_max {
+        nonneg("power_slew_w_per_deg_max", s);
+    }
+    if l.power_w_min > l.power_w_max {
+        v.push(Violation::BadLimit {
+            field: "power_w_min",
+            value: l.power_w_min,
+            reason: "is above power_w_max",
+        });
+    }
+    if l.spin_rad_s_min > l.spin_rad_s_max {
+        v.push(Violation::BadLimit {
+            field: "spin_rad_s_min",
+            value: l.spin_rad_s_min,
+            reason: "is above spin_rad_s_max",
+        });
+    }
+}
+
+/// Checks bin fields and coverage; returns false if the bins are too broken
+/// for the physical checks to mean anything.
+fn check_structure(p: &Profile, v: &mut Vec<Violation>) -> bool {
+    let n = p.bins.len();
+    if n == 0 || n > MAX_PROFILE_BINS {
+        v.push(Violation::BinCount { count: n });
+        return false;
+    }
+    let before = v.len();
+    let mut expected = 0.0;
+    for (i, b) in p.bins.iter().enumerate() {
+        let fields = [
+            ("start_deg", b.start_deg),
+            ("width_deg", b.width_deg),
+            ("power_w", b.power_w),
+            ("spin_start_rad_s", b.spin_start_rad_s),
+            ("spin_end_rad_s", b.spin_end_rad_s),
+        ];
+        for (field, value) in fields {
+            if !value.is_finite() {
+                v.push(Violation::BinField {
+                    bin: i,
+                    field,
+                    value,
+                    reason: "must be finite",
+                });
+            }
+        }
+        if !(b.width_deg > 0.0) {
+            v.push(Violation::BinField {
+                bin: i,
+                field: "width_deg",
+                value: b.width_deg,
+                reason: "must be > 0",
+            });
+        }
+        for (field, value) in [
+            ("spin_start_rad_s", b.spin_start_rad_s),
+            ("spin_end_rad_s", b.spin_end_rad_s),
+        ] {
+            if !(value > 0.0) {
+                v.push(Violation::BinField {
+                    bin: i,
+                    field,
+                    value,
+                    reason: "must be > 0 (the head must turn)",
+                });
+            }
+        }
+        if !((b.start_deg - expected).abs() <= ANGLE_TOL_DEG) {
+            v.push(Violation::Coverage {
+                bin: i,
+                expected_start_deg: expected,
+                start_deg: b.start_deg,
+            });
+        }
+        expected = b.start_deg + b.width_deg;
+    }
+    if !((expected - FULL_TURN_DEG).abs() <= ANGLE_TOL_DEG) {
+        v.push(Violation::CoverageEnd { end_deg: expected });
+    }
+    v.len() == before
+}
+
+fn check_limits(p: &Profile, s: &Summary, v: &mut Vec<Violation>) {
+    let l = &p.limits;
+    let n = p.bins.len();
+    let expected_s = 1.0 / p.frame_rate_hz;
+    if !((s.frame_period_s - expected_s).abs() <= REL_TOL * expected_s) {
+        v.push(Violation::FramePeriod {
+            period_s: s.frame_period_s,
+            expected_s,
+        });
+    }
+    // Average power is judged against the nominal frame period for `time`.
+    let average_w = match p.power_accounting {
+        PowerAccounting::Angle => s.average_power_angle_w,
+        PowerAccounting::Time => s.energy_per_frame_j * p.frame_rate_hz,
+    };
+    if !le_tol(average_w, p.average_power_w) {
+        v.push(Violation::AveragePower {
+            accounting: p.power_accounting,
+            average_w,
+            budget_w: p.average_power_w,
+        });
+    }
+    for (i, b) in p.bins.iter().enumerate() {
+        if !ge_tol(b.power_w, l.power_w_min) {
+            v.push(Violation::PowerMin {
+                bin: i,
+                power_w: b.power_w,
+                limit_w: l.power_w_min,
+            });
+        }
+        if !le_tol(b.power_w, l.power_w_max) {
+            v.push(Violation::PowerMax {
+                bin: i,
+                power_w: b.power_w,
+                limit_w: l.power_w_max,
+            });
+        }
+        let lo = b.spin_start_rad_s.min(b.spin_end_rad_s);
+        let hi = b.spin_start_rad_s.max(b.spin_end_rad_s);
+        if !ge_tol(lo, l.spin_rad_s_min) {
+            v.push(Violation::SpinMin {
+                bin: i,
+                spin_rad_s: lo,
+                limit_rad_s: l.spin_rad_s_min,
+            });
+        }
+        if !le_tol(hi, l.spin_rad_s_max) {
+            v.push(Violation::SpinMax {
+                bin: i,
+                spin_rad_s: hi,
+                limit_rad_s: l.spin_rad_s_max,
+            });
+        }
+        let next = &p.bins[next_index(i, n)];
+        if let Some(a_max) = l.spin_accel_rad_s2_max {
+            let a = b.spin_accel_rad_s2().abs();
+            if !le_tol(a, a_max) {
+                v.push(Violation::SpinAccel {
+                    bin: i,
+                    accel_rad_s2: a,
+                    limit_rad_s2: a_max,
+                });
+            }
+            let jump = (b.spin_end_rad_s - next.spin_start_rad_s).abs();
+            if jump > REL_TOL * b.spin_end_rad_s.abs().max(1.0) {
+                v.push(Violation::SpinStep {
+                    bin: i,
+                    end_rad_s: b.spin_end_rad_s,
+                    next_start_rad_s: next.spin_start_rad_s,
+                    limit_rad_s2: a_max,
+                });
+            }
+        }
+        if let Some(slew_max) = l.power_slew_w_per_deg_max {
+            if n > 1 {
+                let slew = (next.power_w - b.power_w).abs() / (0.5 * (b.width_deg + next.width_deg));
+                if !le_tol(slew, slew_max) {
+                    v.push(Violation::PowerSlew {
+                        bin: i,
+                        slew_w_per_deg: slew,
+                        limit_w_per_deg: slew_max,
+                    });
+                }
+            }
+        }
+    }
+}
+
+fn check_eye_safety(p: &Profile, v: &mut Vec<Violation>) {
+    let Some(params) = &p.limits.eye_safety else {
+        return;
+    };
+    match eye_safety::evaluate_profile(p, params) {
+        Ok(report) => v.extend(eye_safety_violation(&report)),
+        Err(e) => v.push(Violation::EyeSafetyParams {
+            reason: e.to_string(),
+        }),
+    }
+}
+
+/// The violation an exposure report implies, if any.
+fn eye_safety_violation(r: &ExposureReport) -> Option<Violation> {
+    (!le_tol(r.worst_ratio, 1.0)).then(|| Violation::EyeSafety {
+        azimuth_deg: r.worst_azimuth_deg,
+        rule: r.binding_rule.to_string(),
+        ratio: r.worst_ratio,
+    })
+}
+
+/// Every violation of `profile`, recomputed from the profile alone.
+#[must_use]
+pub fn check(profile: &Profile) -> Vec<Violation> {
+    let mut v = Vec::new();
+    check_header(profile, &mut v);
+    if check_structure(profile, &mut v) && v.is_empty() {
+        let s = summarize(profile);
+        check_limits(profile, &s, &mut v);
+        check_eye_safety(profile, &mut v);
+    }
+    v
+}
+
+/// Certifies a profile: the only way to obtain a [`CertifiedProfile`].
+/// The checker's own [`Summary`] replaces any the input carried.
+pub fn certify(mut profile: Profile) -> Result<CertifiedProfile, Rejected> {
+    let violations = check(&profile);
+    if !violations.is_empty() {
+        return Err(Rejected { violations });
+    }
+    profile.summary = Some(summarize(&profile));
+    Ok(CertifiedProfile { profile })
+}

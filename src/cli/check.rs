@@ -1,0 +1,117 @@
+//! `gaze-lidar check`: verify a profile@1 file.
+
+use clap::ValueEnum;
+use std::io::Read;
+use std::path::PathBuf;
+
+use gaze_lidar::checker::{certify, summarize};
+use gaze_lidar::eye_safety::evaluate_profile;
+use gaze_lidar::profile::Profile;
+
+use super::CliError;
+
+/// Report format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// One line per violation (or a certified summary).
+    Text,
+    /// `{"certified": bool, "violations": [...], "summary": {...}}`.
+    Json,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Profile JSON file (`-` for stdin).
+    file: PathBuf,
+    /// Report format.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+}
+
+pub fn run(a: &Args) -> Result<u8, CliError> {
+    let profile = if a.file.as_os_str() == "-" {
+        let mut text = String::new();
+        std::io::stdin()
+            .read_to_string(&mut text)
+            .map_err(|e| CliError::input(format!("stdin: {e}")))?;
+        Profile::from_json(&text, "<stdin>")?
+    } else {
+        Profile::read_json(&a.file)?
+    };
+    let origin = a.file.display().to_string();
+    match certify(profile.clone()) {
+        Ok(c) => {
+            let eye = profile
+                .limits
+                .eye_safety
+                .as_ref()
+                .and_then(|p| evaluate_profile(&profile, p).ok());
+            match a.format {
+                Format::Json => {
+                    let v = serde_json::json!({
+                        "certified": true, "violations": [], "summary": c.summary(),
+                        "eye_safety": eye.as_ref().map(|r| serde_json::json!({
+                            "worst_azimuth_deg": r.worst_azimuth_deg, "binding_rule": r.binding_rule,
+                            "worst_ratio": r.worst_ratio, "margin": r.margin,
+                            "stalled_rotor_ratio": r.stalled_rotor_ratio,
+                        })),
+                    });
+                    println!("{v}");
+                }
+                Format::Text => {
+                    let s = c.summary();
+                    println!(
+                        "certified: {origin}: {} bins; average power {:.6e} W (angle) / {:.6e} W (time) of budget {:.6e} W ({}); frame period {:.9} s; max |spin accel| {} rad/s²",
+                        profile.bins.len(), s.average_power_angle_w, s.average_power_time_w,
+                        profile.average_power_w, profile.power_accounting, s.frame_period_s, s.max_spin_accel_rad_s2.map_or("∞ (steps)".to_owned(), |a| format!("{a:.4e}"))
+                    );
+                    match &eye {
+                        Some(r) => println!(
+                            "eye safety: Class 1 at every azimuth; worst {:.3}° ({}), {:.1} % of the limit (margin {:.2}×)",
+                            r.worst_azimuth_deg, r.binding_rule, 100.0 * r.worst_ratio, r.margin
+                        ),
+                        None => println!("eye safety: not evaluated (limits.eye_safety is null)"),
+                    }
+                }
+            }
+            if let Some(r) = &eye {
+                if r.stalled_rotor_ratio > 1.0 {
+                    eprintln!(
+                        "gaze-lidar: warning: a stalled rotor with the laser firing reaches {:.0} % of the Class 1 limit: the product needs a stall interlock",
+                        100.0 * r.stalled_rotor_ratio
+                    );
+                }
+            }
+            Ok(0)
+        }
+        Err(rej) => {
+            match a.format {
+                Format::Json => {
+                    let summary = rej
+                        .violations
+                        .iter()
+                        .all(|v| !matches!(v, gaze_lidar::checker::Violation::BinCount { .. }))
+                        .then(|| summarize(&profile));
+                    let v = serde_json::json!({
+                        "certified": false,
+                        "violations": rej.violations.iter().map(|v| serde_json::json!({
+                            "limit": v.limit_key(), "message": v.to_string(), "detail": v,
+                        })).collect::<Vec<_>>(),
+                        "summary": summary,
+                    });
+                    println!("{v}");
+                }
+                Format::Text => {
+                    for v in &rej.violations {
+                        println!("violation: {v}");
+                    }
+                }
+            }
+            eprintln!(
+                "gaze-lidar: {origin}: rejected, {} violation(s)",
+                rej.violations.len()
+            );
+            Ok(1)
+        }
+    }
+}

@@ -1,0 +1,378 @@
+//! Class 1 accessible emission limits (AEL) of IEC 60825-1:2014 for the bands
+//! LiDARs use, as functions of wavelength and exposure duration.
+//!
+//! **Check before relying on these.** The constants come from the standard's
+//! Table 3 (Class 1 / 1M, C6 = 1) and Table 9/10 (correction factors,
+//! breakpoints, measurement conditions) as quoted by public
+//! re-implementations of the 2014 tables; they have not been compared with a
+//! licensed copy of the standard. A vendor must verify them before use.
+//!
+//! Supported: 700–1050 nm (retinal thermal hazard, where 850–940 nm LiDARs
+//! sit) and 1400–1800 nm (corneal, 1550 nm LiDARs). Small source
+//! (α ≤ α_min = 1.5 mrad, C6 = 1) throughout: a collimated beam seen from
+//! 100 mm.
+
+use serde::Serialize;
+use thiserror::Error;
+
+/// Errors from the AEL functions.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum AelError {
+    /// Wavelength outside the supported bands.
+    #[error("wavelength_nm = {0}: supported bands are 700–1050 nm and 1400–1800 nm")]
+    Wavelength(f64),
+    /// Duration out of the tabulated domain.
+    #[error("{what} = {value} s: {reason}")]
+    Duration {
+        /// Which duration.
+        what: &'static str,
+        /// Value.
+        value: f64,
+        /// Why.
+        reason: &'static str,
+    },
+}
+
+/// Spectral band, selecting the rows of Table 3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Band {
+    /// 700–1050 nm, retinal hazard region (thermal).
+    RetinalNir,
+    /// 1400–1500 nm, corneal.
+    Ir1400,
+    /// 1500–1800 nm, corneal.
+    Ir1500,
+}
+
+/// Minimum angular subtense α_min, rad (Table 9 note; small source below it).
+pub const ALPHA_MIN_RAD: f64 = 1.5e-3;
+/// Time base for Class 1 when intentional long-term viewing is not intended, s (clause 4.3 e).
+pub const TIME_BASE_S: f64 = 100.0;
+/// Condition 3 aperture for 400–1400 nm: 7 mm (Table 10).
+pub const APERTURE_RETINAL_MM: f64 = 7.0;
+/// Condition 3 aperture for 1400–4000 nm: 3.5 mm (Table 10).
+pub const APERTURE_IR_MM: f64 = 3.5;
+/// Condition 3 distance from the reference point (scan mirror): 100 mm (Table 10).
+pub const APERTURE_DISTANCE_MM: f64 = 100.0;
+
+impl Band {
+    /// The band of `wavelength_nm`.
+    pub fn of(wavelength_nm: f64) -> Result<Self, AelError> {
+        if !wavelength_nm.is_finite() {
+            return Err(AelError::Wavelength(wavelength_nm));
+        }
+        if (700.0..=1050.0).contains(&wavelength_nm) {
+            Ok(Self::RetinalNir)
+        } else if (1400.0..1500.0).contains(&wavelength_nm) {
+            Ok(Self::Ir1400)
+        } else if (1500.0..=1800.0).contains(&wavelength_nm) {
+            Ok(Self::Ir1500)
+        } else {
+            Err(AelError::Wavelength(wavelength_nm))
+        }
+    }
+
+    /// Measurement aperture diameter of Condition 3, mm (Table 10).
+    #[must_use]
+    pub fn aperture_mm(self) -> f64 {
+        match self {
+            Self::RetinalNir => APERTURE_RETINAL_MM,
+            Self::Ir1400 | Self::Ir1500 => APERTURE_IR_MM,
+        }
+    }
+
+    /// `T_i`, below which pulses are summed into one (Table 9 / clause 4.3 f), s:
+    /// 5 µs for 400–1050 nm, 1 ms for 1400–1500 nm, 10 s for 1500–1800 nm.
+    #[must_use]
+    pub fn t_i_s(self) -> f64 {
+        match self {
+            Self::RetinalNir => 5e-6,
+            Self::Ir1400 => 1e-3,
+            Self::Ir1500 => 10.0,
+        }
+    }
+}
+
+/// C4 = 10^(0.002(λ − 700)) for 700–1050 nm (Table 9); 1 elsewhere here.
+#[must_use]
+pub fn c4(wavelength_nm: f64) -> f64 {
+    if (700.0..=1050.0).contains(&wavelength_nm) {
+        10f64.powf(0.002 * (wavelength_nm - 700.0))
+    } else {
+        1.0
+    }
+}
+
+/// C7 = 1 for 700–1150 nm (Table 9).
+#[must_use]
+pub fn c7(_wavelength_nm: f64) -> f64 {
+    1.0
+}
+
+/// C6 = 1 for a small source, α ≤ α_min (Table 9).
+#[must_use]
+pub fn c6() -> f64 {
+    1.0
+}
+
+/// T2 = 10 s for α ≤ α_min, 400–1400 nm (Table 9).
+pub const T2_S: f64 = 10.0;
+
+/// C5, the repetitive-pulse correction (clause 4.3 f, 2014 rules), for pulses
+/// no longer than `T_i`, a small source, and `n_pulses` effective pulses
+/// within `T_max = min(T2, time base)`:
+/// 1 if `T_max <= 0.25 s` or `N <= 600`, else `max(0.4, 5 · N^−0.25)`.
+/// Applies to 400–1400 nm only; the corneal bands sum pulses within `T_i`.
+#[must_use]
+pub fn c5(band: Band, n_pulses: f64, t_max_s: f64) -> f64 {
+    if band != Band::RetinalNir || t_max_s <= 0.25 || n_pulses <= 600.0 {
+        1.0
+    } else {
+        (5.0 * n_pulses.powf(-0.25)).max(0.4)
+    }
+}
+
+fn check_duration(what: &'static str, t: f64, min: f64) -> Result<(), AelError> {
+    if !(t.is_finite() && t > 0.0) {
+        return Err(AelError::Duration {
+            what,
+            value: t,
+            reason: "must be finite and > 0",
+        });
+    }
+    if t < min {
+        return Err(AelError::Duration {
+            what,
+            value: t,
+            reason: "is shorter than the shortest tabulated duration for this band",
+        });
+    }
+    if t > 3e4 {
+        return Err(AelError::Duration {
+            what,
+            value: t,
+            reason: "exceeds 3·10⁴ s, beyond Table 3",
+        });
+    }
+    Ok(())
+}
+
+/// Class 1 AEL (J) for a single exposure of duration `t_s` (Table 3, C6 = 1),
+/// without C5.
+///
+/// - 700–1050 nm, 1e-11 ≤ t ≤ 5e-6 s: 7.7e-8 · C4 J (905 nm: 0.198 µJ).
+/// - 700–1050 nm, 5e-6 ≤ t ≤ T2 = 10 s: 7e-4 · C4 · t^0.75 J.
+/// - 700–1050 nm, t > T2: 3.9e-4 · C4 · C7 W · t (905 nm: 1.0 mW).
+/// - 1400–1500 nm: 8e-4 J to 1e-3 s; 4.4e-3 · t^0.25 J to 0.35 s;
+///   1.8e-2 · t^0.75 J to 10 s; 1e-2 W beyond.
+/// - 1500–1800 nm: 8e-3 J for 1e-9 ≤ t ≤ 0.35 s; 1.8e-2 · t^0.75 J to 10 s;
+///   1e-2 W beyond.
+pub fn ael_j(wavelength_nm: f64, t_s: f64) -> Result<f64, AelError> {
+    let band = Band::of(wavelength_nm)?;
+    let c4 = c4(wavelength_nm);
+    match band {
+        Band::RetinalNir => {
+            check_duration("duration", t_s, 1e-11)?;
+            Ok(if t_s <= 5e-6 {
+                7.7e-8 * c4 * c6()
+            } else if t_s <= T2_S {
+                7e-4 * c4 * c6() * t_s.powf(0.75)
+            } else {
+                3.9e-4 * c4 * c7(wavelength_nm) * t_s
+            })
+        }
+        Band::Ir1400 => {
+            check_duration("duration", t_s, 1e-9)?;
+            Ok(if t_s <= 1e-3 {
+                8e-4
+            } else if t_s <= 0.35 {
+                4.4e-3 * t_s.powf(0.25)
+            } else if t_s <= 10.0 {
+                1.8e-2 * t_s.powf(0.75)
+            } else {
+                1e-2 * t_s
+            })
+        }
+        Band::Ir1500 => {
+            check_duration("duration", t_s, 1e-9)?;
+            Ok(if t_s <= 0.35 {
+                8e-3
+            } else if t_s <= 10.0 {
+                1.8e-2 * t_s.powf(0.75)
+            } else {
+                1e-2 * t_s
+            })
+        }
+    }
+}
+
+/// The Class 1 figures the `ael` command reports.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AelReport {
+    /// Wavelength, nm.
+    pub wavelength_nm: f64,
+    /// Band used.
+    pub band: Band,
+    /// Pulse duration, s.
+    pub pulse_duration_s: f64,
+    /// Single-pulse AEL (no C5), J.
+    pub single_pulse_ael_j: f64,
+    /// Long-exposure average-power AEL at the 100 s time base, W.
+    pub average_power_ael_w: f64,
+    /// C4.
+    pub c4: f64,
+    /// C6 (small source).
+    pub c6: f64,
+    /// C7.
+    pub c7: f64,
+    /// T2, s (retinal band).
+    pub t2_s: f64,
+    /// T_i, s.
+    pub t_i_s: f64,
+    /// Time base, s.
+    pub time_base_s: f64,
+    /// Condition 3 aperture diameter, mm.
+    pub aperture_diameter_mm: f64,
+    /// Condition 3 aperture distance, mm.
+    pub aperture_distance_mm: f64,
+    /// With a pulse rate: figures for a stationary (non-scanning, e.g.
+    /// stalled) beam with all pulses entering the aperture.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stationary_beam: Option<StationaryBeam>,
+}
+
+/// AEL figures for a stationary beam at a given pulse rate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StationaryBeam {
+    /// Pulse rate, Hz.
+    pub pulse_rate_hz: f64,
+    /// Effective pulses within min(T2, time base).
+    pub pulses_in_t_max: f64,
+    /// C5 for those pulses.
+    pub c5: f64,
+    /// Per-pulse AEL with C5, J.
+    pub per_pulse_ael_j: f64,
+    /// Highest mean power meeting every rule, W.
+    pub max_average_power_w: f64,
+}
+
+/// Computes the `ael` report for a wavelength, pulse duration and optional pulse rate.
+pub fn ael_report(
+    wavelength_nm: f64,
+    pulse_duration_s: f64,
+    pulse_rate_hz: Option<f64>,
+) -> Result<AelReport, AelError> {
+    let band = Band::of(wavelength_nm)?;
+    let single = ael_j(wavelength_nm, pulse_duration_s)?;
+    let average_power_ael_w = ael_j(wavelength_nm, TIME_BASE_S)? / TIME_BASE_S;
+    let stationary_beam = match pulse_rate_hz {
+        None => None,
+        Some(rate) => {
+            if !(rate.is_finite() && rate > 0.0) {
+                return Err(AelError::Duration {
+                    what: "pulse_rate_hz (as 1/period)",
+                    value: rate,
+                    reason: "must be finite and > 0",
+                });
+            }
+            let t_max = T2_S.min(TIME_BASE_S);
+            let group = (band.t_i_s() * rate).max(1.0);
+            let n = t_max * rate / group;
+            let c5 = c5(band, n, t_max);
+            let t_eff = if group > 1.0 {
+                band.t_i_s()
+            } else {
+                pulse_duration_s
+            };
+            let per_pulse = c5 * ael_j(wavelength_nm, t_eff)? / group;
+            let limit_from_pulse = per_pulse * rate;
+            let limit_from_tbase = average_power_ael_w;
+            let limit_from_t2 = ael_j(wavelength_nm, t_max)? / t_max;
+            Some(StationaryBeam {
+                pulse_rate_hz: rate,
+                pulses_in_t_max: n,
+                c5,
+                per_pulse_ael_j: per_pulse,
+                max_average_power_w: limit_from_pulse.min(limit_from_tbase).min(limit_from_t2),
+            })
+        }
+    };
+    Ok(AelReport {
+        wavelength_nm,
+        band,
+        pulse_duration_s,
+        single_pulse_ael_j: single,
+        average_power_ael_w,
+        c4: c4(wavelength_nm),
+        c6: c6(),
+        c7: c7(wavelength_nm),
+        t2_s: T2_S,
+        t_i_s: band.t_i_s(),
+        time_base_s: TIME_BASE_S,
+        aperture_diameter_mm: band.aperture_mm(),
+        aperture_distance_mm: APERTURE_DISTANCE_MM,
+        stationary_beam,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn design_figures() {
+        let r = ael_report(905.0, 5e-9, None).unwrap();
+        assert_relative_eq!(r.single_pulse_ael_j, 1.98e-7, max_relative = 0.02);
+        assert_relative_eq!(r.average_power_ael_w, 1.0e-3, max_relative = 0.02);
+        assert_relative_eq!(r.c4, 2.570, max_relative = 1e-3);
+        let r = ael_report(850.0, 5e-9, None).unwrap();
+        assert_relative_eq!(r.average_power_ael_w, 7.8e-4, max_relative = 0.02);
+        let r = ael_report(1550.0, 5e-9, None).unwrap();
+        assert_relative_eq!(r.single_pulse_ael_j, 8e-3, max_relative = 0.02);
+        assert_relative_eq!(r.average_power_ael_w, 1e-2, max_relative = 0.02);
+    }
+
+    #[test]
+    fn breakpoints_are_continuous() {
+        // 700–1050 nm at 5 µs and at T2; 1500 nm at 0.35 s and 10 s.
+        for (lambda, t) in [(905.0, 5e-6), (905.0, 10.0), (1550.0, 0.35), (1550.0, 10.0), (1450.0, 1e-3)] {
+            let lo = ael_j(lambda, t * (1.0 - 1e-9)).unwrap();
+            let hi = ael_j(lambda, t * (1.0 + 1e-9)).unwrap();
+            assert_relative_eq!(lo, hi, max_relative = 0.03);
+        }
+    }
+
+    #[test]
+    fn band_edges_and_errors() {
+        assert_eq!(Band::of(700.0).unwrap(), Band::RetinalNir);
+        assert_eq!(Band::of(1050.0).unwrap(), Band::RetinalNir);
+        assert!(Band::of(1051.0).is_err());
+        assert_eq!(Band::of(1400.0).unwrap(), Band::Ir1400);
+        assert_eq!(Band::of(1800.0).unwrap(), Band::Ir1500);
+        assert!(Band::of(1800.1).is_err() && Band::of(f64::NAN).is_err());
+        assert!(ael_j(905.0, 0.0).is_err());
+        assert!(ael_j(905.0, 1e-12).is_err());
+        assert!(ael_j(905.0, f64::NAN).is_err());
+        assert!(ael_j(1550.0, 1e-10).is_err());
+    }
+
+    #[test]
+    fn c5_rules() {
+        assert_eq!(c5(Band::RetinalNir, 600.0, 10.0), 1.0);
+        assert_eq!(c5(Band::RetinalNir, 1e6, 0.2), 1.0);
+        assert_relative_eq!(c5(Band::RetinalNir, 10_000.0, 10.0), 0.5);
+        assert_eq!(c5(Band::RetinalNir, 1e9, 10.0), 0.4);
+        assert_eq!(c5(Band::Ir1500, 1e9, 10.0), 1.0);
+    }
+
+    #[test]
+    fn stationary_beam_is_stricter_than_single_pulse() {
+        let r = ael_report(905.0, 5e-9, Some(7812.5)).unwrap();
+        let s = r.stationary_beam.unwrap();
+        assert_eq!(s.c5, 0.4);
+        assert!(s.per_pulse_ael_j < r.single_pulse_ael_j);
+        assert!(s.max_average_power_w <= r.average_power_ael_w);
+    }
+}

@@ -1,0 +1,70 @@
+//! Eye safety (IEC 60825-1:2014, Class 1) for a pulsed, scanned beam.
+//!
+//! - [`ael`]: the accessible emission limits and correction factors.
+//! - [`exposure`]: the exposure of a stationary measurement aperture placed
+//!   at every azimuth around a spinning head running a profile, against
+//!   those limits. Concentrating power or slowing the spin in a sector raises
+//!   the exposure there, so the limits are checked **per azimuth**.
+//!
+//! The figures must be checked against the standard by a vendor before use
+//! (see [`ael`]).
+
+pub mod ael;
+pub mod exposure;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+pub use ael::{ael_report, AelError, AelReport};
+pub use exposure::{evaluate_profile, ExposureReport, Rule};
+
+/// Laser and optics parameters the eye-safety check needs; stored in a
+/// profile's `limits.eye_safety` so any tool can re-check a profile from the file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EyeSafetyParams {
+    /// Emission wavelength, nm.
+    pub wavelength_nm: f64,
+    /// Pulse duration (FWHM), s.
+    pub pulse_duration_s: f64,
+    /// Beam diameter at the measurement aperture (100 mm from the scan centre), mm.
+    pub beam_diameter_mm: f64,
+}
+
+/// Errors evaluating eye safety.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum EyeSafetyError {
+    /// From the AEL tables.
+    #[error(transparent)]
+    Ael(#[from] AelError),
+    /// A parameter is invalid.
+    #[error("eye_safety.{field} = {value}: {reason}")]
+    Param {
+        /// Field.
+        field: &'static str,
+        /// Value.
+        value: f64,
+        /// Why.
+        reason: &'static str,
+    },
+}
+
+impl EyeSafetyParams {
+    /// Validates the parameters (band, durations, beam size).
+    pub fn validate(&self) -> Result<ael::Band, EyeSafetyError> {
+        let band = ael::Band::of(self.wavelength_nm)?;
+        ael::ael_j(self.wavelength_nm, self.pulse_duration_s).map_err(|_| EyeSafetyError::Param {
+            field: "pulse_duration_s",
+            value: self.pulse_duration_s,
+            reason: "must be finite, > 0 and within Table 3's durations for the band",
+        })?;
+        if !(self.beam_diameter_mm.is_finite() && self.beam_diameter_mm > 0.0 && self.beam_diameter_mm < 1000.0) {
+            return Err(EyeSafetyError::Param {
+                field: "beam_diameter_mm",
+                value: self.beam_diameter_mm,
+                reason: "must be finite, > 0 and < 1000",
+            });
+        }
+        Ok(band)
+    }
+}

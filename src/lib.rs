@@ -1,0 +1,36 @@
+//! # gaze-lidar
+//!
+//! Turns a driver's gaze into a **certified scan schedule** for a spinning
+//! LiDAR: an azimuthal profile of laser power (range) and spin rate
+//! (resolution) that moves the sensor's budget to where the driver is *not*
+//! looking, while staying inside the power budget, the frame rate, the
+//! hardware limits and the eye-safety limits (Scarì et al., "Hybrid
+//! Human-Machine Perception via Adaptive LiDAR for ADAS").
+//!
+//! Data flows one way:
+//! gaze → [`model`] (regions) → [`planner`] → [`profile`] → [`checker`]
+//! (certify, with [`eye_safety`]) → outputs.
+//!
+//! ```
+//! use gaze_lidar::model::presets;
+//! use gaze_lidar::planner::{closed_form, Mode};
+//!
+//! // The paper's LiDAR, driver looking left (90°), range control, 360 bins.
+//! let preset = presets::paper();
+//! let certified = closed_form(&preset, Mode::Range, Some(90.0), 360).unwrap();
+//! let s = certified.summary();
+//! // Eq. 4: a 60° region of focus at half power leaves 1.1 × P̄ for the rest.
+//! assert!((s.power_w_range[1] / preset.lidar.average_power_w - 1.1).abs() < 1e-9);
+//! assert!((s.average_power_angle_w - preset.lidar.average_power_w).abs() < 1e-15);
+//! let json = certified.profile().to_json().unwrap();
+//! assert!(json.contains("gaze-lidar/profile@1"));
+//! ```
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod checker;
+pub mod eye_safety;
+pub mod model;
+pub mod planner;
+pub mod profile;

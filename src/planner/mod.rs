@@ -1,0 +1,116 @@
+//! Planners turn a gaze into a certified profile. [`closed_form`] implements
+//! the paper's two-level controllers (eq. 3–6).
+
+pub mod closed_form;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::checker::Rejected;
+use crate::model::acuity::AcuityError;
+use crate::model::angle::AngleError;
+
+pub use closed_form::closed_form;
+
+/// Which of the paper's controllers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Uniform power and spin (the non-adaptive LiDAR; also the fail-safe).
+    Baseline,
+    /// Range control: `P_low` in the RoF, `P_high` in the RoI (eq. 3–4).
+    Range,
+    /// Resolution control: `ω_high` in the RoF, `ω_low` in the RoI (eq. 5–6).
+    Resolution,
+    /// Both.
+    Joint,
+}
+
+impl Mode {
+    /// All modes, in the paper's order.
+    pub const ALL: [Mode; 4] = [Mode::Baseline, Mode::Range, Mode::Resolution, Mode::Joint];
+
+    /// Lower-case name.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Baseline => "baseline",
+            Self::Range => "range",
+            Self::Resolution => "resolution",
+            Self::Joint => "joint",
+        }
+    }
+
+    /// Whether the power is modulated.
+    #[must_use]
+    pub fn controls_range(self) -> bool {
+        matches!(self, Self::Range | Self::Joint)
+    }
+
+    /// Whether the spin is modulated.
+    #[must_use]
+    pub fn controls_resolution(self) -> bool {
+        matches!(self, Self::Resolution | Self::Joint)
+    }
+}
+
+/// Why a planner could not produce a certified profile.
+#[derive(Debug, Error)]
+pub enum PlanError {
+    /// The request itself is malformed (bad argument): exit code 2.
+    #[error("{field}: {reason}")]
+    InvalidInput {
+        /// The argument or config key.
+        field: &'static str,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The request is well-formed but cannot be met (exit code 1).
+    #[error("infeasible: {0}")]
+    Infeasible(String),
+    /// The planned profile failed the checker (exit code 1): never handed out.
+    #[error("the planned profile violates its limits: {}", .0.violations.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))]
+    Rejected(#[from] Rejected),
+}
+
+impl From<AngleError> for PlanError {
+    fn from(e: AngleError) -> Self {
+        Self::InvalidInput {
+            field: "bins",
+            reason: e.to_string(),
+        }
+    }
+}
+
+impl From<AcuityError> for PlanError {
+    fn from(e: AcuityError) -> Self {
+        Self::InvalidInput {
+            field: "acuity",
+            reason: e.to_string(),
+        }
+    }
+}
+
+impl PlanError {
+    /// Whether the fault is in the input (exit 2) rather than infeasibility (exit 1).
+    #[must_use]
+    pub fn is_input_error(&self) -> bool {
+        matches!(self, Self::InvalidInput { .. })
+    }
+}
+
+/// Largest |gaze| accepted, degrees (anything beyond is surely a unit bug).
+pub const MAX_ABS_GAZE_DEG: f64 = 3600.0;
+
+/// Validates a gaze angle argument.
+pub fn validate_gaze(gaze_deg: f64) -> Result<(), PlanError> {
+    if !gaze_deg.is_finite() || gaze_deg.abs() > MAX_ABS_GAZE_DEG {
+        return Err(PlanError::InvalidInput {
+            field: "gaze-deg",
+            reason: format!(
+                "{gaze_deg:e} is not a finite azimuth within ±{MAX_ABS_GAZE_DEG} degrees"
+            ),
+        });
+    }
+    Ok(())
+}

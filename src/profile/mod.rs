@@ -1,0 +1,259 @@
+//! The scan profile and its interchange formats: `gaze-lidar/profile@1` JSON
+//! and a one-row-per-bin CSV.
+//!
+//! A [`Profile`] is plain data and may be anything a file says; only a
+//! [`crate::checker::CertifiedProfile`] is known to respect its limits.
+
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::Path;
+use thiserror::Error;
+
+pub mod kinematics;
+
+use crate::model::lidar::{Limits, PowerAccounting};
+
+/// The value of the `format` field.
+pub const PROFILE_FORMAT: &str = "gaze-lidar/profile@1";
+
+/// Which region a bin belongs to (informational).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Region {
+    /// Driver's region of focus.
+    Rof,
+    /// LiDAR region of interest (outside the driver's focus).
+    Roi,
+}
+
+/// One azimuth bin of a profile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Bin {
+    /// Start azimuth, degrees.
+    pub start_deg: f64,
+    /// Angular width, degrees.
+    pub width_deg: f64,
+    /// Laser power (mean optical output while scanning this bin), W.
+    pub power_w: f64,
+    /// Spin at the bin's start, rad/s.
+    pub spin_start_rad_s: f64,
+    /// Spin at the bin's end, rad/s (constant angular acceleration in between).
+    pub spin_end_rad_s: f64,
+    /// Region (informational; not trusted by the checker).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<Region>,
+    /// Dwell time in the bin, s (informational; the checker recomputes it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dwell_s: Option<f64>,
+}
+
+impl Bin {
+    /// Dwell time `t = 2Δθ / (ω_start + ω_end)` (constant acceleration), s.
+    #[must_use]
+    pub fn dwell_time_s(&self) -> f64 {
+        2.0 * self.width_deg.to_radians() / (self.spin_start_rad_s + self.spin_end_rad_s)
+    }
+
+    /// Angular acceleration `a = (ω_end² − ω_start²) / (2Δθ)`, rad/s².
+    #[must_use]
+    pub fn spin_accel_rad_s2(&self) -> f64 {
+        (self.spin_end_rad_s.powi(2) - self.spin_start_rad_s.powi(2))
+            / (2.0 * self.width_deg.to_radians())
+    }
+
+    /// Centre azimuth, degrees.
+    #[must_use]
+    pub fn center_deg(&self) -> f64 {
+        self.start_deg + 0.5 * self.width_deg
+    }
+}
+
+/// Figures derived from the bins; written by the checker on certified output.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Summary {
+    /// `Σ P_i Δθ_i / 360°`, W (eq. 4 as printed).
+    pub average_power_angle_w: f64,
+    /// Energy per frame / frame period, W.
+    pub average_power_time_w: f64,
+    /// Energy per frame, J.
+    pub energy_per_frame_j: f64,
+    /// Sum of the bins' dwell times, s.
+    pub frame_period_s: f64,
+    /// Largest |angular acceleration| the profile needs, rad/s²; `null` when
+    /// the spin steps at a bin edge (an infinite acceleration).
+    pub max_spin_accel_rad_s2: Option<f64>,
+    /// Total width of bins marked `rof`, degrees.
+    pub rof_width_deg: f64,
+    /// Lowest and highest power, W.
+    pub power_w_range: [f64; 2],
+    /// Lowest and highest spin, rad/s.
+    pub spin_rad_s_range: [f64; 2],
+}
+
+/// A scan profile in the `gaze-lidar/profile@1` layout (DESIGN.md §3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Profile {
+    /// Always [`PROFILE_FORMAT`].
+    pub format: String,
+    /// Nominal revolutions per second.
+    pub frame_rate_hz: f64,
+    /// Laser firing rate per channel, Hz.
+    pub pulse_rate_hz: f64,
+    /// The average power budget the profile was built for, W.
+    pub average_power_w: f64,
+    /// How the budget is accounted.
+    pub power_accounting: PowerAccounting,
+    /// Gaze azimuth used; `null` for a gaze-free profile.
+    #[serde(deserialize_with = "required_f64")]
+    pub gaze_deg: Option<f64>,
+    /// Limits the profile was built and is checked against.
+    pub limits: Limits,
+    /// Bins in azimuth order covering `[0, 360)`.
+    pub bins: Vec<Bin>,
+    /// How it was made (e.g. `closed-form range`); informational.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<String>,
+    /// Derived figures; informational on input (the checker recomputes them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub summary: Option<Summary>,
+}
+
+fn required_f64<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    Option::<f64>::deserialize(d)
+}
+
+/// Errors reading or writing profiles and other output files.
+#[derive(Debug, Error)]
+pub enum IoError {
+    /// Could not read or write a file.
+    #[error("{path}: {source}")]
+    File {
+        /// The file.
+        path: String,
+        /// Cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// JSON did not parse or did not match the format; names line and column.
+    #[error("{path}:{line}:{column}: {message}")]
+    Json {
+        /// The file (or `-` for stdin).
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// serde's message (names the field).
+        message: String,
+    },
+    /// The `format` field is not `gaze-lidar/profile@1`.
+    #[error("{path}: field 'format' is '{found}', expected '{PROFILE_FORMAT}'")]
+    Format {
+        /// The file.
+        path: String,
+        /// What it said.
+        found: String,
+    },
+    /// CSV encoding failed.
+    #[error("csv: {0}")]
+    Csv(#[from] csv::Error),
+    /// JSON encoding failed.
+    #[error("json: {0}")]
+    Encode(#[from] serde_json::Error),
+}
+
+/// serde_json appends " at line L column C"; the error prints them already.
+fn strip_position(msg: &str) -> String {
+    match msg.rfind(" at line ") {
+        Some(i) => msg[..i].to_owned(),
+        None => msg.to_owned(),
+    }
+}
+
+impl Profile {
+    /// Parses profile@1 JSON; `origin` names the source in errors.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self, IoError> {
+        let p: Self = serde_json::from_str(text).map_err(|e| IoError::Json {
+            path: origin.to_owned(),
+            line: e.line(),
+            column: e.column(),
+            message: strip_position(&e.to_string()),
+        })?;
+        if p.format != PROFILE_FORMAT {
+            return Err(IoError::Format {
+                path: origin.to_owned(),
+                found: p.format,
+            });
+        }
+        Ok(p)
+    }
+
+    /// Reads a profile@1 JSON file.
+    pub fn read_json(path: &Path) -> Result<Self, IoError> {
+        let text = std::fs::read_to_string(path).map_err(|source| IoError::File {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_json(&text, &path.display().to_string())
+    }
+
+    /// Pretty JSON with a trailing newline.
+    pub fn to_json(&self) -> Result<String, IoError> {
+        let mut s = serde_json::to_string_pretty(self)?;
+        s.push('\n');
+        Ok(s)
+    }
+
+    /// CSV, one row per bin: the per-bin fields of profile@1.
+    pub fn to_csv(&self) -> Result<String, IoError> {
+        #[derive(Serialize)]
+        struct Row<'a> {
+            start_deg: f64,
+            width_deg: f64,
+            power_w: f64,
+            spin_start_rad_s: f64,
+            spin_end_rad_s: f64,
+            region: Option<&'a str>,
+            dwell_s: f64,
+        }
+        let mut w = csv::Writer::from_writer(Vec::new());
+        for b in &self.bins {
+            w.serialize(Row {
+                start_deg: b.start_deg,
+                width_deg: b.width_deg,
+                power_w: b.power_w,
+                spin_start_rad_s: b.spin_start_rad_s,
+                spin_end_rad_s: b.spin_end_rad_s,
+                region: b.region.map(|r| match r {
+                    Region::Rof => "rof",
+                    Region::Roi => "roi",
+                }),
+                dwell_s: b.dwell_time_s(),
+            })?;
+        }
+        let bytes = w.into_inner().map_err(|e| IoError::File {
+            path: "<csv buffer>".into(),
+            source: e.into_error(),
+        })?;
+        Ok(String::from_utf8_lossy(&bytes).into_owned())
+    }
+}
+
+/// Writes `contents` to `path` atomically: a temporary file in the same
+/// folder, then a rename, so a failure never leaves a partial file.
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), IoError> {
+    let err = |source| IoError::File {
+        path: path.display().to_string(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(err)?;
+    tmp.write_all(contents).map_err(err)?;
+    tmp.flush().map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error))?;
+    Ok(())
+}
