@@ -9,6 +9,10 @@
 //! [`ANGLE_TOL_DEG`] on bin edges — far below any hardware resolution, large
 //! enough for `f64` sums over 36,000 bins.
 
+// Negated comparisons (`!(x <= limit)`) are deliberate throughout: a NaN
+// must fail every check, which `x > limit` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use serde::Serialize;
 use std::fmt;
 use thiserror::Error;
@@ -621,7 +625,8 @@ fn check_limits(p: &Profile, s: &Summary, v: &mut Vec<Violation>) {
         }
         if let Some(slew_max) = l.power_slew_w_per_deg_max {
             if n > 1 {
-                let slew = (next.power_w - b.power_w).abs() / (0.5 * (b.width_deg + next.width_deg));
+                let slew =
+                    (next.power_w - b.power_w).abs() / (0.5 * (b.width_deg + next.width_deg));
                 if !le_tol(slew, slew_max) {
                     v.push(Violation::PowerSlew {
                         bin: i,

@@ -18,16 +18,16 @@ pub enum Format {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Wavelength, nm (700–1050 or 1400–1800).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     wavelength_nm: f64,
     /// Pulse duration, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pulse_duration_s: f64,
     /// Pulse rate, Hz: adds the figures for a stationary (stalled) beam.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pulse_rate_hz: Option<f64>,
     /// Beam diameter at 100 mm, mm: adds the scan pass angle.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     beam_diameter_mm: Option<f64>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -36,26 +36,43 @@ pub struct Args {
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
     if !(a.wavelength_nm.is_finite()) {
-        return Err(CliError::input(format!("--wavelength-nm: {} is not a finite number", a.wavelength_nm)));
+        return Err(CliError::input(format!(
+            "--wavelength-nm: {} is not a finite number",
+            a.wavelength_nm
+        )));
     }
     if !(a.pulse_duration_s.is_finite() && a.pulse_duration_s > 0.0) {
-        return Err(CliError::input(format!("--pulse-duration-s: {} must be finite and > 0", a.pulse_duration_s)));
+        return Err(CliError::input(format!(
+            "--pulse-duration-s: {} must be finite and > 0",
+            a.pulse_duration_s
+        )));
     }
     if let Some(r) = a.pulse_rate_hz {
         if !(r.is_finite() && r > 0.0) {
-            return Err(CliError::input(format!("--pulse-rate-hz: {r} must be finite and > 0")));
+            return Err(CliError::input(format!(
+                "--pulse-rate-hz: {r} must be finite and > 0"
+            )));
         }
     }
     let pass_angle_deg = match a.beam_diameter_mm {
         Some(d) if d.is_finite() && d > 0.0 => Some(d),
-        Some(d) => return Err(CliError::input(format!("--beam-diameter-mm: {d} must be finite and > 0"))),
+        Some(d) => {
+            return Err(CliError::input(format!(
+                "--beam-diameter-mm: {d} must be finite and > 0"
+            )))
+        }
         None => None,
     };
     let r = ael_report(a.wavelength_nm, a.pulse_duration_s, a.pulse_rate_hz).map_err(|e| {
         let msg = e.to_string();
-        if msg.starts_with("wavelength") { CliError::input(format!("--wavelength-nm: {msg}")) } else { CliError::input(format!("--pulse-duration-s: {msg}")) }
+        if msg.starts_with("wavelength") {
+            CliError::input(format!("--wavelength-nm: {msg}"))
+        } else {
+            CliError::input(format!("--pulse-duration-s: {msg}"))
+        }
     })?;
-    let pass = pass_angle_deg.map(|d| ((r.aperture_diameter_mm + d) / r.aperture_distance_mm).to_degrees());
+    let pass = pass_angle_deg
+        .map(|d| ((r.aperture_diameter_mm + d) / r.aperture_distance_mm).to_degrees());
     match a.format {
         Format::Json => {
             let mut v = serde_json::to_value(&r).map_err(|e| CliError::input(e.to_string()))?;
@@ -65,14 +82,23 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             println!("{v}");
         }
         Format::Table => {
-            println!("IEC 60825-1:2014 Class 1, small source (C6 = 1), time base {} s", r.time_base_s);
-            println!("wavelength              {} nm ({:?})", r.wavelength_nm, r.band);
+            println!(
+                "IEC 60825-1:2014 Class 1, small source (C6 = 1), time base {} s",
+                r.time_base_s
+            );
+            println!(
+                "wavelength              {} nm ({:?})",
+                r.wavelength_nm, r.band
+            );
             println!("pulse duration          {:e} s", r.pulse_duration_s);
             println!("single-pulse AEL        {:.4e} J", r.single_pulse_ael_j);
             println!("average-power AEL       {:.4e} W", r.average_power_ael_w);
             println!("C4 / C6 / C7            {:.4} / {} / {}", r.c4, r.c6, r.c7);
             println!("T2 / T_i                {} s / {:e} s", r.t2_s, r.t_i_s);
-            println!("aperture (Condition 3)  {} mm at {} mm", r.aperture_diameter_mm, r.aperture_distance_mm);
+            println!(
+                "aperture (Condition 3)  {} mm at {} mm",
+                r.aperture_diameter_mm, r.aperture_distance_mm
+            );
             if let Some(s) = &r.stationary_beam {
                 println!("stationary beam         {} Hz: N = {:.0} in T2, C5 = {:.4}, per-pulse AEL {:.4e} J, max mean power {:.4e} W",
                     s.pulse_rate_hz, s.pulses_in_t_max, s.c5, s.per_pulse_ael_j, s.max_average_power_w);

@@ -78,7 +78,9 @@ enum Command {
 /// Writes `text` to `out` atomically, or to stdout.
 pub fn emit(text: &str, out: Option<&Path>) -> Result<(), CliError> {
     match out {
-        Some(path) => write_atomic(path, text.as_bytes()).map_err(|e| CliError::input(e.to_string())),
+        Some(path) => {
+            write_atomic(path, text.as_bytes()).map_err(|e| CliError::input(e.to_string()))
+        }
         None => {
             use std::io::Write;
             let mut stdout = std::io::stdout().lock();
@@ -96,7 +98,12 @@ pub fn main() -> ExitCode {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;
-            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
                 let _ = e.print();
                 return ExitCode::SUCCESS;
             }

@@ -39,7 +39,7 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     gaze_deg: Option<f64>,
     /// Number of equal bins (4..=36000); region boundaries are added as edges.
-    #[arg(long, default_value_t = 360)]
+    #[arg(long, default_value_t = 360, allow_negative_numbers = true)]
     bins: usize,
     /// Override the preset's power accounting.
     #[arg(long, value_enum)]
@@ -53,7 +53,8 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
-    let mut preset = presets::preset(&a.preset).map_err(|e| CliError::input(format!("--preset: {e}")))?;
+    let mut preset =
+        presets::preset(&a.preset).map_err(|e| CliError::input(format!("--preset: {e}")))?;
     if let Some(acc) = a.accounting {
         preset.lidar.power_accounting = match acc {
             Accounting::Time => PowerAccounting::Time,
@@ -66,7 +67,11 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             a.mode.name()
         )));
     }
-    let gaze = if a.mode == Mode::Baseline { None } else { a.gaze_deg };
+    let gaze = if a.mode == Mode::Baseline {
+        None
+    } else {
+        a.gaze_deg
+    };
     if let Some(g) = a.gaze_deg {
         gaze_lidar::planner::validate_gaze(g).map_err(|e| CliError::input(format!("--{e}")))?;
     }

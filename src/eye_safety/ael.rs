@@ -336,11 +336,18 @@ mod tests {
 
     #[test]
     fn breakpoints_are_continuous() {
-        // 700–1050 nm at 5 µs and at T2; 1500 nm at 0.35 s and 10 s.
-        for (lambda, t) in [(905.0, 5e-6), (905.0, 10.0), (1550.0, 0.35), (1550.0, 10.0), (1450.0, 1e-3)] {
+        // 700–1050 nm at 5 µs and at T2; 1500 nm at 0.35 s and 10 s. The
+        // table itself steps by ≈ 4 % at 5 µs (7.7e-8 vs 7e-4·(5e-6)^0.75).
+        for (lambda, t) in [
+            (905.0, 5e-6),
+            (905.0, 10.0),
+            (1550.0, 0.35),
+            (1550.0, 10.0),
+            (1450.0, 1e-3),
+        ] {
             let lo = ael_j(lambda, t * (1.0 - 1e-9)).unwrap();
             let hi = ael_j(lambda, t * (1.0 + 1e-9)).unwrap();
-            assert_relative_eq!(lo, hi, max_relative = 0.03);
+            assert_relative_eq!(lo, hi, max_relative = 0.05);
         }
     }
 

@@ -79,7 +79,12 @@ impl AzimuthExposure {
     /// The binding rule and its ratio.
     #[must_use]
     pub fn worst(&self) -> (Rule, f64) {
-        const RULES: [Rule; 4] = [Rule::SinglePulse, Rule::PassTrain, Rule::T2Train, Rule::TimeBase];
+        const RULES: [Rule; 4] = [
+            Rule::SinglePulse,
+            Rule::PassTrain,
+            Rule::T2Train,
+            Rule::TimeBase,
+        ];
         let mut best = (RULES[0], self.ratios[0]);
         for (r, &x) in RULES.iter().zip(&self.ratios).skip(1) {
             if x > best.1 {

@@ -53,12 +53,17 @@ impl EyeSafetyParams {
     /// Validates the parameters (band, durations, beam size).
     pub fn validate(&self) -> Result<ael::Band, EyeSafetyError> {
         let band = ael::Band::of(self.wavelength_nm)?;
-        ael::ael_j(self.wavelength_nm, self.pulse_duration_s).map_err(|_| EyeSafetyError::Param {
-            field: "pulse_duration_s",
-            value: self.pulse_duration_s,
-            reason: "must be finite, > 0 and within Table 3's durations for the band",
+        ael::ael_j(self.wavelength_nm, self.pulse_duration_s).map_err(|_| {
+            EyeSafetyError::Param {
+                field: "pulse_duration_s",
+                value: self.pulse_duration_s,
+                reason: "must be finite, > 0 and within Table 3's durations for the band",
+            }
         })?;
-        if !(self.beam_diameter_mm.is_finite() && self.beam_diameter_mm > 0.0 && self.beam_diameter_mm < 1000.0) {
+        if !(self.beam_diameter_mm.is_finite()
+            && self.beam_diameter_mm > 0.0
+            && self.beam_diameter_mm < 1000.0)
+        {
             return Err(EyeSafetyError::Param {
                 field: "beam_diameter_mm",
                 value: self.beam_diameter_mm,

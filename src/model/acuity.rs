@@ -108,7 +108,9 @@ impl AcuityModel {
                     return Err(AcuityError::BadTable("needs at least 2 samples".into()));
                 }
                 for (k, s) in samples.iter().enumerate() {
-                    if !(s.eccentricity_deg.is_finite() && (-180.0..=180.0).contains(&s.eccentricity_deg)) {
+                    if !(s.eccentricity_deg.is_finite()
+                        && (-180.0..=180.0).contains(&s.eccentricity_deg))
+                    {
                         return Err(AcuityError::BadTable(format!(
                             "sample {k}: eccentricity_deg {} is not in [-180, 180]",
                             s.eccentricity_deg
@@ -121,7 +123,10 @@ impl AcuityModel {
                         )));
                     }
                 }
-                if samples.windows(2).any(|w| w[1].eccentricity_deg <= w[0].eccentricity_deg) {
+                if samples
+                    .windows(2)
+                    .any(|w| w[1].eccentricity_deg <= w[0].eccentricity_deg)
+                {
                     return Err(AcuityError::BadTable(
                         "eccentricity_deg must increase strictly".into(),
                     ));
@@ -218,7 +223,7 @@ impl AcuityModel {
         };
         match self {
             Self::Box { half_width_deg } => {
-                if threshold < 1.0 && threshold >= 0.0 {
+                if (0.0..1.0).contains(&threshold) {
                     symmetric(*half_width_deg)
                 } else if threshold < 0.0 {
                     symmetric(180.0)
@@ -336,11 +341,7 @@ impl FocusModel {
             });
         let rof = CircularSet::from_arcs(arcs);
         let roi = rof.complement();
-        Regions {
-            gaze_deg,
-            rof,
-            roi,
-        }
+        Regions { gaze_deg, rof, roi }
     }
 }
 
@@ -354,7 +355,13 @@ mod tests {
         let m = AcuityModel::LeviE2 {
             e2_deg: LEVI_E2_DEG,
         };
-        for (e, v) in [(0.0, 1.0), (5.0, 0.35), (10.0, 0.21), (30.0, 0.083), (60.0, 0.043)] {
+        for (e, v) in [
+            (0.0, 1.0),
+            (5.0, 0.35),
+            (10.0, 0.21),
+            (30.0, 0.083),
+            (60.0, 0.043),
+        ] {
             assert!((m.value(e) - v).abs() < 0.006, "V({e}) = {}", m.value(e));
         }
     }

@@ -130,7 +130,9 @@ pub fn build_profile(
                 power_w: lv.power_w[r],
                 spin_start_rad_s: spin,
                 spin_end_rad_s: spin,
-                region: regions.as_ref().map(|_| if in_rof[i] { Region::Rof } else { Region::Roi }),
+                region: regions
+                    .as_ref()
+                    .map(|_| if in_rof[i] { Region::Rof } else { Region::Roi }),
                 dwell_s: Some(grid.width_deg(i).to_radians() / spin),
             }
         })
@@ -174,7 +176,11 @@ mod tests {
         assert_relative_eq!(lv.power_w[0], 0.5e-3);
         assert_relative_eq!(lv.power_w[1], 1.1e-3, max_relative = 1e-12);
         let lv = levels(&p, Mode::Resolution, 60.0, 300.0).unwrap();
-        assert_relative_eq!(lv.spin_rad_s[0] / lv.spin_rad_s[1], 5.4, max_relative = 1e-12);
+        assert_relative_eq!(
+            lv.spin_rad_s[0] / lv.spin_rad_s[1],
+            5.4,
+            max_relative = 1e-12
+        );
         let period = 60f64.to_radians() / lv.spin_rad_s[0] + 300f64.to_radians() / lv.spin_rad_s[1];
         assert_relative_eq!(period, 0.05, max_relative = 1e-12);
     }

@@ -15,7 +15,9 @@ pub fn time_into_bin_s(bin: &Bin, x_rad: f64) -> f64 {
         return 0.0;
     }
     let a = bin.spin_accel_rad_s2();
-    let w_x = (bin.spin_start_rad_s.powi(2) + 2.0 * a * x_rad).max(0.0).sqrt();
+    let w_x = (bin.spin_start_rad_s.powi(2) + 2.0 * a * x_rad)
+        .max(0.0)
+        .sqrt();
     2.0 * x_rad / (bin.spin_start_rad_s + w_x)
 }
 
@@ -93,9 +95,14 @@ impl<'a> Timeline<'a> {
     pub fn time_energy_at(&self, azimuth_deg: f64) -> (f64, f64) {
         let i = self.bin_index(azimuth_deg);
         let b = &self.bins[i];
-        let x = (azimuth_deg - b.start_deg).clamp(0.0, b.width_deg).to_radians();
+        let x = (azimuth_deg - b.start_deg)
+            .clamp(0.0, b.width_deg)
+            .to_radians();
         let dt = time_into_bin_s(b, x);
-        (self.cum_time_s[i] + dt, self.cum_energy_j[i] + dt * b.power_w)
+        (
+            self.cum_time_s[i] + dt,
+            self.cum_energy_j[i] + dt * b.power_w,
+        )
     }
 
     /// Time and energy spent sweeping the arc `[lo, lo + width)` (wrapping), width ≤ 360.
