@@ -34,3 +34,9 @@ pub mod eye_safety;
 pub mod model;
 pub mod planner;
 pub mod profile;
+pub mod sim;
+
+/// The README's examples, compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -8,6 +8,7 @@
 mod ael;
 mod check;
 mod profile;
+mod simulate;
 
 use clap::{Parser, Subcommand};
 use std::path::Path;
@@ -73,6 +74,8 @@ enum Command {
     Check(check::Args),
     /// Class 1 eye-safety limits (IEC 60825-1:2014) for a laser.
     Ael(ael::Args),
+    /// Run the paper's T-intersection experiment (variants × fog × trials).
+    Simulate(simulate::Args),
 }
 
 /// Writes `text` to `out` atomically, or to stdout.
@@ -117,6 +120,7 @@ pub fn main() -> ExitCode {
         Command::Profile(a) => profile::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Ael(a) => ael::run(&a),
+        Command::Simulate(a) => simulate::run(&a),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -1,0 +1,281 @@
+//! Figures: TTA and density box plots laid out like the paper's figures 3
+//! and 4 (one panel per fog level, one box per variant), and a polar view of
+//! the four profiles. Each is written as SVG and PNG; text uses the DejaVu
+//! Sans font embedded in the binary, so no system fonts are needed.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use super::{GridResult, ModelKind, SimConfig};
+use crate::model::presets;
+use crate::planner::{closed_form, Mode};
+
+static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+fn register_font() {
+    REGISTER.call_once(|| {
+        // The embedded file is a valid TTF (checked by the plot tests).
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// Plotting failed.
+#[derive(Debug, thiserror::Error)]
+#[error("plot {path}: {message}")]
+pub struct PlotError {
+    /// File.
+    pub path: String,
+    /// Cause.
+    pub message: String,
+}
+
+const COLORS: [RGBColor; 4] = [
+    RGBColor(90, 90, 90),
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+];
+
+type DrawResult = Result<(), Box<dyn std::error::Error>>;
+
+/// Box plots of `metric` for one model: one panel per fog level.
+fn draw_boxes<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    result: &GridResult,
+    config: &SimConfig,
+    model: ModelKind,
+    metric: Metric,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let title = format!(
+        "{} — {} ({} model)",
+        metric.title(),
+        metric.subtitle(),
+        model.name()
+    );
+    let root = root.titled(&title, ("sans-serif", 22))?;
+    let panels = root.split_evenly((1, config.fog_pcts.len()));
+    // Shared y range over the model so panels compare.
+    let all: Vec<f32> = config
+        .fog_pcts
+        .iter()
+        .flat_map(|&f| {
+            config
+                .variants
+                .iter()
+                .flat_map(move |v| metric.values(result, model, v.name(), f))
+        })
+        .collect();
+    let (lo, hi) = all
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) };
+    let pad = ((hi - lo) * 0.08).max(0.05);
+    let y_range = (lo - pad).max(0.0)..(hi + pad);
+    for (panel, &fog) in panels.iter().zip(&config.fog_pcts) {
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("fog {fog} %"), ("sans-serif", 18))
+            .margin(8)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(
+                -0.5f32..(config.variants.len() as f32 - 0.5),
+                y_range.clone(),
+            )?;
+        let names: Vec<&str> = config.variants.iter().map(|v| v.name()).collect();
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(names.len())
+            .x_label_formatter(&|x| {
+                let i = x.round();
+                if (x - i).abs() < 1e-3 && i >= 0.0 {
+                    names
+                        .get(i as usize)
+                        .map_or(String::new(), |s| (*s).to_owned())
+                } else {
+                    String::new()
+                }
+            })
+            .y_desc(metric.axis())
+            .label_style(("sans-serif", 13))
+            .draw()?;
+        for (i, v) in config.variants.iter().enumerate() {
+            let values = metric.values(result, model, v.name(), fog);
+            if values.is_empty() {
+                continue;
+            }
+            let q = Quartiles::new(&values);
+            let color = COLORS[i % COLORS.len()];
+            chart.draw_series(std::iter::once(
+                Boxplot::new_vertical(i as f32, &q)
+                    .width(28)
+                    .whisker_width(0.5)
+                    .style(color),
+            ))?;
+        }
+    }
+    Ok(())
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Metric {
+    Tta,
+    Density,
+}
+
+impl Metric {
+    fn title(self) -> &'static str {
+        match self {
+            Self::Tta => "Time to arrival at detection",
+            Self::Density => "Point density in the LiDAR's region of interest",
+        }
+    }
+    fn subtitle(self) -> &'static str {
+        match self {
+            Self::Tta => "car from the right",
+            Self::Density => "accumulated, 64-channel scale",
+        }
+    }
+    fn axis(self) -> &'static str {
+        match self {
+            Self::Tta => "TTA at detection [s]",
+            Self::Density => "points per degree",
+        }
+    }
+    fn values(self, r: &GridResult, model: ModelKind, variant: &str, fog: u32) -> Vec<f32> {
+        r.cell(model, variant, fog)
+            .filter_map(|t| match self {
+                Self::Tta => t.outcome.tta_s[1],
+                Self::Density => {
+                    Some(t.outcome.density_pts_per_deg_s() * 64.0 * t.outcome.duration_s)
+                }
+            })
+            .map(|x| x as f32)
+            .collect()
+    }
+}
+
+/// Polar view of the paper's four profiles at gaze 90° (forward up, left left).
+fn draw_profiles<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let root = root.titled(
+        "Paper profiles, gaze 90° (left): top view, forward up",
+        ("sans-serif", 22),
+    )?;
+    let panels = root.split_evenly((1, 2));
+    let preset = presets::paper();
+    let p_mean = preset.lidar.average_power_w;
+    let w_mean = preset.lidar.mean_spin_rad_s();
+    for (k, panel) in panels.iter().enumerate() {
+        let (caption, max_r) = if k == 0 {
+            ("power P/P̄", 1.3)
+        } else {
+            ("spin ω/ω̄ (log scale: 1 + log₅ ratio)", 2.2)
+        };
+        let mut chart = ChartBuilder::on(panel)
+            .caption(caption, ("sans-serif", 18))
+            .margin(10)
+            .build_cartesian_2d(-max_r..max_r, -max_r..max_r)?;
+        for (i, mode) in Mode::ALL.iter().enumerate() {
+            let gaze = (*mode != Mode::Baseline).then_some(90.0);
+            let c = closed_form(&preset, *mode, gaze, 720)?;
+            let pts: Vec<(f64, f64)> = c
+                .profile()
+                .bins
+                .iter()
+                .flat_map(|b| [b.start_deg, b.start_deg + b.width_deg].map(|a| (a, b)))
+                .map(|(a, b)| {
+                    let r = if k == 0 {
+                        b.power_w / p_mean
+                    } else {
+                        1.0 + (b.spin_start_rad_s / w_mean).log(5.0)
+                    };
+                    let rad = a.to_radians();
+                    (-r * rad.sin(), r * rad.cos())
+                })
+                .collect();
+            let color = COLORS[i % COLORS.len()];
+            // Wider strokes first, so curves that coincide stay visible.
+            let width = 8 - 2 * i as u32;
+            chart
+                .draw_series(LineSeries::new(pts, color.stroke_width(width)))?
+                .label(mode.name())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(3))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()?;
+    }
+    Ok(())
+}
+
+/// Draws one figure with `$draw(&root)` into `$stem.svg` and `$stem.png`.
+macro_rules! svg_and_png {
+    ($dir:expr, $stem:expr, $size:expr, $written:expr, $draw:expr) => {{
+        let svg = $dir.join(format!("{}.svg", $stem));
+        let png = $dir.join(format!("{}.png", $stem));
+        let fail = |path: &Path, e: &dyn std::fmt::Display| PlotError {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        };
+        {
+            let root = SVGBackend::new(&svg, $size).into_drawing_area();
+            $draw(&root).map_err(|e| fail(&svg, &e))?;
+            root.present().map_err(|e| fail(&svg, &e))?;
+        }
+        {
+            let root = BitMapBackend::new(&png, $size).into_drawing_area();
+            $draw(&root).map_err(|e| fail(&png, &e))?;
+            root.present().map_err(|e| fail(&png, &e))?;
+        }
+        $written.push(svg);
+        $written.push(png);
+    }};
+}
+
+/// Writes every figure into `dir` (created if missing); returns the files.
+pub fn write_all(
+    result: &GridResult,
+    config: &SimConfig,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, PlotError> {
+    register_font();
+    std::fs::create_dir_all(dir).map_err(|e| PlotError {
+        path: dir.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let mut written = Vec::new();
+    for &model in &config.models {
+        for (metric, stem) in [(Metric::Tta, "tta"), (Metric::Density, "density")] {
+            svg_and_png!(
+                dir,
+                format!("{stem}_{}", model.name()),
+                (1200, 460),
+                written,
+                |root| { draw_boxes(root, result, config, model, metric) }
+            );
+        }
+    }
+    svg_and_png!(dir, "profiles_polar", (1000, 520), written, |root| {
+        draw_profiles(root)
+    });
+    Ok(written)
+}

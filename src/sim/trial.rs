@@ -1,0 +1,325 @@
+//! One trial: fire every pulse of a profile at the moving scene.
+//!
+//! Pulse `k` fires at `t_k = k / pulse_rate_hz` (trial time); the head's
+//! azimuth follows the profile in time, starting at a random phase; the ray
+//! is cast at `t_k` against the static boxes and both cars at their
+//! positions at `t_k`. The nearest hit decides; the return model decides
+//! whether it yields a point.
+//!
+//! Acceleration: each object is tested only if the pulse azimuth lies in
+//! the object's angular extent (static: once; cars: swept over the frame,
+//! padded by [`CULL_PAD_DEG`]). Rays outside an object's extent cannot hit it,
+//! so results are bit-identical to testing everything (`brute_force = true`;
+//! checked by tests).
+
+use crate::model::acuity::Regions;
+use crate::model::angle::{diff_deg, wrap_deg, Arc};
+use crate::profile::kinematics::Timeline;
+use crate::profile::Profile;
+
+use super::returns::ReturnModel;
+use super::scene::{Aabb, Scenario};
+
+/// Padding of the culling arcs, degrees (far above `f64` rounding of atan2).
+pub const CULL_PAD_DEG: f64 = 1e-6;
+
+/// k-of-n detection over consecutive frames (paper: 1 of 1, the first return).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct KOfN {
+    /// Frames with a return needed.
+    pub k: u32,
+    /// Window of consecutive frames.
+    pub n: u32,
+}
+
+impl Default for KOfN {
+    fn default() -> Self {
+        Self { k: 1, n: 1 }
+    }
+}
+
+/// Per-trial randomness, drawn by the caller.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrialDraw {
+    /// LiDAR phase as a fraction of the frame period, `[0, 1)`.
+    pub phase_frac: f64,
+    /// Start offsets beyond the bend, m: [left car, right car].
+    pub start_offset_m: [f64; 2],
+    /// Driver's gaze this trial, degrees.
+    pub gaze_deg: f64,
+    /// Seed of the per-pulse detection noise.
+    pub noise_seed: u64,
+}
+
+/// What one trial measured. Index 0 is the car from the left, 1 from the right.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct TrialOutcome {
+    /// LiDAR TTA at detection, s (`None`: not detected before arrival).
+    pub tta_s: [Option<f64>; 2],
+    /// Hybrid TTA: the earlier of the driver seeing the car inside the RoF
+    /// and the LiDAR detecting it, s.
+    pub hybrid_tta_s: [Option<f64>; 2],
+    /// Points returned from pulses inside the RoI.
+    pub roi_points: u64,
+    /// Pulses fired inside the RoI.
+    pub roi_pulses: u64,
+    /// RoI width, degrees.
+    pub roi_width_deg: f64,
+    /// Simulated duration, s.
+    pub duration_s: f64,
+    /// Frames simulated.
+    pub frames: u64,
+}
+
+impl TrialOutcome {
+    /// RoI points per degree per second (one channel).
+    #[must_use]
+    pub fn density_pts_per_deg_s(&self) -> f64 {
+        self.roi_points as f64 / (self.roi_width_deg * self.duration_s)
+    }
+}
+
+/// SplitMix64 finaliser: a counter-based generator, so per-pulse noise is
+/// the same whatever the thread schedule.
+#[must_use]
+pub fn mix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Uniform in `[0, 1)` from a key.
+fn unit(key: u64) -> f64 {
+    (mix64(key) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// The smallest arc containing the directions to `points` (none may be the origin).
+fn arc_of(points: &[(f64, f64)]) -> Arc {
+    let angles: Vec<f64> = points
+        .iter()
+        .map(|&(x, y)| y.atan2(x).to_degrees())
+        .collect();
+    let reference = angles[0];
+    let (mut lo, mut hi) = (0.0f64, 0.0f64);
+    for &a in &angles[1..] {
+        let d = diff_deg(a, reference);
+        lo = lo.min(d);
+        hi = hi.max(d);
+    }
+    let width = (hi - lo + 2.0 * CULL_PAD_DEG).min(360.0);
+    Arc {
+        start_deg: wrap_deg(reference + lo - CULL_PAD_DEG),
+        width_deg: width,
+    }
+}
+
+/// An object's culling arc; a box around the origin gets the full circle.
+fn cull_arc(boxes: &[Aabb]) -> Arc {
+    if boxes.iter().any(Aabb::contains_origin) {
+        return Arc {
+            start_deg: 0.0,
+            width_deg: 360.0,
+        };
+    }
+    let corners: Vec<(f64, f64)> = boxes.iter().flat_map(|b| b.corners()).collect();
+    arc_of(&corners)
+}
+
+/// Everything a trial needs besides its random draw.
+#[derive(Debug, Clone, Copy)]
+pub struct TrialSetup<'a> {
+    /// Scene.
+    pub scenario: &'a Scenario,
+    /// Static boxes (from the scenario).
+    pub statics: &'a [Aabb],
+    /// The certified profile the LiDAR runs.
+    pub profile: &'a Profile,
+    /// Fraction of RoF points kept (the ARGUS resolution variant: 1/5.4).
+    pub rof_keep: f64,
+    /// Driver regions for this trial's gaze.
+    pub regions: &'a Regions,
+    /// Return model at this fog level.
+    pub model: &'a ReturnModel,
+    /// Driver's visual range in this fog (MOR), m.
+    pub driver_range_m: f64,
+    /// Detection rule.
+    pub detection: KOfN,
+    /// Disable culling (reference path for tests).
+    pub brute_force: bool,
+}
+
+/// Runs one trial.
+#[must_use]
+pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
+    let sc = setup.scenario;
+    let tl = Timeline::new(setup.profile);
+    let period = tl.period_s();
+    let pulse_rate = setup.profile.pulse_rate_hz;
+    let p_mean = setup.profile.average_power_w;
+    let v = sc.speed_m_s();
+    let lane_x = sc.lane_x_m();
+    let half_w = 0.5 * sc.vehicle_width_m;
+    let len = sc.vehicle_length_m;
+    let ch = sc.conflict_half_width_m;
+    // Fronts at t = 0: the left car drives −y, the right car +y.
+    let front0 = [
+        sc.bend_distance_m + draw.start_offset_m[0],
+        -(sc.bend_distance_m + draw.start_offset_m[1]),
+    ];
+    let dir = [-1.0, 1.0];
+    let t_conflict = [(front0[0] - ch) / v, (-ch - front0[1]) / v];
+    let t_end = t_conflict[0].max(t_conflict[1]);
+    let car_box = |j: usize, t: f64| -> Aabb {
+        let front = front0[j] + dir[j] * v * t;
+        let back = front - dir[j] * len;
+        Aabb::new(lane_x[j] - half_w, lane_x[j] + half_w, front, back)
+    };
+    let static_arcs: Vec<Arc> = setup
+        .statics
+        .iter()
+        .map(|b| cull_arc(std::slice::from_ref(b)))
+        .collect();
+    let phase = draw.phase_frac * period;
+
+    let mut detected_at: [Option<f64>; 2] = [None, None];
+    let mut driver_at: [Option<f64>; 2] = [None, None];
+    let mut hit_frames: [Vec<u64>; 2] = [Vec::new(), Vec::new()];
+    let mut roi_points = 0u64;
+    let mut roi_pulses = 0u64;
+    let mut keep_acc = 0.0f64;
+    let mut current_frame = u64::MAX;
+    let mut car_arcs = [static_arcs[0]; 2];
+    let n_pulses = (t_end * pulse_rate).floor() as u64;
+    let mut frames = 0u64;
+
+    // Nearest hit among statics and cars: (range, cos, reflectivity, car index).
+    let cast = |c: f64,
+                s: f64,
+                az: f64,
+                t: f64,
+                car_arcs: &[Arc; 2]|
+     -> Option<(f64, f64, f64, Option<usize>)> {
+        let mut best: Option<(f64, f64, f64, Option<usize>)> = None;
+        for (b, arc) in setup.statics.iter().zip(&static_arcs) {
+            if setup.brute_force || arc.contains(az) {
+                if let Some(h) = b.ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.building_reflectivity, None));
+                    }
+                }
+            }
+        }
+        for (j, arc) in car_arcs.iter().enumerate() {
+            if setup.brute_force || arc.contains(az) {
+                if let Some(h) = car_box(j, t).ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.vehicle_reflectivity, Some(j)));
+                    }
+                }
+            }
+        }
+        best
+    };
+
+    for k in 0..n_pulses {
+        let t = k as f64 / pulse_rate;
+        let tau_total = t + phase;
+        let frame = (tau_total / period).floor() as u64;
+        let tau = (tau_total - frame as f64 * period).clamp(0.0, period);
+        if frame != current_frame {
+            current_frame = frame;
+            frames += 1;
+            let t0 = (frame as f64 * period - phase).max(0.0);
+            let t1 = (frame + 1) as f64 * period - phase;
+            for (j, arc) in car_arcs.iter_mut().enumerate() {
+                *arc = cull_arc(&[car_box(j, t0), car_box(j, t1)]);
+            }
+            // The driver: looks at each car's front centre at the frame start.
+            for j in 0..2 {
+                if driver_at[j].is_none() && t0 <= t_conflict[j] {
+                    let (x, y) = (lane_x[j], front0[j] + dir[j] * v * t0);
+                    let az = y.atan2(x).to_degrees();
+                    let dist = x.hypot(y);
+                    if setup.regions.rof.contains(az) && dist <= setup.driver_range_m {
+                        let (c, s) = (x / dist, y / dist);
+                        let all = [
+                            Arc {
+                                start_deg: 0.0,
+                                width_deg: 360.0,
+                            },
+                            Arc {
+                                start_deg: 0.0,
+                                width_deg: 360.0,
+                            },
+                        ];
+                        if let Some((_, _, _, Some(hit))) = cast(c, s, wrap_deg(az), t0, &all) {
+                            if hit == j {
+                                driver_at[j] = Some(t0);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let (az, bin) = tl.azimuth_at(tau);
+        let in_roi = setup.regions.roi.contains(az);
+        roi_pulses += u64::from(in_roi);
+        let rad = az.to_radians();
+        let (s, c) = rad.sin_cos();
+        let Some((range, cos_i, refl, car)) = cast(c, s, az, t, &car_arcs) else {
+            continue;
+        };
+        let power_ratio = setup.profile.bins[bin].power_w / p_mean;
+        let p_d = setup
+            .model
+            .detection_probability(power_ratio, refl, cos_i, range);
+        let returned = p_d >= 1.0
+            || (p_d > 0.0 && unit(draw.noise_seed ^ k.wrapping_mul(0xD1B5_4A32_D192_ED03)) < p_d);
+        if !returned {
+            continue;
+        }
+        if setup.rof_keep < 1.0 && setup.regions.rof.contains(az) {
+            keep_acc += setup.rof_keep;
+            if keep_acc < 1.0 {
+                continue;
+            }
+            keep_acc -= 1.0;
+        }
+        roi_points += u64::from(in_roi);
+        if let Some(j) = car {
+            if detected_at[j].is_none() && t <= t_conflict[j] {
+                let frames_hit = &mut hit_frames[j];
+                if frames_hit.last() != Some(&frame) {
+                    frames_hit.push(frame);
+                }
+                let window_start = frame.saturating_sub(u64::from(setup.detection.n) - 1);
+                let recent = frames_hit
+                    .iter()
+                    .rev()
+                    .take_while(|&&f| f >= window_start)
+                    .count();
+                if recent as u32 >= setup.detection.k {
+                    detected_at[j] = Some(t);
+                }
+            }
+        }
+    }
+
+    let tta = |j: usize, t: Option<f64>| t.map(|t| t_conflict[j] - t).filter(|x| *x >= 0.0);
+    let tta_s = [tta(0, detected_at[0]), tta(1, detected_at[1])];
+    let driver_tta = [tta(0, driver_at[0]), tta(1, driver_at[1])];
+    let hybrid = |j: usize| match (tta_s[j], driver_tta[j]) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
+    };
+    TrialOutcome {
+        tta_s,
+        hybrid_tta_s: [hybrid(0), hybrid(1)],
+        roi_points,
+        roi_pulses,
+        roi_width_deg: setup.regions.roi.measure_deg(),
+        duration_s: n_pulses as f64 / pulse_rate,
+        frames,
+    }
+}
