@@ -31,10 +31,13 @@
 
 pub mod checker;
 pub mod eye_safety;
+pub mod firmware;
 pub mod model;
 pub mod planner;
 pub mod profile;
 pub mod sim;
+#[cfg(any(test, kani))]
+pub(crate) mod verification;
 
 /// The README's examples, compiled and run as doctests.
 #[doc = include_str!("../README.md")]

@@ -337,6 +337,22 @@ impl fmt::Display for Violation {
     }
 }
 
+/// Joins the first few items' messages, with a count of the rest.
+#[must_use]
+pub fn summarize_list<T: fmt::Display>(items: &[T]) -> String {
+    const SHOWN: usize = 5;
+    let mut s = items
+        .iter()
+        .take(SHOWN)
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join("; ");
+    if items.len() > SHOWN {
+        s.push_str(&format!("; … and {} more", items.len() - SHOWN));
+    }
+    s
+}
+
 /// A profile failed the checker; every violation is listed.
 #[derive(Debug, Clone, Error, PartialEq)]
 #[error("profile rejected: {} violation(s); first: {}", violations.len(), violations.first().map(ToString::to_string).unwrap_or_default())]

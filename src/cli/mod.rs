@@ -80,15 +80,18 @@ enum Command {
 
 /// Writes `text` to `out` atomically, or to stdout.
 pub fn emit(text: &str, out: Option<&Path>) -> Result<(), CliError> {
+    emit_bytes(text.as_bytes(), out)
+}
+
+/// Writes `bytes` to `out` atomically, or to stdout.
+pub fn emit_bytes(bytes: &[u8], out: Option<&Path>) -> Result<(), CliError> {
     match out {
-        Some(path) => {
-            write_atomic(path, text.as_bytes()).map_err(|e| CliError::input(e.to_string()))
-        }
+        Some(path) => write_atomic(path, bytes).map_err(|e| CliError::input(e.to_string())),
         None => {
             use std::io::Write;
             let mut stdout = std::io::stdout().lock();
             // A closed pipe (e.g. `| head`) is not an error worth a message.
-            let _ = stdout.write_all(text.as_bytes());
+            let _ = stdout.write_all(bytes);
             let _ = stdout.flush();
             Ok(())
         }

@@ -7,7 +7,9 @@ use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::model::presets;
 use gaze_lidar::planner::{closed_form, Mode};
 
-use super::{emit, CliError};
+use gaze_lidar::firmware::{binary, FirmwareConfig, FirmwareError, FirmwareTable};
+
+use super::{emit_bytes, CliError};
 
 /// Output format of a profile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -16,6 +18,10 @@ pub enum Format {
     Json,
     /// One row per bin.
     Csv,
+    /// `gaze-lidar/firmware@1` JSON: integer ticks and DAC codes.
+    Firmware,
+    /// The firmware table's fixed-size binary encoding (needs --out).
+    FirmwareBin,
 }
 
 /// Accounting override.
@@ -50,6 +56,12 @@ pub struct Args {
     /// Write to this file (atomically) instead of stdout.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Firmware timer frequency, Hz.
+    #[arg(long, default_value_t = 80_000_000)]
+    tick_hz: u64,
+    /// Firmware DAC step, W per code (default: power_w_max / 4095).
+    #[arg(long)]
+    power_w_per_code: Option<f64>,
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
@@ -81,10 +93,32 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
         other => CliError::from(other),
     })?;
-    let text = match a.format {
-        Format::Json => certified.profile().to_json()?,
-        Format::Csv => certified.profile().to_csv()?,
+    let firmware = || {
+        let cfg = FirmwareConfig {
+            tick_hz: a.tick_hz,
+            power_w_per_code: a.power_w_per_code,
+        };
+        FirmwareTable::from_certified(&certified, &cfg).map_err(|e| match e {
+            FirmwareError::Config { .. } => CliError::input(format!("firmware: {e}")),
+            other => CliError::infeasible(format!("firmware: {other}")),
+        })
     };
-    emit(&text, a.out.as_deref())?;
+    let bytes = match a.format {
+        Format::Json => certified.profile().to_json()?.into_bytes(),
+        Format::Csv => certified.profile().to_csv()?.into_bytes(),
+        Format::Firmware => firmware()?
+            .to_json()
+            .map_err(|e| CliError::input(e.to_string()))?
+            .into_bytes(),
+        Format::FirmwareBin => {
+            if a.out.is_none() {
+                return Err(CliError::input(
+                    "--format firmware-bin writes binary: give --out FILE",
+                ));
+            }
+            binary::encode(&firmware()?)
+        }
+    };
+    emit_bytes(&bytes, a.out.as_deref())?;
     Ok(0)
 }

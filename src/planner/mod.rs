@@ -69,7 +69,7 @@ pub enum PlanError {
     #[error("infeasible: {0}")]
     Infeasible(String),
     /// The planned profile failed the checker (exit code 1): never handed out.
-    #[error("the planned profile violates its limits: {}", .0.violations.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))]
+    #[error("the planned profile violates its limits: {}", crate::checker::summarize_list(&.0.violations))]
     Rejected(#[from] Rejected),
 }
 

@@ -251,7 +251,14 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), IoError> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(err)?;
+    let mut builder = tempfile::Builder::new();
+    // Ordinary output files: readable by others (tempfile defaults to 0600).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder.tempfile_in(dir).map_err(err)?;
     tmp.write_all(contents).map_err(err)?;
     tmp.flush().map_err(err)?;
     tmp.persist(path).map_err(|e| err(e.error))?;

@@ -1,0 +1,288 @@
+//! Fixed-size binary encoding of a firmware table (what a vendor flashes),
+//! little-endian:
+//!
+//! | offset | size | field |
+//! |---:|---:|---|
+//! | 0 | 4 | magic `GLFW` |
+//! | 4 | 2 | version = 1 |
+//! | 6 | 1 | accounting: 0 time, 1 angle |
+//! | 7 | 1 | reserved, 0 |
+//! | 8 | 8 | tick_hz |
+//! | 16 | 8 | frame_ticks |
+//! | 24 | 8 | power_w_per_code (IEEE-754 f64) |
+//! | 32 | 4 | power_code_min |
+//! | 36 | 4 | power_code_max |
+//! | 40 | 8 | energy_budget |
+//! | 48 | 4 | window_bins |
+//! | 52 | 8 | window_energy_max |
+//! | 60 | 4 | bin count n |
+//! | 64 | 36·n | records: width_mdeg u32, dwell_ticks u64, power_code u32, dwell_ticks_min u64, dwell_ticks_max u64, power_code_cap u32 |
+//!
+//! [`decode`] never panics and rejects anything that is not exactly this layout.
+
+use thiserror::Error;
+
+use super::{FirmwareTable, FwBin, IntLimits, FIRMWARE_FORMAT, MAX_TABLE_BINS};
+use crate::model::lidar::PowerAccounting;
+
+/// Header size, bytes.
+pub const HEADER_LEN: usize = 64;
+/// Record size, bytes.
+pub const RECORD_LEN: usize = 36;
+const MAGIC: &[u8; 4] = b"GLFW";
+const VERSION: u16 = 1;
+
+/// Why bytes are not a table.
+#[derive(Debug, Error, Clone, PartialEq, Eq)]
+pub enum DecodeError {
+    /// Too short for the header.
+    #[error("{0} bytes: shorter than the {HEADER_LEN}-byte header")]
+    Short(usize),
+    /// Wrong magic.
+    #[error("not a gaze-lidar firmware table (bad magic)")]
+    Magic,
+    /// Unknown version.
+    #[error("unsupported version {0}")]
+    Version(u16),
+    /// Bad accounting byte.
+    #[error("accounting byte {0} is neither 0 (time) nor 1 (angle)")]
+    Accounting(u8),
+    /// Bin count out of range.
+    #[error("bin count {0} outside 1..={MAX_TABLE_BINS}")]
+    Count(u32),
+    /// Length does not match the bin count.
+    #[error("length {found} bytes, expected {expected} for the bin count")]
+    Length {
+        /// Found.
+        found: usize,
+        /// Expected.
+        expected: usize,
+    },
+    /// The reserved header byte is not zero.
+    #[error("reserved header byte is {0}, must be 0")]
+    Reserved(u8),
+    /// The DAC step is not a positive finite number.
+    #[error("power_w_per_code is not finite and > 0")]
+    Step,
+}
+
+fn u16_at(b: &[u8], at: usize) -> Option<u16> {
+    Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
+}
+fn u32_at(b: &[u8], at: usize) -> Option<u32> {
+    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
+}
+fn u64_at(b: &[u8], at: usize) -> Option<u64> {
+    Some(u64::from_le_bytes(b.get(at..at + 8)?.try_into().ok()?))
+}
+
+/// Encodes a table.
+#[must_use]
+pub fn encode(t: &FirmwareTable) -> Vec<u8> {
+    let mut out = Vec::with_capacity(HEADER_LEN + RECORD_LEN * t.bins.len());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.push(match t.power_accounting {
+        PowerAccounting::Time => 0,
+        PowerAccounting::Angle => 1,
+    });
+    out.push(0);
+    out.extend_from_slice(&t.tick_hz.to_le_bytes());
+    out.extend_from_slice(&t.frame_ticks.to_le_bytes());
+    out.extend_from_slice(&t.power_w_per_code.to_le_bytes());
+    out.extend_from_slice(&t.limits.power_code_min.to_le_bytes());
+    out.extend_from_slice(&t.limits.power_code_max.to_le_bytes());
+    out.extend_from_slice(&t.limits.energy_budget.to_le_bytes());
+    out.extend_from_slice(&t.limits.window_bins.to_le_bytes());
+    out.extend_from_slice(&t.limits.window_energy_max.to_le_bytes());
+    out.extend_from_slice(&(t.bins.len() as u32).to_le_bytes());
+    for b in &t.bins {
+        out.extend_from_slice(&b.width_mdeg.to_le_bytes());
+        out.extend_from_slice(&b.dwell_ticks.to_le_bytes());
+        out.extend_from_slice(&b.power_code.to_le_bytes());
+        out.extend_from_slice(&b.dwell_ticks_min.to_le_bytes());
+        out.extend_from_slice(&b.dwell_ticks_max.to_le_bytes());
+        out.extend_from_slice(&b.power_code_cap.to_le_bytes());
+    }
+    out
+}
+
+/// Decodes a table; never panics. Bin start azimuths are rebuilt from the widths.
+pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
+    let short = || DecodeError::Short(bytes.len());
+    if bytes.len() < HEADER_LEN {
+        return Err(short());
+    }
+    if bytes.get(0..4) != Some(&MAGIC[..]) {
+        return Err(DecodeError::Magic);
+    }
+    let version = u16_at(bytes, 4).ok_or_else(short)?;
+    if version != VERSION {
+        return Err(DecodeError::Version(version));
+    }
+    let accounting = match bytes.get(6).copied().ok_or_else(short)? {
+        0 => PowerAccounting::Time,
+        1 => PowerAccounting::Angle,
+        other => return Err(DecodeError::Accounting(other)),
+    };
+    let reserved = bytes.get(7).copied().ok_or_else(short)?;
+    if reserved != 0 {
+        return Err(DecodeError::Reserved(reserved));
+    }
+    let step = f64::from_bits(u64_at(bytes, 24).ok_or_else(short)?);
+    if !(step.is_finite() && step > 0.0) {
+        return Err(DecodeError::Step);
+    }
+    let n = u32_at(bytes, 60).ok_or_else(short)?;
+    if n == 0 || n as usize > MAX_TABLE_BINS {
+        return Err(DecodeError::Count(n));
+    }
+    let expected = HEADER_LEN + RECORD_LEN * n as usize;
+    if bytes.len() != expected {
+        return Err(DecodeError::Length {
+            found: bytes.len(),
+            expected,
+        });
+    }
+    let mut bins = Vec::with_capacity(n as usize);
+    let mut start_mdeg: u64 = 0;
+    for k in 0..n as usize {
+        let at = HEADER_LEN + RECORD_LEN * k;
+        let width_mdeg = u32_at(bytes, at).ok_or_else(short)?;
+        bins.push(FwBin {
+            start_deg: start_mdeg as f64 / 1000.0,
+            width_mdeg,
+            dwell_ticks: u64_at(bytes, at + 4).ok_or_else(short)?,
+            power_code: u32_at(bytes, at + 12).ok_or_else(short)?,
+            dwell_ticks_min: u64_at(bytes, at + 16).ok_or_else(short)?,
+            dwell_ticks_max: u64_at(bytes, at + 24).ok_or_else(short)?,
+            power_code_cap: u32_at(bytes, at + 32).ok_or_else(short)?,
+        });
+        start_mdeg += u64::from(width_mdeg);
+    }
+    Ok(FirmwareTable {
+        format: FIRMWARE_FORMAT.to_owned(),
+        tick_hz: u64_at(bytes, 8).ok_or_else(short)?,
+        frame_ticks: u64_at(bytes, 16).ok_or_else(short)?,
+        power_w_per_code: step,
+        power_accounting: accounting,
+        limits: IntLimits {
+            power_code_min: u32_at(bytes, 32).ok_or_else(short)?,
+            power_code_max: u32_at(bytes, 36).ok_or_else(short)?,
+            energy_budget: u64_at(bytes, 40).ok_or_else(short)?,
+            window_bins: u32_at(bytes, 48).ok_or_else(short)?,
+            window_energy_max: u64_at(bytes, 52).ok_or_else(short)?,
+        },
+        bins,
+    })
+}
+
+#[cfg(any(kani, test))]
+mod verification {
+    use super::*;
+    use crate::verification::cover;
+
+    /// REQ-IN-3: decoding any byte string never panics; whatever decodes
+    /// has a consistent length.
+    #[cfg_attr(kani, kani::proof, kani::unwind(4))]
+    #[cfg_attr(not(kani), test)]
+    fn decode_never_panics() {
+        bolero::check!()
+            .with_type::<([u8; 104], u8)>()
+            .cloned()
+            .for_each(|(raw, len)| {
+                let mut bytes = raw.to_vec();
+                // Make the valid-header path reachable from random bytes.
+                if len % 2 == 0 {
+                    bytes[0..4].copy_from_slice(MAGIC);
+                    bytes[4..6].copy_from_slice(&VERSION.to_le_bytes());
+                    bytes[6] %= 2;
+                    bytes[7] = 0;
+                    bytes[24..32].copy_from_slice(&1.0f64.to_le_bytes());
+                    bytes[60..64].copy_from_slice(&1u32.to_le_bytes());
+                }
+                let len = usize::from(len) % (bytes.len() + 1);
+                match decode(&bytes[..len]) {
+                    Ok(t) => {
+                        cover!(true, "a record decodes");
+                        assert_eq!(HEADER_LEN + RECORD_LEN * t.bins.len(), len);
+                        // Only the exact layout decodes: re-encoding gives the input back.
+                        assert_eq!(encode(&t), &bytes[..len]);
+                    }
+                    Err(_) => cover!(true, "garbage is rejected"),
+                }
+            });
+        #[cfg(not(kani))]
+        crate::verification::assert_covered(&["a record decodes", "garbage is rejected"]);
+    }
+
+    /// REQ-FW-5: encode then decode is the identity on the integer content.
+    #[cfg_attr(kani, kani::proof, kani::unwind(4))]
+    #[cfg_attr(not(kani), test)]
+    fn encode_decode_round_trip() {
+        bolero::check!()
+            .with_type::<([(u32, u64, u32); 3], u8, u64, bool)>()
+            .cloned()
+            .for_each(|(raw, n, frame_ticks, angle)| {
+                let n = 1 + usize::from(n % 3);
+                let bins: Vec<FwBin> = raw[..n]
+                    .iter()
+                    .map(|&(w, ticks, code)| FwBin {
+                        start_deg: 0.0,
+                        width_mdeg: w % 1_000_000,
+                        dwell_ticks: ticks,
+                        power_code: code,
+                        dwell_ticks_min: ticks / 2,
+                        dwell_ticks_max: ticks,
+                        power_code_cap: code / 3,
+                    })
+                    .collect();
+                let t = FirmwareTable {
+                    format: FIRMWARE_FORMAT.to_owned(),
+                    tick_hz: 80_000_000,
+                    frame_ticks,
+                    power_w_per_code: 0.25,
+                    power_accounting: if angle {
+                        PowerAccounting::Angle
+                    } else {
+                        PowerAccounting::Time
+                    },
+                    limits: IntLimits {
+                        power_code_min: 1,
+                        power_code_max: 4095,
+                        energy_budget: frame_ticks,
+                        window_bins: 2,
+                        window_energy_max: 7,
+                    },
+                    bins,
+                };
+                let back = decode(&encode(&t)).expect("an encoded table decodes");
+                cover!(n == 3, "three records");
+                assert_eq!(back.limits, t.limits);
+                assert_eq!(back.frame_ticks, t.frame_ticks);
+                assert_eq!(back.power_accounting, t.power_accounting);
+                for (a, b) in back.bins.iter().zip(&t.bins) {
+                    assert_eq!(
+                        (
+                            a.width_mdeg,
+                            a.dwell_ticks,
+                            a.power_code,
+                            a.dwell_ticks_min,
+                            a.dwell_ticks_max,
+                            a.power_code_cap
+                        ),
+                        (
+                            b.width_mdeg,
+                            b.dwell_ticks,
+                            b.power_code,
+                            b.dwell_ticks_min,
+                            b.dwell_ticks_max,
+                            b.power_code_cap
+                        )
+                    );
+                }
+            });
+        #[cfg(not(kani))]
+        crate::verification::assert_covered(&["three records"]);
+    }
+}

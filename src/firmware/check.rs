@@ -1,0 +1,338 @@
+//! The integer checker for firmware tables: re-verifies a table against its
+//! integer limits with exact integer arithmetic (u128 sums, no floats).
+
+use serde::Serialize;
+use std::fmt;
+
+use super::{FirmwareTable, FULL_TURN_MDEG, MAX_TABLE_BINS};
+use crate::model::angle::rotate_index;
+use crate::model::lidar::PowerAccounting;
+
+/// One violated integer requirement.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FwViolation {
+    /// No bins or too many.
+    BinCount {
+        /// Count.
+        count: usize,
+    },
+    /// Σ dwell_ticks ≠ frame_ticks.
+    FrameTicks {
+        /// Sum found.
+        sum: u128,
+        /// frame_ticks.
+        frame_ticks: u64,
+    },
+    /// Σ width_mdeg ≠ 360,000.
+    Coverage {
+        /// Sum found.
+        sum: u128,
+    },
+    /// A dwell outside its bin's bounds (or bounds inverted).
+    Dwell {
+        /// Bin.
+        bin: usize,
+        /// Ticks.
+        ticks: u64,
+        /// Bounds.
+        min: u64,
+        /// Bounds.
+        max: u64,
+    },
+    /// A power code outside `[power_code_min, power_code_max]`.
+    PowerCode {
+        /// Bin.
+        bin: usize,
+        /// Code.
+        code: u32,
+    },
+    /// Energy budget exceeded (declared accounting, integer units).
+    Budget {
+        /// Σ found.
+        energy: u128,
+        /// Limit.
+        limit: u64,
+    },
+    /// Energy in a window of consecutive bins above the eye-safety bound.
+    Window {
+        /// First bin of the window.
+        bin: usize,
+        /// Σ code·ticks found.
+        energy: u128,
+        /// Limit.
+        limit: u64,
+    },
+}
+
+impl fmt::Display for FwViolation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BinCount { count } => write!(f, "bins: {count}; a table needs 1 to {MAX_TABLE_BINS}"),
+            Self::FrameTicks { sum, frame_ticks } => {
+                write!(f, "dwell_ticks sum to {sum}, frame_ticks is {frame_ticks}")
+            }
+            Self::Coverage { sum } => write!(f, "width_mdeg sum to {sum}, not {FULL_TURN_MDEG}"),
+            Self::Dwell { bin, ticks, min, max } => {
+                write!(f, "bins[{bin}].dwell_ticks = {ticks} outside [{min}, {max}] (spin limits)")
+            }
+            Self::PowerCode { bin, code } => {
+                write!(f, "bins[{bin}].power_code = {code} outside [power_code_min, min(power_code_max, power_code_cap)]")
+            }
+            Self::Budget { energy, limit } => {
+                write!(f, "energy {energy} exceeds limits.energy_budget {limit}")
+            }
+            Self::Window { bin, energy, limit } => write!(
+                f,
+                "eye safety: energy {energy} in the window starting at bins[{bin}] exceeds limits.window_energy_max {limit}"
+            ),
+        }
+    }
+}
+
+/// Every integer violation of `table`.
+#[must_use]
+pub fn check_table(table: &FirmwareTable) -> Vec<FwViolation> {
+    let mut v = Vec::new();
+    let n = table.bins.len();
+    if n == 0 || n > MAX_TABLE_BINS {
+        v.push(FwViolation::BinCount { count: n });
+        return v;
+    }
+    let l = &table.limits;
+    let ticks_sum: u128 = table.bins.iter().map(|b| u128::from(b.dwell_ticks)).sum();
+    if ticks_sum != u128::from(table.frame_ticks) {
+        v.push(FwViolation::FrameTicks {
+            sum: ticks_sum,
+            frame_ticks: table.frame_ticks,
+        });
+    }
+    let width_sum: u128 = table.bins.iter().map(|b| u128::from(b.width_mdeg)).sum();
+    if width_sum != u128::from(FULL_TURN_MDEG) {
+        v.push(FwViolation::Coverage { sum: width_sum });
+    }
+    for (i, b) in table.bins.iter().enumerate() {
+        if !(b.dwell_ticks_min <= b.dwell_ticks && b.dwell_ticks <= b.dwell_ticks_max) {
+            v.push(FwViolation::Dwell {
+                bin: i,
+                ticks: b.dwell_ticks,
+                min: b.dwell_ticks_min,
+                max: b.dwell_ticks_max,
+            });
+        }
+        if !(l.power_code_min <= b.power_code
+            && b.power_code <= l.power_code_max.min(b.power_code_cap))
+        {
+            v.push(FwViolation::PowerCode {
+                bin: i,
+                code: b.power_code,
+            });
+        }
+    }
+    let energy: u128 = table
+        .bins
+        .iter()
+        .map(|b| {
+            let weight = match table.power_accounting {
+                PowerAccounting::Time => u128::from(b.dwell_ticks),
+                PowerAccounting::Angle => u128::from(b.width_mdeg),
+            };
+            u128::from(b.power_code) * weight
+        })
+        .sum();
+    if energy > u128::from(l.energy_budget) {
+        v.push(FwViolation::Budget {
+            energy,
+            limit: l.energy_budget,
+        });
+    }
+    let w = (l.window_bins as usize).min(n);
+    for i in 0..n {
+        let e = window_energy(table, i, w);
+        if e > u128::from(l.window_energy_max) {
+            v.push(FwViolation::Window {
+                bin: i,
+                energy: e,
+                limit: l.window_energy_max,
+            });
+        }
+    }
+    v
+}
+
+/// Σ code·ticks over the `w` consecutive bins starting at `start` (cyclic).
+#[must_use]
+pub fn window_energy(table: &FirmwareTable, start: usize, w: usize) -> u128 {
+    let n = table.bins.len();
+    (0..w)
+        .map(|k| {
+            let b = &table.bins[rotate_index(start, k, n)];
+            u128::from(b.power_code) * u128::from(b.dwell_ticks)
+        })
+        .sum()
+}
+
+#[cfg(any(kani, test))]
+mod verification {
+    use super::*;
+    use crate::firmware::{FwBin, IntLimits, FIRMWARE_FORMAT};
+    use crate::verification::cover;
+
+    /// A small symbolic table: up to 4 bins with small values.
+    fn table(
+        raw: &[(u8, u8, u8, u8)],
+        frame: u16,
+        limits: (u8, u8, u16, u8, u16),
+        angle: bool,
+    ) -> FirmwareTable {
+        let n = raw.len();
+        let bins = raw
+            .iter()
+            .enumerate()
+            .map(|(i, &(ticks, code, min, span))| FwBin {
+                start_deg: 0.0,
+                // Widths sum to 360,000 exactly (the last takes the rest).
+                width_mdeg: if i + 1 == n {
+                    FULL_TURN_MDEG - 90_000 * (n as u32 - 1)
+                } else {
+                    90_000
+                },
+                dwell_ticks: u64::from(ticks),
+                power_code: u32::from(code),
+                dwell_ticks_min: u64::from(min),
+                dwell_ticks_max: u64::from(min) + u64::from(span),
+                power_code_cap: u32::from(span) * 2,
+            })
+            .collect();
+        FirmwareTable {
+            format: FIRMWARE_FORMAT.to_owned(),
+            tick_hz: 1000,
+            frame_ticks: u64::from(frame),
+            power_w_per_code: 1.0,
+            power_accounting: if angle {
+                PowerAccounting::Angle
+            } else {
+                PowerAccounting::Time
+            },
+            limits: IntLimits {
+                power_code_min: u32::from(limits.0),
+                power_code_max: u32::from(limits.1),
+                energy_budget: u64::from(limits.2) * 1000,
+                window_bins: u32::from(limits.3 % 5),
+                window_energy_max: u64::from(limits.4),
+            },
+            bins,
+        }
+    }
+
+    /// The specification, restated as directly as possible.
+    fn within_limits(t: &FirmwareTable) -> bool {
+        let n = t.bins.len();
+        if n == 0 {
+            return false;
+        }
+        let mut ticks: u128 = 0;
+        let mut energy: u128 = 0;
+        for b in &t.bins {
+            ticks += u128::from(b.dwell_ticks);
+            let weight = if t.power_accounting == PowerAccounting::Angle {
+                b.width_mdeg as u128
+            } else {
+                b.dwell_ticks as u128
+            };
+            energy += b.power_code as u128 * weight;
+            if b.dwell_ticks < b.dwell_ticks_min || b.dwell_ticks > b.dwell_ticks_max {
+                return false;
+            }
+            if b.power_code < t.limits.power_code_min
+                || b.power_code > t.limits.power_code_max
+                || b.power_code > b.power_code_cap
+            {
+                return false;
+            }
+        }
+        let w = (t.limits.window_bins as usize).min(n);
+        for s in 0..n {
+            let mut e: u128 = 0;
+            for k in 0..w {
+                let b = &t.bins[(s + k) % n];
+                e += b.power_code as u128 * b.dwell_ticks as u128;
+            }
+            if e > t.limits.window_energy_max as u128 {
+                return false;
+            }
+        }
+        ticks == t.frame_ticks as u128 && energy <= t.limits.energy_budget as u128
+    }
+
+    /// REQ-FW-3: the integer checker accepts exactly the tables within their limits.
+    #[cfg_attr(kani, kani::proof, kani::unwind(6))]
+    #[cfg_attr(not(kani), test)]
+    fn integer_checker_accepts_exactly_tables_within_limits() {
+        bolero::check!()
+            .with_type::<([(u8, u8, u8, u8); 4], u8, u16, (u8, u8, u16, u8, u16), bool)>()
+            .cloned()
+            .for_each(|(raw, n, frame, limits, angle)| {
+                let n = 1 + usize::from(n % 4);
+                let t = table(&raw[..n], frame, limits, angle);
+                let accepted = check_table(&t).is_empty();
+                cover!(accepted, "a table is accepted");
+                cover!(!accepted, "a table is rejected");
+                assert_eq!(accepted, within_limits(&t));
+            });
+        #[cfg(not(kani))]
+        {
+            // Random tables almost never sum to their frame: also run the
+            // property on tables built to be consistent.
+            bolero::check!()
+                .with_type::<([(u8, u8, u8, u8); 4], u8, (u8, u8, u16, u8, u16), bool)>()
+                .cloned()
+                .for_each(|(mut raw, n, limits, angle)| {
+                    let n = 1 + usize::from(n % 4);
+                    for r in raw.iter_mut() {
+                        r.2 = r.2.min(r.0);
+                    }
+                    let frame: u16 = raw[..n].iter().map(|r| u16::from(r.0)).sum();
+                    let t = table(&raw[..n], frame, limits, angle);
+                    let accepted = check_table(&t).is_empty();
+                    cover!(accepted, "a consistent table is accepted");
+                    assert_eq!(accepted, within_limits(&t));
+                });
+            crate::verification::assert_covered(&[
+                "a table is rejected",
+                "a consistent table is accepted",
+            ]);
+        }
+    }
+
+    /// REQ-FW-4: window sums never overflow and equal the naive cyclic sum,
+    /// for every start and window length.
+    #[cfg_attr(kani, kani::proof, kani::unwind(6))]
+    #[cfg_attr(not(kani), test)]
+    fn window_sum_matches_naive_and_never_overflows() {
+        bolero::check!()
+            .with_type::<([(u8, u8, u8, u8); 4], u8, u8, u8)>()
+            .cloned()
+            .for_each(|(raw, n, start, w)| {
+                let n = 1 + usize::from(n % 4);
+                let mut t = table(&raw[..n], 0, (0, 255, 0, 0, 0), false);
+                for b in &mut t.bins {
+                    // Extremes: the largest codes and tick counts a table can hold.
+                    b.power_code = u32::MAX - b.power_code;
+                    b.dwell_ticks = u64::MAX - b.dwell_ticks;
+                }
+                let start = usize::from(start) % n;
+                let w = usize::from(w) % (n + 1);
+                cover!(w == n && start > 0, "full wrap-around window");
+                let naive: u128 = (0..w)
+                    .map(|k| {
+                        let b = &t.bins[(start + k) % n];
+                        u128::from(b.power_code) * u128::from(b.dwell_ticks)
+                    })
+                    .sum();
+                assert_eq!(window_energy(&t, start, w), naive);
+            });
+        #[cfg(not(kani))]
+        crate::verification::assert_covered(&["full wrap-around window"]);
+    }
+}
