@@ -33,6 +33,8 @@ pub mod checker;
 pub mod eye_safety;
 pub mod firmware;
 pub mod model;
+#[cfg(feature = "solver")]
+pub mod optimizer;
 pub mod planner;
 pub mod profile;
 pub mod sim;

@@ -38,9 +38,17 @@ pub struct Args {
     /// LiDAR preset: paper, vls128.
     #[arg(long, default_value = "paper")]
     preset: String,
-    /// Controller: the paper's closed forms.
-    #[arg(long, value_enum, default_value_t = Mode::Range)]
-    mode: Mode,
+    /// Controller: the paper's closed forms (default range); with --optimize
+    /// or --config, the optimizer's objective mode.
+    #[arg(long, value_enum)]
+    mode: Option<Mode>,
+    /// Derive the profile with the optimizer (HiGHS) instead of the closed form;
+    /// with a preset: its paper-equivalent problem (two power levels, two spin set-points).
+    #[arg(long)]
+    optimize: bool,
+    /// Optimizer configuration (TOML); implies --optimize.
+    #[arg(long)]
+    config: Option<PathBuf>,
     /// Gaze azimuth, degrees CCW from straight ahead (ISO 8855). Omit for the baseline.
     #[arg(long, allow_negative_numbers = true)]
     gaze_deg: Option<f64>,
@@ -73,13 +81,14 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             Accounting::Angle => PowerAccounting::Angle,
         };
     }
-    if a.gaze_deg.is_none() && a.mode != Mode::Baseline {
+    let mode = a.mode.unwrap_or(Mode::Range);
+    if a.gaze_deg.is_none() && mode != Mode::Baseline {
         return Err(CliError::input(format!(
             "--gaze-deg is required for --mode {}",
-            a.mode.name()
+            mode.name()
         )));
     }
-    let gaze = if a.mode == Mode::Baseline {
+    let gaze = if mode == Mode::Baseline {
         None
     } else {
         a.gaze_deg
@@ -87,12 +96,16 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     if let Some(g) = a.gaze_deg {
         gaze_lidar::planner::validate_gaze(g).map_err(|e| CliError::input(format!("--{e}")))?;
     }
-    let certified = closed_form(&preset, a.mode, gaze, a.bins).map_err(|e| match e {
-        gaze_lidar::planner::PlanError::InvalidInput { field, reason } => {
-            CliError::input(format!("--{field}: {reason}"))
-        }
-        other => CliError::from(other),
-    })?;
+    let certified = if a.optimize || a.config.is_some() {
+        optimized(a, &preset, gaze)?
+    } else {
+        closed_form(&preset, mode, gaze, a.bins).map_err(|e| match e {
+            gaze_lidar::planner::PlanError::InvalidInput { field, reason } => {
+                CliError::input(format!("--{field}: {reason}"))
+            }
+            other => CliError::from(other),
+        })?
+    };
     let firmware = || {
         let cfg = FirmwareConfig {
             tick_hz: a.tick_hz,
@@ -121,4 +134,48 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     };
     emit_bytes(&bytes, a.out.as_deref())?;
     Ok(0)
+}
+
+#[cfg(feature = "solver")]
+fn optimized(
+    a: &Args,
+    preset: &gaze_lidar::model::presets::Preset,
+    gaze: Option<f64>,
+) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
+    use gaze_lidar::optimizer::{optimize, OptError, OptimizerConfig, Problem};
+    let err = |e: OptError| {
+        if e.is_input_error() {
+            CliError::input(e.to_string())
+        } else {
+            CliError::infeasible(e.to_string())
+        }
+    };
+    let Some(gaze) = gaze else {
+        return Err(CliError::input(
+            "--optimize needs --gaze-deg (the baseline has nothing to optimize)",
+        ));
+    };
+    let mut problem = match &a.config {
+        Some(path) => OptimizerConfig::read(path)
+            .and_then(|c| c.problem())
+            .map_err(err)?,
+        None => {
+            Problem::paper_equivalent(preset, a.mode.unwrap_or(Mode::Range), a.bins).map_err(err)?
+        }
+    };
+    if let Some(m) = a.mode {
+        problem.objective.mode = m;
+    }
+    optimize(&problem, gaze).map_err(err)
+}
+
+#[cfg(not(feature = "solver"))]
+fn optimized(
+    _a: &Args,
+    _preset: &gaze_lidar::model::presets::Preset,
+    _gaze: Option<f64>,
+) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
+    Err(CliError::input(
+        "--optimize/--config: this build has no solver (enable the `solver` feature)",
+    ))
 }

@@ -1,0 +1,267 @@
+//! TOML configuration of an optimization problem.
+//!
+//! ```toml
+//! bins = 360                       # equal bins (4..=36000)
+//!
+//! [lidar]                          # a preset, then overrides of its fields
+//! preset = "paper"                 # "paper" or "vls128"
+//! average_power_w = 1.0e-3
+//! power_accounting = "time"        # or "angle"
+//!
+//! [limits]                         # overrides of the preset's limits
+//! power_w_max = 1.3e-3
+//! spin_accel_rad_s2_max = 400.0    # or "unlimited"
+//! power_slew_w_per_deg_max = "unlimited"
+//!
+//! [focus]                          # region of focus: acuity model and η
+//! threshold = 0.083
+//! acuity = { model = "levi_e2", e2_deg = 2.72 }
+//!
+//! [levels]                         # hardware levels; omit for continuous
+//! power_w = [0.5e-3, 0.8e-3, 1.1e-3]
+//!
+//! [objective]
+//! mode = "joint"                   # range | resolution | joint
+//! range_weight = 1.0
+//! resolution_weight = 1.0
+//! floor_weight = 0.001
+//! priors = [{ start_deg = 250.0, width_deg = 40.0, weight = 0.5 }]
+//! ```
+
+use serde::Deserialize;
+use std::path::Path;
+
+use super::{Levels, Objective, OptError, Problem};
+use crate::eye_safety::EyeSafetyParams;
+use crate::model::acuity::FocusModel;
+use crate::model::lidar::PowerAccounting;
+use crate::model::presets;
+
+/// A limit value in TOML: a number, or the word `"unlimited"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum LimitValue {
+    /// A finite limit.
+    Value(f64),
+    /// `"unlimited"`.
+    Word(String),
+}
+
+/// `[lidar]`: a preset and overrides.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LidarSection {
+    /// Base preset (default `paper`).
+    pub preset: Option<String>,
+    /// Overrides.
+    pub frame_rate_hz: Option<f64>,
+    /// Overrides.
+    pub pulse_rate_hz: Option<f64>,
+    /// Overrides.
+    pub average_power_w: Option<f64>,
+    /// Overrides.
+    pub power_accounting: Option<PowerAccounting>,
+}
+
+/// `[limits]`: overrides.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LimitsSection {
+    /// Override.
+    pub power_w_min: Option<f64>,
+    /// Override.
+    pub power_w_max: Option<f64>,
+    /// Override.
+    pub spin_rad_s_min: Option<f64>,
+    /// Override.
+    pub spin_rad_s_max: Option<f64>,
+    /// Override (`"unlimited"` allowed).
+    pub spin_accel_rad_s2_max: Option<LimitValue>,
+    /// Override (`"unlimited"` allowed).
+    pub power_slew_w_per_deg_max: Option<LimitValue>,
+    /// Override of the laser/optics parameters.
+    pub eye_safety: Option<EyeSafetyParams>,
+}
+
+/// The whole file.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OptimizerConfig {
+    /// Bins (default 360).
+    pub bins: Option<usize>,
+    /// Sensor.
+    pub lidar: LidarSection,
+    /// Limits.
+    pub limits: LimitsSection,
+    /// Driver model (default: the preset's).
+    pub focus: Option<FocusModel>,
+    /// Hardware levels.
+    pub levels: Levels,
+    /// Objective.
+    pub objective: Objective,
+}
+
+fn limit(field: &str, v: &LimitValue) -> Result<Option<f64>, OptError> {
+    match v {
+        LimitValue::Value(x) if x.is_finite() && *x >= 0.0 => Ok(Some(*x)),
+        LimitValue::Word(w) if w == "unlimited" => Ok(None),
+        other => Err(OptError::Invalid {
+            field: format!("limits.{field}"),
+            reason: format!("{other:?} is neither a finite number >= 0 nor \"unlimited\""),
+        }),
+    }
+}
+
+fn positive(field: &str, v: f64) -> Result<f64, OptError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(OptError::Invalid {
+            field: field.into(),
+            reason: format!("{v} must be finite and > 0"),
+        })
+    }
+}
+
+fn nonneg(field: &str, v: f64) -> Result<f64, OptError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(OptError::Invalid {
+            field: field.into(),
+            reason: format!("{v} must be finite and >= 0"),
+        })
+    }
+}
+
+impl OptimizerConfig {
+    /// Parses TOML; `origin` names the file in errors (toml names key and line).
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self, OptError> {
+        toml::from_str(text).map_err(|e| OptError::Invalid {
+            field: origin.to_owned(),
+            reason: e.to_string().replace('\n', " ").trim().to_owned(),
+        })
+    }
+
+    /// Reads a TOML file.
+    pub fn read(path: &Path) -> Result<Self, OptError> {
+        let text = std::fs::read_to_string(path).map_err(|e| OptError::Invalid {
+            field: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
+        Self::from_toml(&text, &path.display().to_string())
+    }
+
+    /// Builds and validates the problem.
+    pub fn problem(&self) -> Result<Problem, OptError> {
+        let name = self.lidar.preset.as_deref().unwrap_or("paper");
+        let mut preset = presets::preset(name).map_err(|e| OptError::Invalid {
+            field: "lidar.preset".into(),
+            reason: e.to_string(),
+        })?;
+        let lid = &mut preset.lidar;
+        if let Some(v) = self.lidar.frame_rate_hz {
+            lid.frame_rate_hz = positive("lidar.frame_rate_hz", v)?;
+        }
+        if let Some(v) = self.lidar.pulse_rate_hz {
+            lid.pulse_rate_hz = positive("lidar.pulse_rate_hz", v)?;
+        }
+        if let Some(v) = self.lidar.average_power_w {
+            lid.average_power_w = positive("lidar.average_power_w", v)?;
+        }
+        if let Some(v) = self.lidar.power_accounting {
+            lid.power_accounting = v;
+        }
+        let l = &self.limits;
+        let lim = &mut lid.limits;
+        if let Some(v) = l.power_w_min {
+            lim.power_w_min = nonneg("limits.power_w_min", v)?;
+        }
+        if let Some(v) = l.power_w_max {
+            lim.power_w_max = positive("limits.power_w_max", v)?;
+        }
+        if let Some(v) = l.spin_rad_s_min {
+            lim.spin_rad_s_min = nonneg("limits.spin_rad_s_min", v)?;
+        }
+        if let Some(v) = l.spin_rad_s_max {
+            lim.spin_rad_s_max = positive("limits.spin_rad_s_max", v)?;
+        }
+        if let Some(v) = &l.spin_accel_rad_s2_max {
+            lim.spin_accel_rad_s2_max = limit("spin_accel_rad_s2_max", v)?;
+        }
+        if let Some(v) = &l.power_slew_w_per_deg_max {
+            lim.power_slew_w_per_deg_max = limit("power_slew_w_per_deg_max", v)?;
+        }
+        if let Some(v) = &l.eye_safety {
+            v.validate().map_err(|e| OptError::Invalid {
+                field: "limits.eye_safety".into(),
+                reason: e.to_string(),
+            })?;
+            lim.eye_safety = Some(v.clone());
+        }
+        let focus = self.focus.clone().unwrap_or(preset.focus);
+        focus.validate().map_err(|e| OptError::Invalid {
+            field: "focus".into(),
+            reason: e.to_string(),
+        })?;
+        let o = &self.objective;
+        nonneg("objective.range_weight", o.range_weight)?;
+        nonneg("objective.resolution_weight", o.resolution_weight)?;
+        nonneg("objective.floor_weight", o.floor_weight)?;
+        for (k, p) in o.priors.iter().enumerate() {
+            nonneg(&format!("objective.priors[{k}].weight"), p.weight)?;
+            if !(p.start_deg.is_finite()
+                && p.width_deg.is_finite()
+                && (0.0..=360.0).contains(&p.width_deg))
+            {
+                return Err(OptError::Invalid {
+                    field: format!("objective.priors[{k}]"),
+                    reason: "start_deg must be finite and width_deg in [0, 360]".into(),
+                });
+            }
+        }
+        if o.mode == crate::planner::Mode::Baseline {
+            return Err(OptError::Invalid {
+                field: "objective.mode".into(),
+                reason: "baseline has nothing to optimize; use range, resolution or joint".into(),
+            });
+        }
+        Ok(Problem {
+            lidar: preset.lidar,
+            focus,
+            levels: self.levels.clone(),
+            objective: self.objective.clone(),
+            bins: self.bins.unwrap_or(360),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn errors_name_the_key() {
+        let e = OptimizerConfig::from_toml("[objective]\nmode = \"warp\"\n", "c.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("c.toml") && e.contains("mode"), "{e}");
+        let e =
+            OptimizerConfig::from_toml("[limits]\nspin_accel_rad_s2_max = \"fast\"\n", "c.toml")
+                .unwrap()
+                .problem()
+                .unwrap_err()
+                .to_string();
+        assert!(e.contains("limits.spin_accel_rad_s2_max"), "{e}");
+        let e = OptimizerConfig::from_toml("[lidar]\naverage_power_w = -1.0\n", "c.toml")
+            .unwrap()
+            .problem()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lidar.average_power_w"), "{e}");
+        let e = OptimizerConfig::from_toml("[limts]\n", "c.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("limts"), "{e}");
+    }
+}

@@ -1,0 +1,138 @@
+//! Fast replanning for a gaze stream (up to 200 Hz).
+//!
+//! On `N` equal bins with no static priors, the problem is invariant under
+//! rotation by whole bins: the limits do not depend on azimuth and the
+//! weights depend only on the eccentricity from the gaze. A gaze `g` is
+//! split into whole bins `k` and a phase within a bin, quantized to
+//! 1/[`PHASE_STEPS`] of a bin (0.016° for 360 bins, far below eye-tracker
+//! accuracy). The solution for the phase is solved once and cached; every
+//! later gaze with the same phase is that solution rotated by `k` bins, then
+//! **certified again** (the checker never trusts the cache). With priors the
+//! symmetry is broken and the cache is keyed by the quantized gaze itself.
+//!
+//! The rotated solution equals a fresh solve at the quantized gaze because
+//! the rotated problem is the same LP with its variables renumbered (tests
+//! check the profiles agree).
+
+use std::collections::BTreeMap;
+
+use super::{optimize, OptError, Problem};
+use crate::checker::{certify, CertifiedProfile};
+use crate::model::angle::{rotate_index, wrap_deg, FULL_TURN_DEG};
+use crate::profile::Profile;
+
+/// Gaze phases per bin.
+pub const PHASE_STEPS: u32 = 64;
+
+/// A planner with a solution cache.
+#[derive(Debug, Clone)]
+pub struct FastPlanner {
+    problem: Problem,
+    cache: BTreeMap<u64, Profile>,
+    rotation_invariant: bool,
+    fresh_solves: u64,
+}
+
+impl FastPlanner {
+    /// A planner for `problem`.
+    #[must_use]
+    pub fn new(problem: Problem) -> Self {
+        let rotation_invariant = problem.objective.priors.is_empty();
+        Self {
+            problem,
+            cache: BTreeMap::new(),
+            rotation_invariant,
+            fresh_solves: 0,
+        }
+    }
+
+    /// How many fresh HiGHS solves so far.
+    #[must_use]
+    pub fn fresh_solves(&self) -> u64 {
+        self.fresh_solves
+    }
+
+    /// The problem.
+    #[must_use]
+    pub fn problem(&self) -> &Problem {
+        &self.problem
+    }
+
+    /// Whole bins and phase step of a gaze.
+    fn split(&self, gaze_deg: f64) -> (usize, u32) {
+        let n = self.problem.bins;
+        let width = FULL_TURN_DEG / n as f64;
+        let g = wrap_deg(gaze_deg);
+        let mut k = (g / width).floor() as usize;
+        let mut q = ((g - k as f64 * width) / width * f64::from(PHASE_STEPS)).round() as u32;
+        if q >= PHASE_STEPS {
+            q = 0;
+            k += 1;
+        }
+        (k % n, q)
+    }
+
+    /// The gaze actually planned for (quantized), degrees.
+    #[must_use]
+    pub fn quantized_gaze(&self, gaze_deg: f64) -> f64 {
+        let (k, q) = self.split(gaze_deg);
+        let width = FULL_TURN_DEG / self.problem.bins as f64;
+        wrap_deg(k as f64 * width + f64::from(q) * width / f64::from(PHASE_STEPS))
+    }
+
+    /// A certified profile for `gaze_deg`.
+    pub fn plan(&mut self, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
+        crate::planner::validate_gaze(gaze_deg).map_err(|e| OptError::Invalid {
+            field: "gaze-deg".into(),
+            reason: e.to_string(),
+        })?;
+        let (k, q) = self.split(gaze_deg);
+        let width = FULL_TURN_DEG / self.problem.bins as f64;
+        if !self.rotation_invariant {
+            let key = (k as u64) << 32 | u64::from(q);
+            let gaze = self.quantized_gaze(gaze_deg);
+            if let Some(p) = self.cache.get(&key) {
+                return Ok(certify(p.clone())?);
+            }
+            let c = optimize(&self.problem, gaze)?;
+            self.fresh_solves += 1;
+            self.cache.insert(key, c.profile().clone());
+            return Ok(c);
+        }
+        let canonical = match self.cache.get(&u64::from(q)) {
+            Some(p) => p,
+            None => {
+                let c = optimize(&self.problem, f64::from(q) * width / f64::from(PHASE_STEPS))?;
+                self.fresh_solves += 1;
+                self.cache
+                    .entry(u64::from(q))
+                    .or_insert_with(|| c.into_inner())
+            }
+        };
+        let rotated = rotate(
+            canonical,
+            k,
+            wrap_deg(k as f64 * width + f64::from(q) * width / f64::from(PHASE_STEPS)),
+        );
+        Ok(certify(rotated)?)
+    }
+}
+
+/// Rotates a uniform-bin profile by `k` bins (counter-clockwise).
+#[must_use]
+pub fn rotate(p: &Profile, k: usize, gaze_deg: f64) -> Profile {
+    let n = p.bins.len();
+    let mut bins = p.bins.clone();
+    for (i, b) in p.bins.iter().enumerate() {
+        let j = rotate_index(i, k, n);
+        bins[j] = b.clone();
+        bins[j].start_deg = p.bins[j].start_deg;
+        bins[j].width_deg = p.bins[j].width_deg;
+    }
+    Profile {
+        bins,
+        gaze_deg: Some(gaze_deg),
+        summary: None,
+        ..p.clone()
+    }
+}

@@ -1,0 +1,693 @@
+//! The block-coordinate LP/MILP (see the module docs of [`super`]).
+//!
+//! Variables are normalised to order one (`x = p/P̄`, `τ = t·N/T`) because
+//! HiGHS's feasibility tolerances are absolute (1e-7). Continuous solutions
+//! are clamped and rescaled to meet bounds, budget and frame exactly, which
+//! is why continuous bounds carry a [`MARGIN`]; level (MILP) solutions are
+//! exact by construction.
+
+// Loops over bins index several parallel per-bin arrays (θ, weights, caps,
+// variables); indices read like the formulation.
+#![allow(clippy::needless_range_loop)]
+
+use good_lp::solvers::highs::highs;
+use good_lp::{
+    constraint, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
+};
+use std::f64::consts::TAU;
+
+use super::{OptError, Problem};
+use crate::eye_safety::ael::{self, Band, APERTURE_DISTANCE_MM, T2_S, TIME_BASE_S};
+use crate::model::angle::{next_index, wrap_deg, Arc, Binning, CircularSet};
+use crate::model::lidar::PowerAccounting;
+use crate::planner::Mode;
+use crate::profile::{Bin, Profile, Region, PROFILE_FORMAT};
+
+/// Relative margin kept from continuous bounds, budget and caps.
+const MARGIN: f64 = 1e-6;
+/// Tie-break added to the weights, growing with signed eccentricity: makes
+/// the optimum unique where the acuity is symmetric about the gaze, and is
+/// itself rotation-equivariant (a function of eccentricity only), so a
+/// rotated problem has the rotated optimum.
+const TIE_BREAK: f64 = 1e-3;
+/// Trust region of the sequential LP for acceleration limits.
+const TRUST: f64 = 0.3;
+/// Share of the acceleration limit the linearised constraint may use.
+const ACCEL_SHARE: f64 = 0.8;
+/// Relative margin on eye-safety power caps (covers spin variation within a
+/// bin once the continuous spin profile is rebuilt).
+const CAP_MARGIN: f64 = 1e-3;
+/// Dwell-step iterations when the acceleration limit is finite.
+const SLP_ROUNDS: usize = 5;
+
+struct Grid {
+    n: usize,
+    width_deg: Vec<f64>,
+    theta: Vec<f64>,
+    start_deg: Vec<f64>,
+    weight: Vec<f64>,
+    in_rof: Vec<bool>,
+}
+
+fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
+    let b = Binning::uniform(problem.bins).map_err(|e| OptError::Invalid {
+        field: "bins".into(),
+        reason: e.to_string(),
+    })?;
+    let n = b.len();
+    let regions = problem.focus.regions(gaze_deg);
+    let eps = problem.objective.floor_weight;
+    let mut weight = Vec::with_capacity(n);
+    let mut in_rof = Vec::with_capacity(n);
+    for i in 0..n {
+        let c = b.center_deg(i);
+        let prior: f64 = problem
+            .objective
+            .priors
+            .iter()
+            .filter(|p| {
+                Arc {
+                    start_deg: wrap_deg(p.start_deg),
+                    width_deg: p.width_deg,
+                }
+                .contains(c)
+            })
+            .map(|p| p.weight)
+            .sum();
+        let ecc = crate::model::angle::diff_deg(c, gaze_deg);
+        weight.push(
+            problem.focus.acuity.deficit(ecc) + prior + eps + TIE_BREAK * (ecc + 180.0) / 360.0,
+        );
+        in_rof.push(regions.rof.contains(c));
+    }
+    Ok(Grid {
+        n,
+        width_deg: (0..n).map(|i| b.width_deg(i)).collect(),
+        theta: (0..n).map(|i| b.width_deg(i).to_radians()).collect(),
+        start_deg: (0..n).map(|i| b.start_deg(i)).collect(),
+        weight,
+        in_rof,
+    })
+}
+
+/// Chords of √x on `[lo, hi]`: (slope, intercept) pairs.
+fn sqrt_chords(lo: f64, hi: f64) -> Vec<(f64, f64)> {
+    let (a, b) = (lo.max(0.0).sqrt(), hi.max(lo).sqrt());
+    let k = super::UTILITY_SEGMENTS;
+    (0..k)
+        .filter_map(|j| {
+            let x0 = (a + (b - a) * j as f64 / k as f64).powi(2);
+            let x1 = (a + (b - a) * (j + 1) as f64 / k as f64).powi(2);
+            (x1 > x0).then(|| {
+                let slope = (x1.sqrt() - x0.sqrt()) / (x1 - x0);
+                (slope, x0.sqrt() - slope * x0)
+            })
+        })
+        .collect()
+}
+
+/// Eye-safety windows: for every bin edge, the pass window starting and
+/// ending there, as (bin, covered fraction) lists.
+struct Eye {
+    windows: Vec<Vec<(usize, f64)>>,
+    /// Single-pulse AEL at the effective pulse duration, J.
+    ael_single_j: f64,
+    /// Pulses per effective pulse.
+    group: f64,
+    /// Passes within T_max = min(T2, time base).
+    passes_tmax: f64,
+    /// Largest energy per pass from the T2 and time-base rules, J.
+    pass_energy_max_j: f64,
+    band: Band,
+}
+
+fn eye(problem: &Problem, g: &Grid) -> Result<Option<Eye>, OptError> {
+    let Some(params) = &problem.lidar.limits.eye_safety else {
+        return Ok(None);
+    };
+    let bad = |e: String| OptError::Invalid {
+        field: "limits.eye_safety".into(),
+        reason: e,
+    };
+    let band = params.validate().map_err(|e| bad(e.to_string()))?;
+    let lambda = params.wavelength_nm;
+    let f_p = problem.lidar.pulse_rate_hz;
+    let f_frame = problem.lidar.frame_rate_hz;
+    let pass_deg = ((band.aperture_mm() + params.beam_diameter_mm) / APERTURE_DISTANCE_MM)
+        .to_degrees()
+        .min(360.0);
+    let passes = |t: f64| (t * f_frame).floor() + 1.0;
+    let group = if band == Band::RetinalNir {
+        (band.t_i_s() * f_p).ceil().max(1.0)
+    } else {
+        1.0
+    };
+    let t_eff = if group > 1.0 {
+        band.t_i_s()
+    } else {
+        params.pulse_duration_s
+    };
+    let ael_single_j = ael::ael_j(lambda, t_eff).map_err(|e| bad(e.to_string()))?;
+    let pass_energy_max_j = (ael::ael_j(lambda, T2_S).map_err(|e| bad(e.to_string()))?
+        / passes(T2_S))
+    .min(ael::ael_j(lambda, TIME_BASE_S).map_err(|e| bad(e.to_string()))? / passes(TIME_BASE_S));
+    let mut windows = Vec::with_capacity(2 * g.n);
+    for &e in &g.start_deg {
+        for start in [e, e - pass_deg] {
+            let set = CircularSet::from_arcs([Arc {
+                start_deg: wrap_deg(start),
+                width_deg: pass_deg,
+            }]);
+            let w: Vec<(usize, f64)> = (0..g.n)
+                .filter_map(|j| {
+                    let lo = g.start_deg[j];
+                    let cover = set.overlap_deg(lo, lo + g.width_deg[j]) / g.width_deg[j];
+                    (cover > 1e-12).then_some((j, cover.min(1.0)))
+                })
+                .collect();
+            windows.push(w);
+        }
+    }
+    Ok(Some(Eye {
+        windows,
+        ael_single_j,
+        group,
+        passes_tmax: passes(T2_S.min(TIME_BASE_S)),
+        pass_energy_max_j,
+        band,
+    }))
+}
+
+impl Eye {
+    /// C5 for a window of dwell `t_w`.
+    fn c5(&self, f_p: f64, t_w: f64) -> f64 {
+        ael::c5(
+            self.band,
+            f_p * t_w * self.passes_tmax / self.group,
+            T2_S.min(TIME_BASE_S),
+        )
+    }
+
+    /// Per-bin power caps from the single-pulse rule at the given dwells, W.
+    fn power_caps(&self, f_p: f64, t: &[f64]) -> Vec<f64> {
+        let mut cap = vec![f64::INFINITY; t.len()];
+        for w in &self.windows {
+            let t_w: f64 = w.iter().map(|&(j, f)| f * t[j]).sum();
+            let allowed =
+                self.c5(f_p, t_w) * self.ael_single_j / self.group * f_p * (1.0 - CAP_MARGIN);
+            for &(j, _) in w {
+                cap[j] = cap[j].min(allowed);
+            }
+        }
+        cap
+    }
+
+    /// Largest window dwell at which the single-pulse rule holds for powers `p`, s.
+    fn window_dwell_max(&self, f_p: f64, w: &[(usize, f64)], p: &[f64]) -> Result<f64, OptError> {
+        let p_max = w.iter().map(|&(j, _)| p[j]).fold(0.0, f64::max);
+        let c = p_max * self.group / f_p / self.ael_single_j;
+        if c > 1.0 {
+            return Err(OptError::Infeasible(format!(
+                "eye safety: {:.4e} W gives {:.3e} J per pulse, above the single-pulse AEL {:.3e} J at any spin",
+                p_max,
+                p_max / f_p,
+                self.ael_single_j
+            )));
+        }
+        if c <= 0.4 || self.band != Band::RetinalNir {
+            return Ok(f64::INFINITY);
+        }
+        let n_max = (5.0 / c).powi(4).max(600.0);
+        Ok(n_max * self.group / (f_p * self.passes_tmax))
+    }
+}
+
+/// Plain-words checks of requests that cannot be met, before any solve.
+fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
+    let l = &problem.lidar.limits;
+    let lid = &problem.lidar;
+    let w_mean = lid.mean_spin_rad_s();
+    if l.spin_rad_s_max < w_mean * (1.0 - 1e-12) {
+        return Err(OptError::Infeasible(format!(
+            "spin_rad_s_max {:.3} rad/s cannot meet the frame period: one turn in 1/frame_rate_hz = {:.4} s needs a mean spin of {:.3} rad/s",
+            l.spin_rad_s_max,
+            1.0 / lid.frame_rate_hz,
+            w_mean
+        )));
+    }
+    if l.spin_rad_s_min > w_mean * (1.0 + 1e-12) {
+        return Err(OptError::Infeasible(format!(
+            "spin_rad_s_min {:.3} rad/s is above the mean spin {w_mean:.3} rad/s that frame_rate_hz {} requires",
+            l.spin_rad_s_min, lid.frame_rate_hz
+        )));
+    }
+    if l.power_w_min > lid.average_power_w * (1.0 + 1e-12) {
+        return Err(OptError::Infeasible(format!(
+            "power_w_min {:.4e} W alone exceeds the average power budget {:.4e} W",
+            l.power_w_min, lid.average_power_w
+        )));
+    }
+    if l.power_w_min > l.power_w_max {
+        return Err(OptError::Invalid {
+            field: "limits.power_w_min".into(),
+            reason: format!("{} is above power_w_max {}", l.power_w_min, l.power_w_max),
+        });
+    }
+    if let Some(e) = eye {
+        // The most lenient single-pulse cap: the fastest spin everywhere.
+        let f_p = lid.pulse_rate_hz;
+        let t_fast: Vec<f64> = vec![TAU / l.spin_rad_s_max / problem.bins as f64; problem.bins];
+        let cap = e
+            .power_caps(f_p, &t_fast)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        if cap < l.power_w_min {
+            let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
+            return Err(OptError::Infeasible(format!(
+                "eye-safety cap {cap:.4e} W at {wl} nm (even at spin_rad_s_max) is below power_w_min {:.4e} W",
+                l.power_w_min
+            )));
+        }
+    }
+    if !problem.levels.spin_rad_s.is_empty()
+        && l.spin_accel_rad_s2_max.is_some()
+        && problem.objective.mode.controls_resolution()
+    {
+        return Err(OptError::Invalid {
+            field: "levels.spin_rad_s".into(),
+            reason: "spin set-points step the spin, which a finite limits.spin_accel_rad_s2_max forbids; drop the set-points for smooth spin".into(),
+        });
+    }
+    for (k, &lv) in problem.levels.power_w.iter().enumerate() {
+        if !(lv.is_finite() && lv >= 0.0) {
+            return Err(OptError::Invalid {
+                field: format!("levels.power_w[{k}]"),
+                reason: format!("{lv} must be finite and >= 0"),
+            });
+        }
+    }
+    for (k, &lv) in problem.levels.spin_rad_s.iter().enumerate() {
+        if !(lv.is_finite() && lv > 0.0) {
+            return Err(OptError::Invalid {
+                field: format!("levels.spin_rad_s[{k}]"),
+                reason: format!("{lv} must be finite and > 0"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// HiGHS pinned for determinism (one thread, fixed seed), MILPs solved to
+/// optimality (zero gap) so equal problems give equal answers.
+fn configured(
+    model: good_lp::solvers::highs::HighsProblem,
+    cons: Vec<good_lp::Constraint>,
+) -> good_lp::solvers::highs::HighsProblem {
+    let mut m = model
+        .set_threads(1)
+        .set_option("random_seed", 0)
+        .set_option("mip_rel_gap", 0.0)
+        .set_option("mip_abs_gap", 1e-12);
+    for c in cons {
+        m = m.with(c);
+    }
+    m
+}
+
+fn solve_model<M: SolverModel<Error = good_lp::ResolutionError>>(
+    model: M,
+    what: &str,
+) -> Result<M::Solution, OptError> {
+    model.solve().map_err(|e| match e {
+        good_lp::ResolutionError::Infeasible => OptError::Infeasible(format!(
+            "the {what} step has no solution within the limits (power_w_min/max, the budget, spin limits, slew, acceleration and eye safety together)"
+        )),
+        other => OptError::Solver(format!("{what} step: {other}")),
+    })
+}
+
+/// Power step: dwell `t` fixed.
+fn power_step(
+    problem: &Problem,
+    g: &Grid,
+    eye: Option<&Eye>,
+    t: &[f64],
+) -> Result<Vec<f64>, OptError> {
+    let lid = &problem.lidar;
+    let l = &lid.limits;
+    let p_mean = lid.average_power_w;
+    let period: f64 = t.iter().sum();
+    let caps = eye.map_or_else(
+        || vec![f64::INFINITY; g.n],
+        |e| e.power_caps(lid.pulse_rate_hz, t),
+    );
+    let lam = problem.objective.range_weight;
+    let levels = &problem.levels.power_w;
+    let mut vars = ProblemVariables::new();
+    let mut objective = Expression::from(0.0);
+    let mut cons = Vec::new();
+    // x_i = p_i / P̄ as an expression (continuous var or Σ levels).
+    let mut x: Vec<Expression> = Vec::with_capacity(g.n);
+    let mut level_vars: Vec<Vec<(f64, Variable)>> = Vec::new();
+    for i in 0..g.n {
+        let hi = l.power_w_max.min(caps[i]);
+        if levels.is_empty() {
+            let lo_x = l.power_w_min / p_mean;
+            let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
+            let xi = vars.add(variable().min(lo_x).max(hi_x));
+            let u = vars.add(variable());
+            for (a, b) in sqrt_chords(lo_x, hi_x) {
+                cons.push(constraint!(u <= a * xi + b));
+            }
+            objective.add_mul(lam * g.theta[i] * g.weight[i], u);
+            x.push(Expression::from(xi));
+        } else {
+            let allowed: Vec<f64> = levels
+                .iter()
+                .copied()
+                .filter(|&lv| lv >= l.power_w_min && lv <= hi)
+                .collect();
+            if allowed.is_empty() {
+                return Err(OptError::Infeasible(format!(
+                    "no power level lies within [power_w_min, min(power_w_max, eye-safety cap)] = [{:.4e}, {:.4e}] W in bin {i}",
+                    l.power_w_min, hi
+                )));
+            }
+            let zs: Vec<(f64, Variable)> = allowed
+                .iter()
+                .map(|&lv| (lv, vars.add(variable().binary())))
+                .collect();
+            let mut xe = Expression::from(0.0);
+            let mut one = Expression::from(0.0);
+            for &(lv, z) in &zs {
+                xe.add_mul(lv / p_mean, z);
+                one.add_mul(1.0, z);
+                objective.add_mul(lam * g.theta[i] * g.weight[i] * (lv / p_mean).sqrt(), z);
+            }
+            cons.push(constraint!(one == 1.0));
+            x.push(xe);
+            level_vars.push(zs);
+        }
+    }
+    // Budget.
+    let budget_margin = if levels.is_empty() { 1.0 - MARGIN } else { 1.0 };
+    let mut spend = Expression::from(0.0);
+    let budget = match lid.power_accounting {
+        PowerAccounting::Angle => {
+            for i in 0..g.n {
+                spend += g.theta[i] * x[i].clone();
+            }
+            TAU * budget_margin
+        }
+        PowerAccounting::Time => {
+            for i in 0..g.n {
+                spend += (t[i] / period) * x[i].clone();
+            }
+            budget_margin
+        }
+    };
+    cons.push(constraint!(spend <= budget));
+    // Slew.
+    if let Some(s) = l.power_slew_w_per_deg_max {
+        for i in 0..g.n {
+            let j = next_index(i, g.n);
+            let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - MARGIN);
+            cons.push(constraint!(x[j].clone() - x[i].clone() <= lim));
+            cons.push(constraint!(x[i].clone() - x[j].clone() <= lim));
+        }
+    }
+    // Eye safety: energy per pass (T2 and time base).
+    if let Some(e) = eye {
+        for w in &e.windows {
+            let mut en = Expression::from(0.0);
+            for &(j, f) in w {
+                en += (f * t[j] * p_mean) * x[j].clone();
+            }
+            cons.push(constraint!(en <= e.pass_energy_max_j * (1.0 - MARGIN)));
+        }
+    }
+    let model = configured(vars.maximise(objective).using(highs), cons);
+    let sol = solve_model(model, "power")?;
+    let mut p: Vec<f64> = if levels.is_empty() {
+        x.iter().map(|xe| sol.eval(xe) * p_mean).collect()
+    } else {
+        level_vars
+            .iter()
+            .map(|zs| {
+                zs.iter()
+                    .max_by(|a, b| sol.value(a.1).total_cmp(&sol.value(b.1)))
+                    .map_or(0.0, |&(lv, _)| lv)
+            })
+            .collect()
+    };
+    if levels.is_empty() {
+        for (i, pi) in p.iter_mut().enumerate() {
+            *pi = pi.clamp(l.power_w_min, l.power_w_max.min(caps[i]));
+        }
+        // Exact budget: HiGHS meets it to 1e-7 absolute; trim the excess.
+        let spent = match lid.power_accounting {
+            PowerAccounting::Angle => p.iter().zip(&g.theta).map(|(a, b)| a * b).sum::<f64>() / TAU,
+            PowerAccounting::Time => p.iter().zip(t).map(|(a, b)| a * b).sum::<f64>() / period,
+        };
+        if spent > p_mean {
+            let scale = p_mean / spent;
+            for pi in &mut p {
+                *pi = (*pi * scale).max(l.power_w_min);
+            }
+        }
+    }
+    Ok(p)
+}
+
+/// Dwell step: power `p` fixed; `current` is the iterate for linearisation.
+fn dwell_step(
+    problem: &Problem,
+    g: &Grid,
+    eye: Option<&Eye>,
+    p: &[f64],
+    current: &[f64],
+) -> Result<Vec<f64>, OptError> {
+    let lid = &problem.lidar;
+    let l = &lid.limits;
+    let period = 1.0 / lid.frame_rate_hz;
+    let unit = period / g.n as f64; // τ = t / unit
+    let w_mean = lid.mean_spin_rad_s();
+    let lam = problem.objective.resolution_weight;
+    let setpoints = &problem.levels.spin_rad_s;
+    let mut vars = ProblemVariables::new();
+    let mut objective = Expression::from(0.0);
+    let mut cons = Vec::new();
+    let mut tau: Vec<Expression> = Vec::with_capacity(g.n);
+    let mut sp_vars: Vec<Vec<(f64, Variable)>> = Vec::new();
+    for i in 0..g.n {
+        let th = g.theta[i];
+        if setpoints.is_empty() {
+            let lo = th / l.spin_rad_s_max / unit * (1.0 + MARGIN);
+            let hi = if l.spin_rad_s_min > 0.0 {
+                th / l.spin_rad_s_min / unit * (1.0 - MARGIN)
+            } else {
+                1e9
+            };
+            let (mut lo, mut hi) = (lo, hi.max(lo));
+            if l.spin_accel_rad_s2_max.is_some() {
+                lo = lo.max(current[i] / unit * (1.0 - TRUST));
+                hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
+            }
+            let ti = vars.add(variable().min(lo).max(hi));
+            let v = vars.add(variable());
+            // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
+            let k = unit * TAU / (th * period);
+            let (r_lo, r_hi) = (
+                w_mean / l.spin_rad_s_max,
+                if l.spin_rad_s_min > 0.0 {
+                    w_mean / l.spin_rad_s_min
+                } else {
+                    1e3
+                },
+            );
+            for (a, b) in sqrt_chords(r_lo, r_hi) {
+                cons.push(constraint!(v <= a * k * ti + b));
+            }
+            objective.add_mul(lam * th * g.weight[i], v);
+            tau.push(Expression::from(ti));
+        } else {
+            let allowed: Vec<f64> = setpoints
+                .iter()
+                .copied()
+                .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
+                .collect();
+            if allowed.is_empty() {
+                return Err(OptError::Infeasible(
+                    "no spin set-point lies within [spin_rad_s_min, spin_rad_s_max]".into(),
+                ));
+            }
+            let ys: Vec<(f64, Variable)> = allowed
+                .iter()
+                .map(|&w| (w, vars.add(variable().binary())))
+                .collect();
+            let mut te = Expression::from(0.0);
+            let mut one = Expression::from(0.0);
+            for &(w, y) in &ys {
+                te.add_mul(th / w / unit, y);
+                one.add_mul(1.0, y);
+                objective.add_mul(lam * th * g.weight[i] * (w_mean / w).sqrt(), y);
+            }
+            cons.push(constraint!(one == 1.0));
+            tau.push(te);
+            sp_vars.push(ys);
+        }
+    }
+    let mut frame = Expression::from(0.0);
+    for te in &tau {
+        frame += te.clone();
+    }
+    cons.push(constraint!(frame == g.n as f64));
+    if lid.power_accounting == PowerAccounting::Time {
+        let mut spend = Expression::from(0.0);
+        for i in 0..g.n {
+            spend += (p[i] / lid.average_power_w) * tau[i].clone();
+        }
+        // No margin here: with uniform P̄ the budget is exactly tight. The
+        // power step that ends every joint solve trims the budget exactly.
+        cons.push(constraint!(spend <= g.n as f64));
+    }
+    if let Some(a_max) = l.spin_accel_rad_s2_max {
+        for i in 0..g.n {
+            let j = next_index(i, g.n);
+            let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
+            let dtheta = 0.5 * (g.theta[i] + g.theta[j]);
+            let ds = ACCEL_SHARE * a_max * dtheta * (1.0 - TRUST).powi(3) / w_cur.powi(3);
+            // s = t/θ = τ·unit/θ.
+            let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
+            cons.push(constraint!(kj * tau[j].clone() - ki * tau[i].clone() <= ds));
+            cons.push(constraint!(ki * tau[i].clone() - kj * tau[j].clone() <= ds));
+        }
+    }
+    if let Some(e) = eye {
+        let f_p = lid.pulse_rate_hz;
+        for w in &e.windows {
+            let t_max = e.window_dwell_max(f_p, w, p)?;
+            let mut dwell = Expression::from(0.0);
+            let mut en = Expression::from(0.0);
+            for &(j, f) in w {
+                dwell += (f * unit) * tau[j].clone();
+                en += (f * unit * p[j]) * tau[j].clone();
+            }
+            if t_max.is_finite() {
+                cons.push(constraint!(dwell <= t_max * (1.0 - MARGIN)));
+            }
+            cons.push(constraint!(en <= e.pass_energy_max_j * (1.0 - MARGIN)));
+        }
+    }
+    let model = configured(vars.maximise(objective).using(highs), cons);
+    let sol = solve_model(model, "dwell")?;
+    let mut t: Vec<f64> = if setpoints.is_empty() {
+        tau.iter().map(|te| sol.eval(te) * unit).collect()
+    } else {
+        sp_vars
+            .iter()
+            .zip(&g.theta)
+            .map(|(ys, th)| {
+                ys.iter()
+                    .max_by(|a, b| sol.value(a.1).total_cmp(&sol.value(b.1)))
+                    .map_or(0.0, |&(w, _)| th / w)
+            })
+            .collect()
+    };
+    if setpoints.is_empty() {
+        // Exact frame period.
+        let s: f64 = t.iter().sum();
+        for ti in &mut t {
+            *ti *= period / s;
+        }
+    }
+    Ok(t)
+}
+
+/// Solves and builds the (uncertified) profile.
+pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Profile, OptError> {
+    let g = grid(problem, gaze_deg)?;
+    let lid = &problem.lidar;
+    let eye = eye(problem, &g)?;
+    prechecks(problem, eye.as_ref())?;
+    let w_mean = lid.mean_spin_rad_s();
+    let mut t: Vec<f64> = g.theta.iter().map(|th| th / w_mean).collect();
+    let p_start = lid
+        .average_power_w
+        .clamp(lid.limits.power_w_min, lid.limits.power_w_max);
+    let mut p: Vec<f64> = vec![p_start; g.n];
+    let mode = problem.objective.mode;
+    let smooth_spin = lid.limits.spin_accel_rad_s2_max.is_some();
+    let spin_rounds = if smooth_spin { SLP_ROUNDS } else { 1 };
+    match mode {
+        Mode::Baseline => {}
+        Mode::Range => p = power_step(problem, &g, eye.as_ref(), &t)?,
+        Mode::Resolution => {
+            for _ in 0..spin_rounds {
+                t = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
+            }
+        }
+        Mode::Joint => {
+            for _ in 0..spin_rounds.max(2) {
+                t = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
+                p = power_step(problem, &g, eye.as_ref(), &t)?;
+            }
+        }
+    }
+    // Spin: steps when unlimited, else continuous node spins rescaled to the period.
+    let spins: Vec<(f64, f64)> = if smooth_spin && mode.controls_resolution() {
+        let s: Vec<f64> = t.iter().zip(&g.theta).map(|(t, th)| t / th).collect();
+        let node: Vec<f64> = (0..g.n)
+            .map(|i| 2.0 / (s[(i + g.n - 1) % g.n] + s[i]))
+            .collect();
+        let dwell: f64 = (0..g.n)
+            .map(|i| 2.0 * g.theta[i] / (node[i] + node[next_index(i, g.n)]))
+            .sum();
+        let c = dwell * lid.frame_rate_hz;
+        let spins: Vec<(f64, f64)> = (0..g.n)
+            .map(|i| (node[i] * c, node[next_index(i, g.n)] * c))
+            .collect();
+        if mode.controls_range() {
+            // Final power step on the exact dwell of the rebuilt spin.
+            let exact: Vec<f64> = spins
+                .iter()
+                .zip(&g.theta)
+                .map(|(w, th)| 2.0 * th / (w.0 + w.1))
+                .collect();
+            p = power_step(problem, &g, eye.as_ref(), &exact)?;
+        }
+        spins
+    } else {
+        t.iter()
+            .zip(&g.theta)
+            .map(|(t, th)| (th / t, th / t))
+            .collect()
+    };
+    let bins = (0..g.n)
+        .map(|i| Bin {
+            start_deg: g.start_deg[i],
+            width_deg: g.width_deg[i],
+            power_w: p[i],
+            spin_start_rad_s: spins[i].0,
+            spin_end_rad_s: spins[i].1,
+            region: Some(if g.in_rof[i] {
+                Region::Rof
+            } else {
+                Region::Roi
+            }),
+            dwell_s: Some(2.0 * g.theta[i] / (spins[i].0 + spins[i].1)),
+        })
+        .collect();
+    Ok(Profile {
+        format: PROFILE_FORMAT.to_owned(),
+        frame_rate_hz: lid.frame_rate_hz,
+        pulse_rate_hz: lid.pulse_rate_hz,
+        average_power_w: lid.average_power_w,
+        power_accounting: lid.power_accounting,
+        gaze_deg: Some(wrap_deg(gaze_deg)),
+        limits: lid.limits.clone(),
+        bins,
+        mode: Some(format!("optimized {}", mode.name())),
+        summary: None,
+    })
+}

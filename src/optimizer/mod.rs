@@ -1,0 +1,203 @@
+//! The optimizer: power and spin profiles derived from the driver's acuity
+//! function, with good_lp + HiGHS.
+//!
+//! # Formulation
+//!
+//! `N` equal bins of width `θ_i`; per bin a power `p_i` and a dwell `t_i`
+//! (mean spin `θ_i / t_i`). Weights `w_i = (1 − V(e_i)/V(0)) + priors(β_i)`
+//! (the driver's deficit at the bin centre, plus static priors), and a small
+//! floor `ε` so that budget nobody needs still goes somewhere sensible.
+//!
+//! Objective (maximise):
+//! `λ_R Σ θ_i (w_i + ε) U_R(p_i/P̄) + λ_ρ Σ θ_i (w_i + ε) U_ρ(r_i)`
+//! - `U_R`: range utility, concave: range ∝ √P (range equation, clear air),
+//!   made piecewise-linear from below with [`UTILITY_SEGMENTS`] chords;
+//! - `U_ρ`: resolution utility of the density ratio `r_i = t_i·2π/(θ_i·T)`,
+//!   √r piecewise-linear likewise (diminishing returns of extra points).
+//!
+//! Constraints: frame period `Σ t_i = T`; budget `Σ θ_i p_i <= 2π P̄`
+//! (angle) or `Σ t_i p_i <= P̄ T` (time); `p_i ∈ [P_min, P_max]`;
+//! `t_i ∈ [θ_i/ω_max, θ_i/ω_min]`; slew `|p_{i+1} − p_i| <= s·(Δ_i+Δ_{i+1})/2`;
+//! acceleration (linearised, see below); eye safety per aperture window
+//! (single-pulse rule with C5 from the window's dwell; energy over T2 and
+//! the 100 s time base), windows aligned with every bin edge, bins counted
+//! by their exact covered fraction.
+//!
+//! Power × dwell is bilinear under time accounting and in the eye-safety
+//! rules, so the problem is solved by **block-coordinate ascent**: a power
+//! step (dwell fixed: an LP, or a MILP with `K` hardware power levels) and a
+//! dwell step (power fixed: an LP, or a MILP with spin set-points), starting
+//! from the uniform baseline and ending with a power step. Under `angle`
+//! accounting without binding eye-safety coupling the two blocks separate
+//! and one round is exact; in general the result is a good feasible point,
+//! not a certified global optimum.
+//!
+//! Acceleration: with a finite motor limit the dwell step bounds the change
+//! of slowness `s = t/θ` between neighbours, `|Δs| <= a·Δθ·(1−ρ)³/ω̃³`
+//! linearised around the current iterate ω̃ with a trust region `ρ`
+//! (sequential LP); the continuous spin profile is then built from node
+//! spins between bins and rescaled so the frame period is exact. The
+//! checker has the last word: a solution that fails it is an error.
+
+pub mod config;
+pub mod fast;
+mod lp;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::checker::{certify, CertifiedProfile, Rejected};
+use crate::model::acuity::FocusModel;
+use crate::model::lidar::{LidarSpec, PowerAccounting};
+use crate::planner::Mode;
+
+pub use config::OptimizerConfig;
+
+/// Chords of the piecewise-linear utilities.
+pub const UTILITY_SEGMENTS: usize = 8;
+
+/// A static prior: extra weight on a sector (e.g. cross-traffic directions).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Prior {
+    /// Sector start, degrees.
+    pub start_deg: f64,
+    /// Sector width, degrees.
+    pub width_deg: f64,
+    /// Weight added to the deficit inside the sector (>= 0).
+    pub weight: f64,
+}
+
+/// What to maximise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Objective {
+    /// Which blocks move: `range` (power), `resolution` (spin) or `joint`.
+    pub mode: Mode,
+    /// λ_R: value of range (1 = the baseline's range over the whole turn).
+    pub range_weight: f64,
+    /// λ_ρ: value of resolution (1 = the baseline's density over the whole turn).
+    pub resolution_weight: f64,
+    /// ε: weight everywhere, so spare budget is spread rather than wasted.
+    pub floor_weight: f64,
+    /// Static priors.
+    pub priors: Vec<Prior>,
+}
+
+impl Default for Objective {
+    fn default() -> Self {
+        Self {
+            mode: Mode::Joint,
+            range_weight: 1.0,
+            resolution_weight: 1.0,
+            floor_weight: 1e-3,
+            priors: Vec::new(),
+        }
+    }
+}
+
+/// Hardware levels: empty = continuous.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Levels {
+    /// Allowed laser powers, W (K levels → MILP).
+    pub power_w: Vec<f64>,
+    /// Allowed spin set-points, rad/s (→ MILP; steps, so no acceleration limit).
+    pub spin_rad_s: Vec<f64>,
+}
+
+/// A complete optimization problem (everything but the gaze).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    /// The sensor and its limits.
+    pub lidar: LidarSpec,
+    /// Driver model.
+    pub focus: FocusModel,
+    /// Hardware levels.
+    pub levels: Levels,
+    /// Objective.
+    pub objective: Objective,
+    /// Number of equal bins.
+    pub bins: usize,
+}
+
+/// Why no certified profile came out.
+#[derive(Debug, Error)]
+pub enum OptError {
+    /// Bad configuration or argument (exit 2).
+    #[error("{field}: {reason}")]
+    Invalid {
+        /// Key.
+        field: String,
+        /// Why.
+        reason: String,
+    },
+    /// The limits cannot all be met (exit 1); says which.
+    #[error("infeasible: {0}")]
+    Infeasible(String),
+    /// HiGHS failed.
+    #[error("solver: {0}")]
+    Solver(String),
+    /// The solution failed the checker (never handed out).
+    #[error("the optimized profile violates its limits: {}", crate::checker::summarize_list(&.0.violations))]
+    Rejected(#[from] Rejected),
+}
+
+impl OptError {
+    /// Input fault (exit 2) rather than infeasibility (exit 1).
+    #[must_use]
+    pub fn is_input_error(&self) -> bool {
+        matches!(self, Self::Invalid { .. })
+    }
+}
+
+impl Problem {
+    /// The paper-equivalent problem for a preset: box acuity, the paper's two
+    /// power levels (`P_low`, and `P_high` from eq. 4) and two spin
+    /// set-points (eq. 6), no smoothing. Its optimum is the closed form.
+    pub fn paper_equivalent(
+        preset: &crate::model::presets::Preset,
+        mode: Mode,
+        bins: usize,
+    ) -> Result<Self, OptError> {
+        let rof = preset.focus.regions(0.0).rof.measure_deg();
+        let lv = crate::planner::closed_form::levels(preset, Mode::Joint, rof, 360.0 - rof)
+            .map_err(|e| OptError::Invalid {
+                field: "levels".into(),
+                reason: e.to_string(),
+            })?;
+        let power = crate::planner::closed_form::levels(preset, Mode::Range, rof, 360.0 - rof)
+            .map_err(|e| OptError::Invalid {
+                field: "levels".into(),
+                reason: e.to_string(),
+            })?
+            .power_w;
+        let mut power_w = power.to_vec();
+        if preset.lidar.power_accounting == PowerAccounting::Time && mode == Mode::Joint {
+            power_w = lv.power_w.to_vec();
+        }
+        Ok(Self {
+            lidar: preset.lidar.clone(),
+            focus: preset.focus.clone(),
+            levels: Levels {
+                power_w,
+                spin_rad_s: lv.spin_rad_s.to_vec(),
+            },
+            objective: Objective {
+                mode,
+                ..Objective::default()
+            },
+            bins,
+        })
+    }
+}
+
+/// Optimizes for `gaze_deg` and certifies the result.
+pub fn optimize(problem: &Problem, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
+    crate::planner::validate_gaze(gaze_deg).map_err(|e| OptError::Invalid {
+        field: "gaze-deg".into(),
+        reason: e.to_string(),
+    })?;
+    let profile = lp::solve(problem, gaze_deg)?;
+    Ok(certify(profile)?)
+}
