@@ -32,6 +32,7 @@
 pub mod checker;
 pub mod eye_safety;
 pub mod firmware;
+pub mod gaze;
 pub mod model;
 #[cfg(feature = "solver")]
 pub mod optimizer;

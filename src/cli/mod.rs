@@ -9,6 +9,7 @@ mod ael;
 mod check;
 mod profile;
 mod simulate;
+mod stream;
 
 use clap::{Parser, Subcommand};
 use std::path::Path;
@@ -76,6 +77,8 @@ enum Command {
     Ael(ael::Args),
     /// Run the paper's T-intersection experiment (variants × fog × trials).
     Simulate(simulate::Args),
+    /// Gaze samples on stdin → one certified profile per LiDAR frame (JSON lines).
+    Stream(stream::Args),
 }
 
 /// Writes `text` to `out` atomically, or to stdout.
@@ -124,6 +127,7 @@ pub fn main() -> ExitCode {
         Command::Check(a) => check::run(&a),
         Command::Ael(a) => ael::run(&a),
         Command::Simulate(a) => simulate::run(&a),
+        Command::Stream(a) => stream::run(&a),
     };
     match result {
         Ok(code) => ExitCode::from(code),

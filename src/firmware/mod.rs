@@ -341,7 +341,7 @@ fn pulse_code_caps(certified: &CertifiedProfile, step: f64) -> Result<Vec<u32>, 
         for _ in 0..n {
             cap_w[i] = cap_w[i].min(allowed);
             covered += p.bins[i].width_deg;
-            if covered >= report.pass_angle_deg {
+            if covered >= report.pass_angle_deg - crate::model::angle::EDGE_SNAP_DEG {
                 break;
             }
             i = crate::model::angle::next_index(i, n);

@@ -48,6 +48,16 @@ pub enum AngleError {
 /// Wraps an angle into `[0, 360)`. NaN and infinities propagate as NaN.
 #[must_use]
 pub fn wrap_deg(angle_deg: f64) -> f64 {
+    // Fast paths, bit-identical to `rem_euclid` (whose `%` is exact, and
+    // `x − 360` is exact for x in [360, 720) by Sterbenz's lemma): the hot
+    // loops of the simulator call this per pulse.
+    if (0.0..FULL_TURN_DEG).contains(&angle_deg) {
+        return angle_deg;
+    }
+    if (-FULL_TURN_DEG..0.0).contains(&angle_deg) {
+        let w = angle_deg + FULL_TURN_DEG;
+        return if w >= FULL_TURN_DEG { 0.0 } else { w };
+    }
     let w = angle_deg.rem_euclid(FULL_TURN_DEG);
     // rem_euclid can return exactly 360.0 for tiny negative inputs (rounding).
     if w >= FULL_TURN_DEG {
@@ -543,6 +553,15 @@ mod tests {
         fn rotate_matches_modular(i in 0usize..1000, shift in any::<usize>(), n in 1usize..1000) {
             let i = i % n;
             prop_assert_eq!(rotate_index(i, shift, n), ((i as u128 + shift as u128) % n as u128) as usize);
+        }
+
+        #[test]
+        fn wrap_fast_paths_match_rem_euclid(a in -1000.0f64..1000.0) {
+            let reference = {
+                let w = a.rem_euclid(FULL_TURN_DEG);
+                if w >= FULL_TURN_DEG { 0.0 } else { w }
+            };
+            prop_assert_eq!(wrap_deg(a).to_bits(), reference.to_bits());
         }
 
         #[test]

@@ -130,11 +130,19 @@ impl<'a> Timeline<'a> {
         let lo = wrap_deg(lo_deg);
         let mut i = self.bin_index(lo);
         let mut covered = -(lo - self.bins[i].start_deg);
+        // A window starting a rounding error before a bin edge does not reach
+        // into the bin before it: start at the edge.
+        if covered + self.bins[i].width_deg <= crate::model::angle::EDGE_SNAP_DEG {
+            covered += self.bins[i].width_deg;
+            i = crate::model::angle::next_index(i, n);
+        }
         let mut best: f64 = 0.0;
         for _ in 0..n {
             best = best.max(self.bins[i].power_w);
             covered += self.bins[i].width_deg;
-            if covered >= width_deg {
+            // A bin the window only touches at its edge (up to rounding)
+            // receives no pulse: stop there.
+            if covered >= width_deg - crate::model::angle::EDGE_SNAP_DEG {
                 break;
             }
             i = crate::model::angle::next_index(i, n);
@@ -155,5 +163,29 @@ impl<'a> Timeline<'a> {
         let b = &self.bins[i];
         let x = angle_into_bin_rad(b, t_s - self.cum_time_s[i]);
         (wrap_deg(b.start_deg + x.to_degrees()), i)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+    use crate::planner::{closed_form, Mode};
+
+    #[test]
+    fn windows_touching_a_bin_edge_do_not_reach_past_it() {
+        let c = closed_form(&presets::paper(), Mode::Range, Some(90.0), 360).unwrap();
+        let tl = Timeline::new(c.profile());
+        let (p_low, p_high) = (0.5e-3, 1.1e-3);
+        // RoF is [60, 120): a window [120 − 1e-13, 125) only touches it.
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-15;
+        assert!(close(tl.max_power_in(120.0 - 1e-13, 5.0), p_high));
+        assert!(close(tl.max_power_in(55.0, 5.0 - 1e-13), p_high));
+        assert!((tl.max_power_in(60.5, 2.0) - p_low).abs() < 1e-18);
+        let (t, e) = tl.window(350.0, 20.0);
+        assert!((t - 20f64.to_radians() / presets::paper().lidar.mean_spin_rad_s()).abs() < 1e-15);
+        assert!(e > 0.0);
+        let (az, bin) = tl.azimuth_at(0.0125);
+        assert!((az - 90.0).abs() < 1e-9 && bin == 90);
     }
 }

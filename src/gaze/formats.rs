@@ -1,0 +1,299 @@
+//! Gaze input formats. Every parser turns one line into a [`GazeSample`] in
+//! the vehicle frame (azimuth CCW from straight ahead, degrees) or an error
+//! naming the field; callers add the line number.
+//!
+//! - `jsonl`: `{"t_s": 1.23, "gaze_deg": 87.5, "valid": true}` (`valid`
+//!   optional, default true; `gaze_deg` null → invalid).
+//! - `csv`: header `t_s,gaze_deg[,valid]`.
+//! - `varjo`: Varjo Base gaze recordings (CSV). Uses `raw_timestamp` (ns),
+//!   `status` (2 = valid; 0 invalid, 1 adjusting), the head-relative unit
+//!   vector `gaze_forward_x/y/z` (HMD axes: x right, y up, z forward) and
+//!   the head orientation quaternion `HMD_rotation_x/y/z/w` (same axes,
+//!   head in the vehicle frame). Azimuth = atan2(−x_w, z_w) of the rotated
+//!   gaze (vehicle x forward = HMD z, y left = −HMD x). Assumption to check
+//!   against a vendor recording: the simulator's world frame is the vehicle
+//!   frame (ego stopped), as in the paper's setup.
+//! - `neon`: Pupil Neon `gaze.csv`: `timestamp [ns]`, `azimuth [deg]`
+//!   (positive to the right of the scene camera), `worn` (1 = on the head).
+//!   Head-relative: the head is assumed to face straight ahead (no IMU
+//!   fusion), so gaze = −azimuth.
+
+use serde::Deserialize;
+use std::collections::HashMap;
+use thiserror::Error;
+
+/// One gaze sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GazeSample {
+    /// Timestamp, s (monotonic within a recording).
+    pub t_s: f64,
+    /// Gaze azimuth, degrees (meaningless when `!valid`).
+    pub gaze_deg: f64,
+    /// Whether the tracker had the eyes.
+    pub valid: bool,
+}
+
+/// Input formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// JSON lines.
+    Jsonl,
+    /// CSV with `t_s,gaze_deg[,valid]`.
+    Csv,
+    /// Varjo Base gaze CSV.
+    Varjo,
+    /// Pupil Neon `gaze.csv`.
+    Neon,
+}
+
+/// A line that is not a sample.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum LineError {
+    /// Malformed JSON (serde names the field).
+    #[error("{0}")]
+    Json(String),
+    /// A CSV field is missing or unparsable.
+    #[error("field '{field}': {reason}")]
+    Field {
+        /// Column name.
+        field: String,
+        /// Why.
+        reason: String,
+    },
+    /// The header lacks a required column.
+    #[error("header: missing column '{0}'")]
+    Header(String),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonSample {
+    t_s: f64,
+    gaze_deg: Option<f64>,
+    #[serde(default)]
+    valid: Option<bool>,
+}
+
+/// A line parser with the state CSV formats need (the header).
+#[derive(Debug, Clone)]
+pub struct Parser {
+    format: Format,
+    columns: Option<HashMap<String, usize>>,
+}
+
+impl Parser {
+    /// A parser for `format`.
+    #[must_use]
+    pub fn new(format: Format) -> Self {
+        Self {
+            format,
+            columns: None,
+        }
+    }
+
+    /// Parses one line: `Ok(None)` for a header or blank line.
+    pub fn line(&mut self, line: &str) -> Result<Option<GazeSample>, LineError> {
+        let line = line.trim_end_matches(['\r', '\n']);
+        if line.trim().is_empty() {
+            return Ok(None);
+        }
+        match self.format {
+            Format::Jsonl => {
+                let s: JsonSample =
+                    serde_json::from_str(line).map_err(|e| LineError::Json(e.to_string()))?;
+                if !s.t_s.is_finite() {
+                    return Err(LineError::Field {
+                        field: "t_s".into(),
+                        reason: "not a finite time".into(),
+                    });
+                }
+                let g = s.gaze_deg.unwrap_or(f64::NAN);
+                Ok(Some(GazeSample {
+                    t_s: s.t_s,
+                    gaze_deg: g,
+                    valid: s.valid.unwrap_or(true) && g.is_finite(),
+                }))
+            }
+            Format::Csv | Format::Varjo | Format::Neon => self.csv_line(line),
+        }
+    }
+
+    fn csv_line(&mut self, line: &str) -> Result<Option<GazeSample>, LineError> {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let Some(cols) = &self.columns else {
+            let cols: HashMap<String, usize> = fields
+                .iter()
+                .enumerate()
+                .map(|(i, f)| ((*f).to_owned(), i))
+                .collect();
+            let required: &[&str] = match self.format {
+                Format::Csv => &["t_s", "gaze_deg"],
+                Format::Varjo => &[
+                    "raw_timestamp",
+                    "status",
+                    "gaze_forward_x",
+                    "gaze_forward_y",
+                    "gaze_forward_z",
+                    "HMD_rotation_x",
+                    "HMD_rotation_y",
+                    "HMD_rotation_z",
+                    "HMD_rotation_w",
+                ],
+                Format::Neon => &["timestamp [ns]", "azimuth [deg]", "worn"],
+                Format::Jsonl => &[],
+            };
+            if let Some(missing) = required.iter().find(|r| !cols.contains_key(**r)) {
+                return Err(LineError::Header((*missing).to_owned()));
+            }
+            self.columns = Some(cols);
+            return Ok(None);
+        };
+        let get = |name: &str| -> Result<f64, LineError> {
+            let i = cols[name];
+            let raw = fields.get(i).ok_or_else(|| LineError::Field {
+                field: name.into(),
+                reason: "missing".into(),
+            })?;
+            raw.parse::<f64>().map_err(|_| LineError::Field {
+                field: name.into(),
+                reason: format!("'{raw}' is not a number"),
+            })
+        };
+        let time = |name: &str, scale: f64| -> Result<f64, LineError> {
+            let t = get(name)? * scale;
+            if t.is_finite() {
+                Ok(t)
+            } else {
+                Err(LineError::Field {
+                    field: name.into(),
+                    reason: "not a finite time".into(),
+                })
+            }
+        };
+        match self.format {
+            Format::Csv => {
+                let t_s = time("t_s", 1.0)?;
+                let g = get("gaze_deg").unwrap_or(f64::NAN);
+                let valid = match cols.get("valid").and_then(|&i| fields.get(i)) {
+                    None => true,
+                    Some(v) => match v.to_ascii_lowercase().as_str() {
+                        "true" | "1" => true,
+                        "false" | "0" => false,
+                        other => {
+                            return Err(LineError::Field {
+                                field: "valid".into(),
+                                reason: format!("'{other}' is not true/false"),
+                            })
+                        }
+                    },
+                };
+                Ok(Some(GazeSample {
+                    t_s,
+                    gaze_deg: g,
+                    valid: valid && g.is_finite(),
+                }))
+            }
+            Format::Varjo => {
+                let t_s = time("raw_timestamp", 1e-9)?;
+                let status = get("status")?;
+                let g = [
+                    get("gaze_forward_x")?,
+                    get("gaze_forward_y")?,
+                    get("gaze_forward_z")?,
+                ];
+                let q = [
+                    get("HMD_rotation_x")?,
+                    get("HMD_rotation_y")?,
+                    get("HMD_rotation_z")?,
+                    get("HMD_rotation_w")?,
+                ];
+                let w = rotate(q, g);
+                let az = (-w[0]).atan2(w[2]).to_degrees();
+                let norm = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+                let valid = status == 2.0 && az.is_finite() && norm > 0.5;
+                Ok(Some(GazeSample {
+                    t_s,
+                    gaze_deg: az,
+                    valid,
+                }))
+            }
+            Format::Neon => {
+                let t_s = time("timestamp [ns]", 1e-9)?;
+                let az = get("azimuth [deg]").unwrap_or(f64::NAN);
+                let worn = get("worn")?;
+                Ok(Some(GazeSample {
+                    t_s,
+                    gaze_deg: -az,
+                    valid: worn >= 0.5 && az.is_finite(),
+                }))
+            }
+            Format::Jsonl => Ok(None),
+        }
+    }
+}
+
+/// Rotates vector `v` by the unit quaternion `q = (x, y, z, w)`.
+fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    let [x, y, z, w] = q;
+    let n = (x * x + y * y + z * z + w * w).sqrt();
+    if n.is_nan() || n <= 0.0 {
+        return [f64::NAN; 3];
+    }
+    let (x, y, z, w) = (x / n, y / n, z / n, w / n);
+    // v' = v + 2w (u × v) + 2 u × (u × v), u = (x, y, z).
+    let c1 = [
+        y * v[2] - z * v[1],
+        z * v[0] - x * v[2],
+        x * v[1] - y * v[0],
+    ];
+    let c2 = [
+        y * c1[2] - z * c1[1],
+        z * c1[0] - x * c1[2],
+        x * c1[1] - y * c1[0],
+    ];
+    [
+        v[0] + 2.0 * (w * c1[0] + c2[0]),
+        v[1] + 2.0 * (w * c1[1] + c2[1]),
+        v[2] + 2.0 * (w * c1[2] + c2[2]),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quaternion_yaw_left_turns_gaze_left() {
+        // Head yawed 90° to the left about the up axis (HMD y); HMD axes are
+        // left-handed-like (x right, z forward): a left turn maps forward (0,0,1) to (−1,0,0).
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let w = rotate([0.0, -h, 0.0, h], [0.0, 0.0, 1.0]);
+        assert!((w[0] + 1.0).abs() < 1e-12 && w[2].abs() < 1e-12, "{w:?}");
+        assert!(((-w[0]).atan2(w[2]).to_degrees() - 90.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn jsonl_validity_rules() {
+        let mut p = Parser::new(Format::Jsonl);
+        assert!(
+            p.line(r#"{"t_s": 0.1, "gaze_deg": 90}"#)
+                .unwrap()
+                .unwrap()
+                .valid
+        );
+        assert!(
+            !p.line(r#"{"t_s": 0.1, "gaze_deg": null}"#)
+                .unwrap()
+                .unwrap()
+                .valid
+        );
+        assert!(
+            !p.line(r#"{"t_s": 0.1, "gaze_deg": 90, "valid": false}"#)
+                .unwrap()
+                .unwrap()
+                .valid
+        );
+        assert!(p.line(r#"{"t_s": 0.1, "gaze": 90}"#).is_err());
+        assert!(p.line("").unwrap().is_none());
+    }
+}
