@@ -81,7 +81,11 @@ fn bench(c: &mut Criterion) {
     }
     let mut g = c.benchmark_group("optimizer");
     g.sample_size(10);
-    let sizes: &[usize] = if std::env::args().any(|a| a == "--bench") { &[360, 3600] } else { &[360] };
+    let sizes: &[usize] = if std::env::args().any(|a| a == "--bench") {
+        &[360, 3600]
+    } else {
+        &[360]
+    };
     for &n in sizes {
         let paper = presets::paper();
         g.bench_with_input(BenchmarkId::new("closed_form_joint", n), &n, |b, &n| {

@@ -15,7 +15,8 @@ fuzz_target!(|data: &[u8]| {
     let f = |i: usize| f64::from_le_bytes(data[i..i + 8].try_into().unwrap_or([0; 8]));
     let gaze = f(0);
     let param = f(8);
-    let bins = usize::from(u16::from_le_bytes([data[16], data[17]]));
+    // Up to 2051 bins keeps runs fast; 0..=3 exercises the bin-count errors.
+    let bins = usize::from(u16::from_le_bytes([data[16], data[17]]) % 2052);
     let mode = Mode::ALL[usize::from(data[18]) % 4];
     let mut p = presets::paper();
     p.focus.threshold = (f64::from(data[19]) / 255.0).max(0.0);

@@ -192,6 +192,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
     let mut car_arcs = [static_arcs[0]; 2];
     let n_pulses = (t_end * pulse_rate).floor() as u64;
     let mut frames = 0u64;
+    let mut bin_hint = 0usize;
 
     // Nearest hit among statics and cars: (range, cos, reflectivity, car index).
     let cast = |c: f64,
@@ -230,6 +231,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
         if frame != current_frame {
             current_frame = frame;
             frames += 1;
+            bin_hint = 0;
             let t0 = (frame as f64 * period - phase).max(0.0);
             let t1 = (frame + 1) as f64 * period - phase;
             for (j, arc) in car_arcs.iter_mut().enumerate() {
@@ -262,7 +264,8 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
                 }
             }
         }
-        let (az, bin) = tl.azimuth_at(tau);
+        let (az, bin) = tl.azimuth_at_from(tau, bin_hint);
+        bin_hint = bin;
         let in_roi = setup.regions.roi.contains(az);
         roi_pulses += u64::from(in_roi);
         let rad = az.to_radians();
