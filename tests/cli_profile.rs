@@ -2,27 +2,22 @@
 
 mod common;
 
-use common::{assert_bad_input, run, stderr, stdout};
+use common::{assert_bad_input, run, stdout};
 use gaze_lidar::model::angle::diff_deg;
 use gaze_lidar::profile::{Profile, Region};
 
 fn profile(mode: &str, gaze: &str) -> Profile {
-    let o = run(
-        &[
-            "profile",
-            "--preset",
-            "paper",
-            "--mode",
-            mode,
-            "--gaze-deg",
-            gaze,
-            "--format",
-            "json",
-        ],
-        None,
-    );
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    Profile::from_json(&stdout(&o), "stdout").unwrap()
+    common::profile_from(&[
+        "profile",
+        "--preset",
+        "paper",
+        "--mode",
+        mode,
+        "--gaze-deg",
+        gaze,
+        "--format",
+        "json",
+    ])
 }
 
 fn distinct(values: impl Iterator<Item = f64>) -> Vec<f64> {

@@ -47,3 +47,10 @@ pub fn assert_bad_input(o: &Output, needle: &str) {
     );
     assert!(err.contains(needle), "expected '{needle}' in: {err}");
 }
+
+/// Runs `gaze-lidar` expecting success and parses its stdout as profile@1.
+pub fn profile_from(args: &[&str]) -> gaze_lidar::profile::Profile {
+    let o = run(args, None);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+    gaze_lidar::profile::Profile::from_json(&stdout(&o), "stdout").unwrap()
+}

@@ -7,18 +7,6 @@ use gaze_lidar::firmware::{binary, check_table, FirmwareTable};
 use gaze_lidar::profile::Profile;
 
 fn profile_and_table(mode: &str, gaze: &str) -> (Profile, FirmwareTable) {
-    let p = run(
-        &[
-            "profile",
-            "--preset",
-            "paper",
-            "--mode",
-            mode,
-            "--gaze-deg",
-            gaze,
-        ],
-        None,
-    );
     let t = run(
         &[
             "profile",
@@ -35,7 +23,15 @@ fn profile_and_table(mode: &str, gaze: &str) -> (Profile, FirmwareTable) {
     );
     assert_eq!(t.status.code(), Some(0), "{}", common::stderr(&t));
     (
-        Profile::from_json(&stdout(&p), "p").unwrap(),
+        common::profile_from(&[
+            "profile",
+            "--preset",
+            "paper",
+            "--mode",
+            mode,
+            "--gaze-deg",
+            gaze,
+        ]),
         serde_json::from_str(&stdout(&t)).unwrap(),
     )
 }

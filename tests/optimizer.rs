@@ -14,9 +14,7 @@ use gaze_lidar::profile::Profile;
 const CONFIGS: [&str; 4] = ["paper", "multi_level", "smooth", "vls128_eye"];
 
 fn profile(args: &[&str]) -> Profile {
-    let o = run(args, None);
-    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
-    Profile::from_json(&stdout(&o), "stdout").unwrap()
+    common::profile_from(args)
 }
 
 #[test]

@@ -326,6 +326,14 @@ fn solve_model<M: SolverModel<Error = good_lp::ResolutionError>>(
     })
 }
 
+/// The level a solved one-hot group of binaries picked.
+fn chosen(sol: &impl Solution, group: &[(f64, Variable)]) -> f64 {
+    group
+        .iter()
+        .max_by(|a, b| sol.value(a.1).total_cmp(&sol.value(b.1)))
+        .map_or(0.0, |&(level, _)| level)
+}
+
 /// Power step: dwell `t` fixed.
 fn power_step(
     problem: &Problem,
@@ -431,14 +439,7 @@ fn power_step(
     let mut p: Vec<f64> = if levels.is_empty() {
         x.iter().map(|xe| sol.eval(xe) * p_mean).collect()
     } else {
-        level_vars
-            .iter()
-            .map(|zs| {
-                zs.iter()
-                    .max_by(|a, b| sol.value(a.1).total_cmp(&sol.value(b.1)))
-                    .map_or(0.0, |&(lv, _)| lv)
-            })
-            .collect()
+        level_vars.iter().map(|zs| chosen(&sol, zs)).collect()
     };
     if levels.is_empty() {
         for (i, pi) in p.iter_mut().enumerate() {
@@ -587,11 +588,7 @@ fn dwell_step(
         sp_vars
             .iter()
             .zip(&g.theta)
-            .map(|(ys, th)| {
-                ys.iter()
-                    .max_by(|a, b| sol.value(a.1).total_cmp(&sol.value(b.1)))
-                    .map_or(0.0, |&(w, _)| th / w)
-            })
+            .map(|(ys, th)| th / chosen(&sol, ys))
             .collect()
     };
     if setpoints.is_empty() {
