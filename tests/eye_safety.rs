@@ -260,14 +260,22 @@ fn slowing_one_sector_raises_its_single_pulse_exposure() {
     let params = base.limits.eye_safety.clone().unwrap();
     let r0 = evaluate_profile(&base, &params).unwrap();
     let r1 = evaluate_profile(&res, &params).unwrap();
-    let at = |r: &gaze_lidar::eye_safety::ExposureReport, az: f64| {
+    // An aperture position deep in the RoI (≈ 270°), present in both reports
+    // (same bin edges).
+    let probe = r0
+        .positions
+        .iter()
+        .find(|p| (265.0..275.0).contains(&p.azimuth_deg))
+        .unwrap()
+        .azimuth_deg;
+    let at = |r: &gaze_lidar::eye_safety::ExposureReport| {
         r.positions
             .iter()
-            .find(|p| (p.azimuth_deg - az).abs() < 1e-9)
+            .find(|p| p.azimuth_deg == probe)
             .unwrap()
             .clone()
     };
-    let (a, b) = (at(&r0, 270.5), at(&r1, 270.5));
+    let (a, b) = (at(&r0), at(&r1));
     assert!(b.pulses_per_pass > a.pulses_per_pass);
     assert!(b.c5 < a.c5 && b.ratios[0] > a.ratios[0]);
 }

@@ -170,21 +170,31 @@ fn check_duration(what: &'static str, t: f64, min: f64) -> Result<(), AelError> 
 ///   1e-2 W beyond.
 pub fn ael_j(wavelength_nm: f64, t_s: f64) -> Result<f64, AelError> {
     let band = Band::of(wavelength_nm)?;
-    let c4 = c4(wavelength_nm);
+    let min = match band {
+        Band::RetinalNir => 1e-11,
+        Band::Ir1400 | Band::Ir1500 => 1e-9,
+    };
+    check_duration("duration", t_s, min)?;
+    Ok(table3_j(band, c4(wavelength_nm), t_s))
+}
+
+/// Table 3 without validation, for hot loops whose inputs were validated
+/// once: `band` and `c4` of the wavelength, `t_s` within the band's domain.
+#[must_use]
+pub(crate) fn table3_j(band: Band, c4: f64, t_s: f64) -> f64 {
     match band {
         Band::RetinalNir => {
-            check_duration("duration", t_s, 1e-11)?;
-            Ok(if t_s <= 5e-6 {
+            if t_s <= 5e-6 {
                 7.7e-8 * c4 * c6()
             } else if t_s <= T2_S {
                 7e-4 * c4 * c6() * t_s.powf(0.75)
             } else {
-                3.9e-4 * c4 * c7(wavelength_nm) * t_s
-            })
+                // C7 = 1 throughout 700–1050 nm.
+                3.9e-4 * c4 * t_s
+            }
         }
         Band::Ir1400 => {
-            check_duration("duration", t_s, 1e-9)?;
-            Ok(if t_s <= 1e-3 {
+            if t_s <= 1e-3 {
                 8e-4
             } else if t_s <= 0.35 {
                 4.4e-3 * t_s.powf(0.25)
@@ -192,17 +202,16 @@ pub fn ael_j(wavelength_nm: f64, t_s: f64) -> Result<f64, AelError> {
                 1.8e-2 * t_s.powf(0.75)
             } else {
                 1e-2 * t_s
-            })
+            }
         }
         Band::Ir1500 => {
-            check_duration("duration", t_s, 1e-9)?;
-            Ok(if t_s <= 0.35 {
+            if t_s <= 0.35 {
                 8e-3
             } else if t_s <= 10.0 {
                 1.8e-2 * t_s.powf(0.75)
             } else {
                 1e-2 * t_s
-            })
+            }
         }
     }
 }

@@ -121,67 +121,60 @@ fn passes_in(window_s: f64, frame_rate_hz: f64) -> f64 {
     (window_s * frame_rate_hz).floor() + 1.0
 }
 
-/// Evaluates a structurally valid profile (checked bins, positive spin)
-/// against Class 1 at every azimuth.
-pub fn evaluate_profile(
-    profile: &Profile,
-    params: &EyeSafetyParams,
-) -> Result<ExposureReport, EyeSafetyError> {
-    let band = params.validate()?;
-    let lambda = params.wavelength_nm;
-    let pass_angle_deg = ((band.aperture_mm() + params.beam_diameter_mm) / APERTURE_DISTANCE_MM)
-        .to_degrees()
-        .min(360.0);
-    let tl = Timeline::new(profile);
-    let f_frame = 1.0 / tl.period_s();
-    let f_pulse = profile.pulse_rate_hz;
-    let t_max = T2_S.min(TIME_BASE_S);
-    let ael_pulse = ael::ael_j(lambda, params.pulse_duration_s)?;
-    let ael_t2 = ael::ael_j(lambda, T2_S)?;
-    let ael_tb = ael::ael_j(lambda, TIME_BASE_S)?;
-    let half = 0.5 * pass_angle_deg;
+/// Per-evaluation constants and the exposure at one aperture azimuth.
+struct Evaluator<'a> {
+    tl: Timeline<'a>,
+    band: Band,
+    c4: f64,
+    pulse_duration_s: f64,
+    pass_angle_deg: f64,
+    f_frame: f64,
+    f_pulse: f64,
+    t_max: f64,
+    ael_pulse: f64,
+    ael_t2: f64,
+    ael_tb: f64,
+}
 
-    let mut centers: Vec<f64> = Vec::with_capacity(3 * profile.bins.len());
-    for b in &profile.bins {
-        centers.push(wrap_deg(b.start_deg + half));
-        centers.push(wrap_deg(b.start_deg - half));
-        centers.push(wrap_deg(b.center_deg()));
-    }
-    centers.sort_by(f64::total_cmp);
-    centers.dedup();
-
-    let mut positions = Vec::with_capacity(centers.len());
-    for phi in centers {
-        let (t_pass, e_pass) = tl.window(phi - half, pass_angle_deg);
-        let pulses = f_pulse * t_pass;
-        let p_max = tl.max_power_in(phi - half, pass_angle_deg);
+impl Evaluator<'_> {
+    fn at(&self, phi: f64) -> Result<AzimuthExposure, EyeSafetyError> {
+        let half = 0.5 * self.pass_angle_deg;
+        let (t_pass, e_pass) = self.tl.window(phi - half, self.pass_angle_deg);
+        let pulses = self.f_pulse * t_pass;
+        let p_max = self.tl.max_power_in(phi - half, self.pass_angle_deg);
         // Pulses closer than T_i are one effective pulse (retinal band).
-        let group = if band == Band::RetinalNir {
-            (band.t_i_s() * f_pulse).ceil().clamp(1.0, pulses.max(1.0))
+        let group = if self.band == Band::RetinalNir {
+            (self.band.t_i_s() * self.f_pulse)
+                .ceil()
+                .clamp(1.0, pulses.max(1.0))
         } else {
             1.0
         };
-        let e_pulse = p_max / f_pulse * group;
-        let n_eff = pulses * passes_in(t_max, f_frame) / group;
-        let c5 = ael::c5(band, n_eff, t_max);
-        let t_eff = if group > 1.0 {
-            band.t_i_s()
-        } else {
-            params.pulse_duration_s
-        };
+        let e_pulse = p_max / self.f_pulse * group;
+        let n_eff = pulses * passes_in(self.t_max, self.f_frame) / group;
+        let c5 = ael::c5(self.band, n_eff, self.t_max);
         let ael_single = if group > 1.0 {
-            ael::ael_j(lambda, t_eff)?
+            ael::table3_j(self.band, self.c4, self.band.t_i_s())
         } else {
-            ael_pulse
+            self.ael_pulse
         };
-        let ael_pass = ael::ael_j(lambda, t_pass.max(params.pulse_duration_s))?;
+        let t_pass_eff = t_pass.max(self.pulse_duration_s);
+        if t_pass_eff > 3e4 {
+            return Err(ael::AelError::Duration {
+                what: "pass duration",
+                value: t_pass_eff,
+                reason: "exceeds 3·10⁴ s, beyond Table 3 (the spin is too slow)",
+            }
+            .into());
+        }
+        let ael_pass = ael::table3_j(self.band, self.c4, t_pass_eff);
         let ratios = [
             e_pulse / (c5 * ael_single),
             e_pass / ael_pass,
-            e_pass * passes_in(T2_S, f_frame) / ael_t2,
-            e_pass * passes_in(TIME_BASE_S, f_frame) / ael_tb,
+            e_pass * passes_in(T2_S, self.f_frame) / self.ael_t2,
+            e_pass * passes_in(TIME_BASE_S, self.f_frame) / self.ael_tb,
         ];
-        positions.push(AzimuthExposure {
+        Ok(AzimuthExposure {
             azimuth_deg: phi,
             pass_duration_s: t_pass,
             pulses_per_pass: pulses,
@@ -189,8 +182,68 @@ pub fn evaluate_profile(
             max_pulse_energy_j: e_pulse,
             c5,
             ratios,
-        });
+        })
     }
+}
+
+fn evaluator<'a>(
+    profile: &'a Profile,
+    params: &EyeSafetyParams,
+) -> Result<Evaluator<'a>, EyeSafetyError> {
+    let band = params.validate()?;
+    let lambda = params.wavelength_nm;
+    let tl = Timeline::new(profile);
+    let f_frame = 1.0 / tl.period_s();
+    Ok(Evaluator {
+        band,
+        c4: ael::c4(lambda),
+        pulse_duration_s: params.pulse_duration_s,
+        pass_angle_deg: ((band.aperture_mm() + params.beam_diameter_mm) / APERTURE_DISTANCE_MM)
+            .to_degrees()
+            .min(360.0),
+        f_frame,
+        f_pulse: profile.pulse_rate_hz,
+        t_max: T2_S.min(TIME_BASE_S),
+        ael_pulse: ael::ael_j(lambda, params.pulse_duration_s)?,
+        ael_t2: ael::ael_j(lambda, T2_S)?,
+        ael_tb: ael::ael_j(lambda, TIME_BASE_S)?,
+        tl,
+    })
+}
+
+/// Evaluates a structurally valid profile (checked bins, positive spin)
+/// against Class 1 at every azimuth.
+pub fn evaluate_profile(
+    profile: &Profile,
+    params: &EyeSafetyParams,
+) -> Result<ExposureReport, EyeSafetyError> {
+    let ev = evaluator(profile, params)?;
+    let (band, lambda, f_pulse, t_max) = (ev.band, params.wavelength_nm, ev.f_pulse, ev.t_max);
+    let (ael_t2, ael_tb, pass_angle_deg) = (ev.ael_t2, ev.ael_tb, ev.pass_angle_deg);
+    let half = 0.5 * pass_angle_deg;
+    // With constant spin and power in every bin the window quantities are
+    // piecewise linear in the aperture azimuth with breakpoints where a
+    // window edge meets a bin edge, so those positions contain the maximum.
+    // Accelerating bins make the dwell density vary inside a bin: then the
+    // bin centres are sampled as well.
+    let accelerating = profile
+        .bins
+        .iter()
+        .any(|b| b.spin_start_rad_s != b.spin_end_rad_s);
+    let mut centers: Vec<f64> = Vec::with_capacity(3 * profile.bins.len());
+    for b in &profile.bins {
+        centers.push(wrap_deg(b.start_deg + half));
+        centers.push(wrap_deg(b.start_deg - half));
+        if accelerating {
+            centers.push(wrap_deg(b.center_deg()));
+        }
+    }
+    centers.sort_by(f64::total_cmp);
+    centers.dedup();
+    let positions = centers
+        .into_iter()
+        .map(|phi| ev.at(phi))
+        .collect::<Result<Vec<_>, _>>()?;
 
     let (mut worst_i, mut worst_rule, mut worst_ratio) = (0, Rule::SinglePulse, f64::NEG_INFINITY);
     for (i, p) in positions.iter().enumerate() {
@@ -230,4 +283,42 @@ pub fn evaluate_profile(
         stalled_rotor_ratio: stalled_ratio,
         positions,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+    use crate::planner::closed_form::build_profile;
+    use crate::planner::Mode;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(40))]
+
+        /// Without acceleration, the edge-aligned positions hold the maximum
+        /// over every azimuth: dense sampling never finds a worse one.
+        #[test]
+        fn edge_positions_bound_dense_sampling(
+            gaze in 0.0f64..360.0,
+            bins in 8usize..200,
+            mode in 0usize..4,
+            scale in proptest::collection::vec(0.3f64..1.7, 200),
+        ) {
+            let mut p = build_profile(&presets::paper(), Mode::ALL[mode], Some(gaze), bins).unwrap();
+            for (b, k) in p.bins.iter_mut().zip(scale.iter().cycle()) {
+                b.power_w *= k;
+            }
+            let params = p.limits.eye_safety.clone().unwrap();
+            let report = evaluate_profile(&p, &params).unwrap();
+            let ev = evaluator(&p, &params).unwrap();
+            for b in &p.bins {
+                for k in 0..17 {
+                    let phi = wrap_deg(b.start_deg + b.width_deg * f64::from(k) / 17.0 + 0.013);
+                    let (_, r) = ev.at(phi).unwrap().worst();
+                    prop_assert!(r <= report.worst_ratio * (1.0 + 1e-9), "{} > {} at {}", r, report.worst_ratio, phi);
+                }
+            }
+        }
+    }
 }
