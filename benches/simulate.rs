@@ -11,7 +11,7 @@ use gaze_lidar::sim::{self, ModelKind, SimConfig};
 fn bench(c: &mut Criterion) {
     let one = |brute_force| SimConfig {
         models: vec![ModelKind::Physical],
-        variants: vec![gaze_lidar::planner::Mode::Joint],
+        variants: vec![gaze_lidar::sim::Variant::Joint],
         fog_pcts: vec![25],
         trials: 1,
         brute_force,

@@ -178,7 +178,7 @@ fn scenario_speed_changes_tta_as_expected() {
     // At 30 km/h the car needs longer to arrive from the same visible distance.
     let mut slow = SimConfig {
         models: vec![ModelKind::Argus],
-        variants: vec![Mode::Baseline],
+        variants: vec![gaze_lidar::sim::Variant::Baseline],
         fog_pcts: vec![0],
         trials: 5,
         ..SimConfig::default()
@@ -187,4 +187,26 @@ fn scenario_speed_changes_tta_as_expected() {
     let r = sim::run(&slow, &|| {}).unwrap();
     let t = r.rows[0].tta_median_s.unwrap();
     assert!((9.0..10.5).contains(&t), "{t}");
+}
+
+#[cfg(feature = "solver")]
+#[test]
+fn optimized_variant_runs_on_shared_phase_solutions() {
+    use gaze_lidar::sim::Variant;
+    let config = SimConfig {
+        models: vec![ModelKind::Physical],
+        variants: vec![Variant::Baseline, Variant::Optimized],
+        fog_pcts: vec![25],
+        trials: 6,
+        ..SimConfig::default()
+    };
+    let r = sim::run(&config, &|| {}).unwrap();
+    let base = r.row(ModelKind::Physical, "baseline", 25).unwrap();
+    let opt = r.row(ModelKind::Physical, "optimized", 25).unwrap();
+    assert_eq!(opt.detected, opt.trials);
+    // More power and points where the driver does not look: detected earlier.
+    assert!(opt.tta_median_s.unwrap() > base.tta_median_s.unwrap());
+    assert!(opt.density_median_pts_per_deg > base.density_median_pts_per_deg);
+    // Same seed, same answer (the phase table is built in parallel).
+    assert_eq!(sim::run(&config, &|| {}).unwrap().rows, r.rows);
 }

@@ -4,8 +4,7 @@ use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
-use gaze_lidar::planner::Mode;
-use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, FOG_LEVELS_PCT};
+use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, Variant, FOG_LEVELS_PCT};
 
 use super::{emit, CliError};
 
@@ -25,9 +24,12 @@ pub struct Args {
     /// Return model(s); default both.
     #[arg(long, value_enum)]
     model: Vec<ModelKind>,
-    /// Variants; default all four.
+    /// Variants; default the paper's four (`optimized` adds the optimizer's profile).
     #[arg(long, value_enum)]
-    variant: Vec<Mode>,
+    variant: Vec<Variant>,
+    /// Optimizer configuration (TOML) for the `optimized` variant (no priors).
+    #[arg(long)]
+    optimizer_config: Option<PathBuf>,
     /// Fog levels in % (paper labels 0, 25, 50); default all.
     #[arg(long)]
     fog: Vec<u32>,
@@ -111,7 +113,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             a.model.clone()
         },
         variants: if a.variant.is_empty() {
-            Mode::ALL.to_vec()
+            Variant::PAPER.to_vec()
         } else {
             a.variant.clone()
         },

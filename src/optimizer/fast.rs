@@ -136,3 +136,55 @@ pub fn rotate(p: &Profile, k: usize, gaze_deg: f64) -> Profile {
         ..p.clone()
     }
 }
+
+/// Canonical solutions for a set of gazes, built in parallel, shared
+/// read-only across threads (the simulator's `optimized` variant).
+#[derive(Debug, Clone)]
+pub struct PhaseTable {
+    problem: Problem,
+    canonical: BTreeMap<u32, Profile>,
+}
+
+impl PhaseTable {
+    /// Solves every phase the `gazes` need (rotation-invariant problems only).
+    pub fn build(problem: &Problem, gazes: &[f64]) -> Result<Self, OptError> {
+        use rayon::prelude::*;
+        if !problem.objective.priors.is_empty() {
+            return Err(OptError::Invalid {
+                field: "objective.priors".into(),
+                reason: "a phase table needs a rotation-invariant problem (no priors)".into(),
+            });
+        }
+        let planner = FastPlanner::new(problem.clone());
+        let mut phases: Vec<u32> = gazes.iter().map(|&g| planner.split(g).1).collect();
+        phases.sort_unstable();
+        phases.dedup();
+        let width = FULL_TURN_DEG / problem.bins as f64;
+        let solved: Vec<(u32, Profile)> = phases
+            .par_iter()
+            .map(|&q| {
+                optimize(problem, f64::from(q) * width / f64::from(PHASE_STEPS))
+                    .map(|c| (q, c.into_inner()))
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            problem: problem.clone(),
+            canonical: solved.into_iter().collect(),
+        })
+    }
+
+    /// The certified profile for `gaze_deg` (its phase must have been built).
+    pub fn plan(&self, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
+        let planner = FastPlanner::new(self.problem.clone());
+        let (k, q) = planner.split(gaze_deg);
+        let canonical = self.canonical.get(&q).ok_or_else(|| OptError::Invalid {
+            field: "gaze-deg".into(),
+            reason: format!("phase {q} of gaze {gaze_deg} was not built"),
+        })?;
+        Ok(certify(rotate(
+            canonical,
+            k,
+            planner.quantized_gaze(gaze_deg),
+        ))?)
+    }
+}

@@ -57,13 +57,65 @@ pub enum SimError {
     Argument(String),
 }
 
+/// A LiDAR variant of the experiment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum Variant {
+    /// Uniform (the non-adaptive LiDAR).
+    Baseline,
+    /// Range control (closed form).
+    Range,
+    /// Resolution control (closed form; in `argus`, the paper code's variant).
+    Resolution,
+    /// Both (closed form).
+    Joint,
+    /// The optimizer's profile (needs the `solver` feature): by default the
+    /// paper's sensor with Levi's E2 acuity (60° region of focus), joint,
+    /// continuous levels; or `SimConfig::optimizer`.
+    Optimized,
+}
+
+impl Variant {
+    /// The paper's four.
+    pub const PAPER: [Variant; 4] = [
+        Variant::Baseline,
+        Variant::Range,
+        Variant::Resolution,
+        Variant::Joint,
+    ];
+
+    /// Lower-case name.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Optimized => "optimized",
+            other => other.mode().map_or("optimized", Mode::name),
+        }
+    }
+
+    /// The closed-form controller, if any.
+    #[must_use]
+    pub fn mode(self) -> Option<Mode> {
+        match self {
+            Self::Baseline => Some(Mode::Baseline),
+            Self::Range => Some(Mode::Range),
+            Self::Resolution => Some(Mode::Resolution),
+            Self::Joint => Some(Mode::Joint),
+            Self::Optimized => None,
+        }
+    }
+}
+
 /// What to run.
 #[derive(Debug, Clone)]
 pub struct SimConfig {
     /// Return models.
     pub models: Vec<ModelKind>,
     /// LiDAR variants.
-    pub variants: Vec<Mode>,
+    pub variants: Vec<Variant>,
+    /// The optimizer problem of the `optimized` variant (`None`: the default).
+    #[cfg(feature = "solver")]
+    pub optimizer: Option<crate::optimizer::Problem>,
     /// Fog levels, % (paper labels).
     pub fog_pcts: Vec<u32>,
     /// Trials per cell.
@@ -84,7 +136,9 @@ impl Default for SimConfig {
     fn default() -> Self {
         Self {
             models: vec![ModelKind::Argus, ModelKind::Physical],
-            variants: Mode::ALL.to_vec(),
+            variants: Variant::PAPER.to_vec(),
+            #[cfg(feature = "solver")]
+            optimizer: None,
             fog_pcts: FOG_LEVELS_PCT.to_vec(),
             trials: 100,
             seed: 1,
@@ -270,9 +324,96 @@ impl GridResult {
     }
 }
 
+/// Plans the trial's profile for any variant.
+fn plan_variant(
+    model: ModelKind,
+    variant: Variant,
+    gaze_deg: f64,
+    bins: usize,
+    table: Option<&OptTable>,
+) -> Result<(CertifiedProfile, f64), SimError> {
+    match (variant.mode(), table) {
+        (Some(m), _) => {
+            variant_profile(model, m, gaze_deg, bins).map_err(|source| SimError::Plan {
+                variant: variant.name(),
+                source,
+            })
+        }
+        (None, Some(t)) => t.plan(gaze_deg),
+        (None, None) => Err(SimError::Argument(
+            "the optimized variant needs the `solver` feature".into(),
+        )),
+    }
+}
+
+/// The optimized variant's shared solutions.
+#[cfg(feature = "solver")]
+struct OptTable(crate::optimizer::fast::PhaseTable);
+
+#[cfg(feature = "solver")]
+impl OptTable {
+    fn plan(&self, gaze_deg: f64) -> Result<(CertifiedProfile, f64), SimError> {
+        self.0
+            .plan(gaze_deg)
+            .map(|c| (c, 1.0))
+            .map_err(|e| SimError::Argument(format!("optimized variant: {e}")))
+    }
+
+    fn build(config: &SimConfig) -> Result<Option<Self>, SimError> {
+        if !config.variants.contains(&Variant::Optimized) {
+            return Ok(None);
+        }
+        let problem = match &config.optimizer {
+            Some(p) => p.clone(),
+            None => default_optimized_problem(config.bins),
+        };
+        let gazes: Vec<f64> = (0..config.trials)
+            .map(|t| draw(config.seed, t, &config.scenario).gaze_deg)
+            .collect();
+        crate::optimizer::fast::PhaseTable::build(&problem, &gazes)
+            .map(|t| Some(Self(t)))
+            .map_err(|e| SimError::Argument(format!("optimized variant: {e}")))
+    }
+}
+
+/// The default problem of the `optimized` variant.
+#[cfg(feature = "solver")]
+#[must_use]
+pub fn default_optimized_problem(bins: usize) -> crate::optimizer::Problem {
+    let paper = presets::paper();
+    crate::optimizer::Problem {
+        lidar: paper.lidar,
+        focus: crate::model::acuity::FocusModel::levi_e2_with_width(60.0),
+        levels: crate::optimizer::Levels::default(),
+        objective: crate::optimizer::Objective::default(),
+        bins,
+    }
+}
+
+#[cfg(not(feature = "solver"))]
+struct OptTable;
+
+#[cfg(not(feature = "solver"))]
+impl OptTable {
+    fn plan(&self, _gaze_deg: f64) -> Result<(CertifiedProfile, f64), SimError> {
+        Err(SimError::Argument(
+            "the optimized variant needs the `solver` feature".into(),
+        ))
+    }
+
+    fn build(config: &SimConfig) -> Result<Option<Self>, SimError> {
+        if config.variants.contains(&Variant::Optimized) {
+            return Err(SimError::Argument(
+                "the optimized variant needs the `solver` feature".into(),
+            ));
+        }
+        Ok(None)
+    }
+}
+
 struct Job {
     model: ModelKind,
-    variant: Mode,
+    variant: Variant,
     fog: FogLevel,
     trial: usize,
 }
@@ -293,7 +434,7 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
         .collect::<Result<_, _>>()?;
     // Plan every variant once up front so a bad one fails before any work.
     for &m in &config.models {
-        for &v in &config.variants {
+        for v in config.variants.iter().filter_map(|v| v.mode()) {
             variant_profile(m, v, config.scenario.gaze_deg, config.bins).map_err(|source| {
                 SimError::Plan {
                     variant: v.name(),
@@ -302,6 +443,7 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
             })?;
         }
     }
+    let table = OptTable::build(config)?;
     let mut jobs = Vec::new();
     for &model in &config.models {
         for &variant in &config.variants {
@@ -323,13 +465,13 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
         .par_iter()
         .map(|job| {
             let d = draw(config.seed, job.trial, &config.scenario);
-            let (profile, rof_keep) =
-                variant_profile(job.model, job.variant, d.gaze_deg, config.bins).map_err(
-                    |source| SimError::Plan {
-                        variant: job.variant.name(),
-                        source,
-                    },
-                )?;
+            let (profile, rof_keep) = plan_variant(
+                job.model,
+                job.variant,
+                d.gaze_deg,
+                config.bins,
+                table.as_ref(),
+            )?;
             let regions = paper.focus.regions(d.gaze_deg);
             let model = ReturnModel::new(
                 job.model,

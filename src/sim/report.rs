@@ -122,7 +122,7 @@ pub fn render(r: &GridResult, config: &SimConfig) -> String {
                     },
                 )
             };
-            let paper_txt = if *v == Mode::Baseline {
+            let paper_txt = if *v == super::Variant::Baseline {
                 PAPER_TTA.iter().find(|p| p.0 == fog).map_or("", |p| p.1)
             } else {
                 ""
