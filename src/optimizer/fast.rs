@@ -58,26 +58,10 @@ impl FastPlanner {
         &self.problem
     }
 
-    /// Whole bins and phase step of a gaze.
-    fn split(&self, gaze_deg: f64) -> (usize, u32) {
-        let n = self.problem.bins;
-        let width = FULL_TURN_DEG / n as f64;
-        let g = wrap_deg(gaze_deg);
-        let mut k = (g / width).floor() as usize;
-        let mut q = ((g - k as f64 * width) / width * f64::from(PHASE_STEPS)).round() as u32;
-        if q >= PHASE_STEPS {
-            q = 0;
-            k += 1;
-        }
-        (k % n, q)
-    }
-
     /// The gaze actually planned for (quantized), degrees.
     #[must_use]
     pub fn quantized_gaze(&self, gaze_deg: f64) -> f64 {
-        let (k, q) = self.split(gaze_deg);
-        let width = FULL_TURN_DEG / self.problem.bins as f64;
-        wrap_deg(k as f64 * width + f64::from(q) * width / f64::from(PHASE_STEPS))
+        quantized_gaze(self.problem.bins, gaze_deg)
     }
 
     /// A certified profile for `gaze_deg`.
@@ -86,7 +70,7 @@ impl FastPlanner {
             field: "gaze-deg".into(),
             reason: e.to_string(),
         })?;
-        let (k, q) = self.split(gaze_deg);
+        let (k, q) = split(self.problem.bins, gaze_deg);
         let width = FULL_TURN_DEG / self.problem.bins as f64;
         if !self.rotation_invariant {
             let key = (k as u64) << 32 | u64::from(q);
@@ -109,13 +93,29 @@ impl FastPlanner {
                     .or_insert_with(|| c.into_inner())
             }
         };
-        let rotated = rotate(
-            canonical,
-            k,
-            wrap_deg(k as f64 * width + f64::from(q) * width / f64::from(PHASE_STEPS)),
-        );
+        let rotated = rotate(canonical, k, quantized_gaze(self.problem.bins, gaze_deg));
         Ok(certify(rotated)?)
     }
+}
+
+/// Whole bins `k` and phase step `q` of a gaze on `n` equal bins.
+fn split(n: usize, gaze_deg: f64) -> (usize, u32) {
+    let width = FULL_TURN_DEG / n as f64;
+    let g = wrap_deg(gaze_deg);
+    let mut k = (g / width).floor() as usize;
+    let mut q = ((g - k as f64 * width) / width * f64::from(PHASE_STEPS)).round() as u32;
+    if q >= PHASE_STEPS {
+        q = 0;
+        k += 1;
+    }
+    (k % n, q)
+}
+
+/// The gaze a quantized plan is for: `k` whole bins plus `q` phase steps.
+fn quantized_gaze(n: usize, gaze_deg: f64) -> f64 {
+    let (k, q) = split(n, gaze_deg);
+    let width = FULL_TURN_DEG / n as f64;
+    wrap_deg(k as f64 * width + f64::from(q) * width / f64::from(PHASE_STEPS))
 }
 
 /// Rotates a uniform-bin profile by `k` bins (counter-clockwise).
@@ -155,8 +155,7 @@ impl PhaseTable {
                 reason: "a phase table needs a rotation-invariant problem (no priors)".into(),
             });
         }
-        let planner = FastPlanner::new(problem.clone());
-        let mut phases: Vec<u32> = gazes.iter().map(|&g| planner.split(g).1).collect();
+        let mut phases: Vec<u32> = gazes.iter().map(|&g| split(problem.bins, g).1).collect();
         phases.sort_unstable();
         phases.dedup();
         let width = FULL_TURN_DEG / problem.bins as f64;
@@ -175,8 +174,7 @@ impl PhaseTable {
 
     /// The certified profile for `gaze_deg` (its phase must have been built).
     pub fn plan(&self, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
-        let planner = FastPlanner::new(self.problem.clone());
-        let (k, q) = planner.split(gaze_deg);
+        let (k, q) = split(self.problem.bins, gaze_deg);
         let canonical = self.canonical.get(&q).ok_or_else(|| OptError::Invalid {
             field: "gaze-deg".into(),
             reason: format!("phase {q} of gaze {gaze_deg} was not built"),
@@ -184,7 +182,7 @@ impl PhaseTable {
         Ok(certify(rotate(
             canonical,
             k,
-            planner.quantized_gaze(gaze_deg),
+            quantized_gaze(self.problem.bins, gaze_deg),
         ))?)
     }
 }
