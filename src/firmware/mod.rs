@@ -334,17 +334,8 @@ fn pulse_code_caps(certified: &CertifiedProfile, step: f64) -> Result<Vec<u32>, 
         } else {
             f64::INFINITY
         };
-        // Bins the pass window [φ − h, φ + h) touches.
-        let mut i = tl.bin_index(crate::model::angle::wrap_deg(pos.azimuth_deg - half));
-        let mut covered =
-            -(crate::model::angle::wrap_deg(pos.azimuth_deg - half) - p.bins[i].start_deg);
-        for _ in 0..n {
+        for i in tl.bins_touching(pos.azimuth_deg - half, report.pass_angle_deg) {
             cap_w[i] = cap_w[i].min(allowed);
-            covered += p.bins[i].width_deg;
-            if covered >= report.pass_angle_deg - crate::model::angle::EDGE_SNAP_DEG {
-                break;
-            }
-            i = crate::model::angle::next_index(i, n);
         }
     }
     Ok(cap_w

@@ -158,11 +158,19 @@ fn eye(problem: &Problem, g: &Grid) -> Result<Option<Eye>, OptError> {
                 start_deg: wrap_deg(start),
                 width_deg: pass_deg,
             }]);
+            // Bins touched at an edge are in the window too (covered fraction
+            // 0): their power counts for the single-pulse rule, as in the checker.
+            let snap = crate::model::angle::EDGE_SNAP_DEG;
+            let reach = CircularSet::from_arcs([Arc {
+                start_deg: wrap_deg(start - snap),
+                width_deg: (pass_deg + 2.0 * snap).min(360.0),
+            }]);
             let w: Vec<(usize, f64)> = (0..g.n)
                 .filter_map(|j| {
                     let lo = g.start_deg[j];
+                    let touches = reach.overlap_deg(lo, lo + g.width_deg[j]) > 0.0;
                     let cover = set.overlap_deg(lo, lo + g.width_deg[j]) / g.width_deg[j];
-                    (cover > 1e-12).then_some((j, cover.min(1.0)))
+                    touches.then_some((j, cover.clamp(0.0, 1.0)))
                 })
                 .collect();
             windows.push(w);

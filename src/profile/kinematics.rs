@@ -123,31 +123,39 @@ impl<'a> Timeline<'a> {
         }
     }
 
-    /// Highest bin power over the arc `[lo, lo + width)` (wrapping), W.
-    #[must_use]
-    pub fn max_power_in(&self, lo_deg: f64, width_deg: f64) -> f64 {
+    /// Indices of the bins whose closed extent meets the closed arc
+    /// `[lo, lo + width]` (wrapping), bins touched only at an edge included
+    /// (up to [`EDGE_SNAP_DEG`](crate::model::angle::EDGE_SNAP_DEG)). A window
+    /// that reaches a bin by any amount can receive its pulses, so the
+    /// supremum over windows next to a bin edge includes that bin.
+    pub fn bins_touching(&self, lo_deg: f64, width_deg: f64) -> Vec<usize> {
+        let snap = crate::model::angle::EDGE_SNAP_DEG;
         let n = self.bins.len();
-        let lo = wrap_deg(lo_deg);
-        let mut i = self.bin_index(lo);
-        let mut covered = -(lo - self.bins[i].start_deg);
-        // A window starting a rounding error before a bin edge does not reach
-        // into the bin before it: start at the edge.
-        if covered + self.bins[i].width_deg <= crate::model::angle::EDGE_SNAP_DEG {
-            covered += self.bins[i].width_deg;
-            i = crate::model::angle::next_index(i, n);
-        }
-        let mut best: f64 = 0.0;
+        let a = lo_deg - snap;
+        let hi = lo_deg + width_deg + snap;
+        let mut i = self.bin_index(wrap_deg(a));
+        // Unwrapped start of bin i on the same turn as `a`.
+        let mut pos = self.bins[i].start_deg + (a - wrap_deg(a));
+        let mut out = Vec::new();
         for _ in 0..n {
-            best = best.max(self.bins[i].power_w);
-            covered += self.bins[i].width_deg;
-            // A bin the window only touches at its edge (up to rounding)
-            // receives no pulse: stop there.
-            if covered >= width_deg - crate::model::angle::EDGE_SNAP_DEG {
+            out.push(i);
+            pos += self.bins[i].width_deg;
+            if pos > hi {
                 break;
             }
             i = crate::model::angle::next_index(i, n);
         }
-        best
+        out
+    }
+
+    /// Highest bin power over the closed arc `[lo, lo + width]` (wrapping;
+    /// see [`Self::bins_touching`]), W.
+    #[must_use]
+    pub fn max_power_in(&self, lo_deg: f64, width_deg: f64) -> f64 {
+        self.bins_touching(lo_deg, width_deg)
+            .into_iter()
+            .map(|i| self.bins[i].power_w)
+            .fold(0.0, f64::max)
     }
 
     /// Azimuth (degrees, `[0, 360)`) and bin index at `t_s` after the head passed 0°,
@@ -193,15 +201,19 @@ mod tests {
     use crate::planner::{closed_form, Mode};
 
     #[test]
-    fn windows_touching_a_bin_edge_do_not_reach_past_it() {
+    fn windows_touching_a_bin_edge_include_it() {
         let c = closed_form(&presets::paper(), Mode::Range, Some(90.0), 360).unwrap();
         let tl = Timeline::new(c.profile());
         let (p_low, p_high) = (0.5e-3, 1.1e-3);
         // RoF is [60, 120): a window [120 − 1e-13, 125) only touches it.
         let close = |a: f64, b: f64| (a - b).abs() < 1e-15;
-        assert!(close(tl.max_power_in(120.0 - 1e-13, 5.0), p_high));
+        // RoF is [60, 120) at P_low; windows that touch it include it.
+        assert!(close(tl.max_power_in(120.0, 5.0), p_high));
+        assert!(close(tl.max_power_in(115.0, 5.0), p_high));
         assert!(close(tl.max_power_in(55.0, 5.0 - 1e-13), p_high));
         assert!((tl.max_power_in(60.5, 2.0) - p_low).abs() < 1e-18);
+        assert_eq!(tl.bins_touching(60.0, 2.0), vec![59, 60, 61, 62]);
+        assert_eq!(tl.bins_touching(359.0, 2.0), vec![358, 359, 0, 1]);
         let (t, e) = tl.window(350.0, 20.0);
         assert!((t - 20f64.to_radians() / presets::paper().lidar.mean_spin_rad_s()).abs() < 1e-15);
         assert!(e > 0.0);
