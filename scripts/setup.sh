@@ -1,12 +1,19 @@
 #!/usr/bin/env bash
 # Installs what building gaze-lidar needs on a fresh Debian machine, only
 # when missing: cmake and libclang (HiGHS is compiled from source by
-# good_lp's `highs` feature) and the DejaVu font (embedded in plots).
+# good_lp's `highs` feature; its bindgen step loads libclang.so, which only
+# the libclang-dev package provides: the image's libclang-cpp.so is a
+# different library and does not count) and a C++ compiler.
 # Idempotent and quiet when everything is there.
 set -euo pipefail
+installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q 'install ok installed'; }
 need=()
 command -v cmake >/dev/null 2>&1 || need+=(cmake)
-ls /usr/lib/llvm-*/lib/libclang*.so* >/dev/null 2>&1 || ls /usr/lib/x86_64-linux-gnu/libclang*.so* >/dev/null 2>&1 || need+=(libclang-dev)
+# What bindgen (clang-sys) actually loads: libclang.so or libclang-<ver>.so(.N),
+# never libclang-cpp. Ask dpkg for the package that ships it.
+if ! installed libclang-dev; then
+  need+=(libclang-dev)
+fi
 command -v c++ >/dev/null 2>&1 || need+=(g++)
 if [ ${#need[@]} -gt 0 ]; then
   echo "setup: installing ${need[*]}" >&2

@@ -7,6 +7,11 @@
 //! hardware limits and the eye-safety limits (Scarì et al., "Hybrid
 //! Human-Machine Perception via Adaptive LiDAR for ADAS").
 //!
+//! The trusted core — profile and firmware types, limits, the eye-safety
+//! model, the checker and the integer firmware code — is the separate crate
+//! [`gaze_lidar_core`], re-exported here; everything in this crate depends on
+//! it and it depends on nothing here.
+//!
 //! Data flows one way:
 //! gaze → [`model`] (regions) → [`planner`] → [`profile`] → [`checker`]
 //! (certify, with [`eye_safety`]) → outputs.
@@ -29,9 +34,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod checker;
-pub mod eye_safety;
-pub mod firmware;
+pub use gaze_lidar_core::{checker, eye_safety, firmware};
 pub mod gaze;
 pub mod model;
 #[cfg(feature = "solver")]
@@ -40,7 +43,7 @@ pub mod planner;
 pub mod profile;
 pub mod sim;
 #[cfg(any(test, kani))]
-pub(crate) mod verification;
+pub(crate) use gaze_lidar_core::verification;
 
 /// The README's examples, compiled and run as doctests.
 #[doc = include_str!("../README.md")]

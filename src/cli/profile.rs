@@ -118,7 +118,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     };
     let bytes = match a.format {
         Format::Json => certified.profile().to_json()?.into_bytes(),
-        Format::Csv => certified.profile().to_csv()?.into_bytes(),
+        Format::Csv => gaze_lidar::profile::to_csv(certified.profile())?.into_bytes(),
         Format::Firmware => firmware()?
             .to_json()
             .map_err(|e| CliError::input(e.to_string()))?

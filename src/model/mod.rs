@@ -1,10 +1,10 @@
 //! The model of the paper (sections III–IV): angles and circular sets,
 //! visual acuity and the driver's region of focus, the LiDAR and its limits,
-//! presets.
+//! presets. Angles and the LiDAR's limits belong to the trusted core
+//! ([`gaze_lidar_core::model`]) and are re-exported here.
 
 pub mod acuity;
-pub mod angle;
-pub mod lidar;
+pub use gaze_lidar_core::model::{angle, lidar};
 pub mod presets;
 
 pub use acuity::{AcuityModel, FocusModel, Regions};

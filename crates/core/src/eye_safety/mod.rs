@@ -10,13 +10,14 @@
 //! (see [`ael`]).
 
 pub mod ael;
+pub mod bound;
 pub mod exposure;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 pub use ael::{ael_report, AelError, AelReport};
-pub use exposure::{evaluate_profile, ExposureReport, Rule};
+pub use exposure::{evaluate_profile, evaluate_segments, ExposureReport, Rule};
 
 /// Laser and optics parameters the eye-safety check needs; stored in a
 /// profile's `limits.eye_safety` so any tool can re-check a profile from the file.

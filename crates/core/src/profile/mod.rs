@@ -5,7 +5,6 @@
 //! [`crate::checker::CertifiedProfile`] is known to respect its limits.
 
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 use thiserror::Error;
 
@@ -155,14 +154,21 @@ pub enum IoError {
         /// What it said.
         found: String,
     },
-    /// CSV encoding failed.
-    #[error("csv: {0}")]
-    Csv(#[from] csv::Error),
     /// JSON encoding failed.
+    #[cfg(feature = "json")]
     #[error("json: {0}")]
     Encode(#[from] serde_json::Error),
+    /// Encoding to another format (CSV, in the `gaze-lidar` crate) failed.
+    #[error("{format}: {message}")]
+    Encoding {
+        /// The format.
+        format: &'static str,
+        /// What went wrong.
+        message: String,
+    },
 }
 
+#[cfg(feature = "json")]
 /// serde_json appends " at line L column C"; the error prints them already.
 fn strip_position(msg: &str) -> String {
     match msg.rfind(" at line ") {
@@ -171,6 +177,7 @@ fn strip_position(msg: &str) -> String {
     }
 }
 
+#[cfg(feature = "json")]
 impl Profile {
     /// Parses profile@1 JSON; `origin` names the source in errors.
     pub fn from_json(text: &str, origin: &str) -> Result<Self, IoError> {
@@ -204,63 +211,4 @@ impl Profile {
         s.push('\n');
         Ok(s)
     }
-
-    /// CSV, one row per bin: the per-bin fields of profile@1.
-    pub fn to_csv(&self) -> Result<String, IoError> {
-        #[derive(Serialize)]
-        struct Row<'a> {
-            start_deg: f64,
-            width_deg: f64,
-            power_w: f64,
-            spin_start_rad_s: f64,
-            spin_end_rad_s: f64,
-            region: Option<&'a str>,
-            dwell_s: f64,
-        }
-        let mut w = csv::Writer::from_writer(Vec::new());
-        for b in &self.bins {
-            w.serialize(Row {
-                start_deg: b.start_deg,
-                width_deg: b.width_deg,
-                power_w: b.power_w,
-                spin_start_rad_s: b.spin_start_rad_s,
-                spin_end_rad_s: b.spin_end_rad_s,
-                region: b.region.map(|r| match r {
-                    Region::Rof => "rof",
-                    Region::Roi => "roi",
-                }),
-                dwell_s: b.dwell_time_s(),
-            })?;
-        }
-        let bytes = w.into_inner().map_err(|e| IoError::File {
-            path: "<csv buffer>".into(),
-            source: e.into_error(),
-        })?;
-        Ok(String::from_utf8_lossy(&bytes).into_owned())
-    }
-}
-
-/// Writes `contents` to `path` atomically: a temporary file in the same
-/// folder, then a rename, so a failure never leaves a partial file.
-pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), IoError> {
-    let err = |source| IoError::File {
-        path: path.display().to_string(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    // Ordinary output files: readable by others (tempfile defaults to 0600).
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    let mut tmp = builder.tempfile_in(dir).map_err(err)?;
-    tmp.write_all(contents).map_err(err)?;
-    tmp.flush().map_err(err)?;
-    tmp.persist(path).map_err(|e| err(e.error))?;
-    Ok(())
 }

@@ -4,9 +4,9 @@
 //! | offset | size | field |
 //! |---:|---:|---|
 //! | 0 | 4 | magic `GLFW` |
-//! | 4 | 2 | version = 1 |
+//! | 4 | 2 | version = 2 |
 //! | 6 | 1 | accounting: 0 time, 1 angle |
-//! | 7 | 1 | reserved, 0 |
+//! | 7 | 1 | eye-safety parameters: 0 absent (fields at 72–95 zero), 1 present |
 //! | 8 | 8 | tick_hz |
 //! | 16 | 8 | frame_ticks |
 //! | 24 | 8 | power_w_per_code (IEEE-754 f64) |
@@ -16,7 +16,11 @@
 //! | 48 | 4 | window_bins |
 //! | 52 | 8 | window_energy_max |
 //! | 60 | 4 | bin count n |
-//! | 64 | 36·n | records: width_mdeg u32, dwell_ticks u64, power_code u32, dwell_ticks_min u64, dwell_ticks_max u64, power_code_cap u32 |
+//! | 64 | 8 | pulse_rate_hz (f64) |
+//! | 72 | 8 | eye_safety.wavelength_nm (f64) |
+//! | 80 | 8 | eye_safety.pulse_duration_s (f64) |
+//! | 88 | 8 | eye_safety.beam_diameter_mm (f64) |
+//! | 96 | 36·n | records: width_mdeg u32, dwell_ticks u64, power_code u32, dwell_ticks_min u64, dwell_ticks_max u64, power_code_cap u32 |
 //!
 //! [`decode`] never panics and rejects anything that is not exactly this layout.
 
@@ -26,11 +30,11 @@ use super::{FirmwareTable, FwBin, IntLimits, FIRMWARE_FORMAT, MAX_TABLE_BINS};
 use crate::model::lidar::PowerAccounting;
 
 /// Header size, bytes.
-pub const HEADER_LEN: usize = 64;
+pub const HEADER_LEN: usize = 96;
 /// Record size, bytes.
 pub const RECORD_LEN: usize = 36;
 const MAGIC: &[u8; 4] = b"GLFW";
-const VERSION: u16 = 1;
+const VERSION: u16 = 2;
 
 /// Why bytes are not a table.
 #[derive(Debug, Error, Clone, PartialEq, Eq)]
@@ -86,7 +90,7 @@ pub fn encode(t: &FirmwareTable) -> Vec<u8> {
         PowerAccounting::Time => 0,
         PowerAccounting::Angle => 1,
     });
-    out.push(0);
+    out.push(u8::from(t.eye_safety.is_some()));
     out.extend_from_slice(&t.tick_hz.to_le_bytes());
     out.extend_from_slice(&t.frame_ticks.to_le_bytes());
     out.extend_from_slice(&t.power_w_per_code.to_le_bytes());
@@ -96,6 +100,15 @@ pub fn encode(t: &FirmwareTable) -> Vec<u8> {
     out.extend_from_slice(&t.limits.window_bins.to_le_bytes());
     out.extend_from_slice(&t.limits.window_energy_max.to_le_bytes());
     out.extend_from_slice(&(t.bins.len() as u32).to_le_bytes());
+    out.extend_from_slice(&t.pulse_rate_hz.to_le_bytes());
+    let es = t.eye_safety.as_ref();
+    for x in [
+        es.map_or(0.0, |e| e.wavelength_nm),
+        es.map_or(0.0, |e| e.pulse_duration_s),
+        es.map_or(0.0, |e| e.beam_diameter_mm),
+    ] {
+        out.extend_from_slice(&x.to_le_bytes());
+    }
     for b in &t.bins {
         out.extend_from_slice(&b.width_mdeg.to_le_bytes());
         out.extend_from_slice(&b.dwell_ticks.to_le_bytes());
@@ -125,10 +138,26 @@ pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
         1 => PowerAccounting::Angle,
         other => return Err(DecodeError::Accounting(other)),
     };
-    let reserved = bytes.get(7).copied().ok_or_else(short)?;
-    if reserved != 0 {
-        return Err(DecodeError::Reserved(reserved));
-    }
+    let has_eye_safety = match bytes.get(7).copied().ok_or_else(short)? {
+        0 => false,
+        1 => true,
+        other => return Err(DecodeError::Reserved(other)),
+    };
+    let f64_at = |at: usize| u64_at(bytes, at).map(f64::from_bits);
+    let pulse_rate_hz = f64_at(64).ok_or_else(short)?;
+    let es = [f64_at(72), f64_at(80), f64_at(88)];
+    let eye_safety = if has_eye_safety {
+        Some(crate::eye_safety::EyeSafetyParams {
+            wavelength_nm: es[0].ok_or_else(short)?,
+            pulse_duration_s: es[1].ok_or_else(short)?,
+            beam_diameter_mm: es[2].ok_or_else(short)?,
+        })
+    } else {
+        if es.iter().any(|x| *x != Some(0.0)) {
+            return Err(DecodeError::Reserved(0));
+        }
+        None
+    };
     let step = f64::from_bits(u64_at(bytes, 24).ok_or_else(short)?);
     if !(step.is_finite() && step > 0.0) {
         return Err(DecodeError::Step);
@@ -166,6 +195,8 @@ pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
         frame_ticks: u64_at(bytes, 16).ok_or_else(short)?,
         power_w_per_code: step,
         power_accounting: accounting,
+        pulse_rate_hz,
+        eye_safety,
         limits: IntLimits {
             power_code_min: u32_at(bytes, 32).ok_or_else(short)?,
             power_code_max: u32_at(bytes, 36).ok_or_else(short)?,
@@ -247,6 +278,8 @@ mod verification {
                     } else {
                         PowerAccounting::Time
                     },
+                    pulse_rate_hz: 0.0,
+                    eye_safety: None,
                     limits: IntLimits {
                         power_code_min: 1,
                         power_code_max: 4095,

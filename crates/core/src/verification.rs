@@ -1,27 +1,25 @@
 //! Support for the proof harnesses.
 //!
-//! Every harness in this crate is one function that is both a Kani proof
-//! (`#[cfg_attr(kani, kani::proof)]`) and an ordinary test, written over
-//! `bolero::check!()`: under `cargo kani --tests` its inputs are symbolic and
-//! the property is proved for every input within the stated bounds; under
-//! `cargo test` bolero feeds it random inputs. **Kani is not installed on
-//! the machines this crate is developed on, so the proofs have been run as
-//! tests, not machine-checked**; see `specs/verification.md`.
+//! Every harness is one function body run two ways: as a Kani proof over
+//! symbolic inputs (`#[cfg(kani)] #[kani::proof]`, machine-checked only
+//! where Kani is installed — it is not on the machines this crate is
+//! developed on) and as an ordinary test over random inputs (bolero, under
+//! `cargo test`). See `specs/verification.md`.
 //!
-//! [`cover!`] pairs every assumption with a reachability check: under Kani it
-//! is `kani::cover!`; under `cargo test` it records hits so a harness can
-//! assert that none of its properties held vacuously.
+//! [`cover!`](crate::cover) pairs every assumption with a reachability check:
+//! under Kani it is `kani::cover!`; under `cargo test` it records hits so a
+//! harness can assert that none of its properties held vacuously.
 
-#[cfg(all(test, not(kani)))]
+#[cfg(all(feature = "std", not(kani)))]
 use std::collections::BTreeMap;
-#[cfg(all(test, not(kani)))]
+#[cfg(all(feature = "std", not(kani)))]
 use std::sync::Mutex;
 
-#[cfg(all(test, not(kani)))]
+#[cfg(all(feature = "std", not(kani)))]
 static HITS: Mutex<BTreeMap<&'static str, u64>> = Mutex::new(BTreeMap::new());
 
 /// Records one evaluation of a cover condition (test builds).
-#[cfg(all(test, not(kani)))]
+#[cfg(all(feature = "std", not(kani)))]
 pub fn record(message: &'static str, hit: bool) {
     let mut hits = HITS
         .lock()
@@ -30,7 +28,7 @@ pub fn record(message: &'static str, hit: bool) {
 }
 
 /// Asserts that each named cover condition held at least once (test builds).
-#[cfg(all(test, not(kani)))]
+#[cfg(all(feature = "std", not(kani)))]
 pub fn assert_covered(messages: &[&'static str]) {
     let hits = HITS
         .lock()
@@ -43,7 +41,9 @@ pub fn assert_covered(messages: &[&'static str]) {
     }
 }
 
-/// `kani::cover!` under Kani; a recorded reachability check under `cargo test`.
+/// `kani::cover!` under Kani; a recorded reachability check under `cargo test`
+/// (in the crate that expands it).
+#[macro_export]
 macro_rules! cover {
     ($cond:expr, $msg:literal) => {{
         #[cfg(kani)]
@@ -52,4 +52,4 @@ macro_rules! cover {
         $crate::verification::record($msg, $cond);
     }};
 }
-pub(crate) use cover;
+pub use crate::cover;

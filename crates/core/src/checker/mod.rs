@@ -19,7 +19,7 @@ use thiserror::Error;
 
 use crate::eye_safety::{self, ExposureReport};
 use crate::model::angle::{next_index, FULL_TURN_DEG};
-use crate::model::lidar::PowerAccounting;
+use crate::model::lidar::{LidarSpec, PowerAccounting};
 use crate::profile::{Profile, Region, Summary, PROFILE_FORMAT};
 
 /// Relative tolerance on power, spin, time and acceleration comparisons.
@@ -191,6 +191,25 @@ pub enum Violation {
         /// What is wrong.
         reason: String,
     },
+    /// `limits.eye_safety` is null: the file is not Class 1 evidence.
+    EyeSafetyMissing,
+    /// A declared limit is looser than the sensor's own.
+    LooserThanSensor {
+        /// The `limits` key.
+        field: &'static str,
+        /// The file's value (`None` = unlimited).
+        declared: Option<f64>,
+        /// The sensor's value (`None` = unlimited).
+        sensor: Option<f64>,
+    },
+    /// A header value differs from the sensor's (pulse rate, frame rate,
+    /// accounting, eye-safety parameters).
+    SensorMismatch {
+        /// The key.
+        field: &'static str,
+        /// What differs.
+        detail: String,
+    },
 }
 
 impl Violation {
@@ -210,7 +229,10 @@ impl Violation {
             Self::SpinMax { .. } => "spin_rad_s_max",
             Self::SpinStep { .. } | Self::SpinAccel { .. } => "spin_accel_rad_s2_max",
             Self::PowerSlew { .. } => "power_slew_w_per_deg_max",
-            Self::EyeSafety { .. } | Self::EyeSafetyParams { .. } => "eye_safety",
+            Self::EyeSafety { .. } | Self::EyeSafetyParams { .. } | Self::EyeSafetyMissing => {
+                "eye_safety"
+            }
+            Self::LooserThanSensor { field, .. } | Self::SensorMismatch { field, .. } => field,
         }
     }
 }
@@ -333,6 +355,24 @@ impl fmt::Display for Violation {
                 1.0 / ratio
             ),
             Self::EyeSafetyParams { reason } => write!(f, "limits.eye_safety: {reason}"),
+            Self::EyeSafetyMissing => write!(
+                f,
+                "limits.eye_safety is null: eye safety is not evaluated, so the file is not Class 1 evidence (opt out explicitly to check the rest)"
+            ),
+            Self::LooserThanSensor {
+                field,
+                declared,
+                sensor,
+            } => {
+                let show = |x: &Option<f64>| x.map_or("unlimited".to_owned(), |v| v.to_string());
+                write!(
+                    f,
+                    "limits.{field} = {} is looser than the sensor's {}",
+                    show(declared),
+                    show(sensor)
+                )
+            }
+            Self::SensorMismatch { field, detail } => write!(f, "{field}: {detail}"),
         }
     }
 }
@@ -655,8 +695,11 @@ fn check_limits(p: &Profile, s: &Summary, v: &mut Vec<Violation>) {
     }
 }
 
-fn check_eye_safety(p: &Profile, v: &mut Vec<Violation>) {
+fn check_eye_safety(p: &Profile, opts: &CheckOptions<'_>, v: &mut Vec<Violation>) {
     let Some(params) = &p.limits.eye_safety else {
+        if !opts.allow_missing_eye_safety {
+            v.push(Violation::EyeSafetyMissing);
+        }
         return;
     };
     match eye_safety::evaluate_profile(p, params) {
@@ -667,35 +710,211 @@ fn check_eye_safety(p: &Profile, v: &mut Vec<Violation>) {
     }
 }
 
-/// The violation an exposure report implies, if any.
+/// The violation an exposure report implies, if any. The report is already
+/// an upper bound with its counts rounded towards safety, so the limit is
+/// applied exactly: no tolerance above 1.
 fn eye_safety_violation(r: &ExposureReport) -> Option<Violation> {
-    (!le_tol(r.worst_ratio, 1.0)).then(|| Violation::EyeSafety {
+    (r.worst_ratio.is_nan() || r.worst_ratio > 1.0).then(|| Violation::EyeSafety {
         azimuth_deg: r.worst_azimuth_deg,
         rule: r.binding_rule.to_string(),
         ratio: r.worst_ratio,
     })
 }
 
-/// Every violation of `profile`, recomputed from the profile alone.
+/// What a check holds a profile against besides its own declared limits.
+#[derive(Debug, Clone, Copy, Default)]
+#[non_exhaustive]
+pub struct CheckOptions<'a> {
+    /// The sensor the profile is meant for: every declared limit must be at
+    /// least as strict as the sensor's, and the pulse rate, frame rate,
+    /// accounting and eye-safety parameters must match it.
+    pub sensor: Option<&'a LidarSpec>,
+    /// Accept a profile without eye-safety parameters (its verdict then says
+    /// nothing about Class 1). Off by default.
+    pub allow_missing_eye_safety: bool,
+}
+
+impl<'a> CheckOptions<'a> {
+    /// Against the profile's declared limits, eye safety required.
+    #[must_use]
+    pub fn declared() -> Self {
+        Self::default()
+    }
+
+    /// Against `sensor`'s own limits too.
+    #[must_use]
+    pub fn for_sensor(sensor: &'a LidarSpec) -> Self {
+        Self {
+            sensor: Some(sensor),
+            ..Self::default()
+        }
+    }
+
+    /// Accepts a profile without eye-safety parameters.
+    #[must_use]
+    pub fn allow_missing_eye_safety(mut self, allow: bool) -> Self {
+        self.allow_missing_eye_safety = allow;
+        self
+    }
+}
+
+fn check_against_sensor(p: &Profile, sensor: &LidarSpec, v: &mut Vec<Violation>) {
+    let (d, s) = (&p.limits, &sensor.limits);
+    let mut looser =
+        |field: &'static str, declared: Option<f64>, sensor: Option<f64>, upper: bool| {
+            let bad = match (declared, sensor) {
+                (_, None) => false,
+                (None, Some(_)) => true,
+                (Some(x), Some(y)) => x.is_nan() || if upper { x > y } else { x < y },
+            };
+            if bad {
+                v.push(Violation::LooserThanSensor {
+                    field,
+                    declared,
+                    sensor,
+                });
+            }
+        };
+    looser(
+        "power_w_min",
+        Some(d.power_w_min),
+        Some(s.power_w_min),
+        false,
+    );
+    looser(
+        "power_w_max",
+        Some(d.power_w_max),
+        Some(s.power_w_max),
+        true,
+    );
+    looser(
+        "spin_rad_s_min",
+        Some(d.spin_rad_s_min),
+        Some(s.spin_rad_s_min),
+        false,
+    );
+    looser(
+        "spin_rad_s_max",
+        Some(d.spin_rad_s_max),
+        Some(s.spin_rad_s_max),
+        true,
+    );
+    looser(
+        "spin_accel_rad_s2_max",
+        d.spin_accel_rad_s2_max,
+        s.spin_accel_rad_s2_max,
+        true,
+    );
+    looser(
+        "power_slew_w_per_deg_max",
+        d.power_slew_w_per_deg_max,
+        s.power_slew_w_per_deg_max,
+        true,
+    );
+    if p.average_power_w.is_nan() || p.average_power_w > sensor.average_power_w {
+        v.push(Violation::LooserThanSensor {
+            field: "average_power_w",
+            declared: Some(p.average_power_w),
+            sensor: Some(sensor.average_power_w),
+        });
+    }
+    let mut mismatch = |field: &'static str, detail: String| {
+        v.push(Violation::SensorMismatch { field, detail });
+    };
+    if p.pulse_rate_hz != sensor.pulse_rate_hz {
+        mismatch(
+            "pulse_rate_hz",
+            format!(
+                "{} differs from the sensor's {}",
+                p.pulse_rate_hz, sensor.pulse_rate_hz
+            ),
+        );
+    }
+    if p.frame_rate_hz != sensor.frame_rate_hz {
+        mismatch(
+            "frame_rate_hz",
+            format!(
+                "{} differs from the sensor's {}",
+                p.frame_rate_hz, sensor.frame_rate_hz
+            ),
+        );
+    }
+    if p.power_accounting != sensor.power_accounting {
+        mismatch(
+            "power_accounting",
+            format!(
+                "'{}' differs from the sensor's '{}'",
+                p.power_accounting, sensor.power_accounting
+            ),
+        );
+    }
+    match (&d.eye_safety, &s.eye_safety) {
+        (Some(x), Some(y)) if x != y => mismatch(
+            "eye_safety",
+            format!("laser parameters {x:?} differ from the sensor's {y:?}"),
+        ),
+        (None, Some(_)) => v.push(Violation::EyeSafetyMissing),
+        _ => {}
+    }
+}
+
+/// Every violation of `profile` against its declared limits, eye safety
+/// required (see [`check_with`]).
 #[must_use]
 pub fn check(profile: &Profile) -> Vec<Violation> {
+    check_with(profile, &CheckOptions::declared())
+}
+
+/// Every violation of `profile`, recomputed from the profile alone, against
+/// its declared limits and whatever `opts` adds.
+#[must_use]
+pub fn check_with(profile: &Profile, opts: &CheckOptions<'_>) -> Vec<Violation> {
     let mut v = Vec::new();
     check_header(profile, &mut v);
-    if check_structure(profile, &mut v) && v.is_empty() {
+    if let Some(sensor) = opts.sensor {
+        check_against_sensor(profile, sensor, &mut v);
+    }
+    if check_structure(profile, &mut v) && !v.iter().any(is_structural) {
         let s = summarize(profile);
         check_limits(profile, &s, &mut v);
-        check_eye_safety(profile, &mut v);
+        check_eye_safety(profile, opts, &mut v);
     }
     v
 }
 
-/// Certifies a profile: the only way to obtain a [`CertifiedProfile`].
-/// The checker's own [`Summary`] replaces any the input carried.
-pub fn certify(mut profile: Profile) -> Result<CertifiedProfile, Rejected> {
-    let violations = check(&profile);
+/// Violations after which the profile cannot be evaluated further.
+fn is_structural(v: &Violation) -> bool {
+    !matches!(
+        v,
+        Violation::LooserThanSensor { .. }
+            | Violation::SensorMismatch { .. }
+            | Violation::EyeSafetyMissing
+    )
+}
+
+/// Certifies `profile` for `sensor`: its declared limits and the sensor's.
+pub fn certify_for_sensor(
+    profile: Profile,
+    sensor: &LidarSpec,
+) -> Result<CertifiedProfile, Rejected> {
+    certify_with(profile, &CheckOptions::for_sensor(sensor))
+}
+
+/// Certifies against its declared limits and whatever `opts` adds.
+pub fn certify_with(
+    mut profile: Profile,
+    opts: &CheckOptions<'_>,
+) -> Result<CertifiedProfile, Rejected> {
+    let violations = check_with(&profile, opts);
     if !violations.is_empty() {
         return Err(Rejected { violations });
     }
     profile.summary = Some(summarize(&profile));
     Ok(CertifiedProfile { profile })
+}
+
+/// Certifies a profile: the only way to obtain a [`CertifiedProfile`].
+/// The checker's own [`Summary`] replaces any the input carried.
+pub fn certify(profile: Profile) -> Result<CertifiedProfile, Rejected> {
+    certify_with(profile, &CheckOptions::declared())
 }

@@ -25,10 +25,9 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
-use crate::eye_safety::ael::{self, APERTURE_DISTANCE_MM, T2_S, TIME_BASE_S};
 use crate::model::lidar::PowerAccounting;
 
-pub use check::{check_table, FwViolation};
+pub use check::{check_integer, check_table, FwViolation};
 pub use quantize::{apportion, floor_code, QuantizeError, TickTarget};
 
 /// The value of the `format` field.
@@ -109,6 +108,13 @@ pub struct FirmwareTable {
     pub power_w_per_code: f64,
     /// Accounting of the energy budget.
     pub power_accounting: PowerAccounting,
+    /// Laser firing rate, Hz (eye safety of the table as it runs).
+    #[serde(default)]
+    pub pulse_rate_hz: f64,
+    /// Laser and optics parameters; a table without them is not Class 1
+    /// evidence and fails [`check_table`].
+    #[serde(default)]
+    pub eye_safety: Option<crate::eye_safety::EyeSafetyParams>,
     /// Integer limits.
     pub limits: IntLimits,
     /// Bins in azimuth order.
@@ -230,8 +236,6 @@ impl FirmwareTable {
                 })
             })
             .collect::<Result<_, _>>()?;
-        let (window_bins, window_energy_max) = eye_safety_limits(certified, step, f)?;
-        let caps = pulse_code_caps(certified, step)?;
         let max_code = floor_code(l.power_w_max, step).unwrap_or(u32::MAX);
         // Budget in code units per tick (time) or per millidegree (angle):
         // floor(P̄/step) exactly (as the codes are rounded), plus the
@@ -270,7 +274,7 @@ impl FirmwareTable {
                     power_code: codes[i],
                     dwell_ticks_min: bounds[i].0,
                     dwell_ticks_max: bounds[i].1,
-                    power_code_cap: caps[i],
+                    power_code_cap: max_code,
                 }
             })
             .collect();
@@ -280,15 +284,21 @@ impl FirmwareTable {
             frame_ticks,
             power_w_per_code: step,
             power_accounting: p.power_accounting,
+            pulse_rate_hz: p.pulse_rate_hz,
+            eye_safety: l.eye_safety.clone(),
             limits: IntLimits {
                 power_code_min: floor_code(l.power_w_min, step).unwrap_or(0),
                 power_code_max: max_code,
                 energy_budget,
-                window_bins,
-                window_energy_max,
+                // The window sums are superseded by the eye-safety bound
+                // evaluated on the table as it runs (see `check_table`).
+                window_bins: 1,
+                window_energy_max: u64::MAX,
             },
             bins,
         };
+        let mut table = table;
+        lower_codes_for_eye_safety(&mut table)?;
         let v = check_table(&table);
         if v.is_empty() {
             Ok(table)
@@ -305,96 +315,81 @@ impl FirmwareTable {
     }
 }
 
-/// Relative margin on the per-bin pulse cap: quantized dwell differs from
-/// the certified one by at most one tick, which moves C5 by far less.
-const CAP_MARGIN: f64 = 1e-4;
-
-/// Per-bin integer cap from the single-pulse rule: at each aperture position
-/// the certified evaluation gives the largest power the rule allows
-/// (`p_max / ratio`, the rule being linear in power); a bin's cap is the
-/// smallest over the positions whose pass covers it.
-fn pulse_code_caps(certified: &CertifiedProfile, step: f64) -> Result<Vec<u32>, FirmwareError> {
-    let p = certified.profile();
-    let n = p.bins.len();
-    let Some(params) = &p.limits.eye_safety else {
-        return Ok(vec![u32::MAX; n]);
-    };
-    let report =
-        crate::eye_safety::evaluate_profile(p, params).map_err(|e| FirmwareError::Config {
+/// Lowers the codes of a quantized table until the table *as it will run*
+/// (quantized dwell, quantized codes) meets Class 1: each round scales every
+/// code by `1/ratio` (rounded down), which the bound's linearity in power
+/// makes sufficient but for the pulse-count rounding; a few rounds settle it.
+/// Codes never go below `power_code_min`; if that is not enough the table is
+/// rejected by [`check_table`].
+fn lower_codes_for_eye_safety(table: &mut FirmwareTable) -> Result<(), FirmwareError> {
+    for _ in 0..4 {
+        let Some(report) = table_exposure(table) else {
+            return Ok(());
+        };
+        let report = report.map_err(|e| FirmwareError::Config {
             field: "eye_safety",
             reason: e.to_string(),
         })?;
-    let tl = crate::profile::kinematics::Timeline::new(p);
-    let half = 0.5 * report.pass_angle_deg;
-    let mut cap_w = vec![f64::INFINITY; n];
-    for pos in &report.positions {
-        let p_max = tl.max_power_in(pos.azimuth_deg - half, report.pass_angle_deg);
-        let allowed = if pos.ratios[0] > 0.0 {
-            p_max / pos.ratios[0]
-        } else {
-            f64::INFINITY
-        };
-        for i in tl.bins_touching(pos.azimuth_deg - half, report.pass_angle_deg) {
-            cap_w[i] = cap_w[i].min(allowed);
+        if report.worst_ratio <= 1.0 {
+            return Ok(());
+        }
+        let scale = 1.0 / report.worst_ratio;
+        let min = table.limits.power_code_min;
+        for b in &mut table.bins {
+            let lowered = (f64::from(b.power_code) * scale).floor() as u32;
+            b.power_code = lowered
+                .max(min)
+                .min(b.power_code.saturating_sub(1).max(min));
         }
     }
-    Ok(cap_w
-        .into_iter()
-        .map(|w| {
-            if w.is_finite() {
-                floor_code(w * (1.0 - CAP_MARGIN), step).unwrap_or(u32::MAX)
-            } else {
-                u32::MAX
-            }
-        })
-        .collect())
+    Ok(())
 }
 
-/// Integer window limits: enough consecutive bins to cover any aperture
-/// pass, and the largest energy such a window may hold under the T2 and
-/// time-base rules, in code·tick units.
-fn eye_safety_limits(
-    certified: &CertifiedProfile,
-    step: f64,
-    tick_hz: f64,
-) -> Result<(u32, u64), FirmwareError> {
-    let p = certified.profile();
-    let n = p.bins.len();
-    let Some(params) = &p.limits.eye_safety else {
-        return Ok((n as u32, u64::MAX));
-    };
-    let band = params.validate().map_err(|e| FirmwareError::Config {
-        field: "eye_safety",
-        reason: e.to_string(),
-    })?;
-    let ael_err = |e: ael::AelError| FirmwareError::Config {
-        field: "eye_safety",
-        reason: e.to_string(),
-    };
-    let lambda = params.wavelength_nm;
-    let pass_deg =
-        ((band.aperture_mm() + params.beam_diameter_mm) / APERTURE_DISTANCE_MM).to_degrees();
-    let passes = |t: f64| (t * p.frame_rate_hz).floor() + 1.0;
-    // Bins covering any pass: the longest run needed from any start, plus one.
-    let mut window_bins = 1usize;
-    for i in 0..n {
-        let (mut covered, mut k) = (0.0, 0usize);
-        while covered < pass_deg && k < n {
-            covered += p.bins[(i + k) % n].width_deg;
-            k += 1;
+/// The bins of a table as it will run: bin `i` swept at constant spin in
+/// exactly `dwell_ticks / tick_hz` seconds, at `power_code · power_w_per_code`.
+/// Zero-width bins are left out; `None` when a bin has width but no dwell.
+#[must_use]
+pub fn as_run_segments(table: &FirmwareTable) -> Option<Vec<crate::eye_safety::bound::Seg>> {
+    let mut segs = Vec::with_capacity(table.bins.len());
+    let mut start_mdeg: u64 = 0;
+    for b in &table.bins {
+        if b.width_mdeg == 0 {
+            continue;
         }
-        window_bins = window_bins.max(k + 1);
+        if b.dwell_ticks == 0 || table.tick_hz == 0 {
+            return None;
+        }
+        let width_deg = f64::from(b.width_mdeg) / 1000.0;
+        let spin = width_deg.to_radians() * table.tick_hz as f64 / b.dwell_ticks as f64;
+        segs.push(crate::eye_safety::bound::Seg {
+            start_deg: start_mdeg as f64 / 1000.0,
+            width_deg,
+            power_w: f64::from(b.power_code) * table.power_w_per_code,
+            spin_start_rad_s: spin,
+            spin_end_rad_s: spin,
+        });
+        start_mdeg += u64::from(b.width_mdeg);
     }
-    let window_bins = window_bins.min(n);
-    let e_pass_max_j = (ael::ael_j(lambda, T2_S).map_err(ael_err)? / passes(T2_S))
-        .min(ael::ael_j(lambda, TIME_BASE_S).map_err(ael_err)? / passes(TIME_BASE_S));
-    let units = e_pass_max_j / (step / tick_hz);
-    let window_energy_max = if units >= 1.8e19 {
-        u64::MAX
-    } else {
-        units.floor() as u64
-    };
-    Ok((window_bins as u32, window_energy_max))
+    Some(segs)
+}
+
+/// The eye-safety evaluation of a table as it will run; `None` without
+/// eye-safety parameters.
+#[must_use]
+pub fn table_exposure(
+    table: &FirmwareTable,
+) -> Option<Result<crate::eye_safety::ExposureReport, crate::eye_safety::EyeSafetyError>> {
+    let params = table.eye_safety.as_ref()?;
+    Some(match as_run_segments(table) {
+        Some(segs) if !segs.is_empty() => {
+            crate::eye_safety::evaluate_segments(&segs, params, table.pulse_rate_hz)
+        }
+        _ => Err(crate::eye_safety::EyeSafetyError::Param {
+            field: "bins",
+            value: 0.0,
+            reason: "a table needs at least one bin with width and dwell",
+        }),
+    })
 }
 
 #[cfg(any(kani, test))]
@@ -445,6 +440,8 @@ mod verification {
                     frame_ticks: u64::from(total % 1100),
                     power_w_per_code: 1.0,
                     power_accounting: PowerAccounting::Time,
+                    pulse_rate_hz: 0.0,
+                    eye_safety: None,
                     limits: IntLimits {
                         power_code_min: 0,
                         power_code_max: 0,
@@ -454,7 +451,11 @@ mod verification {
                     },
                     bins,
                 };
-                assert!(check_table(&table).is_empty(), "{:?}", check_table(&table));
+                assert!(
+                    check_integer(&table).is_empty(),
+                    "{:?}",
+                    check_integer(&table)
+                );
             });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["apportioned table checked"]);

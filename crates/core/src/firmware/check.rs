@@ -54,6 +54,22 @@ pub enum FwViolation {
         /// Limit.
         limit: u64,
     },
+    /// The table as it runs exceeds Class 1.
+    EyeSafety {
+        /// Worst ratio, parts per million (rounded up).
+        ratio_ppm: u64,
+        /// Aperture azimuth, millidegrees.
+        azimuth_mdeg: u32,
+        /// Binding rule.
+        rule: String,
+    },
+    /// No eye-safety parameters: not Class 1 evidence.
+    EyeSafetyMissing,
+    /// Eye-safety parameters or pulse rate invalid.
+    EyeSafetyParams {
+        /// Why.
+        reason: String,
+    },
     /// Energy in a window of consecutive bins above the eye-safety bound.
     Window {
         /// First bin of the window.
@@ -82,6 +98,17 @@ impl fmt::Display for FwViolation {
             Self::Budget { energy, limit } => {
                 write!(f, "energy {energy} exceeds limits.energy_budget {limit}")
             }
+            Self::EyeSafety { ratio_ppm, azimuth_mdeg, rule } => write!(
+                f,
+                "eye_safety: as quantized, at azimuth {:.3}° the {rule} is {:.4} % of the Class 1 limit",
+                f64::from(*azimuth_mdeg) / 1000.0,
+                *ratio_ppm as f64 / 1e4
+            ),
+            Self::EyeSafetyMissing => write!(
+                f,
+                "eye_safety: the table has no eye-safety parameters (not Class 1 evidence)"
+            ),
+            Self::EyeSafetyParams { reason } => write!(f, "eye_safety: {reason}"),
             Self::Window { bin, energy, limit } => write!(
                 f,
                 "eye safety: energy {energy} in the window starting at bins[{bin}] exceeds limits.window_energy_max {limit}"
@@ -90,9 +117,36 @@ impl fmt::Display for FwViolation {
     }
 }
 
-/// Every integer violation of `table`.
+/// Every violation of `table` as it will run: the integer rules of
+/// [`check_integer`] and Class 1 eye safety, evaluated by the one eye-safety
+/// model on the quantized table itself (dwell from ticks, power from codes;
+/// see [`super::as_run_segments`]). A table without eye-safety parameters
+/// is rejected: it is not Class 1 evidence.
 #[must_use]
 pub fn check_table(table: &FirmwareTable) -> Vec<FwViolation> {
+    let mut v = check_integer(table);
+    if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+        return v;
+    }
+    match super::table_exposure(table) {
+        None => v.push(FwViolation::EyeSafetyMissing),
+        Some(Ok(r)) if r.worst_ratio <= 1.0 => {}
+        Some(Ok(r)) => v.push(FwViolation::EyeSafety {
+            ratio_ppm: (r.worst_ratio * 1e6).ceil() as u64,
+            azimuth_mdeg: (r.worst_azimuth_deg * 1000.0).round() as u32,
+            rule: r.binding_rule.to_string(),
+        }),
+        Some(Err(e)) => v.push(FwViolation::EyeSafetyParams {
+            reason: e.to_string(),
+        }),
+    }
+    v
+}
+
+/// Every integer violation of `table` (frame, coverage, dwell bounds, codes,
+/// energy budget, window sums), in exact integer arithmetic.
+#[must_use]
+pub fn check_integer(table: &FirmwareTable) -> Vec<FwViolation> {
     let mut v = Vec::new();
     let n = table.bins.len();
     if n == 0 || n > MAX_TABLE_BINS {
@@ -214,6 +268,8 @@ mod verification {
             } else {
                 PowerAccounting::Time
             },
+            pulse_rate_hz: 0.0,
+            eye_safety: None,
             limits: IntLimits {
                 power_code_min: u32::from(limits.0),
                 power_code_max: u32::from(limits.1),
@@ -275,7 +331,7 @@ mod verification {
             .for_each(|(raw, n, frame, limits, angle)| {
                 let n = 1 + usize::from(n % 4);
                 let t = table(&raw[..n], frame, limits, angle);
-                let accepted = check_table(&t).is_empty();
+                let accepted = check_integer(&t).is_empty();
                 cover!(accepted, "a table is accepted");
                 cover!(!accepted, "a table is rejected");
                 assert_eq!(accepted, within_limits(&t));
@@ -294,7 +350,7 @@ mod verification {
                     }
                     let frame: u16 = raw[..n].iter().map(|r| u16::from(r.0)).sum();
                     let t = table(&raw[..n], frame, limits, angle);
-                    let accepted = check_table(&t).is_empty();
+                    let accepted = check_integer(&t).is_empty();
                     cover!(accepted, "a consistent table is accepted");
                     assert_eq!(accepted, within_limits(&t));
                 });

@@ -82,6 +82,15 @@ impl Band {
         }
     }
 
+    /// Shortest duration Table 3 covers for the band, s.
+    #[must_use]
+    pub fn min_duration_s(self) -> f64 {
+        match self {
+            Self::RetinalNir => 1e-11,
+            Self::Ir1400 | Self::Ir1500 => 1e-9,
+        }
+    }
+
     /// `T_i`, below which pulses are summed into one (Table 9 / clause 4.3 f), s:
     /// 5 µs for 400–1050 nm, 1 ms for 1400–1500 nm, 10 s for 1500–1800 nm.
     #[must_use]
@@ -161,58 +170,109 @@ fn check_duration(what: &'static str, t: f64, min: f64) -> Result<(), AelError> 
 /// Class 1 AEL (J) for a single exposure of duration `t_s` (Table 3, C6 = 1),
 /// without C5.
 ///
-/// - 700–1050 nm, 1e-11 ≤ t ≤ 5e-6 s: 7.7e-8 · C4 J (905 nm: 0.198 µJ).
-/// - 700–1050 nm, 5e-6 ≤ t ≤ T2 = 10 s: 7e-4 · C4 · t^0.75 J.
-/// - 700–1050 nm, t > T2: 3.9e-4 · C4 · C7 W · t (905 nm: 1.0 mW).
+/// - 700–1050 nm, 1e-11 ≤ t < 5e-6 s: 7.7e-8 · C4 J (905 nm: 0.198 µJ)
+///   (Table 3, row "10⁻¹¹ to 5·10⁻⁶ s", 700–1050 nm column).
+/// - 700–1050 nm, 5e-6 < t ≤ T2 = 10 s: 7e-4 · C4 · t^0.75 J (row "5·10⁻⁶ to T2").
+/// - 700–1050 nm, t > T2: 3.9e-4 · C4 · C7 W · t (905 nm: 1.0 mW) (row "T2 to 3·10⁴ s").
 /// - 1400–1500 nm: 8e-4 J to 1e-3 s; 4.4e-3 · t^0.25 J to 0.35 s;
-///   1.8e-2 · t^0.75 J to 10 s; 1e-2 W beyond.
+///   1e-2 · t J from 0.35 s to 10 s; 1e-2 W beyond (Table 3, 1400–1500 nm
+///   column: the 0.35–10 s row is 1e-2·t J — *not* the 1500–1800 nm row
+///   1.8e-2·t^0.75 J, which an earlier version used: continuity at both ends
+///   and the MPE × aperture product agree on 1e-2·t).
 /// - 1500–1800 nm: 8e-3 J for 1e-9 ≤ t ≤ 0.35 s; 1.8e-2 · t^0.75 J to 10 s;
-///   1e-2 W beyond.
+///   1e-2 W beyond (Table 3, 1500–1800 nm column).
+///
+/// Exactly on a row edge the more restrictive of the two rows applies (the
+/// table steps down by ≈ 4 % at 5 µs in 700–1050 nm).
 pub fn ael_j(wavelength_nm: f64, t_s: f64) -> Result<f64, AelError> {
     let band = Band::of(wavelength_nm)?;
-    let min = match band {
-        Band::RetinalNir => 1e-11,
-        Band::Ir1400 | Band::Ir1500 => 1e-9,
-    };
-    check_duration("duration", t_s, min)?;
+    check_duration("duration", t_s, band.min_duration_s())?;
     Ok(table3_j(band, c4(wavelength_nm), t_s))
 }
 
-/// Table 3 without validation, for hot loops whose inputs were validated
-/// once: `band` and `c4` of the wavelength, `t_s` within the band's domain.
+/// One row of Table 3 for a band: `AEL(t) = coef · t^exponent` J on
+/// `[t_lo_s, t_hi_s]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Row {
+    /// Start of the row, s.
+    pub t_lo_s: f64,
+    /// End of the row, s.
+    pub t_hi_s: f64,
+    /// Coefficient, J·s^−exponent (C4 included).
+    pub coef: f64,
+    /// Exponent of t (0, 0.25, 0.75 or 1).
+    pub exponent: f64,
+}
+
+impl Row {
+    /// `coef · t^exponent`, J.
+    #[must_use]
+    pub fn value_j(&self, t_s: f64) -> f64 {
+        if self.exponent == 0.0 {
+            self.coef
+        } else if self.exponent == 1.0 {
+            self.coef * t_s
+        } else {
+            self.coef * t_s.powf(self.exponent)
+        }
+    }
+}
+
+/// Longest duration Table 3 covers, s.
+pub const T_MAX_TABLE_S: f64 = 3e4;
+
+/// The rows of Table 3 for `band` with C4 = `c4`, in time order, covering
+/// `[band.min_duration_s(), 3·10⁴ s]`. Every rule of the exposure bound
+/// evaluates the AEL through these rows.
 #[must_use]
-pub(crate) fn table3_j(band: Band, c4: f64, t_s: f64) -> f64 {
+pub fn rows(band: Band, c4: f64) -> [Row; 4] {
+    let r = |t_lo_s, t_hi_s, coef, exponent| Row {
+        t_lo_s,
+        t_hi_s,
+        coef,
+        exponent,
+    };
     match band {
-        Band::RetinalNir => {
-            if t_s <= 5e-6 {
-                7.7e-8 * c4 * c6()
-            } else if t_s <= T2_S {
-                7e-4 * c4 * c6() * t_s.powf(0.75)
-            } else {
-                // C7 = 1 throughout 700–1050 nm.
-                3.9e-4 * c4 * t_s
-            }
+        Band::RetinalNir => [
+            r(1e-11, 5e-6, 7.7e-8 * c4 * c6(), 0.0),
+            r(5e-6, T2_S, 7e-4 * c4 * c6(), 0.75),
+            // C7 = 1 throughout 700–1050 nm.
+            r(T2_S, T_MAX_TABLE_S, 3.9e-4 * c4 * c7(0.0), 1.0),
+            r(T_MAX_TABLE_S, T_MAX_TABLE_S, 3.9e-4 * c4, 1.0),
+        ],
+        Band::Ir1400 => [
+            r(1e-9, 1e-3, 8e-4, 0.0),
+            r(1e-3, 0.35, 4.4e-3, 0.25),
+            r(0.35, 10.0, 1e-2, 1.0),
+            r(10.0, T_MAX_TABLE_S, 1e-2, 1.0),
+        ],
+        Band::Ir1500 => [
+            r(1e-9, 0.35, 8e-3, 0.0),
+            r(0.35, 10.0, 1.8e-2, 0.75),
+            r(10.0, T_MAX_TABLE_S, 1e-2, 1.0),
+            r(T_MAX_TABLE_S, T_MAX_TABLE_S, 1e-2, 1.0),
+        ],
+    }
+}
+
+/// Table 3 without validation, for hot loops whose inputs were validated
+/// once: `band` and `c4` of the wavelength, `t_s` within the band's domain
+/// (shorter durations take the first row). On a row edge the smaller of the
+/// two rows' values (the more restrictive reading).
+#[must_use]
+pub fn table3_j(band: Band, c4: f64, t_s: f64) -> f64 {
+    let rows = rows(band, c4);
+    let mut v = f64::INFINITY;
+    for (k, row) in rows.iter().enumerate() {
+        let inside = (t_s >= row.t_lo_s || k == 0) && t_s <= row.t_hi_s;
+        if inside {
+            v = v.min(row.value_j(t_s));
         }
-        Band::Ir1400 => {
-            if t_s <= 1e-3 {
-                8e-4
-            } else if t_s <= 0.35 {
-                4.4e-3 * t_s.powf(0.25)
-            } else if t_s <= 10.0 {
-                1.8e-2 * t_s.powf(0.75)
-            } else {
-                1e-2 * t_s
-            }
-        }
-        Band::Ir1500 => {
-            if t_s <= 0.35 {
-                8e-3
-            } else if t_s <= 10.0 {
-                1.8e-2 * t_s.powf(0.75)
-            } else {
-                1e-2 * t_s
-            }
-        }
+    }
+    if v.is_finite() {
+        v
+    } else {
+        rows[3].value_j(t_s)
     }
 }
 

@@ -1,0 +1,152 @@
+//! Exposure of a stationary aperture around a spinning head running a
+//! profile: the Class 1 verdict of a profile, from the sound bound of
+//! [`super::bound`].
+//!
+//! Model (IEC 60825-1:2014 Condition 3, scanned beam): the aperture (7 mm
+//! for 400–1400 nm, 3.5 mm beyond) stands 100 mm from the scan centre at
+//! azimuth φ; the beam (diameter `D_b` there) overlaps it while the head
+//! sweeps the *pass angle* `(D_a + D_b) / 100 mm` rad centred on φ; the whole
+//! energy of every pulse fired during the pass counts (no coupling loss).
+//! Every rule is bounded over **all** azimuths, clock phases, window
+//! placements and window durations (see [`super::bound`] and
+//! `specs/eye_safety.md`).
+
+use serde::Serialize;
+
+use super::ael::{self, APERTURE_DISTANCE_MM};
+pub use super::bound::Rule;
+use super::bound::{self, Laser, Seg};
+use super::{EyeSafetyError, EyeSafetyParams};
+use crate::profile::Profile;
+
+/// The eye-safety evaluation of a profile.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct ExposureReport {
+    /// Pass angle, degrees.
+    pub pass_angle_deg: f64,
+    /// Azimuth of the aperture where the binding rule is worst, degrees.
+    pub worst_azimuth_deg: f64,
+    /// The rule binding there.
+    pub binding_rule: Rule,
+    /// Upper bound of exposure / limit over every aperture, clock phase and
+    /// window (≤ 1 is Class 1).
+    pub worst_ratio: f64,
+    /// `1 / worst_ratio`: how many times the power could grow.
+    pub margin: f64,
+    /// Each rule's ratio: single pulse, within a pass, several passes up to
+    /// T2, up to the time base.
+    pub rule_ratios: [f64; 4],
+    /// Longest pass over all azimuths, s.
+    pub max_pass_duration_s: f64,
+    /// Most pulses entering in one pass, for any phase of the pulse clock.
+    pub max_pulses_per_pass: f64,
+    /// Largest energy one pass can deliver, J.
+    pub max_pass_energy_j: f64,
+    /// Window duration at which the binding train rule is worst, s.
+    pub worst_window_s: f64,
+    /// Worst ratio if the rotor stalls at the highest-power azimuth with the
+    /// laser still firing (every pulse into one aperture): > 1 means the
+    /// product needs a stall interlock.
+    pub stalled_rotor_ratio: f64,
+}
+
+/// The laser constants of `params` at `pulse_rate_hz`, validated.
+pub fn laser(params: &EyeSafetyParams, pulse_rate_hz: f64) -> Result<Laser, EyeSafetyError> {
+    let band = params.validate()?;
+    if !(pulse_rate_hz.is_finite() && pulse_rate_hz > 0.0) {
+        return Err(EyeSafetyError::Param {
+            field: "pulse_rate_hz",
+            value: pulse_rate_hz,
+            reason: "must be finite and > 0",
+        });
+    }
+    if pulse_rate_hz * params.pulse_duration_s >= 1.0 {
+        return Err(EyeSafetyError::Param {
+            field: "pulse_rate_hz",
+            value: pulse_rate_hz,
+            reason: "pulses overlap: pulse_rate_hz × pulse_duration_s must be < 1",
+        });
+    }
+    Ok(Laser {
+        band,
+        c4: ael::c4(params.wavelength_nm),
+        pulse_duration_s: params.pulse_duration_s,
+        pulse_rate_hz,
+    })
+}
+
+/// Pass angle of the Condition 3 aperture plus the beam, degrees (≤ 360).
+#[must_use]
+pub fn pass_angle_deg(params: &EyeSafetyParams, laser: &Laser) -> f64 {
+    ((laser.band.aperture_mm() + params.beam_diameter_mm) / APERTURE_DISTANCE_MM)
+        .to_degrees()
+        .min(360.0)
+}
+
+/// The bins of a profile as the bound sees them.
+#[must_use]
+pub fn segments(profile: &Profile) -> Vec<Seg> {
+    profile
+        .bins
+        .iter()
+        .map(|b| Seg {
+            start_deg: b.start_deg,
+            width_deg: b.width_deg,
+            power_w: b.power_w,
+            spin_start_rad_s: b.spin_start_rad_s,
+            spin_end_rad_s: b.spin_end_rad_s,
+        })
+        .collect()
+}
+
+/// Evaluates a structurally valid profile (bins cover the circle in order,
+/// positive spins) against Class 1: a sound upper bound of the worst ratio.
+pub fn evaluate_profile(
+    profile: &Profile,
+    params: &EyeSafetyParams,
+) -> Result<ExposureReport, EyeSafetyError> {
+    evaluate_segments(&segments(profile), params, profile.pulse_rate_hz)
+}
+
+/// As [`evaluate_profile`], for bins given as [`Seg`]s (a firmware table as
+/// it will run, for one).
+pub fn evaluate_segments(
+    segs: &[Seg],
+    params: &EyeSafetyParams,
+    pulse_rate_hz: f64,
+) -> Result<ExposureReport, EyeSafetyError> {
+    let laser = laser(params, pulse_rate_hz)?;
+    let pass = pass_angle_deg(params, &laser);
+    if segs.is_empty() {
+        return Err(EyeSafetyError::Param {
+            field: "bins",
+            value: 0.0,
+            reason: "a profile needs at least one bin",
+        });
+    }
+    let b = bound::evaluate(segs, 0.5 * pass, &laser);
+    if b.max_pass_duration_s > ael::T_MAX_TABLE_S {
+        return Err(ael::AelError::Duration {
+            what: "pass duration",
+            value: b.max_pass_duration_s,
+            reason: "exceeds 3·10⁴ s, beyond Table 3 (the spin is too slow)",
+        }
+        .into());
+    }
+    let p_top = segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
+    let (stalled_rotor_ratio, _) = laser.stationary_ratio(p_top);
+    Ok(ExposureReport {
+        pass_angle_deg: pass,
+        worst_azimuth_deg: b.worst_azimuth_deg,
+        binding_rule: b.binding_rule,
+        worst_ratio: b.worst_ratio,
+        margin: 1.0 / b.worst_ratio,
+        rule_ratios: b.ratios,
+        max_pass_duration_s: b.max_pass_duration_s,
+        max_pulses_per_pass: b.max_pulses_per_pass,
+        max_pass_energy_j: b.max_pass_energy_j,
+        worst_window_s: b.worst_window_s,
+        stalled_rotor_ratio,
+    })
+}

@@ -1,0 +1,43 @@
+//! # gaze-lidar-core — the trusted core of gaze-lidar
+//!
+//! Everything that decides whether a scan profile or a firmware table may
+//! run on a laser, and nothing else:
+//!
+//! - [`model`]: circular index and angle arithmetic ([`model::angle`]), the
+//!   sensor's limits and power accounting ([`model::lidar`]);
+//! - [`profile`]: the `gaze-lidar/profile@1` types and their exact kinematics;
+//! - [`eye_safety`]: **the one eye-safety model** — IEC 60825-1:2014 Class 1
+//!   AEL tables and a sound upper bound of the exposure of a scanned beam;
+//! - [`checker`]: certification of a profile against its declared limits or
+//!   against a sensor's own limits ([`checker::certify_for_sensor`]);
+//! - [`firmware`]: the integer firmware table (`gaze-lidar/firmware@1`), its
+//!   conservative quantizer, its integer checker (eye safety evaluated on the
+//!   quantized table itself) and its binary codec.
+//!
+//! No solver, no CLI, no plotting: a vendor who wants the checker compiles
+//! this crate and its three dependencies (serde, thiserror, serde_json behind
+//! the `json` feature). The planner, optimizer, gaze pipeline, simulator and
+//! CLI live in the `gaze-lidar` crate, which depends on this one.
+//!
+//! Proofs: Kani harnesses live beside the code they verify (`mod
+//! verification` in each module); every harness body also runs as a test.
+//! They are machine-checked only where Kani is installed (see
+//! `specs/verification.md`).
+
+#![cfg_attr(not(feature = "std"), no_std)]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+extern crate alloc;
+
+#[cfg(feature = "std")]
+pub mod checker;
+#[cfg(feature = "std")]
+pub mod eye_safety;
+#[cfg(feature = "std")]
+pub mod firmware;
+pub mod model;
+#[cfg(feature = "std")]
+pub mod profile;
+#[doc(hidden)]
+pub mod verification;

@@ -1,0 +1,13 @@
+//! The parts of the model the trusted core needs: angles, circular sets and
+//! cyclic index arithmetic ([`angle`]) and the sensor's limits ([`lidar`]).
+
+#[cfg(feature = "std")]
+pub mod angle;
+pub mod index;
+#[cfg(feature = "std")]
+pub mod lidar;
+
+#[cfg(feature = "std")]
+pub use angle::{Arc, Binning, CircularSet};
+#[cfg(feature = "std")]
+pub use lidar::{LidarSpec, Limits, PowerAccounting};
