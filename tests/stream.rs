@@ -199,6 +199,10 @@ use std::time::{Duration, Instant};
 
 const TIMEOUT_S: f64 = 0.1;
 const PERIOD_S: f64 = 0.05;
+/// Scheduling slack for wall-clock assertions on a loaded 2-core machine
+/// (measured: the first fail-safe frame comes 0.103–0.150 s after the last
+/// sample, by the phase of the frame grid; the bound is 0.150 s).
+const SLACK_S: f64 = 0.075;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_gaze-lidar"))
@@ -208,9 +212,14 @@ fn sample(t: f64, g: f64) -> String {
     format!("{{\"t_s\": {t}, \"gaze_deg\": {g}}}\n")
 }
 
+/// (t_s, state, gaze_deg) of one frame.
+type FrameRow = (f64, String, Option<f64>);
+/// Exit code, frames, stderr, seconds.
+type Replay = (Option<i32>, Vec<FrameRow>, String, f64);
+
 /// Replays `input` through `stream` (stdin), returns (exit code, frames as
 /// (t_s, state, gaze), stderr, seconds).
-fn replay(args: &[&str], input: String) -> (Option<i32>, Vec<(f64, String, Option<f64>)>, String, f64) {
+fn replay(args: &[&str], input: String) -> Replay {
     let t = Instant::now();
     let mut child = bin()
         .arg("stream")
@@ -257,7 +266,10 @@ fn realtime_silence_emits_fail_safe_frames_until_stdin_closes() {
             let Ok(line) = line else { break };
             let v: serde_json::Value = serde_json::from_str(&line).unwrap();
             let state = v["state"].as_str().unwrap().to_owned();
-            if tx.send((Instant::now(), state, v["gaze_deg"].as_f64())).is_err() {
+            if tx
+                .send((Instant::now(), state, v["gaze_deg"].as_f64()))
+                .is_err()
+            {
                 break;
             }
         }
@@ -276,7 +288,10 @@ fn realtime_silence_emits_fail_safe_frames_until_stdin_closes() {
     let last_sample = Instant::now();
     // Silence, with the pipe still open.
     std::thread::sleep(Duration::from_millis(1000));
-    assert!(child.try_wait().unwrap().is_none(), "exited while stdin open");
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "exited while stdin open"
+    );
     let silence: Vec<_> = rx.try_iter().collect();
     drop(stdin);
     let closed = Instant::now();
@@ -284,7 +299,10 @@ fn realtime_silence_emits_fail_safe_frames_until_stdin_closes() {
         if let Some(s) = child.try_wait().unwrap() {
             break s;
         }
-        assert!(closed.elapsed() < Duration::from_secs(5), "no exit after EOF");
+        assert!(
+            closed.elapsed() < Duration::from_secs(5),
+            "no exit after EOF"
+        );
         std::thread::sleep(Duration::from_millis(10));
     };
     let exit_after = closed.elapsed().as_secs_f64();
@@ -293,12 +311,15 @@ fn realtime_silence_emits_fail_safe_frames_until_stdin_closes() {
 
     let since = |at: Instant| at.saturating_duration_since(last_sample).as_secs_f64();
     let adaptive: Vec<_> = silence.iter().filter(|f| f.1 == "adaptive").collect();
-    assert!(!adaptive.is_empty(), "the 0.1 s of gaze adapted the profile");
+    assert!(
+        !adaptive.is_empty(),
+        "the 0.1 s of gaze adapted the profile"
+    );
     for f in &adaptive {
         assert!(diff_deg(f.2.unwrap(), 90.0).abs() < 1.0);
         // Wall-clock property (slack for scheduling on a loaded machine).
         assert!(
-            since(f.0) <= TIMEOUT_S + PERIOD_S + 0.05,
+            since(f.0) <= TIMEOUT_S + PERIOD_S + SLACK_S,
             "adaptive frame {:.3} s after the last sample",
             since(f.0)
         );
@@ -317,9 +338,12 @@ fn realtime_silence_emits_fail_safe_frames_until_stdin_closes() {
         "first fail-safe frame {first:.3} s after the last sample; {} fail-safe frames in 1 s of silence, largest gap {max_gap:.3} s; exit {exit_after:.3} s after EOF",
         after.len()
     );
-    assert!(first <= TIMEOUT_S + PERIOD_S + 0.05, "first fail-safe after {first:.3} s");
+    assert!(
+        first <= TIMEOUT_S + PERIOD_S + SLACK_S,
+        "first fail-safe after {first:.3} s"
+    );
     assert!(in_silence >= 10, "{in_silence} frames in 0.7 s of silence");
-    assert!(max_gap <= 2.0 * PERIOD_S + 0.05, "{max_gap}");
+    assert!(max_gap <= 2.0 * PERIOD_S + SLACK_S, "{max_gap}");
 }
 
 #[test]
@@ -353,7 +377,9 @@ fn a_saccadic_sweep_never_aims_far_from_the_true_gaze() {
 
 #[test]
 fn a_gap_in_replay_produces_its_frames_in_order() {
-    let mut input: String = (0..=20).map(|k| sample(f64::from(k) * 0.005, 90.0)).collect();
+    let mut input: String = (0..=20)
+        .map(|k| sample(f64::from(k) * 0.005, 90.0))
+        .collect();
     input.push_str(&sample(2.1, 90.0));
     let (code, frames, err, _) = replay(&["--bins", "36"], input);
     assert_eq!(code, Some(0), "{err}");
@@ -374,7 +400,9 @@ fn a_gap_in_replay_produces_its_frames_in_order() {
 #[test]
 fn timestamp_jumps_are_bounded_in_time_and_output() {
     for jump in [2000.0, 1e9, 1e300] {
-        let mut input: String = (0..=20).map(|k| sample(f64::from(k) * 0.005, 90.0)).collect();
+        let mut input: String = (0..=20)
+            .map(|k| sample(f64::from(k) * 0.005, 90.0))
+            .collect();
         for k in 0..=20 {
             input.push_str(&sample(jump + f64::from(k) * 0.005, 90.0));
         }
@@ -393,7 +421,9 @@ fn timestamp_jumps_are_bounded_in_time_and_output() {
 
 #[test]
 fn absurd_gaze_is_an_invalid_sample() {
-    let input: String = (0..=40).map(|k| sample(f64::from(k) * 0.005, 1e300)).collect();
+    let input: String = (0..=40)
+        .map(|k| sample(f64::from(k) * 0.005, 1e300))
+        .collect();
     let (code, frames, err, _) = replay(&["--bins", "36"], input);
     assert_eq!(code, Some(0), "{err}");
     assert!(frames.iter().all(|f| f.1 == "fail_safe" && f.2.is_none()));
@@ -409,7 +439,13 @@ fn a_truncated_neon_file_is_rejected_with_line_and_field() {
     std::fs::write(&path, cut).unwrap();
     let lines = cut.lines().count();
     let o = run(
-        &["stream", "--input", path.to_str().unwrap(), "--format", "neon"],
+        &[
+            "stream",
+            "--input",
+            path.to_str().unwrap(),
+            "--format",
+            "neon",
+        ],
         None,
     );
     assert_bad_input(&o, &format!("gaze.csv:{lines}: row:"));
@@ -447,7 +483,12 @@ fn other_stdout_errors_are_one_line_exit_1() {
     let mut child = bin()
         .args(["stream"])
         .stdin(Stdio::piped())
-        .stdout(std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap())
+        .stdout(
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open("/dev/full")
+                .unwrap(),
+        )
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();

@@ -89,10 +89,7 @@ fn cli_error(e: GazeError) -> CliError {
 }
 
 #[cfg(feature = "solver")]
-fn optimizer_planner(
-    a: &Args,
-    path: &std::path::Path,
-) -> Result<Box<dyn FramePlanner>, CliError> {
+fn optimizer_planner(a: &Args, path: &std::path::Path) -> Result<Box<dyn FramePlanner>, CliError> {
     use gaze_lidar::optimizer::OptimizerConfig;
     let mut problem = OptimizerConfig::read(path)
         .and_then(|c| c.problem())

@@ -184,7 +184,11 @@ mod tests {
         assert_eq!(f.push(&s(0.04, 90.0)), Class::Fixation);
         assert_eq!(f.push(&s(0.045, 1e300)), Class::Invalid, "absurd gaze");
         assert_eq!(f.estimate(), None);
-        assert_eq!(f.push(&s(0.05, -3600.0)), Class::Fixation, "bound inclusive");
+        assert_eq!(
+            f.push(&s(0.05, -3600.0)),
+            Class::Fixation,
+            "bound inclusive"
+        );
         assert_eq!(f.push(&s(0.055, 3600.5)), Class::Invalid);
     }
 }

@@ -315,11 +315,12 @@ mod tests {
         let mut p = Parser::new(Format::Neon);
         let header = "section id,recording id,timestamp [ns],gaze x [px],gaze y [px],worn,fixation id,blink id,azimuth [deg],elevation [deg]";
         assert!(p.line(header).unwrap().is_none());
-        assert!(p
-            .line("s1,r1,1700000000000000000,800,600,1,1,,10.000,-2.0")
-            .unwrap()
-            .unwrap()
-            .valid);
+        assert!(
+            p.line("s1,r1,1700000000000000000,800,600,1,1,,10.000,-2.0")
+                .unwrap()
+                .unwrap()
+                .valid
+        );
         let e = p.line("s1,r1,1700000000005000000,800,6").unwrap_err();
         let msg = e.to_string();
         assert!(msg.contains("5 fields where the header has 10"), "{msg}");

@@ -364,7 +364,10 @@ impl<P: FramePlanner> GazeStream<P> {
             return;
         }
         let period_s = self.clock.period_us() as f64 * 1e-6;
-        if self.last_t_s.is_some_and(|last| sample.t_s < last - period_s) {
+        if self
+            .last_t_s
+            .is_some_and(|last| sample.t_s < last - period_s)
+        {
             // The tracker's clock ran backwards: its history means nothing now.
             self.resync(sample.t_s, 0);
             self.latency = None;
@@ -405,19 +408,25 @@ impl<P: FramePlanner> GazeStream<P> {
         loop {
             let due = start + Duration::from_micros(k.saturating_mul(period_us));
             // Absorb everything that arrives before the frame is due.
+            let mut closed = false;
             loop {
                 let now = Instant::now();
                 let msg = if now < due {
                     match rx.recv_timeout(due - now) {
                         Ok(m) => Some(m),
                         Err(RecvTimeoutError::Timeout) => None,
+                        // The input closed before the frame was due: done.
                         Err(RecvTimeoutError::Disconnected) => return Ok(()),
                     }
                 } else {
                     match rx.try_recv() {
                         Ok(m) => Some(m),
                         Err(TryRecvError::Empty) => None,
-                        Err(TryRecvError::Disconnected) => return Ok(()),
+                        // Closed, but this frame is due: emit it, then stop.
+                        Err(TryRecvError::Disconnected) => {
+                            closed = true;
+                            None
+                        }
                     }
                 };
                 match msg {
@@ -442,6 +451,9 @@ impl<P: FramePlanner> GazeStream<P> {
             emit(f)?;
             for n in self.take_notices() {
                 notify(n);
+            }
+            if closed {
+                return Ok(());
             }
             k = k.saturating_add(1);
         }
