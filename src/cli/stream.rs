@@ -49,8 +49,9 @@ pub struct Args {
     /// I-VT saccade threshold, °/s.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     saccade_deg_s: f64,
-    /// Replay: a timestamp jump making more than this many frames due at once
-    /// emits one fail-safe frame, a warning, and restarts the frame clock.
+    /// Replay: a timestamp jump making more than this many frames (plus the
+    /// one at the sample) due at once emits one fail-safe frame, a warning,
+    /// and restarts the frame clock.
     #[arg(long, default_value_t = 200)]
     max_gap_frames: u64,
     /// Live: frames on the wall clock (t_s = seconds since start), fail-safe
@@ -127,7 +128,7 @@ fn report(notices: Vec<Notice>, max_gap_frames: u64) {
                 let why = if frames == 0 {
                     "ran backwards".to_owned()
                 } else {
-                    format!("made {frames} frames due (more than --max-gap-frames {max_gap_frames})")
+                    format!("made {frames} frames due (more than --max-gap-frames {max_gap_frames} + 1)")
                 };
                 warn(&format!(
                     "warning: gaze clock jumped from {from_s} s to {to_s} s and {why}: one fail-safe frame, frame clock restarted at {to_s} s, gaze history discarded"
@@ -322,7 +323,9 @@ fn live(
     mut stream: GazeStream<Box<dyn FramePlanner>>,
     mut source: Source,
 ) -> Result<Stats, GazeError> {
-    let (tx, rx) = mpsc::channel();
+    // Bounded: a reader far ahead of the frames (a file piped in) waits
+    // instead of holding the whole input in memory.
+    let (tx, rx) = mpsc::sync_channel(gaze_lidar::gaze::stream::LIVE_DRAIN_MAX - 1);
     let pace = a.input.is_some();
     let max_wait = Duration::from_micros(stream.period_us().saturating_mul(a.max_gap_frames));
     let start = Instant::now();

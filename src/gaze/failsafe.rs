@@ -22,7 +22,8 @@
 //!   one good sample after a loss is not enough).
 //!
 //! The frame clock ([`FrameClock`]) emits one frame per period whatever the
-//! samples do; when more than `max_gap_frames` frames fall due at once (a
+//! samples do; when a sample makes more than `max_gap_frames + 1` frames due
+//! at once (a gap of more than `max_gap_frames` periods without samples: a
 //! timestamp jump) it reports a jump instead, and the stream resynchronizes.
 
 /// Settings.
@@ -153,7 +154,7 @@ pub enum Due {
     Nothing,
     /// The frame starting at this time (µs on the frame clock) is due.
     Frame(u64),
-    /// More than `max_gap_frames` frames are due at once: the caller emits
+    /// More than `max_gap_frames + 1` frames are due at once: the caller emits
     /// one fail-safe frame and resynchronizes (bounded work and memory
     /// whatever the timestamps).
     Jump {
@@ -330,7 +331,7 @@ mod verification {
     /// REQ-FS-3: the frame clock drives the fail-safe. Replaying samples at
     /// arbitrary times (the stream's replay loop: frames due at or before a
     /// sample are decided before it is absorbed), every period gets exactly
-    /// one frame, in order, unless more than `max_gap_frames` fall due at
+    /// one frame, in order, unless more than `max_gap_frames + 1` fall due at
     /// once; then one fail-safe frame is emitted and the clock restarts at
     /// the sample with the gaze history discarded. At most
     /// `max_gap_frames + 1` frames follow one sample (bounded work and

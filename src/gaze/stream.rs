@@ -9,7 +9,7 @@
 //!   a microsecond) and is decided when the first sample at or after its
 //!   start arrives. A gap produces its frames in order (fail-safe once the
 //!   held fixation is older than the timeout). When more than
-//!   `max_gap_frames` frames fall due at once (a timestamp jump), or time runs
+//!   `max_gap_frames + 1` frames fall due at once (a timestamp jump), or time runs
 //!   backwards by more than a period, the stream emits **one** fail-safe
 //!   frame, reports a [`Notice::Resync`], discards the gaze history and
 //!   restarts the frame clock at the sample: work and memory per sample are
@@ -70,9 +70,10 @@ pub struct Frame {
 /// Stream settings beyond the filter and the fail-safe machine.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StreamConfig {
-    /// Largest number of frames one sample may make due in replay; a larger
-    /// jump emits one fail-safe frame and resynchronizes (default 200: 10 s
-    /// at 20 Hz).
+    /// Longest gap in replay, in frame periods without samples, whose frames
+    /// are produced: a sample may make at most `max_gap_frames + 1` frames
+    /// due; a larger jump emits one fail-safe frame and resynchronizes
+    /// (default 200: 10 s at 20 Hz).
     pub max_gap_frames: u64,
 }
 
@@ -141,6 +142,10 @@ const MAX_PENDING_NOTICES: usize = 64;
 /// Live drift allowance of the latency estimate (0.1 %: far above crystal
 /// drift, far below a growing backlog worth noticing).
 const LATENCY_DRIFT: f64 = 1e-3;
+
+/// Live: most messages absorbed after a frame's due time before it is
+/// decided (a feeder should bound its channel to this size).
+pub const LIVE_DRAIN_MAX: usize = 1025;
 
 /// A live input event.
 #[derive(Debug)]
@@ -409,6 +414,9 @@ impl<P: FramePlanner> GazeStream<P> {
             let due = start + Duration::from_micros(k.saturating_mul(period_us));
             // Absorb everything that arrives before the frame is due.
             let mut closed = false;
+            // Past the due time, take only what a bounded channel can hold
+            // (a flood must not starve the frames).
+            let mut late_budget = LIVE_DRAIN_MAX;
             loop {
                 let now = Instant::now();
                 let msg = if now < due {
@@ -418,7 +426,10 @@ impl<P: FramePlanner> GazeStream<P> {
                         // The input closed before the frame was due: done.
                         Err(RecvTimeoutError::Disconnected) => return Ok(()),
                     }
+                } else if late_budget == 0 {
+                    None
                 } else {
+                    late_budget -= 1;
                     match rx.try_recv() {
                         Ok(m) => Some(m),
                         Err(TryRecvError::Empty) => None,
