@@ -576,6 +576,32 @@ mod tests {
     }
 
     #[test]
+    fn live_samples_are_never_younger_than_their_arrival() {
+        // Samples 5 ms apart by their timestamps, but the last ones arrive
+        // 0.4 s late (a backlog upstream): their gaze is 0.4 s old.
+        let mut st = stream();
+        for k in 0..10 {
+            st.absorb_live(&s(f64::from(k) * 0.005, 90.0), f64::from(k) * 0.005);
+        }
+        for k in 10..20 {
+            st.absorb_live(&s(f64::from(k) * 0.005, 90.0), 0.4 + f64::from(k) * 0.005);
+        }
+        // 95 ms by its timestamp, plus the 0.1 % drift allowance over 0.5 s.
+        let lf = st.failsafe.last_fixation_us().unwrap();
+        assert!((95_000..=95_500).contains(&lf), "{lf}");
+        assert_eq!(st.frame(0.5, 500_000).unwrap().state, State::FailSafe);
+        // A tracker clock jumping ahead: the arrival bounds the sample's time.
+        let mut st = stream();
+        st.absorb_live(&s(0.0, 90.0), 0.0);
+        st.absorb_live(&s(1000.0, 90.0), 0.01);
+        assert_eq!(st.failsafe.last_fixation_us(), Some(10_000));
+        // Running backwards: history discarded, latency re-anchored.
+        st.absorb_live(&s(5.0, 90.0), 0.02);
+        assert_eq!(st.stats().resyncs, 1);
+        assert_eq!(st.failsafe.last_fixation_us(), Some(20_000));
+    }
+
+    #[test]
     fn absurd_gaze_is_invalid() {
         let mut st = stream();
         for k in 0..10 {
