@@ -1,6 +1,10 @@
 //! Gaze filtering: outlier rejection, I-VT fixation/saccade classification
 //! and smoothing.
 //!
+//! - **Invalid**: the tracker's own flag, a non-finite gaze, or |gaze| beyond
+//!   [`MAX_ABS_GAZE_DEG`](crate::planner::MAX_ABS_GAZE_DEG) (3600°, the bound
+//!   `profile --gaze-deg` enforces: anything larger is a unit bug, not an
+//!   azimuth). The estimate is forgotten.
 //! - **Outliers**: a sample implying an angular velocity above
 //!   `outlier_deg_s` (default 1000°/s, beyond the fastest human saccades
 //!   ≈ 700°/s) or a timestamp that does not advance is dropped (it neither
@@ -81,13 +85,21 @@ impl GazeFilter {
         self.estimate
     }
 
+    /// Forgets everything (a clock discontinuity).
+    pub fn reset(&mut self) {
+        self.last = None;
+        self.window.clear();
+        self.estimate = None;
+    }
+
     /// Classifies and absorbs a sample.
     pub fn push(&mut self, s: &GazeSample) -> Class {
-        if !s.valid || !s.gaze_deg.is_finite() {
-            self.last = None;
-            self.window.clear();
-            self.estimate = None;
+        if !s.usable() {
+            self.reset();
             return Class::Invalid;
+        }
+        if !s.t_s.is_finite() {
+            return Class::Outlier;
         }
         let g = wrap_deg(s.gaze_deg);
         let class = match self.last {
@@ -169,5 +181,14 @@ mod tests {
             Class::Invalid
         );
         assert_eq!(f.estimate(), None);
+        assert_eq!(f.push(&s(0.04, 90.0)), Class::Fixation);
+        assert_eq!(f.push(&s(0.045, 1e300)), Class::Invalid, "absurd gaze");
+        assert_eq!(f.estimate(), None);
+        assert_eq!(
+            f.push(&s(0.05, -3600.0)),
+            Class::Fixation,
+            "bound inclusive"
+        );
+        assert_eq!(f.push(&s(0.055, 3600.5)), Class::Invalid);
     }
 }

@@ -33,6 +33,17 @@ pub struct GazeSample {
     pub valid: bool,
 }
 
+impl GazeSample {
+    /// Whether the sample carries a usable gaze: the tracker's flag, a
+    /// finite azimuth and |gaze| ≤ [`MAX_ABS_GAZE_DEG`](crate::planner::MAX_ABS_GAZE_DEG).
+    #[must_use]
+    pub fn usable(&self) -> bool {
+        self.valid
+            && self.gaze_deg.is_finite()
+            && self.gaze_deg.abs() <= crate::planner::MAX_ABS_GAZE_DEG
+    }
+}
+
 /// Input formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
@@ -60,6 +71,9 @@ pub enum LineError {
         /// Why.
         reason: String,
     },
+    /// A CSV row does not have the header's number of fields.
+    #[error("row: {0}")]
+    Row(String),
     /// The header lacks a required column.
     #[error("header: missing column '{0}'")]
     Header(String),
@@ -79,6 +93,7 @@ struct JsonSample {
 pub struct Parser {
     format: Format,
     columns: Option<HashMap<String, usize>>,
+    header_fields: usize,
 }
 
 impl Parser {
@@ -88,11 +103,20 @@ impl Parser {
         Self {
             format,
             columns: None,
+            header_fields: 0,
         }
     }
 
-    /// Parses one line: `Ok(None)` for a header or blank line.
+    /// Parses one line: `Ok(None)` for a header or blank line. A sample
+    /// whose gaze is not [usable](GazeSample::usable) comes back invalid.
     pub fn line(&mut self, line: &str) -> Result<Option<GazeSample>, LineError> {
+        Ok(self.parse(line)?.map(|mut s| {
+            s.valid = s.usable();
+            s
+        }))
+    }
+
+    fn parse(&mut self, line: &str) -> Result<Option<GazeSample>, LineError> {
         let line = line.trim_end_matches(['\r', '\n']);
         if line.trim().is_empty() {
             return Ok(None);
@@ -146,8 +170,22 @@ impl Parser {
                 return Err(LineError::Header((*missing).to_owned()));
             }
             self.columns = Some(cols);
+            self.header_fields = fields.len();
             return Ok(None);
         };
+        if fields.len() != self.header_fields {
+            // A row cut short (a truncated file) or run together with the next.
+            let missing = cols
+                .iter()
+                .filter(|(_, &i)| i >= fields.len())
+                .min_by_key(|(_, &i)| i)
+                .map_or_else(String::new, |(name, _)| format!(" ('{name}' missing)"));
+            return Err(LineError::Row(format!(
+                "{} fields where the header has {}{missing}: truncated or malformed row",
+                fields.len(),
+                self.header_fields
+            )));
+        }
         let get = |name: &str| -> Result<f64, LineError> {
             let i = cols[name];
             let raw = fields.get(i).ok_or_else(|| LineError::Field {
@@ -273,7 +311,36 @@ mod tests {
     }
 
     #[test]
+    fn truncated_csv_rows_are_rejected_naming_the_field() {
+        let mut p = Parser::new(Format::Neon);
+        let header = "section id,recording id,timestamp [ns],gaze x [px],gaze y [px],worn,fixation id,blink id,azimuth [deg],elevation [deg]";
+        assert!(p.line(header).unwrap().is_none());
+        assert!(
+            p.line("s1,r1,1700000000000000000,800,600,1,1,,10.000,-2.0")
+                .unwrap()
+                .unwrap()
+                .valid
+        );
+        let e = p.line("s1,r1,1700000000005000000,800,6").unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains("5 fields where the header has 10"), "{msg}");
+        assert!(msg.contains("'worn' missing"), "{msg}");
+        let mut p = Parser::new(Format::Csv);
+        p.line("t_s,gaze_deg,valid").unwrap();
+        assert!(p.line("0.1,90").is_err());
+        assert!(!p.line("0.1,1e300,true").unwrap().unwrap().valid);
+    }
+
+    #[test]
     fn jsonl_validity_rules() {
+        let mut p = Parser::new(Format::Jsonl);
+        assert!(
+            !p.line(r#"{"t_s": 0.1, "gaze_deg": 1e300}"#)
+                .unwrap()
+                .unwrap()
+                .valid,
+            "absurd gaze is an invalid sample"
+        );
         let mut p = Parser::new(Format::Jsonl);
         assert!(
             p.line(r#"{"t_s": 0.1, "gaze_deg": 90}"#)

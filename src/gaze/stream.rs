@@ -1,28 +1,64 @@
 //! The real-time pipeline: gaze samples in, one certified profile per LiDAR
-//! frame out. Frames are driven by the gaze timestamps (not the wall clock),
-//! so a log replays deterministically: frame `k` starts at `t0 + k·T`
-//! (`t0` the first sample's time) and is decided when the first sample at
-//! or after its start arrives, from the samples before it.
+//! frame out. **The frame clock drives the fail-safe**: a frame is emitted on
+//! every frame period whether or not samples arrive, and each frame is
+//! decided from the samples received before it.
+//!
+//! - **Replay** ([`GazeStream::push_each`]): the frame clock runs on the
+//!   sample clock, so a log replays deterministically. Frame `k` starts at
+//!   `t0 + k·T` (`t0` the first sample's time, `T` the frame period rounded to
+//!   a microsecond) and is decided when the first sample at or after its
+//!   start arrives. A gap produces its frames in order (fail-safe once the
+//!   held fixation is older than the timeout). When more than
+//!   `max_gap_frames + 1` frames fall due at once (a timestamp jump), or time runs
+//!   backwards by more than a period, the stream emits **one** fail-safe
+//!   frame, reports a [`Notice::Resync`], discards the gaze history and
+//!   restarts the frame clock at the sample: work and memory per sample are
+//!   bounded whatever the timestamps.
+//! - **Live** ([`GazeStream::run_live`]): the frame clock is the wall clock
+//!   (from the call). Samples come through a channel; when none arrives the
+//!   frames still go out on time, fail-safe once the gaze is stale. A sample's
+//!   time on the frame clock is its arrival time, or earlier when its own
+//!   timestamps show it was delayed on the way (the smallest observed
+//!   latency, allowed to drift by 0.1 %): never later than its arrival, so
+//!   the age of the gaze is never underestimated against the wall clock.
+//!
+//! Property (REQ-FS-1, REQ-FS-3): no adaptive frame is based on gaze older
+//! than the timeout plus one frame — measured on the sample clock in replay
+//! and on the wall clock live.
+
+use std::sync::mpsc::{Receiver, RecvTimeoutError, TryRecvError};
+use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::failsafe::{FailSafe, FailSafeConfig, State};
+use super::failsafe::{Due, FailSafe, FailSafeConfig, FrameClock, SampleKind, State};
 use super::filter::{Class, FilterConfig, GazeFilter};
 use super::formats::GazeSample;
+use super::GazeError;
 use crate::checker::CertifiedProfile;
 
 /// Something that turns a gaze (or none: fail-safe) into a certified profile.
 pub trait FramePlanner {
     /// The profile for `gaze_deg`; `None` asks for the uniform baseline.
-    fn plan(&mut self, gaze_deg: Option<f64>) -> Result<CertifiedProfile, String>;
+    fn plan(&mut self, gaze_deg: Option<f64>) -> Result<CertifiedProfile, GazeError>;
     /// Nominal frame rate, Hz.
     fn frame_rate_hz(&self) -> f64;
+}
+
+impl<P: FramePlanner + ?Sized> FramePlanner for Box<P> {
+    fn plan(&mut self, gaze_deg: Option<f64>) -> Result<CertifiedProfile, GazeError> {
+        (**self).plan(gaze_deg)
+    }
+    fn frame_rate_hz(&self) -> f64 {
+        (**self).frame_rate_hz()
+    }
 }
 
 /// One emitted frame.
 #[derive(Debug, Clone, Serialize)]
 pub struct Frame {
-    /// Frame start (gaze clock), s.
+    /// Frame start on the frame clock, s: the gaze clock in replay, seconds
+    /// since the stream started when live.
     pub t_s: f64,
     /// State the frame ran in.
     pub state: State,
@@ -31,12 +67,59 @@ pub struct Frame {
     pub profile: CertifiedProfile,
 }
 
+/// Stream settings beyond the filter and the fail-safe machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StreamConfig {
+    /// Longest gap in replay, in frame periods without samples, whose frames
+    /// are produced: a sample may make at most `max_gap_frames + 1` frames
+    /// due; a larger jump emits one fail-safe frame and resynchronizes
+    /// (default 200: 10 s at 20 Hz).
+    pub max_gap_frames: u64,
+}
+
+impl Default for StreamConfig {
+    fn default() -> Self {
+        Self {
+            max_gap_frames: 200,
+        }
+    }
+}
+
+/// Something the caller should tell the user (the library does not print).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Notice {
+    /// The gaze clock jumped: one fail-safe frame, the frame clock restarted
+    /// at `to_s` and the gaze history was discarded.
+    Resync {
+        /// Previous sample time, s.
+        from_s: f64,
+        /// The sample that jumped, s.
+        to_s: f64,
+        /// Frames that fell due at once (0 when time ran backwards).
+        frames: u64,
+    },
+    /// Planning the adaptive profile failed: the frame fell back to the
+    /// baseline (fail-safe).
+    PlanFallback {
+        /// The gaze that could not be planned.
+        gaze_deg: f64,
+        /// Why.
+        error: String,
+    },
+    /// Live: frames were not emitted on time (the output or the planner was
+    /// too slow); the clock skipped them.
+    Late {
+        /// Frames skipped.
+        frames: u64,
+    },
+}
+
 /// Counts for the end-of-stream summary.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct StreamStats {
     /// Samples read.
     pub samples: u64,
-    /// Samples the tracker marked invalid.
+    /// Samples the tracker marked invalid (or with unusable gaze).
     pub invalid: u64,
     /// Outliers dropped.
     pub outliers: u64,
@@ -44,6 +127,33 @@ pub struct StreamStats {
     pub frames: u64,
     /// Frames in fail-safe.
     pub fail_safe_frames: u64,
+    /// Clock resynchronizations (timestamp jumps).
+    pub resyncs: u64,
+    /// Adaptive frames that fell back to the baseline because planning failed.
+    pub plan_fallbacks: u64,
+    /// Live frames skipped because emission ran late.
+    pub late_frames: u64,
+}
+
+/// At most this many notices wait for [`GazeStream::take_notices`]; the
+/// counters in [`StreamStats`] keep counting.
+const MAX_PENDING_NOTICES: usize = 64;
+
+/// Live drift allowance of the latency estimate (0.1 %: far above crystal
+/// drift, far below a growing backlog worth noticing).
+const LATENCY_DRIFT: f64 = 1e-3;
+
+/// Live: most messages absorbed after a frame's due time before it is
+/// decided (a feeder should bound its channel to this size).
+pub const LIVE_DRAIN_MAX: usize = 1025;
+
+/// A live input event.
+#[derive(Debug)]
+pub enum Input {
+    /// A parsed sample and the instant it was read.
+    Sample(GazeSample, Instant),
+    /// The reader failed (e.g. a malformed line in a recorded file): stop.
+    Error(GazeError),
 }
 
 /// The pipeline.
@@ -51,29 +161,52 @@ pub struct GazeStream<P: FramePlanner> {
     planner: P,
     filter: GazeFilter,
     failsafe: FailSafe,
-    period_s: f64,
-    t0: Option<f64>,
-    next_frame: u64,
+    config: StreamConfig,
+    clock: FrameClock,
+    origin_s: Option<f64>,
+    last_t_s: Option<f64>,
     stats: StreamStats,
+    notices: Vec<Notice>,
+    // Live: latency estimate (s) and the arrival it was updated at (s).
+    latency: Option<(f64, f64)>,
 }
 
+/// Seconds → whole microseconds (saturating; negative → 0).
 fn to_us(t_s: f64) -> u64 {
-    // Times are relative to the first sample, so non-negative and small.
+    // `as` saturates and maps NaN to 0.
     (t_s.max(0.0) * 1e6).round() as u64
 }
 
 impl<P: FramePlanner> GazeStream<P> {
-    /// A pipeline around `planner`.
+    /// A pipeline around `planner` with the default [`StreamConfig`].
     pub fn new(planner: P, filter: FilterConfig, failsafe: FailSafeConfig) -> Self {
-        let period_s = 1.0 / planner.frame_rate_hz();
+        Self::with_config(planner, filter, failsafe, StreamConfig::default())
+    }
+
+    /// A pipeline around `planner`.
+    pub fn with_config(
+        planner: P,
+        filter: FilterConfig,
+        failsafe: FailSafeConfig,
+        config: StreamConfig,
+    ) -> Self {
+        let rate = planner.frame_rate_hz();
+        let period_us = if rate.is_finite() && rate > 0.0 {
+            to_us(1.0 / rate).max(1)
+        } else {
+            1
+        };
         Self {
             planner,
             filter: GazeFilter::new(filter),
             failsafe: FailSafe::new(failsafe),
-            period_s,
-            t0: None,
-            next_frame: 0,
+            config,
+            clock: FrameClock::new(period_us, config.max_gap_frames),
+            origin_s: None,
+            last_t_s: None,
             stats: StreamStats::default(),
+            notices: Vec::new(),
+            latency: None,
         }
     }
 
@@ -83,46 +216,397 @@ impl<P: FramePlanner> GazeStream<P> {
         self.stats
     }
 
-    /// Feeds one sample; returns the frames that start at or before it.
-    pub fn push(&mut self, sample: &GazeSample) -> Result<Vec<Frame>, String> {
-        let t0 = *self.t0.get_or_insert(sample.t_s);
-        let rel = sample.t_s - t0;
-        let mut frames = Vec::new();
-        loop {
-            let start = self.next_frame as f64 * self.period_s;
-            if start > rel + 1e-12 {
-                break;
-            }
-            let state = self.failsafe.at_frame(to_us(start));
-            let gaze = match state {
-                State::Adaptive => self.filter.estimate(),
-                State::FailSafe => None,
-            };
-            // Adaptive with no estimate (e.g. only saccades so far) is fail-safe too.
-            let state = if gaze.is_none() {
-                State::FailSafe
-            } else {
-                state
-            };
-            let profile = self.planner.plan(gaze)?;
-            self.stats.frames += 1;
-            self.stats.fail_safe_frames += u64::from(state == State::FailSafe);
-            frames.push(Frame {
-                t_s: t0 + start,
-                state,
-                profile,
-            });
-            self.next_frame += 1;
+    /// The frame period on the frame clock, µs.
+    #[must_use]
+    pub fn period_us(&self) -> u64 {
+        self.clock.period_us()
+    }
+
+    /// Notices since the last call (at most 64 are kept).
+    pub fn take_notices(&mut self) -> Vec<Notice> {
+        std::mem::take(&mut self.notices)
+    }
+
+    fn notice(&mut self, n: Notice) {
+        if self.notices.len() < MAX_PENDING_NOTICES {
+            self.notices.push(n);
         }
+    }
+
+    /// Forgets the gaze (a clock discontinuity): back to fail-safe.
+    fn discard_history(&mut self) {
+        self.filter.reset();
+        self.failsafe = FailSafe::new(self.failsafe.config());
+    }
+
+    /// Absorbs one sample at `t_us` on the frame clock.
+    fn absorb(&mut self, sample: &GazeSample, t_us: u64) {
         self.stats.samples += 1;
-        match self.filter.push(sample) {
+        let kind = match self.filter.push(sample) {
             Class::Invalid => {
                 self.stats.invalid += 1;
-                self.failsafe.on_sample(to_us(rel), false);
+                SampleKind::Invalid
             }
-            Class::Outlier => self.stats.outliers += 1,
-            Class::Fixation | Class::Saccade => self.failsafe.on_sample(to_us(rel), true),
+            Class::Outlier => {
+                self.stats.outliers += 1;
+                return;
+            }
+            Class::Fixation => SampleKind::Fixation,
+            Class::Saccade => SampleKind::Saccade,
+        };
+        self.failsafe.on_sample(t_us, kind);
+    }
+
+    /// Decides and plans the frame starting at `t_s`, deciding staleness at
+    /// `decide_us` on the frame clock.
+    fn frame(&mut self, t_s: f64, decide_us: u64) -> Result<Frame, GazeError> {
+        let state = self.failsafe.at_frame(decide_us);
+        let gaze = match state {
+            State::Adaptive => self.filter.estimate(),
+            State::FailSafe => None,
+        };
+        let (state, profile) = match gaze {
+            Some(g) => match self.planner.plan(Some(g)) {
+                Ok(p) => (State::Adaptive, p),
+                Err(e) => {
+                    // The LiDAR must still get a certified frame: the baseline.
+                    self.stats.plan_fallbacks += 1;
+                    self.notice(Notice::PlanFallback {
+                        gaze_deg: g,
+                        error: e.to_string(),
+                    });
+                    (State::FailSafe, self.planner.plan(None)?)
+                }
+            },
+            // Adaptive with no estimate (e.g. only saccades so far) is fail-safe too.
+            None => (State::FailSafe, self.planner.plan(None)?),
+        };
+        self.stats.frames += 1;
+        self.stats.fail_safe_frames += u64::from(state == State::FailSafe);
+        Ok(Frame {
+            t_s,
+            state,
+            profile,
+        })
+    }
+
+    fn resync(&mut self, to_s: f64, frames: u64) {
+        self.stats.resyncs += 1;
+        self.notice(Notice::Resync {
+            from_s: self.last_t_s.unwrap_or(to_s),
+            to_s,
+            frames,
+        });
+        self.origin_s = Some(to_s);
+        self.clock = FrameClock::new(self.clock.period_us(), self.config.max_gap_frames);
+        self.discard_history();
+    }
+
+    /// Replay: feeds one sample, handing `emit` the frames that start at or
+    /// before it (decided from the samples before it), in order. At most
+    /// `max_gap_frames + 1` frames per sample.
+    pub fn push_each(
+        &mut self,
+        sample: &GazeSample,
+        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
+    ) -> Result<(), GazeError> {
+        if !sample.t_s.is_finite() {
+            self.stats.samples += 1;
+            self.stats.outliers += 1;
+            return Ok(());
         }
+        let period_s = self.clock.period_us() as f64 * 1e-6;
+        let origin = *self.origin_s.get_or_insert(sample.t_s);
+        let mut rel = sample.t_s - origin;
+        if rel < -period_s || !rel.is_finite() {
+            // Time ran backwards (a clock reset): restart at this sample.
+            self.resync(sample.t_s, 0);
+            rel = 0.0;
+        } else if rel < 0.0 {
+            // Before the clock's origin (reordered by less than a period):
+            // too old for any frame still to come.
+            self.stats.samples += 1;
+            self.stats.outliers += 1;
+            self.last_t_s = Some(sample.t_s);
+            return Ok(());
+        }
+        let mut now_us = to_us(rel);
+        loop {
+            match self.clock.due(now_us) {
+                Due::Nothing => break,
+                Due::Frame(start_us) => {
+                    let origin = self.origin_s.unwrap_or(sample.t_s);
+                    let f = self.frame(origin + start_us as f64 * 1e-6, start_us)?;
+                    emit(f)?;
+                }
+                Due::Jump { frames } => {
+                    self.resync(sample.t_s, frames);
+                    now_us = 0;
+                }
+            }
+        }
+        self.last_t_s = Some(sample.t_s);
+        self.absorb(sample, now_us);
+        Ok(())
+    }
+
+    /// Replay: [`push_each`](Self::push_each) collecting the frames (at most
+    /// `max_gap_frames + 1`).
+    pub fn push(&mut self, sample: &GazeSample) -> Result<Vec<Frame>, GazeError> {
+        let mut frames = Vec::new();
+        self.push_each(sample, &mut |f| {
+            frames.push(f);
+            Ok(())
+        })?;
         Ok(frames)
+    }
+
+    /// Live: absorbs a sample that arrived at `arrival_s` on the frame clock.
+    fn absorb_live(&mut self, sample: &GazeSample, arrival_s: f64) {
+        if !sample.t_s.is_finite() {
+            self.stats.samples += 1;
+            self.stats.outliers += 1;
+            return;
+        }
+        let period_s = self.clock.period_us() as f64 * 1e-6;
+        if self
+            .last_t_s
+            .is_some_and(|last| sample.t_s < last - period_s)
+        {
+            // The tracker's clock ran backwards: its history means nothing now.
+            self.resync(sample.t_s, 0);
+            self.latency = None;
+        }
+        self.last_t_s = Some(sample.t_s);
+        let observed = arrival_s - sample.t_s;
+        let latency = match self.latency {
+            Some((l, at)) => observed.min(l + LATENCY_DRIFT * (arrival_s - at).max(0.0)),
+            None => observed,
+        };
+        self.latency = Some((latency, arrival_s));
+        let t = sample.t_s + latency;
+        // Never later than the arrival (rounding included).
+        let t_us = if t.is_finite() {
+            to_us(t).min(to_us(arrival_s))
+        } else {
+            0
+        };
+        self.absorb(sample, t_us);
+    }
+
+    /// Live: emits one frame per period on the wall clock from `start` until
+    /// the channel closes (or `emit` fails), each decided from the samples
+    /// received before it. Staleness is evaluated when the frame is actually
+    /// decided (at or after its nominal start), so a late frame is judged
+    /// late. A frame more than one period late is skipped ([`Notice::Late`]).
+    /// Notices go to `notify` as they happen.
+    pub fn run_live(
+        &mut self,
+        rx: &Receiver<Input>,
+        start: Instant,
+        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
+        notify: &mut dyn FnMut(Notice),
+    ) -> Result<(), GazeError> {
+        let period_us = self.clock.period_us();
+        let since_start = |at: Instant| at.saturating_duration_since(start);
+        let mut k: u64 = 0;
+        loop {
+            let due = start + Duration::from_micros(k.saturating_mul(period_us));
+            // Absorb everything that arrives before the frame is due.
+            let mut closed = false;
+            // Past the due time, take only what a bounded channel can hold
+            // (a flood must not starve the frames).
+            let mut late_budget = LIVE_DRAIN_MAX;
+            loop {
+                let now = Instant::now();
+                let msg = if now < due {
+                    match rx.recv_timeout(due - now) {
+                        Ok(m) => Some(m),
+                        Err(RecvTimeoutError::Timeout) => None,
+                        // The input closed before the frame was due: done.
+                        Err(RecvTimeoutError::Disconnected) => return Ok(()),
+                    }
+                } else if late_budget == 0 {
+                    None
+                } else {
+                    late_budget -= 1;
+                    match rx.try_recv() {
+                        Ok(m) => Some(m),
+                        Err(TryRecvError::Empty) => None,
+                        // Closed, but this frame is due: emit it, then stop.
+                        Err(TryRecvError::Disconnected) => {
+                            closed = true;
+                            None
+                        }
+                    }
+                };
+                match msg {
+                    None => break,
+                    Some(Input::Error(e)) => return Err(e),
+                    Some(Input::Sample(s, arrival)) => {
+                        self.absorb_live(&s, since_start(arrival).as_secs_f64());
+                    }
+                }
+            }
+            let now_us = u64::try_from(since_start(Instant::now()).as_micros()).unwrap_or(u64::MAX);
+            let current = now_us / period_us;
+            if current > k {
+                self.stats.late_frames += current - k;
+                self.notice(Notice::Late {
+                    frames: current - k,
+                });
+                k = current;
+            }
+            let start_us = k.saturating_mul(period_us);
+            let f = self.frame(start_us as f64 * 1e-6, now_us.max(start_us))?;
+            emit(f)?;
+            for n in self.take_notices() {
+                notify(n);
+            }
+            if closed {
+                return Ok(());
+            }
+            k = k.saturating_add(1);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gaze::ClosedFormPlanner;
+    use crate::model::presets;
+    use crate::planner::Mode;
+
+    fn stream() -> GazeStream<ClosedFormPlanner> {
+        GazeStream::new(
+            ClosedFormPlanner {
+                preset: presets::paper(),
+                mode: Mode::Range,
+                bins: 36,
+            },
+            FilterConfig::default(),
+            FailSafeConfig::default(),
+        )
+    }
+
+    fn s(t_s: f64, gaze_deg: f64) -> GazeSample {
+        GazeSample {
+            t_s,
+            gaze_deg,
+            valid: true,
+        }
+    }
+
+    #[test]
+    fn a_gap_produces_its_frames_and_goes_fail_safe() {
+        let mut st = stream();
+        let mut frames = Vec::new();
+        for k in 0..21 {
+            frames.extend(st.push(&s(f64::from(k) * 0.005, 90.0)).unwrap());
+        }
+        // 2 s of silence, then one sample: every frame in between, in order.
+        frames.extend(st.push(&s(2.1, 90.0)).unwrap());
+        assert_eq!(frames.len(), 43, "frames at 0, 0.05, …, 2.1");
+        for w in frames.windows(2) {
+            assert!((w[1].t_s - w[0].t_s - 0.05).abs() < 1e-9);
+        }
+        // Last fixation at 0.1 s: adaptive at most until 0.2 s (timeout 100 ms).
+        for f in &frames {
+            if f.t_s > 0.2 + 1e-9 {
+                assert_eq!(f.state, State::FailSafe, "t = {}", f.t_s);
+            }
+        }
+        assert!(frames
+            .iter()
+            .any(|f| f.state == State::Adaptive && f.t_s > 0.09));
+        assert!(st.take_notices().is_empty());
+    }
+
+    #[test]
+    fn a_jump_emits_one_fail_safe_frame_and_resynchronizes() {
+        let mut st = stream();
+        for k in 0..21 {
+            st.push(&s(f64::from(k) * 0.005, 90.0)).unwrap();
+        }
+        let f = st.push(&s(1e9, 90.0)).unwrap();
+        assert_eq!(f.len(), 1);
+        assert_eq!(f[0].state, State::FailSafe);
+        assert_eq!(f[0].t_s, 1e9);
+        assert!(matches!(
+            st.take_notices()[..],
+            [Notice::Resync { frames, .. }] if frames > 200
+        ));
+        // Recovers on the new clock.
+        let mut adaptive = 0;
+        for k in 1..40 {
+            adaptive += st
+                .push(&s(1e9 + f64::from(k) * 0.005, 90.0))
+                .unwrap()
+                .iter()
+                .filter(|f| f.state == State::Adaptive)
+                .count();
+        }
+        assert!(adaptive >= 2);
+        // Backwards by a second: resync too.
+        let f = st.push(&s(1e9 - 1.0, 90.0)).unwrap();
+        assert_eq!(f.len(), 1);
+        assert_eq!(f[0].state, State::FailSafe);
+        assert_eq!(st.stats().resyncs, 2);
+    }
+
+    #[test]
+    fn saccades_do_not_refresh_a_held_fixation() {
+        let mut st = stream();
+        let mut worst: f64 = 0.0;
+        for k in 0..600 {
+            let t = f64::from(k) * 0.005;
+            let truth = 90.0 + 60.0 * t;
+            for f in st.push(&s(t, truth)).unwrap() {
+                if f.state == State::Adaptive {
+                    let g = f.profile.profile().gaze_deg.unwrap();
+                    let true_at_frame_end = 90.0 + 60.0 * (f.t_s + 0.05);
+                    worst = worst.max(crate::model::angle::diff_deg(g, true_at_frame_end).abs());
+                }
+            }
+        }
+        // Held fixation at most timeout + one frame old: 60°/s · 0.15 s.
+        assert!(worst <= 9.0 + 1e-9, "{worst}");
+        assert!(st.stats().fail_safe_frames >= 55);
+    }
+
+    #[test]
+    fn live_samples_are_never_younger_than_their_arrival() {
+        // Samples 5 ms apart by their timestamps, but the last ones arrive
+        // 0.4 s late (a backlog upstream): their gaze is 0.4 s old.
+        let mut st = stream();
+        for k in 0..10 {
+            st.absorb_live(&s(f64::from(k) * 0.005, 90.0), f64::from(k) * 0.005);
+        }
+        for k in 10..20 {
+            st.absorb_live(&s(f64::from(k) * 0.005, 90.0), 0.4 + f64::from(k) * 0.005);
+        }
+        // 95 ms by its timestamp, plus the 0.1 % drift allowance over 0.5 s.
+        let lf = st.failsafe.last_fixation_us().unwrap();
+        assert!((95_000..=95_500).contains(&lf), "{lf}");
+        assert_eq!(st.frame(0.5, 500_000).unwrap().state, State::FailSafe);
+        // A tracker clock jumping ahead: the arrival bounds the sample's time.
+        let mut st = stream();
+        st.absorb_live(&s(0.0, 90.0), 0.0);
+        st.absorb_live(&s(1000.0, 90.0), 0.01);
+        assert_eq!(st.failsafe.last_fixation_us(), Some(10_000));
+        // Running backwards: history discarded, latency re-anchored.
+        st.absorb_live(&s(5.0, 90.0), 0.02);
+        assert_eq!(st.stats().resyncs, 1);
+        assert_eq!(st.failsafe.last_fixation_us(), Some(20_000));
+    }
+
+    #[test]
+    fn absurd_gaze_is_invalid() {
+        let mut st = stream();
+        for k in 0..10 {
+            st.push(&s(f64::from(k) * 0.005, 1e300)).unwrap();
+        }
+        assert_eq!(st.stats().invalid, 10);
     }
 }
