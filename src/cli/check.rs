@@ -4,7 +4,8 @@ use clap::ValueEnum;
 use std::io::Read;
 use std::path::PathBuf;
 
-use gaze_lidar::checker::{certify, summarize};
+use gaze_lidar::checker::{certify_with, summarize, CheckOptions};
+use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::eye_safety::evaluate_profile;
 use gaze_lidar::profile::Profile;
 
@@ -26,6 +27,36 @@ pub struct Args {
     /// Report format.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
+    /// Also certify against this preset's sensor: any declared limit looser
+    /// than the sensor's is rejected, naming the key.
+    #[arg(long, conflicts_with = "sensor")]
+    preset: Option<String>,
+    /// Also certify against a sensor described in TOML (the fields of a
+    /// preset's `lidar`: name, frame_rate_hz, pulse_rate_hz, channels,
+    /// average_power_w, rated_range_m, reference_reflectivity,
+    /// power_accounting, [limits]).
+    #[arg(long, value_name = "FILE.toml")]
+    sensor: Option<PathBuf>,
+    /// Accept a file without eye-safety parameters (`limits.eye_safety:
+    /// null`); the verdict then says nothing about Class 1, and says so.
+    #[arg(long)]
+    no_eye_safety: bool,
+}
+
+fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
+    if let Some(name) = &a.preset {
+        let p = gaze_lidar::model::presets::preset(name)
+            .map_err(|e| CliError::input(format!("--preset: {e}")))?;
+        return Ok(Some(p.lidar));
+    }
+    if let Some(path) = &a.sensor {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::input(format!("--sensor {}: {e}", path.display())))?;
+        let spec: LidarSpec = toml::from_str(&text)
+            .map_err(|e| CliError::input(format!("--sensor {}: {}", path.display(), e.to_string().lines().collect::<Vec<_>>().join(" "))))?;
+        return Ok(Some(spec));
+    }
+    Ok(None)
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
@@ -39,7 +70,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         Profile::read_json(&a.file)?
     };
     let origin = a.file.display().to_string();
-    match certify(profile.clone()) {
+    let sensor = sensor_of(a)?;
+    let mut opts = CheckOptions::declared().allow_missing_eye_safety(a.no_eye_safety);
+    if let Some(s) = &sensor {
+        opts = CheckOptions::for_sensor(s).allow_missing_eye_safety(a.no_eye_safety);
+    }
+    match certify_with(profile.clone(), &opts) {
         Ok(c) => {
             let eye = profile
                 .limits
@@ -50,6 +86,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 Format::Json => {
                     let v = serde_json::json!({
                         "certified": true, "violations": [], "summary": c.summary(),
+                        "eye_safety_evaluated": eye.is_some(),
+                        "sensor": sensor.as_ref().map(|s| s.name.clone()),
                         "eye_safety": eye.as_ref().map(|r| serde_json::json!({
                             "worst_azimuth_deg": r.worst_azimuth_deg, "binding_rule": r.binding_rule,
                             "worst_ratio": r.worst_ratio, "margin": r.margin,
@@ -70,7 +108,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                             "eye safety: Class 1 at every azimuth; worst {:.3}° ({}), {:.1} % of the limit (margin {:.2}×)",
                             r.worst_azimuth_deg, r.binding_rule, 100.0 * r.worst_ratio, r.margin
                         ),
-                        None => println!("eye safety: not evaluated (limits.eye_safety is null)"),
+                        None => println!("eye safety: NOT evaluated (--no-eye-safety; limits.eye_safety is null): this verdict is not Class 1 evidence"),
                     }
                 }
             }
