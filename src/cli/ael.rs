@@ -104,7 +104,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             );
             o!(
                 "wavelength              {} nm ({:?})",
-                r.wavelength_nm, r.band
+                r.wavelength_nm,
+                r.band
             );
             o!("pulse duration          {:e} s", r.pulse_duration_s);
             o!("single-pulse AEL        {:.4e} J", r.single_pulse_ael_j);
@@ -113,7 +114,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             o!("T2 / T_i                {} s / {:e} s", r.t2_s, r.t_i_s);
             o!(
                 "aperture (Condition 3)  {} mm at {} mm",
-                r.aperture_diameter_mm, r.aperture_distance_mm
+                r.aperture_diameter_mm,
+                r.aperture_distance_mm
             );
             if let Some(s) = &r.stationary_beam {
                 o!("stationary beam         {} Hz: N = {:.0} in T2, C5 = {:.4}, per-pulse AEL {:.4e} J, max mean power {:.4e} W",

@@ -224,7 +224,12 @@ fn check_dir_writable(path: &Path, dir: &Path) -> Result<(), CliError> {
         .prefix(".gaze-lidar-check")
         .tempfile_in(dir)
         .map(drop)
-        .map_err(|e| out_err(path, format!("cannot create a file in {}: {e}", dir.display())))
+        .map_err(|e| {
+            out_err(
+                path,
+                format!("cannot create a file in {}: {e}", dir.display()),
+            )
+        })
 }
 
 /// Checks that every path can be written (see [`Outputs`]); nothing changes.

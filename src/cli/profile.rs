@@ -52,7 +52,7 @@ pub struct Args {
     /// Gaze azimuth, degrees CCW from straight ahead (ISO 8855). Omit for the baseline.
     #[arg(long, allow_hyphen_values = true)]
     gaze_deg: Option<f64>,
-    /// Number of equal bins (4..=36000); region boundaries are added as edges.
+    /// Number of equal bins (4..=36000; with the optimizer 4..=1440); region boundaries are added as edges.
     #[arg(long, default_value_t = 360, allow_negative_numbers = true)]
     bins: usize,
     /// Override the preset's power accounting.

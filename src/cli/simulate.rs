@@ -246,7 +246,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         outputs.add(path, sim::table::render_csv(&result).map_err(render)?);
     }
     if let Some(path) = &a.trials_csv {
-        outputs.add(path, sim::table::render_trials_csv(&result).map_err(render)?);
+        outputs.add(
+            path,
+            sim::table::render_trials_csv(&result).map_err(render)?,
+        );
     }
     if let Some(path) = &a.report {
         outputs.add(path, sim::report::render(&result, &config));

@@ -384,12 +384,12 @@ fn plan_variant(
     table: Option<&OptTable>,
 ) -> Result<(CertifiedProfile, f64), SimError> {
     match (variant.mode(), table) {
-        (Some(m), _) => variant_profile_for(sensor, model, m, gaze_deg, bins).map_err(|source| {
-            SimError::Plan {
+        (Some(m), _) => {
+            variant_profile_for(sensor, model, m, gaze_deg, bins).map_err(|source| SimError::Plan {
                 variant: variant.name(),
                 source,
-            }
-        }),
+            })
+        }
         (None, Some(t)) => t.plan(gaze_deg),
         (None, None) => Err(SimError::Argument(
             "the optimized variant needs the `solver` feature".into(),
