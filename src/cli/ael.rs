@@ -1,10 +1,11 @@
 //! `gaze-lidar ael`: Class 1 accessible emission limits.
 
 use clap::ValueEnum;
+use std::fmt::Write as _;
 
 use gaze_lidar::eye_safety::ael_report;
 
-use super::CliError;
+use super::{emit, CliError};
 
 /// Output format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -18,16 +19,16 @@ pub enum Format {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Wavelength, nm (700–1050 or 1400–1800).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     wavelength_nm: f64,
     /// Pulse duration, s.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pulse_duration_s: f64,
     /// Pulse rate, Hz: adds the figures for a stationary (stalled) beam.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pulse_rate_hz: Option<f64>,
     /// Beam diameter at 100 mm, mm: adds the scan pass angle.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     beam_diameter_mm: Option<f64>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -53,6 +54,14 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 "--pulse-rate-hz: {r} must be finite and > 0"
             )));
         }
+        // Pulses of this duration at this rate would overlap: not a pulse train.
+        if r * a.pulse_duration_s >= 1.0 {
+            return Err(CliError::input(format!(
+                "--pulse-rate-hz: {r:e} Hz × --pulse-duration-s {:e} s = {:e} >= 1: the pulses would overlap (the period must exceed the pulse duration)",
+                a.pulse_duration_s,
+                r * a.pulse_duration_s
+            )));
+        }
     }
     let pass_angle_deg = match a.beam_diameter_mm {
         Some(d) if d.is_finite() && d > 0.0 => Some(d),
@@ -73,41 +82,51 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     })?;
     let pass = pass_angle_deg
         .map(|d| ((r.aperture_diameter_mm + d) / r.aperture_distance_mm).to_degrees());
+    let mut text = String::new();
+    // Writing into a String cannot fail.
+    macro_rules! o {
+        ($($t:tt)*) => {{
+            let _ = writeln!(text, $($t)*);
+        }};
+    }
     match a.format {
         Format::Json => {
             let mut v = serde_json::to_value(&r).map_err(|e| CliError::input(e.to_string()))?;
             if let (Some(p), Some(obj)) = (pass, v.as_object_mut()) {
                 obj.insert("scan_pass_angle_deg".into(), serde_json::json!(p));
             }
-            println!("{v}");
+            o!("{v}");
         }
         Format::Table => {
-            println!(
+            o!(
                 "IEC 60825-1:2014 Class 1, small source (C6 = 1), time base {} s",
                 r.time_base_s
             );
-            println!(
+            o!(
                 "wavelength              {} nm ({:?})",
-                r.wavelength_nm, r.band
+                r.wavelength_nm,
+                r.band
             );
-            println!("pulse duration          {:e} s", r.pulse_duration_s);
-            println!("single-pulse AEL        {:.4e} J", r.single_pulse_ael_j);
-            println!("average-power AEL       {:.4e} W", r.average_power_ael_w);
-            println!("C4 / C6 / C7            {:.4} / {} / {}", r.c4, r.c6, r.c7);
-            println!("T2 / T_i                {} s / {:e} s", r.t2_s, r.t_i_s);
-            println!(
+            o!("pulse duration          {:e} s", r.pulse_duration_s);
+            o!("single-pulse AEL        {:.4e} J", r.single_pulse_ael_j);
+            o!("average-power AEL       {:.4e} W", r.average_power_ael_w);
+            o!("C4 / C6 / C7            {:.4} / {} / {}", r.c4, r.c6, r.c7);
+            o!("T2 / T_i                {} s / {:e} s", r.t2_s, r.t_i_s);
+            o!(
                 "aperture (Condition 3)  {} mm at {} mm",
-                r.aperture_diameter_mm, r.aperture_distance_mm
+                r.aperture_diameter_mm,
+                r.aperture_distance_mm
             );
             if let Some(s) = &r.stationary_beam {
-                println!("stationary beam         {} Hz: N = {:.0} in T2, C5 = {:.4}, per-pulse AEL {:.4e} J, max mean power {:.4e} W",
+                o!("stationary beam         {} Hz: N = {:.0} in T2, C5 = {:.4}, per-pulse AEL {:.4e} J, max mean power {:.4e} W",
                     s.pulse_rate_hz, s.pulses_in_t_max, s.c5, s.per_pulse_ael_j, s.max_average_power_w);
             }
             if let Some(p) = pass {
-                println!("scan pass angle         {p:.3}°");
+                o!("scan pass angle         {p:.3}°");
             }
-            println!("note: figures from public re-implementations of the 2014 tables; verify against the standard");
+            o!("note: figures from public re-implementations of the 2014 tables; verify against the standard");
         }
     }
+    emit(&text, None)?;
     Ok(0)
 }

@@ -1,7 +1,6 @@
 //! `gaze-lidar check`: verify a profile@1 file.
 
 use clap::ValueEnum;
-use std::io::Read;
 use std::path::PathBuf;
 
 use gaze_lidar::checker::{certify_with, summarize, CheckOptions};
@@ -9,6 +8,7 @@ use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::eye_safety::evaluate_profile;
 use gaze_lidar::profile::Profile;
 
+use super::io::{read_text, warn, Stdout, MAX_PROFILE_BYTES};
 use super::CliError;
 
 /// Report format.
@@ -50,8 +50,7 @@ fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
         return Ok(Some(p.lidar));
     }
     if let Some(path) = &a.sensor {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError::input(format!("--sensor {}: {e}", path.display())))?;
+        let text = read_text(path, super::io::MAX_CONFIG_BYTES)?;
         let spec: LidarSpec = toml::from_str(&text)
             .map_err(|e| CliError::input(format!("--sensor {}: {}", path.display(), e.to_string().lines().collect::<Vec<_>>().join(" "))))?;
         return Ok(Some(spec));
@@ -60,21 +59,20 @@ fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
+    let text = read_text(&a.file, MAX_PROFILE_BYTES)?;
     let profile = if a.file.as_os_str() == "-" {
-        let mut text = String::new();
-        std::io::stdin()
-            .read_to_string(&mut text)
-            .map_err(|e| CliError::input(format!("stdin: {e}")))?;
         Profile::from_json(&text, "<stdin>")?
     } else {
-        Profile::read_json(&a.file)?
+        Profile::from_json(&text, &a.file.display().to_string())?
     };
+    drop(text);
     let origin = a.file.display().to_string();
     let sensor = sensor_of(a)?;
     let mut opts = CheckOptions::declared().allow_missing_eye_safety(a.no_eye_safety);
     if let Some(s) = &sensor {
         opts = CheckOptions::for_sensor(s).allow_missing_eye_safety(a.no_eye_safety);
     }
+    let mut out = Stdout::new();
     match certify_with(profile.clone(), &opts) {
         Ok(c) => {
             let eye = profile
@@ -94,30 +92,31 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                             "stalled_rotor_ratio": r.stalled_rotor_ratio,
                         })),
                     });
-                    println!("{v}");
+                    out.line(v)?;
                 }
                 Format::Text => {
                     let s = c.summary();
-                    println!(
+                    out.line(format_args!(
                         "certified: {origin}: {} bins; average power {:.6e} W (angle) / {:.6e} W (time) of budget {:.6e} W ({}); frame period {:.9} s; max |spin accel| {} rad/s²",
                         profile.bins.len(), s.average_power_angle_w, s.average_power_time_w,
                         profile.average_power_w, profile.power_accounting, s.frame_period_s, s.max_spin_accel_rad_s2.map_or("∞ (steps)".to_owned(), |a| format!("{a:.4e}"))
-                    );
+                    ))?;
                     match &eye {
-                        Some(r) => println!(
+                        Some(r) => out.line(format_args!(
                             "eye safety: Class 1 at every azimuth; worst {:.3}° ({}), {:.1} % of the limit (margin {:.2}×)",
                             r.worst_azimuth_deg, r.binding_rule, 100.0 * r.worst_ratio, r.margin
-                        ),
-                        None => println!("eye safety: NOT evaluated (--no-eye-safety; limits.eye_safety is null): this verdict is not Class 1 evidence"),
+                        ))?,
+                        None => out.line("eye safety: NOT evaluated (--no-eye-safety; limits.eye_safety is null): this verdict is not Class 1 evidence")?,
                     }
                 }
             }
+            out.finish()?;
             if let Some(r) = &eye {
                 if r.stalled_rotor_ratio > 1.0 {
-                    eprintln!(
-                        "gaze-lidar: warning: a stalled rotor with the laser firing reaches {:.0} % of the Class 1 limit: the product needs a stall interlock",
+                    warn(format_args!(
+                        "warning: a stalled rotor with the laser firing reaches {:.0} % of the Class 1 limit: the product needs a stall interlock",
                         100.0 * r.stalled_rotor_ratio
-                    );
+                    ));
                 }
             }
             Ok(0)
@@ -137,18 +136,19 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                         })).collect::<Vec<_>>(),
                         "summary": summary,
                     });
-                    println!("{v}");
+                    out.line(v)?;
                 }
                 Format::Text => {
                     for v in &rej.violations {
-                        println!("violation: {v}");
+                        out.line(format_args!("violation: {v}"))?;
                     }
                 }
             }
-            eprintln!(
-                "gaze-lidar: {origin}: rejected, {} violation(s)",
+            out.finish()?;
+            warn(format_args!(
+                "{origin}: rejected, {} violation(s)",
                 rej.violations.len()
-            );
+            ));
             Ok(1)
         }
     }

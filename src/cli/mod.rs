@@ -2,11 +2,14 @@
 //!
 //! Exit codes: 0 success; 1 an infeasible request or a rejected profile
 //! (the limit is named); 2 bad input (argument, file, field; with line and
-//! column for files). Errors are one line on stderr; data goes to stdout or
-//! `--out` (written atomically: never a partial file).
+//! column for files); 1 also for a failed write (a full disk). Errors are
+//! one line on stderr; data goes to stdout or `--out` (written atomically
+//! over regular files: never a partial file; devices and FIFOs are written
+//! in place). A closed stdout pipe (`| head`) ends the output quietly.
 
 mod ael;
 mod check;
+pub mod io;
 mod profile;
 mod simulate;
 mod stream;
@@ -14,8 +17,6 @@ mod stream;
 use clap::{Parser, Subcommand};
 use std::path::Path;
 use std::process::ExitCode;
-
-use gaze_lidar::profile::write_atomic;
 
 /// An error with its exit code.
 #[derive(Debug)]
@@ -31,6 +32,13 @@ impl CliError {
     pub fn input(message: impl Into<String>) -> Self {
         Self {
             code: 2,
+            message: message.into(),
+        }
+    }
+    /// An output could not be written (exit 1).
+    pub fn output(message: impl Into<String>) -> Self {
+        Self {
+            code: 1,
             message: message.into(),
         }
     }
@@ -81,23 +89,42 @@ enum Command {
     Stream(stream::Args),
 }
 
-/// Writes `text` to `out` atomically, or to stdout.
+/// Writes `text` to `out` (see [`io::write_output`]), or to stdout.
 pub fn emit(text: &str, out: Option<&Path>) -> Result<(), CliError> {
     emit_bytes(text.as_bytes(), out)
 }
 
-/// Writes `bytes` to `out` atomically, or to stdout.
+/// Writes `bytes` to `out` (see [`io::write_output`]), or to stdout.
 pub fn emit_bytes(bytes: &[u8], out: Option<&Path>) -> Result<(), CliError> {
     match out {
-        Some(path) => write_atomic(path, bytes).map_err(|e| CliError::input(e.to_string())),
+        Some(path) => io::write_output(path, bytes),
         None => {
-            use std::io::Write;
-            let mut stdout = std::io::stdout().lock();
-            // A closed pipe (e.g. `| head`) is not an error worth a message.
-            let _ = stdout.write_all(bytes);
-            let _ = stdout.flush();
-            Ok(())
+            let mut stdout = io::Stdout::new();
+            stdout.bytes(bytes)?;
+            stdout.finish()
         }
+    }
+}
+
+/// clap's error as one line: the message with its indented continuation
+/// (e.g. the names of the missing arguments), without usage and tips.
+fn clap_line(e: &clap::Error) -> String {
+    let rendered = e.render().to_string();
+    let mut parts: Vec<&str> = Vec::new();
+    for (i, line) in rendered.lines().enumerate() {
+        let t = line.trim();
+        if t.is_empty() || t.starts_with("Usage:") || t.starts_with("For more information") {
+            break;
+        }
+        if i > 0 && !line.starts_with(' ') {
+            break;
+        }
+        parts.push(t.trim_start_matches("error: "));
+    }
+    if parts.is_empty() {
+        "invalid arguments".to_owned()
+    } else {
+        parts.join(" ")
     }
 }
 
@@ -113,12 +140,17 @@ pub fn main() -> ExitCode {
                     | ErrorKind::DisplayVersion
                     | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
             ) {
-                let _ = e.print();
-                return ExitCode::SUCCESS;
+                let text = e.render().to_string();
+                let mut out = io::Stdout::new();
+                return match out.bytes(text.as_bytes()).and_then(|()| out.finish()) {
+                    Ok(()) => ExitCode::SUCCESS,
+                    Err(e) => {
+                        io::warn(format!("error: {}", e.message));
+                        ExitCode::from(e.code)
+                    }
+                };
             }
-            let rendered = e.render().to_string();
-            let line = rendered.lines().next().unwrap_or("invalid arguments");
-            eprintln!("gaze-lidar: {}", line.trim_start_matches("error: "));
+            io::warn(clap_line(&e));
             return ExitCode::from(2);
         }
     };
@@ -132,7 +164,7 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
-            eprintln!("gaze-lidar: error: {}", e.message);
+            io::warn(format!("error: {}", e.message));
             ExitCode::from(e.code)
         }
     }

@@ -50,9 +50,9 @@ pub struct Args {
     #[arg(long)]
     config: Option<PathBuf>,
     /// Gaze azimuth, degrees CCW from straight ahead (ISO 8855). Omit for the baseline.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     gaze_deg: Option<f64>,
-    /// Number of equal bins (4..=36000); region boundaries are added as edges.
+    /// Number of equal bins (4..=36000; with the optimizer 4..=1440); region boundaries are added as edges.
     #[arg(long, default_value_t = 360, allow_negative_numbers = true)]
     bins: usize,
     /// Override the preset's power accounting.
@@ -65,10 +65,10 @@ pub struct Args {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Firmware timer frequency, Hz.
-    #[arg(long, default_value_t = 80_000_000)]
+    #[arg(long, default_value_t = 80_000_000, allow_negative_numbers = true)]
     tick_hz: u64,
     /// Firmware DAC step, W per code (default: power_w_max / 4095).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     power_w_per_code: Option<f64>,
 }
 
@@ -156,9 +156,12 @@ fn optimized(
         ));
     };
     let mut problem = match &a.config {
-        Some(path) => OptimizerConfig::read(path)
-            .and_then(|c| c.problem())
-            .map_err(err)?,
+        Some(path) => {
+            let text = super::io::read_text(path, super::io::MAX_CONFIG_BYTES)?;
+            OptimizerConfig::from_toml(&text, &path.display().to_string())
+                .and_then(|c| c.problem())
+                .map_err(err)?
+        }
         None => {
             Problem::paper_equivalent(preset, a.mode.unwrap_or(Mode::Range), a.bins).map_err(err)?
         }

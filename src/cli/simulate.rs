@@ -2,10 +2,12 @@
 
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 
 use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, Variant, FOG_LEVELS_PCT};
 
+use super::io::{read_text, validate_paths, warn, Outputs, MAX_CONFIG_BYTES};
 use super::{emit, CliError};
 
 /// Output format of the table.
@@ -31,13 +33,13 @@ pub struct Args {
     #[arg(long)]
     optimizer_config: Option<PathBuf>,
     /// Fog levels in % (paper labels 0, 25, 50); default all.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     fog: Vec<u32>,
     /// Trials per cell.
     #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
     trials: i64,
     /// Master seed (same seed → identical output).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     seed: u64,
     /// Scenario TOML (defaults: the paper's scene).
     #[arg(long)]
@@ -83,11 +85,51 @@ fn parse_k_of_n(s: &str) -> Result<KOfN, CliError> {
     Ok(KOfN { k, n })
 }
 
+/// Reads and validates the optimizer configuration (exit 2 for a bad file
+/// or key, 1 when the limits are infeasible — as `profile --config`).
+#[cfg(feature = "solver")]
+fn optimizer_problem(path: &Path) -> Result<gaze_lidar::optimizer::Problem, CliError> {
+    use gaze_lidar::optimizer::OptimizerConfig;
+    let text = read_text(path, MAX_CONFIG_BYTES)?;
+    OptimizerConfig::from_toml(&text, &path.display().to_string())
+        .and_then(|c| c.problem())
+        .map_err(|e| {
+            if e.is_input_error() {
+                CliError::input(e.to_string())
+            } else {
+                CliError::infeasible(e.to_string())
+            }
+        })
+}
+
+/// Checks that the plots folder exists and accepts files, or can be created.
+fn validate_plots_dir(dir: &Path) -> Result<(), CliError> {
+    let bad = |m: String| CliError::input(format!("--plots {}: {m}", dir.display()));
+    let mut probe = dir;
+    loop {
+        match std::fs::metadata(probe) {
+            Ok(m) if m.is_dir() => break,
+            Ok(_) => return Err(bad(format!("{} is not a directory", probe.display()))),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                probe = match probe.parent() {
+                    Some(p) if !p.as_os_str().is_empty() => p,
+                    _ => Path::new("."),
+                };
+            }
+            Err(e) => return Err(bad(e.to_string())),
+        }
+    }
+    tempfile::Builder::new()
+        .prefix(".gaze-lidar-check")
+        .tempdir_in(probe)
+        .map(drop)
+        .map_err(|e| bad(format!("cannot create files in {}: {e}", probe.display())))
+}
+
 pub fn run(a: &Args) -> Result<u8, CliError> {
     let scenario = match &a.scenario {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+            let text = read_text(path, MAX_CONFIG_BYTES)?;
             Scenario::from_toml(&text, &path.display().to_string())
                 .map_err(|e| CliError::input(e.to_string()))?
         }
@@ -106,17 +148,47 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             )));
         }
     }
+    let detection = parse_k_of_n(&a.detect)?;
+    let variants = if a.variant.is_empty() {
+        Variant::PAPER.to_vec()
+    } else {
+        a.variant.clone()
+    };
+    #[cfg(feature = "solver")]
+    let optimizer = match &a.optimizer_config {
+        Some(path) => {
+            if !variants.contains(&Variant::Optimized) {
+                return Err(CliError::input(
+                    "--optimizer-config configures the optimized variant: add --variant optimized",
+                ));
+            }
+            Some(optimizer_problem(path)?)
+        }
+        None => None,
+    };
+    #[cfg(not(feature = "solver"))]
+    if a.optimizer_config.is_some() {
+        return Err(CliError::input(
+            "--optimizer-config: this build has no solver (enable the `solver` feature)",
+        ));
+    }
+    // Every output path is checked before the run: a bad one fails now,
+    // and nothing is replaced.
+    let files: Vec<&Path> = [&a.export_json, &a.export_csv, &a.trials_csv, &a.report]
+        .into_iter()
+        .filter_map(|p| p.as_deref())
+        .collect();
+    validate_paths(files.iter().copied())?;
+    if let Some(dir) = &a.plots {
+        validate_plots_dir(dir)?;
+    }
     let config = SimConfig {
         models: if a.model.is_empty() {
             vec![ModelKind::Argus, ModelKind::Physical]
         } else {
             a.model.clone()
         },
-        variants: if a.variant.is_empty() {
-            Variant::PAPER.to_vec()
-        } else {
-            a.variant.clone()
-        },
+        variants,
         fog_pcts: if a.fog.is_empty() {
             FOG_LEVELS_PCT.to_vec()
         } else {
@@ -125,59 +197,107 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         trials: a.trials as usize,
         seed: a.seed,
         scenario,
-        detection: parse_k_of_n(&a.detect)?,
+        detection,
         brute_force: a.brute_force,
+        #[cfg(feature = "solver")]
+        optimizer,
         ..SimConfig::default()
     };
     let total =
         (config.models.len() * config.variants.len() * config.fog_pcts.len() * config.trials)
             as u64;
-    // Hidden automatically when stderr is not a terminal.
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} simulating [{bar:40}] {pos}/{len} trials ({eta})")
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(total);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} simulating [{bar:40}] {pos}/{len} trials ({eta})",
+            )
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> "),
-    );
-    let result = sim::run(&config, &|| bar.inc(1)).map_err(|e| match e {
-        sim::SimError::Plan { .. } => CliError::infeasible(e.to_string()),
-        other => CliError::input(other.to_string()),
-    })?;
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let result = sim::run(&config, &|| bar.inc(1)).map_err(|e| {
+        if e.is_input_error() {
+            CliError::input(e.to_string())
+        } else {
+            CliError::infeasible(e.to_string())
+        }
+    });
     bar.finish_and_clear();
+    let result = result?;
+    let render = |e: csv::Error| CliError::input(e.to_string());
     let text = match a.format {
         Format::Table => sim::table::render_table(&result),
         Format::Json => {
             sim::table::render_json(&result).map_err(|e| CliError::input(e.to_string()))?
         }
-        Format::Csv => {
-            sim::table::render_csv(&result).map_err(|e| CliError::input(e.to_string()))?
-        }
+        Format::Csv => sim::table::render_csv(&result).map_err(render)?,
     };
-    emit(&text, None)?;
+    // Everything is rendered and staged before anything is replaced.
+    let mut outputs = Outputs::default();
     if let Some(path) = &a.export_json {
         let json = sim::table::render_json(&result).map_err(|e| CliError::input(e.to_string()))?;
-        emit(&json, Some(path))?;
+        outputs.add(path, json);
     }
     if let Some(path) = &a.export_csv {
-        let csv = sim::table::render_csv(&result).map_err(|e| CliError::input(e.to_string()))?;
-        emit(&csv, Some(path))?;
+        outputs.add(path, sim::table::render_csv(&result).map_err(render)?);
     }
     if let Some(path) = &a.trials_csv {
-        let csv =
-            sim::table::render_trials_csv(&result).map_err(|e| CliError::input(e.to_string()))?;
-        emit(&csv, Some(path))?;
-    }
-    if let Some(dir) = &a.plots {
-        let written = sim::plots::write_all(&result, &config, dir)
-            .map_err(|e| CliError::input(e.to_string()))?;
-        for p in written {
-            eprintln!("gaze-lidar: wrote {}", p.display());
-        }
+        outputs.add(
+            path,
+            sim::table::render_trials_csv(&result).map_err(render)?,
+        );
     }
     if let Some(path) = &a.report {
-        let md = sim::report::render(&result, &config);
-        emit(&md, Some(path))?;
-        eprintln!("gaze-lidar: wrote {}", path.display());
+        outputs.add(path, sim::report::render(&result, &config));
+    }
+    let plots = match &a.plots {
+        Some(dir) => Some(stage_plots(&result, &config, dir)?),
+        None => None,
+    };
+    emit(&text, None)?;
+    outputs.commit()?;
+    if let Some(path) = &a.report {
+        warn(format_args!("wrote {}", path.display()));
+    }
+    if let (Some(dir), Some((staging, names))) = (&a.plots, plots) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| CliError::output(format!("--plots {}: {e}", dir.display())))?;
+        for name in names {
+            let dest = dir.join(&name);
+            std::fs::rename(staging.path().join(&name), &dest)
+                .map_err(|e| CliError::output(format!("{}: {e}", dest.display())))?;
+            warn(format_args!("wrote {}", dest.display()));
+        }
     }
     Ok(0)
+}
+
+/// Renders the plots into a temporary folder beside `dir` (moved in at the end).
+fn stage_plots(
+    result: &sim::GridResult,
+    config: &SimConfig,
+    dir: &Path,
+) -> Result<(tempfile::TempDir, Vec<std::ffi::OsString>), CliError> {
+    let mut base = dir;
+    while !base.is_dir() {
+        base = match base.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+    }
+    let staging = tempfile::Builder::new()
+        .prefix(".gaze-lidar-plots")
+        .tempdir_in(base)
+        .map_err(|e| CliError::input(format!("--plots {}: {e}", dir.display())))?;
+    let written = sim::plots::write_all(result, config, staging.path())
+        .map_err(|e| CliError::output(e.to_string()))?;
+    let names = written
+        .iter()
+        .filter_map(|p| p.file_name().map(std::ffi::OsStr::to_os_string))
+        .collect();
+    Ok((staging, names))
 }

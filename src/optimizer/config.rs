@@ -1,7 +1,7 @@
 //! TOML configuration of an optimization problem.
 //!
 //! ```toml
-//! bins = 360                       # equal bins (4..=36000)
+//! bins = 360                       # equal bins (4..=1440, MAX_OPTIMIZER_BINS)
 //!
 //! [lidar]                          # a preset, then overrides of its fields
 //! preset = "paper"                 # "paper" or "vls128"
@@ -220,6 +220,8 @@ impl OptimizerConfig {
                 });
             }
         }
+        let bins = self.bins.unwrap_or(360);
+        super::validate_bins(bins, "bins")?;
         if o.mode == crate::planner::Mode::Baseline {
             return Err(OptError::Invalid {
                 field: "objective.mode".into(),
@@ -231,7 +233,7 @@ impl OptimizerConfig {
             focus,
             levels: self.levels.clone(),
             objective: self.objective.clone(),
-            bins: self.bins.unwrap_or(360),
+            bins,
         })
     }
 }

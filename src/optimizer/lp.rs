@@ -50,6 +50,7 @@ struct Grid {
 }
 
 fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
+    super::validate_bins(problem.bins, "bins")?;
     let b = Binning::uniform(problem.bins).map_err(|e| OptError::Invalid {
         field: "bins".into(),
         reason: e.to_string(),

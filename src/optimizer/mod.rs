@@ -106,6 +106,29 @@ pub struct Levels {
     pub spin_rad_s: Vec<f64>,
 }
 
+/// Most bins the optimizer accepts (0.25° bins). The profile format and
+/// the closed forms go to `model::angle::MAX_BINS` (36,000), but the LP
+/// grows with the bin count and with the eye-safety windows aligned with
+/// every bin edge, and its solve time grows faster than linearly: measured
+/// on a shared 2-core machine, 1,440 bins ≈ 4.5 s of CPU, 3,600 bins
+/// ≈ 22 s, 36,000 bins did not finish in 20 s. 1,440 keeps a solve in seconds.
+pub const MAX_OPTIMIZER_BINS: usize = 1440;
+
+/// Checks the optimizer's bin count (`field` names it in the error).
+pub fn validate_bins(bins: usize, field: &str) -> Result<(), OptError> {
+    if (crate::model::angle::MIN_BINS..=MAX_OPTIMIZER_BINS).contains(&bins) {
+        Ok(())
+    } else {
+        Err(OptError::Invalid {
+            field: field.into(),
+            reason: format!(
+                "{bins} must lie in [{}, {MAX_OPTIMIZER_BINS}] for the optimizer (its solve time grows faster than linearly with the bin count)",
+                crate::model::angle::MIN_BINS
+            ),
+        })
+    }
+}
+
 /// A complete optimization problem (everything but the gaze).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Problem {

@@ -55,6 +55,36 @@ pub enum SimError {
     /// Bad argument.
     #[error("{0}")]
     Argument(String),
+    /// The optimized variant's problem is invalid (`input`) or infeasible.
+    #[error("optimized variant: {message}")]
+    Optimizer {
+        /// What is wrong (names the key or the limit).
+        message: String,
+        /// A configuration fault (exit 2) rather than infeasibility (exit 1).
+        input: bool,
+    },
+}
+
+impl SimError {
+    /// Input fault (exit 2) rather than infeasibility (exit 1).
+    #[must_use]
+    pub fn is_input_error(&self) -> bool {
+        match self {
+            Self::Plan { source, .. } => source.is_input_error(),
+            Self::Optimizer { input, .. } => *input,
+            _ => true,
+        }
+    }
+}
+
+#[cfg(feature = "solver")]
+impl From<crate::optimizer::OptError> for SimError {
+    fn from(e: crate::optimizer::OptError) -> Self {
+        Self::Optimizer {
+            input: e.is_input_error(),
+            message: e.to_string(),
+        }
+    }
 }
 
 /// A LiDAR variant of the experiment.
@@ -130,6 +160,10 @@ pub struct SimConfig {
     pub brute_force: bool,
     /// Bins of the closed-form profiles.
     pub bins: usize,
+    /// The sensor and driver model of the closed-form variants (regions,
+    /// rated range, reference reflectivity, channels); the `optimized`
+    /// variant uses its problem's sensor and focus model.
+    pub sensor: Preset,
 }
 
 impl Default for SimConfig {
@@ -146,12 +180,15 @@ impl Default for SimConfig {
             detection: KOfN::default(),
             brute_force: false,
             bins: 360,
+            sensor: presets::paper(),
         }
     }
 }
 
 /// Points per second of the ARGUS resolution variant (all channels).
 pub const ARGUS_RESOLUTION_POINTS_PER_S: f64 = 687_500.0;
+/// Spin of the ARGUS baseline, Hz.
+pub const ARGUS_BASELINE_FRAME_HZ: f64 = 20.0;
 /// Spin of the ARGUS resolution variant, Hz.
 pub const ARGUS_RESOLUTION_FRAME_HZ: f64 = 27.5;
 /// The ARGUS resolution variant keeps 1 in 5.4 points inside the RoF.
@@ -174,13 +211,26 @@ pub fn variant_profile(
     gaze_deg: f64,
     bins: usize,
 ) -> Result<(CertifiedProfile, f64), PlanError> {
-    let paper = presets::paper();
+    variant_profile_for(&presets::paper(), model, variant, gaze_deg, bins)
+}
+
+/// [`variant_profile`] for any sensor: the `argus` resolution variant
+/// scales the sensor's spin and point rate by 27.5 / 20 (the paper code's
+/// ratio; for the paper's sensor exactly its 27.5 Hz and 687,500 points/s).
+pub fn variant_profile_for(
+    sensor: &Preset,
+    model: ModelKind,
+    variant: Mode,
+    gaze_deg: f64,
+    bins: usize,
+) -> Result<(CertifiedProfile, f64), PlanError> {
+    let paper = sensor.clone();
     match (model, variant) {
         (ModelKind::Argus, Mode::Resolution | Mode::Joint) => {
             let mut p: Preset = paper;
-            let channels = f64::from(p.lidar.channels);
-            p.lidar.frame_rate_hz = ARGUS_RESOLUTION_FRAME_HZ;
-            p.lidar.pulse_rate_hz = ARGUS_RESOLUTION_POINTS_PER_S / channels;
+            let ratio = ARGUS_RESOLUTION_FRAME_HZ / ARGUS_BASELINE_FRAME_HZ;
+            p.lidar.frame_rate_hz *= ratio;
+            p.lidar.pulse_rate_hz *= ratio;
             let mode = if variant == Mode::Joint {
                 Mode::Range
             } else {
@@ -326,6 +376,7 @@ impl GridResult {
 
 /// Plans the trial's profile for any variant.
 fn plan_variant(
+    sensor: &Preset,
     model: ModelKind,
     variant: Variant,
     gaze_deg: f64,
@@ -334,7 +385,7 @@ fn plan_variant(
 ) -> Result<(CertifiedProfile, f64), SimError> {
     match (variant.mode(), table) {
         (Some(m), _) => {
-            variant_profile(model, m, gaze_deg, bins).map_err(|source| SimError::Plan {
+            variant_profile_for(sensor, model, m, gaze_deg, bins).map_err(|source| SimError::Plan {
                 variant: variant.name(),
                 source,
             })
@@ -348,15 +399,24 @@ fn plan_variant(
 
 /// The optimized variant's shared solutions.
 #[cfg(feature = "solver")]
-struct OptTable(crate::optimizer::fast::PhaseTable);
+struct OptTable {
+    table: crate::optimizer::fast::PhaseTable,
+    /// The problem's sensor and focus model.
+    sensor: Preset,
+}
 
 #[cfg(feature = "solver")]
 impl OptTable {
     fn plan(&self, gaze_deg: f64) -> Result<(CertifiedProfile, f64), SimError> {
-        self.0
+        self.table
             .plan(gaze_deg)
             .map(|c| (c, 1.0))
-            .map_err(|e| SimError::Argument(format!("optimized variant: {e}")))
+            .map_err(SimError::from)
+    }
+
+    /// The sensor and driver model of the optimized variant.
+    fn sensor(&self, _base: &Preset) -> Preset {
+        self.sensor.clone()
     }
 
     fn build(config: &SimConfig) -> Result<Option<Self>, SimError> {
@@ -365,14 +425,19 @@ impl OptTable {
         }
         let problem = match &config.optimizer {
             Some(p) => p.clone(),
-            None => default_optimized_problem(config.bins),
+            None => default_optimized_problem_for(&config.sensor, config.bins),
         };
         let gazes: Vec<f64> = (0..config.trials)
             .map(|t| draw(config.seed, t, &config.scenario).gaze_deg)
             .collect();
+        let sensor = Preset {
+            lidar: problem.lidar.clone(),
+            focus: problem.focus.clone(),
+            levels: config.sensor.levels.clone(),
+        };
         crate::optimizer::fast::PhaseTable::build(&problem, &gazes)
-            .map(|t| Some(Self(t)))
-            .map_err(|e| SimError::Argument(format!("optimized variant: {e}")))
+            .map(|table| Some(Self { table, sensor }))
+            .map_err(SimError::from)
     }
 }
 
@@ -380,9 +445,15 @@ impl OptTable {
 #[cfg(feature = "solver")]
 #[must_use]
 pub fn default_optimized_problem(bins: usize) -> crate::optimizer::Problem {
-    let paper = presets::paper();
+    default_optimized_problem_for(&presets::paper(), bins)
+}
+
+/// The default problem of the `optimized` variant for a sensor.
+#[cfg(feature = "solver")]
+#[must_use]
+pub fn default_optimized_problem_for(sensor: &Preset, bins: usize) -> crate::optimizer::Problem {
     crate::optimizer::Problem {
-        lidar: paper.lidar,
+        lidar: sensor.lidar.clone(),
         focus: crate::model::acuity::FocusModel::levi_e2_with_width(60.0),
         levels: crate::optimizer::Levels::default(),
         objective: crate::optimizer::Objective::default(),
@@ -401,6 +472,10 @@ impl OptTable {
         ))
     }
 
+    fn sensor(&self, base: &Preset) -> Preset {
+        base.clone()
+    }
+
     fn build(config: &SimConfig) -> Result<Option<Self>, SimError> {
         if config.variants.contains(&Variant::Optimized) {
             return Err(SimError::Argument(
@@ -408,6 +483,14 @@ impl OptTable {
             ));
         }
         Ok(None)
+    }
+}
+
+/// The sensor and driver model a variant runs with.
+fn sensor_for<'a>(variant: Variant, optimized: Option<&'a Preset>, base: &'a Preset) -> &'a Preset {
+    match (variant, optimized) {
+        (Variant::Optimized, Some(s)) => s,
+        _ => base,
     }
 }
 
@@ -435,12 +518,11 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
     // Plan every variant once up front so a bad one fails before any work.
     for &m in &config.models {
         for v in config.variants.iter().filter_map(|v| v.mode()) {
-            variant_profile(m, v, config.scenario.gaze_deg, config.bins).map_err(|source| {
-                SimError::Plan {
+            variant_profile_for(&config.sensor, m, v, config.scenario.gaze_deg, config.bins)
+                .map_err(|source| SimError::Plan {
                     variant: v.name(),
                     source,
-                }
-            })?;
+                })?;
         }
     }
     let table = OptTable::build(config)?;
@@ -460,24 +542,27 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
         }
     }
     let statics = config.scenario.static_boxes();
-    let paper = presets::paper();
+    let opt_sensor = table.as_ref().map(|t| t.sensor(&config.sensor));
+    let sensor_of = |v: Variant| sensor_for(v, opt_sensor.as_ref(), &config.sensor);
     let records: Result<Vec<TrialRecord>, SimError> = jobs
         .par_iter()
         .map(|job| {
             let d = draw(config.seed, job.trial, &config.scenario);
+            let sensor = sensor_of(job.variant);
             let (profile, rof_keep) = plan_variant(
+                &config.sensor,
                 job.model,
                 job.variant,
                 d.gaze_deg,
                 config.bins,
                 table.as_ref(),
             )?;
-            let regions = paper.focus.regions(d.gaze_deg);
+            let regions = sensor.focus.regions(d.gaze_deg);
             let model = ReturnModel::new(
                 job.model,
                 job.fog,
-                paper.lidar.rated_range_m,
-                paper.lidar.reference_reflectivity,
+                sensor.lidar.rated_range_m,
+                sensor.lidar.reference_reflectivity,
             );
             let setup = trial::TrialSetup {
                 scenario: &config.scenario,
@@ -502,10 +587,15 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
         })
         .collect();
     let records = records?;
-    let channels = f64::from(paper.lidar.channels);
     let mut rows = Vec::new();
     for chunk in records.chunks(config.trials) {
         let first = &chunk[0];
+        let variant = if first.variant == Variant::Optimized.name() {
+            Variant::Optimized
+        } else {
+            Variant::Baseline
+        };
+        let channels = f64::from(sensor_of(variant).lidar.channels);
         let right: Vec<f64> = chunk.iter().filter_map(|r| r.outcome.tta_s[1]).collect();
         let left: Vec<f64> = chunk.iter().filter_map(|r| r.outcome.tta_s[0]).collect();
         let hybrid_r: Vec<f64> = chunk

@@ -8,7 +8,6 @@ use std::fmt::Write;
 use super::returns::{FogLevel, ReturnModel};
 use super::{GridResult, ModelKind, Row, SimConfig};
 use crate::model::lidar::PowerAccounting;
-use crate::model::presets;
 use crate::planner::closed_form::levels;
 use crate::planner::{closed_form, Mode};
 
@@ -39,7 +38,7 @@ fn median_gain(r: &GridResult, m: ModelKind, fog: u32, variant: &str) -> Option<
 pub fn render(r: &GridResult, config: &SimConfig) -> String {
     let mut s = String::new();
     let sc = &config.scenario;
-    let paper = presets::paper();
+    let paper = config.sensor.clone();
     let _ = writeln!(
         s,
         "# Reproduction report: gaze-aware LiDAR at a T-intersection in fog\n"

@@ -27,6 +27,14 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+/// Slowest vehicle speed accepted, km/h.
+pub const MIN_SPEED_KMH: f64 = 1.0;
+/// Fastest vehicle speed accepted, km/h.
+pub const MAX_SPEED_KMH: f64 = 500.0;
+/// Longest simulated time of one trial, s (the paper's scene: ≈ 6.6 s; each
+/// simulated second costs ≈ 10^4 ray casts per channel).
+pub const MAX_SIMULATED_S: f64 = 120.0;
+
 /// Scenario parameters (TOML); defaults reproduce the paper's scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -108,6 +116,14 @@ pub enum ScenarioError {
         value: f64,
         /// Why.
         reason: &'static str,
+    },
+    /// A trial would simulate too long.
+    #[error("scenario: a trial would simulate {seconds:.4e} s (bend_distance_m + start_offset_m[1] − conflict_half_width_m at speed_kmh), more than the {max} s maximum: raise speed_kmh or shorten the distances")]
+    Duration {
+        /// Simulated time of the slowest trial, s.
+        seconds: f64,
+        /// The maximum, s.
+        max: f64,
     },
     /// File unreadable.
     #[error("{path}: {source}")]
@@ -228,7 +244,30 @@ impl Scenario {
                 "must lie beyond the corner buildings",
             );
         }
+        if !(MIN_SPEED_KMH..=MAX_SPEED_KMH).contains(&self.speed_kmh) {
+            return bad(
+                "speed_kmh",
+                self.speed_kmh,
+                "must lie in [1, 500] km/h (a slower car makes a trial simulate hours of pulses)",
+            );
+        }
+        let t = self.max_duration_s();
+        if t.is_nan() || t > MAX_SIMULATED_S {
+            return Err(ScenarioError::Duration {
+                seconds: t,
+                max: MAX_SIMULATED_S,
+            });
+        }
         Ok(())
+    }
+
+    /// The longest simulated time of a trial: until the later car, starting
+    /// at the far end of `start_offset_m` beyond the bend, reaches the
+    /// conflict zone at `speed_kmh`, s.
+    #[must_use]
+    pub fn max_duration_s(&self) -> f64 {
+        (self.bend_distance_m + self.start_offset_m[1] - self.conflict_half_width_m)
+            / self.speed_m_s()
     }
 
     /// Vehicle speed, m/s.
