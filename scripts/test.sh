@@ -5,5 +5,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cargo test --release --all-targets "$@"
-cargo test --release --doc
+cargo test --release --workspace --all-targets "$@"
+cargo test --release --workspace --doc

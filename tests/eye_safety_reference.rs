@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 //! Differential soundness test of the eye-safety checker against an
 //! independent brute-force reference (tests/reference/mod.rs).
 //!

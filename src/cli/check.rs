@@ -4,8 +4,8 @@ use clap::ValueEnum;
 use std::path::PathBuf;
 
 use gaze_lidar::checker::{certify_with, summarize, CheckOptions};
-use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::eye_safety::evaluate_profile;
+use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::profile::Profile;
 
 use super::io::{read_text, warn, Stdout, MAX_PROFILE_BYTES};
@@ -51,8 +51,13 @@ fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
     }
     if let Some(path) = &a.sensor {
         let text = read_text(path, super::io::MAX_CONFIG_BYTES)?;
-        let spec: LidarSpec = toml::from_str(&text)
-            .map_err(|e| CliError::input(format!("--sensor {}: {}", path.display(), e.to_string().lines().collect::<Vec<_>>().join(" "))))?;
+        let spec: LidarSpec = toml::from_str(&text).map_err(|e| {
+            CliError::input(format!(
+                "--sensor {}: {}",
+                path.display(),
+                e.to_string().lines().collect::<Vec<_>>().join(" ")
+            ))
+        })?;
         return Ok(Some(spec));
     }
     Ok(None)

@@ -221,6 +221,45 @@ pub fn optimize(problem: &Problem, gaze_deg: f64) -> Result<CertifiedProfile, Op
         field: "gaze-deg".into(),
         reason: e.to_string(),
     })?;
-    let profile = lp::solve(problem, gaze_deg)?;
+    let mut profile = lp::solve(problem, gaze_deg)?;
+    fit_to_eye_safety_bound(&mut profile);
     Ok(certify(profile)?)
+}
+
+/// Relative head-room left under the Class 1 limit after fitting, so that a
+/// rotated copy of a fitted profile (the fast path) still certifies.
+const EYE_SAFETY_HEADROOM: f64 = 1e-6;
+
+/// The LP's eye-safety rows are a linear surrogate (per-window energy and
+/// pulse caps); the verdict belongs to the one eye-safety model of the core.
+/// Every rule of that model is linear in power, so when the solved profile
+/// exceeds it, scaling every bin's power by `(1 − headroom)/ratio` brings it
+/// just under the limit (a lower power never breaks the budget or the slew
+/// limit; a power floor may make it infeasible, which the checker reports).
+pub(crate) fn fit_to_eye_safety_bound(profile: &mut crate::profile::Profile) {
+    let Some(params) = profile.limits.eye_safety.clone() else {
+        return;
+    };
+    let Ok(report) = crate::eye_safety::evaluate_profile(profile, &params) else {
+        return;
+    };
+    let target = 1.0 - EYE_SAFETY_HEADROOM;
+    let floor = profile.limits.power_w_min.max(0.0);
+    let mut ratio = report.worst_ratio;
+    // Scale the power above the floor; a few rounds settle it (the floor's
+    // own share does not scale).
+    for _ in 0..8 {
+        if ratio <= target {
+            break;
+        }
+        let scale = target / ratio;
+        for b in &mut profile.bins {
+            b.power_w = floor + (b.power_w - floor).max(0.0) * scale;
+        }
+        profile.summary = None;
+        match crate::eye_safety::evaluate_profile(profile, &params) {
+            Ok(r) => ratio = r.worst_ratio,
+            Err(_) => return,
+        }
+    }
 }

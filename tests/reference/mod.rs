@@ -353,7 +353,7 @@ impl Train {
         let hi = ((t2 - r.t_first) * self.fp + TOL)
             .floor()
             .min((r.n - 1) as f64);
-        (hi >= lo).then(|| (lo as u64, hi as u64))
+        (hi >= lo).then_some((lo as u64, hi as u64))
     }
 
     /// The pulses with time in [t1, t2]: (energy, count, first time, last time).

@@ -156,7 +156,7 @@ impl Laser {
         slope_w: f64,
         cap_j: f64,
     ) -> (f64, f64) {
-        if !(t1 >= t0) {
+        if t1.is_nan() || t0.is_nan() || t1 < t0 {
             return (0.0, t0);
         }
         let energy = |t: f64| (e0_j + slope_w * (t - t0)).min(cap_j);
@@ -568,9 +568,8 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
             w
         }
     };
-    for i in 0..n {
-        let a = segs[i].start_deg;
-        let t = clock.cum_s[i];
+    for (seg, &t) in segs.iter().zip(&clock.cum_s) {
+        let a = seg.start_deg;
         cuts.push(wrap(a + h));
         cuts.push(wrap(a - h));
         cuts.push(wrap(clock.angle_at(t + delta) + h));

@@ -219,7 +219,7 @@ mod verification {
     #[cfg_attr(not(kani), test)]
     fn decode_never_panics() {
         bolero::check!()
-            .with_type::<([u8; 104], u8)>()
+            .with_type::<([u8; 136], u8)>()
             .cloned()
             .for_each(|(raw, len)| {
                 let mut bytes = raw.to_vec();
@@ -231,6 +231,8 @@ mod verification {
                     bytes[7] = 0;
                     bytes[24..32].copy_from_slice(&1.0f64.to_le_bytes());
                     bytes[60..64].copy_from_slice(&1u32.to_le_bytes());
+                    // Eye-safety fields absent: all zero (flag byte 7 is 0).
+                    bytes[72..96].fill(0);
                 }
                 let len = usize::from(len) % (bytes.len() + 1);
                 match decode(&bytes[..len]) {
