@@ -322,7 +322,7 @@ impl FirmwareTable {
 /// Codes never go below `power_code_min`; if that is not enough the table is
 /// rejected by [`check_table`].
 fn lower_codes_for_eye_safety(table: &mut FirmwareTable) -> Result<(), FirmwareError> {
-    for _ in 0..4 {
+    for _ in 0..16 {
         let Some(report) = table_exposure(table) else {
             return Ok(());
         };
@@ -333,7 +333,7 @@ fn lower_codes_for_eye_safety(table: &mut FirmwareTable) -> Result<(), FirmwareE
         if report.worst_ratio <= 1.0 {
             return Ok(());
         }
-        let scale = 1.0 / report.worst_ratio;
+        let scale = (1.0 - 1e-6) / report.worst_ratio;
         let min = table.limits.power_code_min;
         for b in &mut table.bins {
             let lowered = (f64::from(b.power_code) * scale).floor() as u32;
