@@ -499,8 +499,9 @@ impl Envelope {
         self.p_w.len()
     }
 
-    /// `∫₀^t P̄` for unwrapped `t`.
-    fn integral_to(&self, t: f64) -> f64 {
+    /// For unwrapped `t`: whole periods before it, its offset in the
+    /// period, and the piece containing that offset.
+    fn locate(&self, t: f64) -> (f64, f64, usize) {
         let k = (t / self.frame_s).floor();
         let r = t - k * self.frame_s;
         let j = self
@@ -508,7 +509,18 @@ impl Envelope {
             .partition_point(|&c| c <= r)
             .saturating_sub(1)
             .min(self.pieces() - 1);
+        (k, r, j)
+    }
+
+    /// `∫₀^t P̄` for unwrapped `t`.
+    fn integral_to(&self, t: f64) -> f64 {
+        let (k, r, j) = self.locate(t);
         k * self.cum_j[self.pieces()] + self.cum_j[j] + self.p_w[j] * (r - self.t_s[j])
+    }
+
+    /// `P̄` on the piece containing unwrapped `t`.
+    fn power_at(&self, t: f64) -> f64 {
+        self.p_w[self.locate(t).2]
     }
 
     /// Unwrapped breakpoint `idx` (piece starts, periodic).
@@ -610,8 +622,8 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
             al + bl * (mid - h - anchor(&clock, mid - h, jl)) - bl * mid,
             bl,
         );
-        let pr = env_p_at(&env, clock.time_at(mid + h) + delta);
-        let pl = env_p_at(&env, clock.time_at(mid - h));
+        let pr = env.power_at(clock.time_at(mid + h) + delta);
+        let pl = env.power_at(clock.time_at(mid - h));
         let mut pts = vec![u, v];
         for (wr, wl) in [(1.0, 1.0), (pr, pl)] {
             // wr²·ω²(φ − h) = wl²·ω²(φ + h)
@@ -699,18 +711,6 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
 fn anchor(clock: &Clock<'_>, theta: f64, j: usize) -> f64 {
     let (k, _, _) = clock.locate(theta);
     360.0 * k + clock.segs[j].start_deg
-}
-
-/// `P̄` on the piece containing unwrapped time `t`.
-fn env_p_at(env: &Envelope, t: f64) -> f64 {
-    let k = (t / env.frame_s).floor();
-    let r = t - k * env.frame_s;
-    let j = env
-        .t_s
-        .partition_point(|&c| c <= r)
-        .saturating_sub(1)
-        .min(env.pieces() - 1);
-    env.p_w[j]
 }
 
 /// Highest power of the bins meeting the closed unwrapped arc `[lo, hi]`
