@@ -153,7 +153,9 @@ pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
             beam_diameter_mm: es[2].ok_or_else(short)?,
         })
     } else {
-        if es.iter().any(|x| *x != Some(0.0)) {
+        // Absent means all-zero bytes (so -0.0 is not accepted: it would
+        // re-encode differently).
+        if es.iter().any(|x| x.map(f64::to_bits) != Some(0)) {
             return Err(DecodeError::Reserved(0));
         }
         None
@@ -319,5 +321,21 @@ mod verification {
             });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["three records"]);
+    }
+
+    /// Found by the fuzz smoke: with the eye-safety flag clear, a -0.0 in
+    /// the parameter fields decoded, then re-encoded as +0.0.
+    #[cfg(not(kani))]
+    #[test]
+    fn absent_eye_safety_fields_must_be_zero_bytes() {
+        let mut bytes = vec![0u8; HEADER_LEN + RECORD_LEN];
+        bytes[0..4].copy_from_slice(MAGIC);
+        bytes[4..6].copy_from_slice(&VERSION.to_le_bytes());
+        bytes[24..32].copy_from_slice(&1.0f64.to_le_bytes());
+        bytes[60..64].copy_from_slice(&1u32.to_le_bytes());
+        let t = decode(&bytes).unwrap();
+        assert_eq!(encode(&t), bytes);
+        bytes[80..88].copy_from_slice(&(-0.0f64).to_le_bytes());
+        assert!(decode(&bytes).is_err());
     }
 }
