@@ -65,6 +65,14 @@ pub fn max_pulses_in(len_s: f64, f_p: f64) -> f64 {
     floor_up(len_s * f_p) + 1.0
 }
 
+/// Greatest number of passes (of up to `pass_s` each, one per frame of
+/// `frame_s`) that meet a window of `window_s`: `⌊(T + τ)/T_f⌋ + 1`
+/// (rounded up).
+#[must_use]
+pub fn passes_in_window(window_s: f64, pass_s: f64, frame_s: f64) -> f64 {
+    floor_up((window_s + pass_s) / frame_s) + 1.0
+}
+
 /// The laser and band constants every rule needs.
 #[derive(Debug, Clone, Copy)]
 pub struct Laser {
@@ -593,8 +601,7 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
     let energy = |phi: f64| {
         env.integral_to(clock.time_at(phi + h) + delta) - env.integral_to(clock.time_at(phi - h))
     };
-    let passes_t2 =
-        |tau_s: f64| floor_up((ael::T2_S.min(ael::TIME_BASE_S) + tau_s) / frame_s) + 1.0;
+    let passes_t2 = |tau_s: f64| passes_in_window(ael::T2_S.min(ael::TIME_BASE_S), tau_s, frame_s);
 
     let mut single = (0.0f64, 0.0f64); // (ratio, azimuth)
     let mut e_max = (0.0f64, 0.0f64); // (energy, azimuth)
