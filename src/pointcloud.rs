@@ -181,6 +181,7 @@ impl BinLookup {
     }
 
     /// The last bin whose start is at or before `key` (0 if none).
+    #[inline]
     fn index(&self, starts: &[f64], key: f64) -> usize {
         let c = ((key * self.per_unit) as usize).min(Self::CELLS - 1);
         // The cell's own start may round above the key: step back if needed.
@@ -198,6 +199,7 @@ impl BinLookup {
 /// A monotone stand-in for the azimuth of (x, y_left) in `[0, 4)` (0 ahead,
 /// 1 left, 2 behind, 3 right): orders directions as `atan2` does, for a
 /// division instead of a transcendental call.
+#[inline]
 fn pseudo_azimuth(x: f64, y_left: f64) -> f64 {
     let d = x.abs() + y_left.abs();
     if d == 0.0 {
