@@ -673,12 +673,37 @@ fn cloud_frame(frame: &str) -> PyResult<CloudFrame> {
     }
 }
 
-/// Hands `f` the x, y, z of an N×3 or N×4 float32/float64 array (a flat
+/// Something computed from a cloud's x, y, z, generic over the iterator so
+/// that the per-point loop is monomorphized and inlined for each layout.
+trait PointsVisitor: Sync {
+    type Out: Send;
+    fn visit<I: ExactSizeIterator<Item = [f64; 3]>>(&self, xyz: I) -> Self::Out;
+}
+
+struct KeepVisitor<'a> {
+    certified: &'a CertifiedProfile,
+    opts: &'a CloudOptions,
+}
+
+impl PointsVisitor for KeepVisitor<'_> {
+    type Out = Result<Vec<bool>, gaze_lidar::pointcloud::CloudError>;
+    fn visit<I: ExactSizeIterator<Item = [f64; 3]>>(&self, xyz: I) -> Self::Out {
+        keep_mask(self.certified, xyz, self.opts)
+    }
+}
+
+struct AzimuthVisitor(CloudFrame);
+
+impl PointsVisitor for AzimuthVisitor {
+    type Out = Vec<f64>;
+    fn visit<I: ExactSizeIterator<Item = [f64; 3]>>(&self, xyz: I) -> Self::Out {
+        xyz.map(|[x, y, _]| self.0.azimuth_deg(x, y)).collect()
+    }
+}
+
+/// Hands `v` the x, y, z of an N×3 or N×4 float32/float64 array (a flat
 /// slice when contiguous, with the GIL released).
-fn with_points<'py, T: Send>(
-    points: &Bound<'py, PyAny>,
-    f: impl Fn(&mut dyn ExactSizeIterator<Item = [f64; 3]>) -> T + Sync,
-) -> PyResult<T> {
+fn with_points<'py, V: PointsVisitor>(points: &Bound<'py, PyAny>, v: V) -> PyResult<V::Out> {
     let shape_error = |dtype: String, shape: Vec<usize>| {
         value_error(format!(
             "points: expected an N×4 float32 array (x, y, z, intensity; N×3 and float64 also accepted), got dtype {dtype} and shape {shape:?}"
@@ -693,15 +718,17 @@ fn with_points<'py, T: Send>(
         let w = shape[1];
         return Ok(match a.as_slice() {
             Ok(flat) => py.detach(|| {
-                f(&mut flat
-                    .chunks_exact(w)
-                    .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])]))
+                v.visit(
+                    flat.chunks_exact(w)
+                        .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])]),
+                )
             }),
-            Err(_) => f(&mut a
-                .as_array()
-                .rows()
-                .into_iter()
-                .map(|r| [f64::from(r[0]), f64::from(r[1]), f64::from(r[2])])),
+            Err(_) => v.visit(
+                a.as_array()
+                    .rows()
+                    .into_iter()
+                    .map(|r| [f64::from(r[0]), f64::from(r[1]), f64::from(r[2])]),
+            ),
         });
     }
     if let Ok(a) = points.extract::<PyReadonlyArray2<'py, f64>>() {
@@ -709,11 +736,7 @@ fn with_points<'py, T: Send>(
         if !(shape[1] == 3 || shape[1] == 4) {
             return Err(shape_error("float64".into(), shape));
         }
-        return Ok(f(&mut a
-            .as_array()
-            .rows()
-            .into_iter()
-            .map(|r| [r[0], r[1], r[2]])));
+        return Ok(v.visit(a.as_array().rows().into_iter().map(|r| [r[0], r[1], r[2]])));
     }
     let dtype = points
         .getattr("dtype")
@@ -736,10 +759,7 @@ fn azimuth_deg<'py>(
     frame: &str,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let frame = cloud_frame(frame)?;
-    let az = with_points(points, |xyz| {
-        xyz.map(|[x, y, _]| frame.azimuth_deg(x, y))
-            .collect::<Vec<f64>>()
-    })?;
+    let az = with_points(points, AzimuthVisitor(frame))?;
     Ok(PyArray1::from_vec(py, az))
 }
 
@@ -768,7 +788,13 @@ fn apply_profile<'py>(
         cloud_spin_rad_s,
     };
     let certified = &profile.get().inner;
-    let mask = with_points(points, |xyz| keep_mask(certified, xyz, &opts))?;
+    let mask = with_points(
+        points,
+        KeepVisitor {
+            certified,
+            opts: &opts,
+        },
+    )?;
     mask.map(|m| PyArray1::from_vec(py, m))
         .map_err(|e| value_error(e.to_string()))
 }
