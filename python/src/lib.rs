@@ -104,6 +104,10 @@ fn mode_of(name: &str) -> PyResult<Mode> {
         })
 }
 
+fn seed_of(seed: i128) -> PyResult<u64> {
+    u64::try_from(seed).map_err(|_| value_error(format!("seed: {seed} must lie in 0..=2**64-1")))
+}
+
 fn finite(field: &str, v: f64) -> PyResult<f64> {
     if v.is_finite() {
         Ok(v)
@@ -525,9 +529,9 @@ impl PyGazeStream {
         mode: &str,
         timeout_ms: f64,
         bins: i64,
-        recover_samples: u32,
+        recover_samples: i64,
         saccade_deg_s: f64,
-        max_gap_frames: u64,
+        max_gap_frames: i64,
         config_toml: Option<&str>,
     ) -> PyResult<Self> {
         if !(timeout_ms.is_finite() && timeout_ms > 0.0 && timeout_ms < 1e7) {
@@ -540,11 +544,19 @@ impl PyGazeStream {
                 "saccade_deg_s: {saccade_deg_s} must be finite and > 0"
             )));
         }
-        if max_gap_frames > 1_000_000 {
-            return Err(value_error(format!(
-                "max_gap_frames: {max_gap_frames} must be at most 1000000"
-            )));
-        }
+        let max_gap_frames = u64::try_from(max_gap_frames)
+            .ok()
+            .filter(|&m| m <= 1_000_000)
+            .ok_or_else(|| {
+                value_error(format!(
+                    "max_gap_frames: {max_gap_frames} must lie in 0..=1000000"
+                ))
+            })?;
+        let recover_samples = u32::try_from(recover_samples).map_err(|_| {
+            value_error(format!(
+                "recover_samples: {recover_samples} must lie in 0..=4294967295"
+            ))
+        })?;
         let mode = mode_of(mode)?;
         let planner: Box<dyn FramePlanner> = match config_toml {
             Some(text) => {
@@ -775,7 +787,7 @@ fn apply_profile<'py>(
     rated_range_m: f64,
     model: &str,
     fog_mor_m: Option<f64>,
-    seed: u64,
+    seed: i128,
     frame: &str,
     cloud_spin_rad_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
@@ -783,7 +795,7 @@ fn apply_profile<'py>(
         rated_range_m,
         model: model_of(model)?,
         fog_mor_m,
-        seed,
+        seed: seed_of(seed)?,
         frame: cloud_frame(frame)?,
         cloud_spin_rad_s,
     };
@@ -824,7 +836,7 @@ fn simulate<'py>(
     py: Python<'py>,
     model: Models,
     trials: i64,
-    seed: u64,
+    seed: i128,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let models = match model {
@@ -839,7 +851,7 @@ fn simulate<'py>(
     let mut config = SimConfig {
         models,
         trials: trials as usize,
-        seed,
+        seed: seed_of(seed)?,
         ..SimConfig::default()
     };
     if let Some(opts) = options {

@@ -147,5 +147,7 @@ def test_layouts_and_errors():
         gl.apply_profile(p, pts, rated_range_m=100.0, model="lambertian")
     with pytest.raises(ValueError, match="^frame"):
         gl.apply_profile(p, pts, rated_range_m=100.0, frame="enu")
+    with pytest.raises(ValueError, match="^seed"):
+        gl.apply_profile(p, pts, rated_range_m=100.0, seed=-1)
     with pytest.raises(TypeError):
         gl.apply_profile(p, pts)  # rated_range_m is required

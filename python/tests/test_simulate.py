@@ -32,6 +32,7 @@ def test_both_models_and_options():
     "kwargs, field",
     [
         ({"trials": 0}, "trials"),
+        ({"seed": -1}, "seed"),
         ({"model": "lambertian"}, "model"),
         ({"fog_pct": [10]}, "fog_pct"),
         ({"variants": ["fast"]}, "variants"),

@@ -80,6 +80,10 @@ def test_bad_arguments():
         gl.GazeStream(mode="fast")
     with pytest.raises(ValueError, match="preset"):
         gl.GazeStream(preset="nope")
+    with pytest.raises(ValueError, match="^recover_samples"):
+        gl.GazeStream(recover_samples=-1)
+    with pytest.raises(ValueError, match="^max_gap_frames"):
+        gl.GazeStream(max_gap_frames=-1)
     s = gl.GazeStream()
     with pytest.raises(ValueError, match="t_s"):
         s.push(float("nan"), 90.0)
