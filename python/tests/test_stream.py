@@ -97,3 +97,33 @@ def test_optimizer_stream(repo):
     frames = fixations(s, 0.1)
     assert frames[-1].state == "adaptive"
     assert gl.check(frames[-1].profile.to_json()).certified
+
+
+def test_same_frames_as_the_cli_stream(repo):
+    """The CLI's `stream` (replay) on the same samples: the same frame times
+    and states, and tick() through the silence changes nothing."""
+    import json
+    import shutil
+    import subprocess
+
+    cli = repo / "target/release/gaze-lidar"
+    if not cli.exists():
+        cli = shutil.which("gaze-lidar")
+        if cli is None:
+            pytest.skip("the gaze-lidar binary is not built (cargo build --release)")
+    samples = [(k / 200, 90.0, True) for k in range(21)] + [(0.12, 0.0, False)]
+    samples += [(0.13 + k / 200, 270.0, True) for k in range(10)] + [(0.6, 270.0, True)]
+    text = "".join(json.dumps({"t_s": t, "gaze_deg": g, "valid": v}) + "\n" for t, g, v in samples)
+    out = subprocess.run(
+        [str(cli), "stream", "--preset", "paper", "--mode", "range", "--timeout-ms", "100"],
+        input=text, capture_output=True, text=True, check=True,
+    ).stdout
+    want = [(round(f["t_s"], 9), f["state"], f["gaze_deg"]) for f in map(json.loads, out.splitlines())]
+    s = gl.GazeStream(preset="paper", mode="range", timeout_ms=100)
+    got = []
+    for t, g, v in samples[:-1]:
+        got += s.push(t, g, v)
+    got += s.tick(0.45)
+    got += s.push(*samples[-1])
+    assert [(round(f.t_s, 9), f.state, f.gaze_deg) for f in got] == want
+    assert {f[1] for f in want} == {"adaptive", "fail_safe"}
