@@ -19,8 +19,7 @@ venv=$(mktemp -d "${TMPDIR:-/tmp}/gaze-lidar-venv.XXXXXX")
 trap 'rm -rf "$venv"' EXIT
 echo "== python: pip install ./python into a fresh venv ($venv)"
 "$PY" -m venv "$venv"
-"$venv/bin/python" -m pip install -q --upgrade pip
-"$venv/bin/python" -m pip install -q ./python
+"$venv/bin/pip" install -q ./python   # exactly what a user runs
 "$venv/bin/python" -m pip install -q pytest
 
 echo "== python: pytest"
