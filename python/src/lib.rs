@@ -945,8 +945,8 @@ fn simulate<'py>(
     json_value(py, &json)?.get_item("rows")
 }
 
-/// Eye-safety (Class 1, IEC 60825-1) limits are part of every certified
-/// profile; this module is the Python face of the `gaze-lidar` crates.
+/// The native half of `gaze_lidar`: certified profiles, the checker, the
+/// gaze stream, point-cloud filtering and the simulator (see `_native.pyi`).
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
