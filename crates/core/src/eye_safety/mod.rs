@@ -9,14 +9,20 @@
 //! The figures must be checked against the standard by a vendor before use
 //! (see [`ael`]).
 
+#[cfg(feature = "std")]
 pub mod ael;
+#[cfg(feature = "std")]
 pub mod bound;
+#[cfg(feature = "std")]
 pub mod exposure;
 
 use serde::{Deserialize, Serialize};
+#[cfg(feature = "std")]
 use thiserror::Error;
 
+#[cfg(feature = "std")]
 pub use ael::{ael_report, AelError, AelReport};
+#[cfg(feature = "std")]
 pub use exposure::{evaluate_profile, evaluate_segments, ExposureReport, Rule};
 
 /// Laser and optics parameters the eye-safety check needs; stored in a
@@ -33,6 +39,7 @@ pub struct EyeSafetyParams {
 }
 
 /// Errors evaluating eye safety.
+#[cfg(feature = "std")]
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum EyeSafetyError {
     /// From the AEL tables.
@@ -50,6 +57,7 @@ pub enum EyeSafetyError {
     },
 }
 
+#[cfg(feature = "std")]
 impl EyeSafetyParams {
     /// Validates the parameters (band, durations, beam size).
     pub fn validate(&self) -> Result<ael::Band, EyeSafetyError> {
