@@ -108,7 +108,6 @@ fn binary_tables_round_trip_and_tampering_is_caught() {
 // ---------------------------------------------------------------------------
 // Eye safety of a table as it will run: the integer check (issue 10, Build 6).
 
-#[allow(dead_code)]
 mod reference;
 
 use gaze_lidar::checker::certify;
@@ -258,9 +257,14 @@ fn default_80mhz_quantizes_certified_near_limit_profiles() {
                     .map(|(b, fw)| f64::from(fw.power_code) * t.power_w_per_code / b.power_w)
                     .fold(f64::INFINITY, f64::min);
                 let int = int_ratio(&t);
-                println!("{mode:?} {gaze} {target}: integer ratio {int:.6}, least power kept {kept:.4}");
+                println!(
+                    "{mode:?} {gaze} {target}: integer ratio {int:.6}, least power kept {kept:.4}"
+                );
                 assert!(int <= 1.0);
-                assert!(kept >= 0.995, "{mode:?} {gaze} {target}: only {kept} of the power kept");
+                assert!(
+                    kept >= 0.995,
+                    "{mode:?} {gaze} {target}: only {kept} of the power kept"
+                );
             }
         }
     }
@@ -305,7 +309,13 @@ fn table_spec() -> impl Strategy<Value = TableSpec> {
             )
         })
         .prop_map(
-            |(band, n, (tick_log, frame_hz, fp_log, locked), (widths, dwells, codes), (hot, dark, beam_mm, pulse_log))| TableSpec {
+            |(
+                band,
+                n,
+                (tick_log, frame_hz, fp_log, locked),
+                (widths, dwells, codes),
+                (hot, dark, beam_mm, pulse_log),
+            )| TableSpec {
                 band,
                 n,
                 tick_log,
@@ -326,10 +336,7 @@ fn table_spec() -> impl Strategy<Value = TableSpec> {
 /// Splits `total` into parts proportional to `weights`, each ≥ 1, exactly.
 fn split(total: u64, weights: &[u64]) -> Vec<u64> {
     let sum: u64 = weights.iter().sum();
-    let mut out: Vec<u64> = weights
-        .iter()
-        .map(|&w| (total * w / sum).max(1))
-        .collect();
+    let mut out: Vec<u64> = weights.iter().map(|&w| (total * w / sum).max(1)).collect();
     let used: u64 = out.iter().sum();
     let last = out.len() - 1;
     // Give the remainder (or take the excess) from the widest part.
@@ -349,10 +356,15 @@ fn build_table(s: &TableSpec) -> FirmwareTable {
         ww[j] = 1; // a narrow hot sector
     }
     let widths = split(360_000, &ww);
-    let in_dark = |i: usize| s.dark.is_some_and(|(d0, len, _)| (i + n - d0) % n < len.min(n / 2));
+    let in_dark = |i: usize| {
+        s.dark
+            .is_some_and(|(d0, len, _)| (i + n - d0) % n < len.min(n / 2))
+    };
     let dw: Vec<u64> = (0..n)
         .map(|i| {
-            let slow = s.dark.map_or(1, |d| if in_dark(i) { u64::from(d.2) } else { 1 });
+            let slow = s
+                .dark
+                .map_or(1, |d| if in_dark(i) { u64::from(d.2) } else { 1 });
             // dwell ∝ width / spin, spin in (0.5, 1.5) of nominal, slower in the dark sector.
             widths[i] * (50 + u64::from(s.dwells[i])) * slow
         })
@@ -429,8 +441,10 @@ fn differential_integer_check_never_below_reference() {
         .unwrap_or(100);
     let mut seed = [0u8; 32];
     seed[..8].copy_from_slice(&0x00f1_ee7e_u64.to_le_bytes());
-    let mut runner =
-        TestRunner::new_with_rng(Config::default(), TestRng::from_seed(RngAlgorithm::ChaCha, &seed));
+    let mut runner = TestRunner::new_with_rng(
+        Config::default(),
+        TestRng::from_seed(RngAlgorithm::ChaCha, &seed),
+    );
     let strategy = table_spec();
     let (mut q_ref_min, mut q_ref_max) = (f64::INFINITY, 0.0f64);
     let (mut q_float_min, mut q_float_max) = (f64::INFINITY, 0.0f64);
@@ -444,7 +458,10 @@ fn differential_integer_check_never_below_reference() {
             // Pulses overlapping, a frame too short: no limits, no verdict.
             continue;
         };
-        let int = evaluate(&t, &limits).expect("within bounds").worst_ratio_ppm as f64 / 1e6;
+        let int = evaluate(&t, &limits)
+            .expect("within bounds")
+            .worst_ratio_ppm as f64
+            / 1e6;
         if int == 0.0 {
             continue;
         }
@@ -455,14 +472,33 @@ fn differential_integer_check_never_below_reference() {
         if int < reference * (1.0 - 1e-12) {
             let r = Reference::new(&scan_of_table(&t));
             for locked in [false, true] {
-                let w = r.worst(&Effort { phases: 3, locked, ..Effort::default() });
+                let w = r.worst(&Effort {
+                    phases: 3,
+                    locked,
+                    ..Effort::default()
+                });
                 println!("reference locked={locked}: {w}");
             }
             let rep = table_exposure(&t).unwrap().unwrap();
             println!("float: {rep:?}");
             println!("int: {:?}", evaluate(&t, &limits));
-            println!("limits: pulse_code_max {} pass {} K {} tau {} arc {} train0 {:?} trainlast {:?}", limits.pulse_code_max, limits.pass_energy_max_quanta, limits.pulses_per_pass_max, limits.pass_ticks_max, limits.pass_arc_mdeg, limits.train.first(), limits.train.last());
-            println!("{:?}", t.bins.iter().map(|b| (b.width_mdeg, b.dwell_ticks, b.power_code)).collect::<Vec<_>>());
+            println!(
+                "limits: pulse_code_max {} pass {} K {} tau {} arc {} train0 {:?} trainlast {:?}",
+                limits.pulse_code_max,
+                limits.pass_energy_max_quanta,
+                limits.pulses_per_pass_max,
+                limits.pass_ticks_max,
+                limits.pass_arc_mdeg,
+                limits.train.first(),
+                limits.train.last()
+            );
+            println!(
+                "{:?}",
+                t.bins
+                    .iter()
+                    .map(|b| (b.width_mdeg, b.dwell_ticks, b.power_code))
+                    .collect::<Vec<_>>()
+            );
         }
         assert!(
             int >= reference * (1.0 - 1e-12),
@@ -487,5 +523,8 @@ fn differential_integer_check_never_below_reference() {
         "integer/reference: smallest {q_ref_min:.6}, largest {q_ref_max:.4}; integer/float: smallest {q_float_min:.6}, largest {q_float_max:.4}; {evaluated} of {cases} tables evaluated; {rejected_by_int_not_float} over 1 in integers only"
     );
     println!("loosest: {loosest}");
-    assert!(evaluated * 2 > cases, "too few tables evaluated: {evaluated}");
+    assert!(
+        evaluated * 2 > cases,
+        "too few tables evaluated: {evaluated}"
+    );
 }

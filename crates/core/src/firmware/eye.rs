@@ -38,6 +38,9 @@ pub const MAX_TICK_HZ: u64 = 1 << 34;
 pub const MAX_FRAME_TICKS: u64 = 1 << 44;
 /// Largest pulse rate the integer evaluation accepts, millihertz (2^40 mHz ≈ 1.1 GHz).
 pub const MAX_PULSE_RATE_MILLIHZ: u64 = 1 << 40;
+/// Most pulses one turn may hold (`frame_ticks · f / tick_hz`): keeps every
+/// pulse count within `u64` (2^40 ≈ 1.1·10^12).
+pub const MAX_PULSES_PER_TURN: u64 = 1 << 40;
 /// Millihertz per hertz.
 pub const MILLIHZ_PER_HZ: u64 = 1000;
 
@@ -261,6 +264,15 @@ fn check_bounds(table: &FirmwareTable, millihz: u64, arc_mdeg: u32) -> Result<()
             "pulse_rate_hz (mHz)",
             millihz,
             "must lie in 1 mHz..=2^40 mHz",
+        );
+    }
+    let per_turn = u128::from(table.frame_ticks) * u128::from(millihz)
+        / (u128::from(MILLIHZ_PER_HZ) * u128::from(table.tick_hz));
+    if per_turn >= u128::from(MAX_PULSES_PER_TURN) {
+        return b(
+            "pulses per turn",
+            u64::try_from(per_turn).unwrap_or(u64::MAX),
+            "a turn may hold fewer than 2^40 pulses",
         );
     }
     if arc_mdeg == 0 || arc_mdeg >= FULL_TURN_MDEG / 2 {
@@ -504,7 +516,7 @@ pub fn evaluate(table: &FirmwareTable, limits: &IntEyeLimits) -> Result<IntEyeRe
         };
         sorted.clear();
         sorted.extend(c.bins.iter().copied());
-        sorted.sort_unstable_by(|x, y| y.0.cmp(&x.0));
+        sorted.sort_unstable_by_key(|x| core::cmp::Reverse(x.0));
         let hottest = sorted.first().map_or(0, |x| x.0);
         note(
             u128::from(hottest),
@@ -777,3 +789,226 @@ mod derive {
 
 #[cfg(feature = "std")]
 pub use derive::{millihz_ceil, DeriveError, EXACT_PULSE_BUCKETS, LIMIT_MARGIN};
+
+#[cfg(any(kani, test))]
+mod verification {
+    use super::*;
+    use crate::firmware::{FwBin, IntLimits, FIRMWARE_FORMAT};
+    use crate::model::accounting::PowerAccounting;
+    use crate::verification::cover;
+    use alloc::borrow::ToOwned;
+
+    /// Up to three raw bins: (width, dwell, code).
+    type RawBins = [(u32, u64, u32); 3];
+
+    /// A table within the format's and the evaluation's bounds: widths sum to
+    /// 360,000 mdeg, dwells (each ≥ 1) to `frame_ticks ≤ MAX_FRAME_TICKS`.
+    fn table(raw: &RawBins, n: usize, tick_hz: u64, frame_ticks: u64) -> FirmwareTable {
+        let mut width_left = FULL_TURN_MDEG;
+        let mut ticks_left = frame_ticks;
+        let bins = (0..n)
+            .map(|i| {
+                let (w, d, code) = raw[i];
+                let last = i + 1 == n;
+                let bins_after = (n - 1 - i) as u64;
+                let width_mdeg = if last {
+                    width_left
+                } else {
+                    w % (width_left + 1)
+                };
+                let dwell_ticks = if last {
+                    ticks_left
+                } else {
+                    1 + d % (ticks_left - bins_after)
+                };
+                width_left -= width_mdeg;
+                ticks_left -= dwell_ticks;
+                FwBin {
+                    start_deg: 0.0,
+                    width_mdeg,
+                    dwell_ticks,
+                    power_code: code,
+                    dwell_ticks_min: 0,
+                    dwell_ticks_max: u64::MAX,
+                    power_code_cap: u32::MAX,
+                }
+            })
+            .collect();
+        FirmwareTable {
+            format: FIRMWARE_FORMAT.to_owned(),
+            tick_hz,
+            frame_ticks,
+            power_w_per_code: 1.0,
+            power_accounting: PowerAccounting::Time,
+            pulse_rate_hz: 1.0,
+            eye_safety: None,
+            limits: IntLimits {
+                power_code_min: 0,
+                power_code_max: u32::MAX,
+                energy_budget: u64::MAX,
+                window_bins: 1,
+                window_energy_max: u64::MAX,
+            },
+            bins,
+        }
+    }
+
+    fn limits(
+        t: &FirmwareTable,
+        millihz: u64,
+        arc_mdeg: u32,
+        l: (u64, u64, u64, u64),
+    ) -> IntEyeLimits {
+        let (code_max, e1, split, e_pass) = l;
+        IntEyeLimits {
+            tick_hz: t.tick_hz,
+            frame_ticks: t.frame_ticks,
+            pulse_rate_millihz_ceil: millihz,
+            pass_arc_mdeg: arc_mdeg,
+            pass_ticks_max: u64::MAX,
+            pulses_per_pass_max: u64::MAX,
+            pulse_code_max: code_max,
+            train: alloc::vec![
+                TrainLimit {
+                    pulses_from: 1,
+                    energy_max_quanta: e1,
+                },
+                TrainLimit {
+                    pulses_from: 2 + split,
+                    energy_max_quanta: e1.saturating_add(split),
+                },
+            ],
+            pass_energy_max_quanta: e_pass,
+            pass_energy_rule: IntRule::T2Train,
+        }
+    }
+
+    type OverflowInput = (RawBins, u8, u64, u64, u64, u32, u8, (u64, u64, u64, u64));
+
+    fn no_overflow(input: OverflowInput) {
+        let (raw, n, tick, frame, millihz, arc, extreme, l) = input;
+        let n = 1 + usize::from(n % 3);
+        // Bounds of the evaluation (`check_bounds`): every value within them.
+        let mut tick_hz = 1 + tick % MAX_TICK_HZ;
+        let mut frame_ticks = n as u64 + frame % (MAX_FRAME_TICKS - n as u64 + 1);
+        let mut millihz = 1 + millihz % MAX_PULSE_RATE_MILLIHZ;
+        let mut raw = raw;
+        if extreme % 2 == 1 {
+            // The corner that maximizes every product: the fastest tick,
+            // the longest frame, the fastest pulse clock, the largest codes.
+            tick_hz = MAX_TICK_HZ;
+            frame_ticks = MAX_FRAME_TICKS;
+            millihz = MAX_PULSE_RATE_MILLIHZ;
+            for r in &mut raw {
+                r.2 = u32::MAX;
+            }
+        }
+        // The joint bound: fewer than MAX_PULSES_PER_TURN pulses per turn.
+        let allowed =
+            (u128::from(MAX_PULSES_PER_TURN) * u128::from(MILLIHZ_PER_HZ) * u128::from(tick_hz)
+                - 1)
+                / u128::from(frame_ticks);
+        // ≥ 62 mHz even at 1 Hz ticks and the longest frame.
+        millihz = millihz
+            .min(u64::try_from(allowed).unwrap_or(u64::MAX))
+            .max(1);
+        let arc_mdeg = 1 + arc % (FULL_TURN_MDEG / 2 - 1);
+        let t = table(&raw, n, tick_hz, frame_ticks);
+        let lim = limits(&t, millihz, arc_mdeg, l);
+        match evaluate(&t, &lim) {
+            Ok(r) => {
+                cover!(
+                    extreme % 2 == 1 && n == 3,
+                    "extreme three-bin table evaluated"
+                );
+                cover!(!r.class1, "a table over its limits evaluated");
+                cover!(r.class1, "a table within its limits evaluated");
+            }
+            Err(e) => panic!("a table within the bounds must evaluate: {e}"),
+        }
+        let timing = pass_timing(&t, millihz, arc_mdeg);
+        assert!(timing.is_ok(), "{timing:?}");
+    }
+
+    /// REQ-FW-7: the integer eye-safety sums (rational pass durations,
+    /// pulse counts, `code × count` window sums in `u128`) never overflow for
+    /// any table within the format's bounds: 1–36,000 bins (the evaluation
+    /// is per cell, so three bins exercise every product), any `u32` code,
+    /// `frame_ticks ≤ 2^44`, `tick_hz ≤ 2^34`, pulse rate ≤ 2^40 mHz and
+    /// fewer than 2^40 pulses per turn.
+    #[cfg_attr(kani, kani::proof, kani::unwind(8))]
+    #[cfg_attr(not(kani), test)]
+    fn eye_sums_never_overflow_within_format_bounds() {
+        #[cfg(kani)]
+        no_overflow(kani::any());
+        #[cfg(not(kani))]
+        {
+            bolero::check!()
+                .with_type::<OverflowInput>()
+                .cloned()
+                .for_each(no_overflow);
+            crate::verification::assert_covered(&[
+                "extreme three-bin table evaluated",
+                "a table over its limits evaluated",
+                "a table within its limits evaluated",
+            ]);
+        }
+    }
+
+    type RotationInput = ([(u16, u16, u16); 3], u8, u8, u16, u16, (u16, u16, u8, u16));
+
+    fn rotation_keeps_verdict(input: RotationInput) {
+        let (raw, n, shift, millihz, arc, (code_max, e1, split, e_pass)) = input;
+        let n = 1 + usize::from(n % 3);
+        let raw3: RawBins = [0, 1, 2].map(|i| {
+            (
+                u32::from(raw[i].0) * 8,
+                u64::from(raw[i].1),
+                u32::from(raw[i].2 % 64),
+            )
+        });
+        let t = table(&raw3, n, 1000, 3 + 100 * n as u64);
+        let millihz = 1_000 + u64::from(millihz) * 100;
+        let arc_mdeg = 1 + u32::from(arc) * 2;
+        let l = (
+            u64::from(code_max % 80),
+            u64::from(e1 % 400),
+            u64::from(split % 8),
+            u64::from(e_pass % 2000),
+        );
+        let mut rotated = t.clone();
+        rotated.bins.rotate_left(usize::from(shift) % n);
+        cover!(
+            usize::from(shift) % n != 0,
+            "a table rotated by a non-zero shift"
+        );
+        let a = evaluate(&t, &limits(&t, millihz, arc_mdeg, l)).expect("within bounds");
+        let b = evaluate(&rotated, &limits(&rotated, millihz, arc_mdeg, l)).expect("within bounds");
+        cover!(!a.class1 && n == 3, "a rejected three-bin table rotated");
+        cover!(a.class1 && n == 3, "an accepted three-bin table rotated");
+        assert_eq!(a.class1, b.class1);
+        assert_eq!(a.worst_ratio_ppm, b.worst_ratio_ppm);
+    }
+
+    /// REQ-FW-8: a cyclic rotation of a table (where the turn starts) keeps
+    /// the integer eye-safety verdict and its worst ratio: the aperture cells
+    /// are the same arcs, shifted.
+    #[cfg_attr(kani, kani::proof, kani::unwind(8))]
+    #[cfg_attr(not(kani), test)]
+    fn rotation_keeps_integer_verdict() {
+        #[cfg(kani)]
+        rotation_keeps_verdict(kani::any());
+        #[cfg(not(kani))]
+        {
+            bolero::check!()
+                .with_type::<RotationInput>()
+                .cloned()
+                .for_each(rotation_keeps_verdict);
+            crate::verification::assert_covered(&[
+                "a table rotated by a non-zero shift",
+                "a rejected three-bin table rotated",
+                "an accepted three-bin table rotated",
+            ]);
+        }
+    }
+}
