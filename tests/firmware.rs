@@ -113,7 +113,9 @@ mod reference;
 use gaze_lidar::checker::certify;
 use gaze_lidar::eye_safety::{evaluate_profile, EyeSafetyParams};
 use gaze_lidar::firmware::eye::{evaluate, IntEyeLimits};
-use gaze_lidar::firmware::{table_exposure, FirmwareConfig, FwBin, IntLimits};
+use gaze_lidar::firmware::{
+    check_table_with, table_exposure, FirmwareConfig, FwBin, FwViolation, IntLimits,
+};
 use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::model::presets;
 use gaze_lidar::planner::{closed_form, Mode};
@@ -526,5 +528,42 @@ fn differential_integer_check_never_below_reference() {
     assert!(
         evaluated * 2 > cases,
         "too few tables evaluated: {evaluated}"
+    );
+}
+
+/// A table whose codes were raised after quantization (caps and budget
+/// moved out of the way, as a careless or hostile edit would) fails the
+/// integer eye-safety check by name; the no-float path against host-derived
+/// limits gives the same verdict; rotating the table keeps it.
+#[test]
+fn raised_codes_fail_the_integer_eye_safety_check() {
+    let c = closed_form(&presets::paper(), Mode::Joint, Some(90.0), 360).unwrap();
+    let c = at_ratio(c.profile(), 0.999_999);
+    let mut t = FirmwareTable::from_certified(&c, &FirmwareConfig::default()).unwrap();
+    let limits = IntEyeLimits::derive(&t).unwrap();
+    let before = evaluate(&t, &limits).unwrap();
+    assert!(
+        before.class1 && before.worst_ratio_ppm > 999_000,
+        "{before:?}"
+    );
+    for b in &mut t.bins {
+        b.power_code = b.power_code * 101 / 100 + 1;
+        b.power_code_cap = u32::MAX;
+    }
+    t.limits.power_code_max = u32::MAX;
+    t.limits.energy_budget = u64::MAX;
+    let v = check_table(&t);
+    assert_eq!(v.len(), 1, "{v:?}");
+    assert!(
+        matches!(&v[0], FwViolation::EyeSafety { ratio_ppm, .. } if *ratio_ppm > 1_000_000),
+        "{v:?}"
+    );
+    assert!(v[0].to_string().starts_with("eye_safety: as quantized"));
+    assert_eq!(check_table_with(&t, &limits), v);
+    let mut rotated = t.clone();
+    rotated.bins.rotate_left(37);
+    assert_eq!(
+        evaluate(&rotated, &limits).unwrap().worst_ratio_ppm,
+        evaluate(&t, &limits).unwrap().worst_ratio_ppm
     );
 }

@@ -223,7 +223,7 @@ fn lower_codes_for_eye_safety(table: &mut FirmwareTable) {
             return;
         };
         if report.class1 {
-            return;
+            break;
         }
         let ppm = u128::from(report.worst_ratio_ppm.max(1_000_001));
         let min = table.limits.power_code_min;
@@ -231,6 +231,11 @@ fn lower_codes_for_eye_safety(table: &mut FirmwareTable) {
             let lowered = u128::from(b.power_code) * 1_000_000 / ppm;
             b.power_code = u32::try_from(lowered).unwrap_or(u32::MAX).max(min);
         }
+    }
+    // Each bin's cap: rule 1 of the integer check (what a sensor may clamp to).
+    let cap = u32::try_from(limits.pulse_code_max).unwrap_or(u32::MAX);
+    for b in &mut table.bins {
+        b.power_code_cap = b.power_code_cap.min(cap);
     }
 }
 

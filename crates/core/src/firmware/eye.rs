@@ -930,7 +930,7 @@ mod verification {
         assert!(timing.is_ok(), "{timing:?}");
     }
 
-    /// REQ-FW-7: the integer eye-safety sums (rational pass durations,
+    /// REQ-FW-5: the integer eye-safety sums (rational pass durations,
     /// pulse counts, `code × count` window sums in `u128`) never overflow for
     /// any table within the format's bounds: 1–36,000 bins (the evaluation
     /// is per cell, so three bins exercise every product), any `u32` code,
@@ -990,7 +990,7 @@ mod verification {
         assert_eq!(a.worst_ratio_ppm, b.worst_ratio_ppm);
     }
 
-    /// REQ-FW-8: a cyclic rotation of a table (where the turn starts) keeps
+    /// REQ-FW-5: a cyclic rotation of a table (where the turn starts) keeps
     /// the integer eye-safety verdict and its worst ratio: the aperture cells
     /// are the same arcs, shifted.
     #[cfg_attr(kani, kani::proof, kani::unwind(8))]

@@ -8,14 +8,20 @@
 //!   tick bounds implied by the spin limits, and the dwells sum to
 //!   `frame_ticks` exactly ([`quantize::apportion`]);
 //! - power codes are rounded down: never above the certified power, within
-//!   one code of it ([`quantize::floor_code`]);
-//! - the integer limits are derived conservatively from the float limits
-//!   (codes floored, eye-safety caps at the worst-case C5 and over windows
-//!   that cover any aperture pass), and the built table must pass
-//!   [`check::check_table`] or no table is returned.
+//!   one code of it (`quantize::floor_code`), then lowered further only if the
+//!   table **as it will run** (quantized dwell, quantized codes) is over the
+//!   Class 1 limits in the integer eye-safety check ([`eye`]);
+//! - the built table must pass [`check_table`] (integer rules and the
+//!   integer eye-safety check) or no table is returned.
+//!
+//! Without `std` (feature off) this module keeps the table types, the
+//! integer checker ([`check_integer`], [`check_table_with`] against integer
+//! eye-safety limits derived on a host), [`apportion`] and the binary codec.
 //!
 //! Spin acceleration is a property of the float profile (certified there);
-//! a table stores dwell per bin and the motor controller ramps between them.
+//! a table stores dwell per bin, and its eye safety is evaluated for each bin
+//! swept at constant spin (`width_mdeg` in exactly `dwell_ticks`), which is
+//! how the table runs: the motor controller must hold each bin's spin.
 
 pub mod binary;
 #[cfg(feature = "std")]
@@ -99,8 +105,8 @@ pub struct FwBin {
     pub dwell_ticks_min: u64,
     /// Largest dwell the spin limit allows, ticks.
     pub dwell_ticks_max: u64,
-    /// Largest code the eye-safety single-pulse rule allows in this bin
-    /// (C5 at this bin's own pulse count, from the certified evaluation).
+    /// Largest code this bin may hold: `power_code_max`, and the integer
+    /// eye-safety check's rule-1 limit (`eye::IntEyeLimits::pulse_code_max`).
     pub power_code_cap: u32,
 }
 
