@@ -230,16 +230,23 @@ impl Clock {
 
 /// One aperture cell: the positions `[a0, a1]` (integer millidegrees) of
 /// the start of the pass arc.
-struct Cell {
+struct Cell<'a> {
     a0: i64,
     /// Largest pass duration over the cell, ticks.
     tau: Ratio,
     /// Most pulses in a pass over the cell.
     pulses: u128,
-    /// `(code, pulse cap)` of every bin the pass can touch over the cell.
-    bins: Vec<(u32, u128)>,
+    /// Hottest code of any bin the pass can touch over the cell.
+    hottest: u32,
+    /// `Σ code × pulse cap` over the bins the pass can touch.
+    energy_all: u128,
+    /// `(code, pulse cap)` of the touched bins not wholly inside the pass
+    /// at both cell ends (at most a few).
+    edge_bins: &'a [(u32, u128)],
+    /// `(code, pulse cap)` of the touched bins wholly inside the pass at
+    /// both cell ends (their cap is all of their dwell).
+    middle_bins: &'a [(u32, u128)],
 }
-
 /// Validates the bounds under which every intermediate fits `u128`.
 fn check_bounds(table: &FirmwareTable, millihz: u64, arc_mdeg: u32) -> Result<(), IntEyeError> {
     let b = |field, value, reason| {
@@ -309,11 +316,15 @@ fn check_bounds(table: &FirmwareTable, millihz: u64, arc_mdeg: u32) -> Result<()
 }
 
 /// Walks every aperture cell of the table, in azimuth order, calling `visit`.
+///
+/// Bins wholly inside the pass at both cell ends are summed through prefix
+/// sums (their dwell and `code × cap`) and their hottest code through a
+/// sliding-window maximum, so a cell costs O(1) beyond its few edge bins.
 fn for_each_cell(
     table: &FirmwareTable,
     clock: Clock,
     arc_mdeg: u32,
-    mut visit: impl FnMut(&Cell) -> Result<(), IntEyeError>,
+    mut visit: impl FnMut(&Cell<'_>) -> Result<(), IntEyeError>,
 ) -> Result<(), IntEyeError> {
     let w_turn = i64::from(FULL_TURN_MDEG);
     let h = i64::from(arc_mdeg);
@@ -335,10 +346,40 @@ fn for_each_cell(
     }
     starts.sort_unstable();
     starts.dedup();
+    let full_cap: Vec<u128> = table
+        .bins
+        .iter()
+        .map(|b| {
+            clock.pulses_in(Ratio {
+                num: u128::from(b.dwell_ticks),
+                den: 1,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    // Per unrolled entry: (code, full cap); prefix sums of dwell and code × cap.
+    let full: Vec<(u32, u128)> = iv
+        .iter()
+        .map(|&(_, _, k)| (table.bins[k].power_code, full_cap[k]))
+        .collect();
+    let mut pre_ticks: Vec<u128> = Vec::with_capacity(iv.len() + 1);
+    let mut pre_energy: Vec<u128> = Vec::with_capacity(iv.len() + 1);
+    pre_ticks.push(0);
+    pre_energy.push(0);
+    for (i, &(_, _, k)) in iv.iter().enumerate() {
+        let t = pre_ticks[i] + u128::from(table.bins[k].dwell_ticks);
+        let e = u128::from(full[i].0)
+            .checked_mul(full[i].1)
+            .and_then(|x| x.checked_add(pre_energy[i]))
+            .ok_or(IntEyeError::Overflow)?;
+        pre_ticks.push(t);
+        pre_energy.push(e);
+    }
     let m = starts.len();
     // starts holds 0 and W − h ≠ 0, so m ≥ 2 and every cell is shorter than a turn.
-    let mut lo = 0usize;
-    let mut bins: Vec<(u32, u128)> = Vec::new();
+    let (mut lo, mut hi, mut mid_lo, mut mid_hi) = (0usize, 0usize, 0usize, 0usize);
+    // Sliding maximum of the code over the touched entries [lo, hi).
+    let mut hot: alloc::collections::VecDeque<usize> = alloc::collections::VecDeque::new();
+    let mut edges: Vec<(u32, u128)> = Vec::new();
     for j in 0..m {
         let a0 = starts[j];
         let a1 = if j + 1 < m { starts[j + 1] } else { w_turn };
@@ -346,56 +387,80 @@ fn for_each_cell(
         while lo < iv.len() && iv[lo].1 < a0 {
             lo += 1;
         }
-        bins.clear();
+        while hi < iv.len() && iv[hi].0 <= reach {
+            while hot.back().is_some_and(|&b| full[b].0 <= full[hi].0) {
+                hot.pop_back();
+            }
+            hot.push_back(hi);
+            hi += 1;
+        }
+        while hot.front().is_some_and(|&f| f < lo) {
+            hot.pop_front();
+        }
+        // Wholly inside at both ends: start ≥ a1 and end ≤ a0 + h.
+        while mid_lo < iv.len() && iv[mid_lo].0 < a1 {
+            mid_lo += 1;
+        }
+        while mid_hi < iv.len() && iv[mid_hi].1 <= a0 + h {
+            mid_hi += 1;
+        }
+        let mid_start = mid_lo.clamp(lo, hi);
+        let mid_end = mid_hi.clamp(mid_start, hi);
         let mut tau0 = Ratio { num: 0, den: 1 };
         let mut tau1 = Ratio { num: 0, den: 1 };
-        let mut idx = lo;
-        while idx < iv.len() && iv[idx].0 <= reach {
-            let (s, e, k) = iv[idx];
-            idx += 1;
+        let mid_ticks = pre_ticks[mid_end] - pre_ticks[mid_start];
+        tau0 = tau0.add_int(mid_ticks)?;
+        tau1 = tau1.add_int(mid_ticks)?;
+        let mut energy_all = pre_energy[mid_end] - pre_energy[mid_start];
+        edges.clear();
+        for &(s, e, k) in iv[lo..mid_start].iter().chain(&iv[mid_end..hi]) {
             let b = &table.bins[k];
             let d = u128::from(b.dwell_ticks);
             let w = e - s;
             let overlap = |a: i64| (e.min(a + h) - s.max(a)).max(0);
             let inside = |a: i64| s <= a + h && e >= a;
-            let mut cap_time = Ratio { num: 0, den: 1 };
+            // Largest overlap at a cell end (the overlap is linear on a cell).
+            let mut x_max: Option<i64> = None;
             for (a, tau) in [(a0, &mut tau0), (a1, &mut tau1)] {
                 if !inside(a) {
                     continue;
                 }
                 let x = overlap(a);
-                let part = if w > 0 && x == 0 {
-                    // Touching at an edge: no time, one pulse (below).
-                    Ratio { num: 0, den: 1 }
-                } else if w == 0 || x == w {
-                    Ratio { num: d, den: 1 }
-                } else {
-                    Ratio {
-                        num: (x as u128) * d,
-                        den: w as u128,
-                    }
-                };
-                *tau = if part.den == 1 {
-                    tau.add_int(part.num)?
-                } else {
-                    tau.add_frac(part.num, part.den)?
-                };
-                cap_time = cap_time.max(part)?;
+                x_max = Some(x_max.map_or(x, |m| m.max(x)));
+                if w == 0 || x == w {
+                    *tau = tau.add_int(d)?;
+                } else if x > 0 {
+                    *tau = tau.add_frac((x as u128) * d, w as u128)?;
+                }
             }
-            // A bin touched only between the cell ends (cannot happen: the
-            // touched set is constant inside a cell) still gets one pulse.
-            let cap = clock.pulses_in(cap_time)?;
-            bins.push((b.power_code, cap));
+            // Pulses this bin can contribute: all of its dwell, a part, or
+            // one (touched at an edge: the code at a boundary instant is
+            // ambiguous). A bin touched only strictly inside the cell cannot
+            // occur (the touched set is constant on a cell); it would get one.
+            let cap = match x_max {
+                Some(x) if w == 0 || x == w => full_cap[k],
+                Some(x) if x > 0 => clock.pulses_in(Ratio {
+                    num: (x as u128) * d,
+                    den: w as u128,
+                })?,
+                _ => 1,
+            };
+            energy_all = u128::from(b.power_code)
+                .checked_mul(cap)
+                .and_then(|x| x.checked_add(energy_all))
+                .ok_or(IntEyeError::Overflow)?;
+            edges.push((b.power_code, cap));
         }
         let tau = tau0.max(tau1)?;
-        let cell = Cell {
+        visit(&Cell {
             a0,
             tau,
             pulses: clock.pulses_in(tau)?,
-            bins: core::mem::take(&mut bins),
-        };
-        visit(&cell)?;
-        bins = cell.bins;
+            hottest: hot.front().map_or(0, |&f| full[f].0),
+            energy_all,
+            edge_bins: &edges,
+            middle_bins: &full[mid_start..mid_end],
+        })?;
     }
     Ok(())
 }
@@ -480,11 +545,14 @@ pub fn evaluate(table: &FirmwareTable, limits: &IntEyeLimits) -> Result<IntEyeRe
     }
     let clock = clock_of(table, limits.pulse_rate_millihz_ceil);
     let half = limits.pass_arc_mdeg / 2;
-    let mut report = IntEyeReport {
-        worst_ratio_ppm: 0,
-        rule: IntRule::SinglePulse,
-        azimuth_mdeg: 0,
-        class1: true,
+    let mut t = Tracker {
+        worst: (0, 1),
+        report: IntEyeReport {
+            worst_ratio_ppm: 0,
+            rule: IntRule::SinglePulse,
+            azimuth_mdeg: 0,
+            class1: true,
+        },
     };
     let mut sorted: Vec<(u32, u128)> = Vec::new();
     for_each_cell(table, clock, limits.pass_arc_mdeg, |c| {
@@ -503,26 +571,44 @@ pub fn evaluate(table: &FirmwareTable, limits: &IntEyeLimits) -> Result<IntEyeRe
             ));
         }
         let azimuth = (c.a0 + i64::from(half)).rem_euclid(i64::from(FULL_TURN_MDEG)) as u32;
-        let mut note = |energy: u128, limit: u64, rule: IntRule| {
-            if energy > u128::from(limit) {
-                report.class1 = false;
-            }
-            let ppm = ratio_ppm(energy, limit);
-            if ppm > report.worst_ratio_ppm {
-                report.worst_ratio_ppm = ppm;
-                report.rule = rule;
-                report.azimuth_mdeg = azimuth;
-            }
-        };
-        sorted.clear();
-        sorted.extend(c.bins.iter().copied());
-        sorted.sort_unstable_by_key(|x| core::cmp::Reverse(x.0));
-        let hottest = sorted.first().map_or(0, |x| x.0);
-        note(
-            u128::from(hottest),
+        t.note(
+            azimuth,
+            u128::from(c.hottest),
             limits.pulse_code_max,
             IntRule::SinglePulse,
         );
+        let k_max = c.pulses;
+        // The bucket ends `to` of every train check, then the pass.
+        let buckets = limits
+            .train
+            .iter()
+            .enumerate()
+            .take_while(|(_, t)| u128::from(t.pulses_from) <= k_max)
+            .map(|(j, t)| {
+                let to = limits
+                    .train
+                    .get(j + 1)
+                    .map_or(k_max, |n| (u128::from(n.pulses_from) - 1).min(k_max));
+                (to, t.energy_max_quanta)
+            });
+        // A quick upper bound first: G(k) ≤ min(Σ code × cap, k × hottest).
+        // If no check can beat the worst ratio so far with it, the exact
+        // greedy cannot either (it is never larger), and the cell is done.
+        let hot = u128::from(c.hottest);
+        let loose = |k: u128| c.energy_all.min(k.saturating_mul(hot));
+        let mut loose_worst = (loose(k_max), limits.pass_energy_max_quanta);
+        for (to, lim) in buckets.clone() {
+            if ratio_greater((loose(to), lim), loose_worst) {
+                loose_worst = (loose(to), lim);
+            }
+        }
+        if !ratio_greater(loose_worst, t.worst) {
+            return Ok(());
+        }
+        sorted.clear();
+        sorted.extend_from_slice(c.edge_bins);
+        sorted.extend_from_slice(c.middle_bins);
+        sorted.sort_unstable_by_key(|x| core::cmp::Reverse(x.0));
         // G(k) by a walk over the hottest-first bins.
         let mut walk = Greedy {
             bins: &sorted,
@@ -531,32 +617,69 @@ pub fn evaluate(table: &FirmwareTable, limits: &IntEyeLimits) -> Result<IntEyeRe
             pulses: 0,
             energy: 0,
         };
-        let k_max = c.pulses;
-        for (j, t) in limits.train.iter().enumerate() {
-            let from = u128::from(t.pulses_from);
-            if from > k_max {
-                break;
-            }
-            let to = limits
-                .train
-                .get(j + 1)
-                .map_or(k_max, |n| (u128::from(n.pulses_from) - 1).min(k_max));
+        for (to, lim) in buckets {
             let g = walk.energy_up_to(to)?;
-            note(g, t.energy_max_quanta, IntRule::PassTrain);
-            if walk.exhausted() && g <= u128::from(t.energy_max_quanta) {
+            t.note(azimuth, g, lim, IntRule::PassTrain);
+            if walk.exhausted() && g <= u128::from(lim) {
                 // G is flat from here and the limits only grow.
                 break;
             }
         }
         let e_pass = walk.energy_up_to(k_max)?;
-        note(
+        t.note(
+            azimuth,
             e_pass,
             limits.pass_energy_max_quanta,
             limits.pass_energy_rule,
         );
         Ok(())
     })?;
-    Ok(report)
+    t.report.worst_ratio_ppm = ratio_ppm(t.worst.0, t.worst.1);
+    Ok(t.report)
+}
+
+/// The worst check so far: `(energy, limit)` compared exactly by
+/// cross-multiplication, with its rule and azimuth.
+struct Tracker {
+    worst: (u128, u64),
+    report: IntEyeReport,
+}
+
+impl Tracker {
+    fn note(&mut self, azimuth_mdeg: u32, energy: u128, limit: u64, rule: IntRule) {
+        if energy > u128::from(limit) {
+            self.report.class1 = false;
+        }
+        if ratio_greater((energy, limit), self.worst) {
+            self.worst = (energy, limit);
+            self.report.rule = rule;
+            self.report.azimuth_mdeg = azimuth_mdeg;
+        }
+    }
+}
+
+/// Whether `a.0 / a.1 > b.0 / b.1` (a zero limit with energy is infinite).
+fn ratio_greater(a: (u128, u64), b: (u128, u64)) -> bool {
+    let ((ea, la), (eb, lb)) = (a, b);
+    if ea == 0 {
+        return false;
+    }
+    if la == 0 {
+        return !(lb == 0 && eb > 0);
+    }
+    if eb == 0 {
+        return true;
+    }
+    if lb == 0 {
+        return false;
+    }
+    match (
+        ea.checked_mul(u128::from(lb)),
+        eb.checked_mul(u128::from(la)),
+    ) {
+        (Some(x), Some(y)) => x > y,
+        _ => ratio_ppm(ea, la) > ratio_ppm(eb, lb),
+    }
 }
 
 /// `G(k)`: the most quanta `k` pulses can carry when bin `i` (hottest
