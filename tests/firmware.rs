@@ -246,16 +246,7 @@ fn default_80mhz_quantizes_certified_near_limit_profiles() {
     for mode in MODES {
         for gaze in [90.0, 5.0] {
             for target in [1.0 - 1e-4, 0.999_999, 1.0 - 1e-9] {
-                let c = closed_form(
-                    &presets::paper(),
-                    mode,
-                    Some(gaze),
-                    std::env::var("FW_BINS")
-                        .ok()
-                        .and_then(|s| s.parse().ok())
-                        .unwrap_or(360),
-                )
-                .unwrap();
+                let c = closed_form(&presets::paper(), mode, Some(gaze), 360).unwrap();
                 let c = at_ratio(c.profile(), target);
                 let t = FirmwareTable::from_certified(&c, &FirmwareConfig::default())
                     .unwrap_or_else(|e| panic!("{mode:?} {gaze} {target}: {e}"));
