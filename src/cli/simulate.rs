@@ -5,7 +5,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, Variant, FOG_LEVELS_PCT};
+use gaze_lidar::sim::{
+    self, Arrival, Detector, Geometry, KOfN, ModelKind, Scenario, SimConfig, Variant,
+    FOG_LEVELS_PCT,
+};
 
 use super::io::{read_text, validate_paths, warn, Outputs, MAX_CONFIG_BYTES};
 use super::{emit, CliError};
@@ -44,6 +47,18 @@ pub struct Args {
     /// Scenario TOML (defaults: the paper's scene).
     #[arg(long)]
     scenario: Option<PathBuf>,
+    /// Sensor geometry: `planar` (one horizontal channel, the lightweight
+    /// default) or `carla` (CARLA's 64-channel 3D ray-cast LiDAR over a road).
+    #[arg(long, value_enum, default_value_t = Geometry::Planar)]
+    geometry: Geometry,
+    /// Detector of the car from the right: `first-return` (any point on it)
+    /// or `argus` (the paper code's road-mask rule; needs `--geometry carla`).
+    #[arg(long, value_enum, default_value_t = Detector::FirstReturn)]
+    detector: Detector,
+    /// Arrival: `front` (the front reaches the conflict line) or
+    /// `argus-centre` (the centre does, as the paper's code).
+    #[arg(long, value_enum, default_value_t = Arrival::Front)]
+    arrival: Arrival,
     /// Detection rule k-of-n frames, e.g. `2/3` (paper: first return, `1/1`).
     #[arg(long, default_value = "1/1")]
     detect: String,
@@ -149,6 +164,11 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
     }
     let detection = parse_k_of_n(&a.detect)?;
+    if a.detector == Detector::Argus && a.geometry != Geometry::Carla {
+        return Err(CliError::input(
+            "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)",
+        ));
+    }
     let variants = if a.variant.is_empty() {
         Variant::PAPER.to_vec()
     } else {
@@ -199,6 +219,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         scenario,
         detection,
         brute_force: a.brute_force,
+        geometry: a.geometry,
+        detector: a.detector,
+        arrival: a.arrival,
         #[cfg(feature = "solver")]
         optimizer,
         ..SimConfig::default()
