@@ -180,10 +180,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
     ];
     let dir = [-1.0, 1.0];
     let extra = setup.arrival.extra_distance_m(len);
-    let t_conflict = [
-        (front0[0] - ch + extra) / v,
-        (-ch - front0[1] + extra) / v,
-    ];
+    let t_conflict = [(front0[0] - ch + extra) / v, (-ch - front0[1] + extra) / v];
     let t_end = t_conflict[0].max(t_conflict[1]);
     let car_box = |j: usize, t: f64| -> Aabb {
         let front = front0[j] + dir[j] * v * t;

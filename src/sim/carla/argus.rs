@@ -44,6 +44,17 @@ pub fn in_density_region(az_deg: f64, gaze_deg: f64, ego_yaw_deg: f64) -> bool {
     in_half_plane(az_deg, ego_yaw_deg) && signed_deg(az_deg) < gaze_deg - 30.0
 }
 
+/// `⌊x⌋` as an integer (saturating far outside the grid; NaN → 0), without
+/// a libm call: `x as i64` truncates toward zero, one less below zero.
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t - 1
+    } else {
+        t
+    }
+}
+
 /// The road mask grid: cells of `cell_m` over `[-extent, extent)²`.
 #[derive(Debug, Clone)]
 pub struct RoadMask {
@@ -73,13 +84,10 @@ impl RoadMask {
     /// or `None` outside the grid.
     #[must_use]
     pub fn index(&self, x: f64, y: f64) -> Option<usize> {
-        let i = (x / self.cell_m).floor() as i64 + self.offset;
-        let j = (y / self.cell_m).floor() as i64 + self.offset;
-        (0..self.side)
-            .contains(&i)
-            .then_some(())
-            .filter(|()| (0..self.side).contains(&j))
-            .map(|()| (i * self.side + j) as usize)
+        let i = floor_i64(x / self.cell_m).checked_add(self.offset)?;
+        let j = floor_i64(y / self.cell_m).checked_add(self.offset)?;
+        ((0..self.side).contains(&i) && (0..self.side).contains(&j))
+            .then(|| (i * self.side + j) as usize)
     }
 
     /// Marks a cell.
@@ -132,19 +140,31 @@ impl ArgusDetector {
 
     /// Takes one point of the kept half-plane (sensor frame).
     pub fn point(&mut self, x: f64, y: f64, z: f64) {
+        let cell = self.mask.index(x, y);
+        self.point_in_cell(x, y, z, cell);
+    }
+
+    /// [`Self::point`] with the point's cell already found ([`Self::cell_of`]).
+    pub fn point_in_cell(&mut self, x: f64, y: f64, z: f64, cell: Option<usize>) {
         if z < self.road_z {
             self.tick_y = Some(match self.tick_y {
                 None => (y, y),
                 Some((lo, hi)) => (lo.min(y), hi.max(y)),
             });
-            if let Some(i) = self.mask.index(x, y) {
+            if let Some(i) = cell {
                 self.tick_road.push(i);
             }
         } else if z >= self.vehicle_z && y < self.y_max && x > self.x_min {
-            if let Some(i) = self.mask.index(x, y) {
+            if let Some(i) = cell {
                 self.tick_candidates.push(i);
             }
         }
+    }
+
+    /// The mask cell of `(x, y)` (the same for every detector of a scenario).
+    #[must_use]
+    pub fn cell_of(&self, x: f64, y: f64) -> Option<usize> {
+        self.mask.index(x, y)
     }
 
     /// Ends a callback: updates the road mask as `GridCache` does and
@@ -182,10 +202,7 @@ impl ArgusDetector {
             self.empty = false;
         }
         self.tick_road.clear();
-        let found = self
-            .tick_candidates
-            .iter()
-            .any(|&i| self.mask.contains(i));
+        let found = self.tick_candidates.iter().any(|&i| self.mask.contains(i));
         self.tick_candidates.clear();
         found
     }
@@ -194,6 +211,24 @@ impl ArgusDetector {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_matches_libm() {
+        for x in [
+            -2.5,
+            -2.0,
+            -1e-300,
+            -0.0,
+            0.0,
+            0.3,
+            1.0,
+            7.999_999_999_999_999,
+            1e15 + 0.5,
+            -1e15 - 0.5,
+        ] {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
+    }
 
     #[test]
     fn half_plane_and_region() {

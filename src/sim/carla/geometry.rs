@@ -38,25 +38,41 @@ pub struct Sensor {
     pub sin_el: Vec<f64>,
     /// Trace length (CARLA's `range`), m: hits farther along the ray are not returned.
     pub range_m: f64,
+    /// Per channel, the direction's components along the azimuth's cosine,
+    /// its sine and the constant part (mount rotation applied once).
+    basis: Vec<[Vector3<f64>; 3]>,
 }
 
 impl Sensor {
     /// A sensor `height_m` above the road, level, with the given channels.
     #[must_use]
     pub fn new(height_m: f64, elevations_deg: Vec<f64>, range_m: f64) -> Self {
-        let (sin_el, cos_el) = elevations_deg
+        let (sin_el, cos_el): (Vec<f64>, Vec<f64>) = elevations_deg
             .iter()
             .map(|e| e.to_radians().sin_cos())
             .unzip();
+        let mount = Isometry3::from_parts(
+            Translation3::new(0.0, 0.0, height_m),
+            UnitQuaternion::identity(),
+        );
+        let basis = cos_el
+            .iter()
+            .zip(&sin_el)
+            .map(|(&c, &s)| {
+                [
+                    mount.rotation * Vector3::new(c, 0.0, 0.0),
+                    mount.rotation * Vector3::new(0.0, c, 0.0),
+                    mount.rotation * Vector3::new(0.0, 0.0, s),
+                ]
+            })
+            .collect();
         Self {
-            mount: Isometry3::from_parts(
-                Translation3::new(0.0, 0.0, height_m),
-                UnitQuaternion::identity(),
-            ),
+            mount,
             elevations_deg,
             cos_el,
             sin_el,
             range_m,
+            basis,
         }
     }
 
@@ -69,12 +85,8 @@ impl Sensor {
     /// Unit direction (road frame) of channel `ch` at azimuth `(cos, sin)`.
     #[must_use]
     pub fn direction(&self, ch: usize, cos_az: f64, sin_az: f64) -> Vector3<f64> {
-        let local = Vector3::new(
-            self.cos_el[ch] * cos_az,
-            self.cos_el[ch] * sin_az,
-            self.sin_el[ch],
-        );
-        self.mount.rotation * local
+        let [a, b, c] = &self.basis[ch];
+        a * cos_az + b * sin_az + c
     }
 
     /// A point of the road frame in the sensor frame.
@@ -362,7 +374,9 @@ mod tests {
         assert!(b.ray_hit(&o, &-Vector3::x(), Surface::Vehicle(1)).is_none());
         // Above the roof: misses.
         let high = Point3::new(0.0, 0.0, 2.0);
-        assert!(b.ray_hit(&high, &Vector3::x(), Surface::Vehicle(1)).is_none());
+        assert!(b
+            .ray_hit(&high, &Vector3::x(), Surface::Vehicle(1))
+            .is_none());
         let (f, z) = b.bounds();
         assert_relative_eq!(f[0], 9.0, epsilon = 1e-12);
         assert_relative_eq!(f[3], 2.0, epsilon = 1e-12);

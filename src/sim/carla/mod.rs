@@ -122,6 +122,8 @@ struct World<'a> {
     /// Horizontal reach of each channel: trace end or ground, m.
     reach_m: Vec<f64>,
     tan_el: Vec<f64>,
+    /// Per channel: the ground's distance along the ray if within the trace.
+    ground_t: Vec<Option<f64>>,
     brute_force: bool,
 }
 
@@ -136,7 +138,9 @@ impl<'a> World<'a> {
         let origin = sensor.origin();
         let h = origin.z;
         let n = sensor.elevations_deg.len();
-        let tan_el: Vec<f64> = (0..n).map(|c| sensor.sin_el[c] / sensor.cos_el[c]).collect();
+        let tan_el: Vec<f64> = (0..n)
+            .map(|c| sensor.sin_el[c] / sensor.cos_el[c])
+            .collect();
         let reach_m: Vec<f64> = (0..n)
             .map(|c| {
                 let trace = p.range_m * sensor.cos_el[c];
@@ -161,14 +165,24 @@ impl<'a> World<'a> {
                 }
                 statics.iter().enumerate().fold(0u64, |m, (i, b)| {
                     let dist = footprint_distances(b.footprint());
-                    let ok = channel_may_reach(h, tan_el[c], b.heights(), dist, reach_m[c], CULL_PAD_M);
+                    let ok =
+                        channel_may_reach(h, tan_el[c], b.heights(), dist, reach_m[c], CULL_PAD_M);
                     m | (u64::from(ok) << i)
                 })
+            })
+            .collect();
+        let ground_t = (0..n)
+            .map(|c| {
+                let d = sensor.direction(c, 1.0, 0.0);
+                geometry::ground_hit(&origin, &d)
+                    .map(|h| h.range_m)
+                    .filter(|&t| t <= p.range_m)
             })
             .collect();
         Self {
             sensor,
             origin,
+            ground_t,
             statics,
             static_arcs,
             static_may,
@@ -209,7 +223,14 @@ impl<'a> World<'a> {
     }
 
     /// Nearest hit of channel `ch`'s ray at azimuth `az` (direction `d`).
-    fn cast(&self, ch: usize, d: &Vector3<f64>, az: f64, pulse_mask: u64, cars: &Cars) -> Option<Hit> {
+    fn cast(
+        &self,
+        ch: usize,
+        d: &Vector3<f64>,
+        az: f64,
+        pulse_mask: u64,
+        cars: &Cars,
+    ) -> Option<Hit> {
         let o = &self.origin;
         let mut best = geometry::ground_hit(o, d);
         let mask = if self.brute_force {
@@ -228,7 +249,7 @@ impl<'a> World<'a> {
             }
         }
         for j in 0..2 {
-            if !self.brute_force && !(cars.may[j][ch] && cars.arcs[j].contains(az)) {
+            if !(self.brute_force || cars.may[j][ch] && cars.arcs[j].contains(az)) {
                 continue;
             }
             if let Some(h) = cars.boxes[j].ray_hit(o, d, Surface::Vehicle(j)) {
@@ -278,10 +299,15 @@ struct CellState {
     power_ratio: Vec<f64>,
     in_roi: bool,
     in_rof: bool,
+    /// Physical model: last `P_D` per channel and the inputs it was for
+    /// (range, power, cosine bits): ground hits repeat them exactly.
+    pd_cache: Vec<([u64; 3], f64)>,
 }
 
 /// Runs one trial for every cell of a group; outcomes in the cells' order.
 #[must_use]
+// Channel and car indices address several parallel arrays at once.
+#[allow(clippy::needless_range_loop)]
 pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> {
     let sc = setup.scenario;
     let p = &sc.carla;
@@ -351,8 +377,13 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
                 .collect(),
             in_roi: false,
             in_rof: false,
+            pd_cache: vec![([u64::MAX; 3], 0.0); channels],
         })
         .collect();
+    let any_argus = cells.iter().any(|c| c.argus.is_some());
+    let cell_grid = ArgusDetector::new(p);
+    // Raw intensity per channel, cached on the range's bits.
+    let mut raw_cache: Vec<(u64, f64)> = vec![(u64::MAX, 0.0); channels];
 
     // Ends tick `tick` (state time `t`) for every cell.
     let end_tick = |cells: &mut [CellState], tick: u64, t: f64| {
@@ -440,7 +471,18 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
             st.roi_pulses += u64::from(st.in_roi) * channels as u64;
         }
         let pulse_mask = world.static_mask_at(az);
+        let car_arc = [cars.arcs[0].contains(az), cars.arcs[1].contains(az)];
         for ch in 0..channels {
+            // A ray that can meet nothing (no ground within its trace, no
+            // box in reach) returns nothing whatever its draws: skip it.
+            if !world.brute_force
+                && world.ground_t[ch].is_none()
+                && world.static_may[ch] & pulse_mask == 0
+                && !(car_arc[0] && cars.may[0][ch])
+                && !(car_arc[1] && cars.may[1][ch])
+            {
+                continue;
+            }
             let idx = k.wrapping_mul(channels as u64).wrapping_add(ch as u64);
             let key = idx.wrapping_mul(0xD1B5_4A32_D192_ED03);
             if p.dropoff_general_rate > 0.0 && unit(seed_general ^ key) < p.dropoff_general_rate {
@@ -451,8 +493,18 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
                 continue;
             };
             let r = hit.range_m;
-            let raw = (-p.atmosphere_attenuation_rate_per_m * r).exp();
-            if raw <= p.dropoff_intensity_limit && unit(seed_intensity ^ key) >= alpha * raw + beta {
+            let raw = {
+                let c = &mut raw_cache[ch];
+                if c.0 != r.to_bits() {
+                    *c = (
+                        r.to_bits(),
+                        (-p.atmosphere_attenuation_rate_per_m * r).exp(),
+                    );
+                }
+                c.1
+            };
+            if raw <= p.dropoff_intensity_limit && unit(seed_intensity ^ key) >= alpha * raw + beta
+            {
                 continue;
             }
             let (refl, car) = match hit.surface {
@@ -460,7 +512,13 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
                 Surface::Building => (sc.building_reflectivity, None),
                 Surface::Vehicle(j) => (sc.vehicle_reflectivity, Some(j)),
             };
-            let ps = world.sensor.to_sensor(&hit.point);
+            // The point in the sensor frame and its road-mask cell (ARGUS).
+            let (ps, cell) = if any_argus && half {
+                let ps = world.sensor.to_sensor(&hit.point);
+                (ps, cell_grid.cell_of(ps.x, ps.y))
+            } else {
+                (hit.point, None)
+            };
             let mut u_noise = None;
             for (st, spec) in cells.iter_mut().zip(setup.cells) {
                 let power = st.power_ratio[bin];
@@ -470,9 +528,16 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
                         threshold,
                     } => r <= ARGUS_RANGE_M && power * raw * fog_factor >= threshold,
                     ReturnModel::Physical { .. } => {
-                        let p_d = spec
-                            .model
-                            .detection_probability(power, refl, hit.cos_incidence, r);
+                        let pd_key = [r.to_bits(), power.to_bits(), hit.cos_incidence.to_bits()];
+                        let cache = &mut st.pd_cache[ch];
+                        if cache.0 != pd_key || hit.surface != Surface::Ground {
+                            *cache = (
+                                pd_key,
+                                spec.model
+                                    .detection_probability(power, refl, hit.cos_incidence, r),
+                            );
+                        }
+                        let p_d = cache.1;
                         p_d >= 1.0
                             || (p_d > 0.0
                                 && *u_noise.get_or_insert_with(|| unit(seed_noise ^ key)) < p_d)
@@ -495,7 +560,7 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
                 }
                 if half {
                     if let Some(det) = st.argus.as_mut() {
-                        det.point(ps.x, ps.y, ps.z);
+                        det.point_in_cell(ps.x, ps.y, ps.z, cell);
                     }
                 }
             }

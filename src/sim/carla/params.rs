@@ -149,7 +149,12 @@ impl CarlaParams {
             ),
             ("carla.tick_s", self.tick_s, 1e-3, 1.0),
             ("carla.vehicle_height_m", self.vehicle_height_m, 0.1, 10.0),
-            ("carla.building_height_m", self.building_height_m, 0.1, 1000.0),
+            (
+                "carla.building_height_m",
+                self.building_height_m,
+                0.1,
+                1000.0,
+            ),
             (
                 "carla.ground_reflectivity",
                 self.ground_reflectivity,
