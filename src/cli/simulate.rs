@@ -74,6 +74,12 @@ pub struct Args {
     /// Write the reproduction report (Markdown) to this file.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// With `--report`: also run the paper's pipeline (`--geometry carla
+    /// --detector argus --arrival argus-centre --model argus`, the paper's
+    /// four variants and fog levels) with this many trials per cell and add
+    /// its column and section to the report (0: none).
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
+    paper_pipeline_trials: i64,
     /// Also write the rows as JSON (`{"rows": [...]}`) to this file.
     #[arg(long)]
     export_json: Option<PathBuf>,
@@ -164,6 +170,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
     }
     let detection = parse_k_of_n(&a.detect)?;
+    if !(0..=100_000).contains(&a.paper_pipeline_trials) {
+        return Err(CliError::input(format!(
+            "--paper-pipeline-trials: {} must lie in 0..=100000",
+            a.paper_pipeline_trials
+        )));
+    }
     if a.detector == Detector::Argus && a.geometry != Geometry::Carla {
         return Err(CliError::input(
             "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)",
@@ -275,7 +287,28 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         );
     }
     if let Some(path) = &a.report {
-        outputs.add(path, sim::report::render(&result, &config));
+        let pipeline = if a.paper_pipeline_trials > 0 {
+            let pc = SimConfig {
+                models: vec![ModelKind::Argus],
+                variants: Variant::PAPER.to_vec(),
+                fog_pcts: FOG_LEVELS_PCT.to_vec(),
+                trials: a.paper_pipeline_trials as usize,
+                geometry: Geometry::Carla,
+                detector: Detector::Argus,
+                arrival: Arrival::ArgusCentre,
+                ..config.clone()
+            };
+            let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
+            Some((r, pc))
+        } else {
+            None
+        };
+        let md = sim::report::render_with_pipeline(
+            &result,
+            &config,
+            pipeline.as_ref().map(|(r, c)| (r, c)),
+        );
+        outputs.add(path, md);
     }
     let plots = match &a.plots {
         Some(dir) => Some(stage_plots(&result, &config, dir)?),
