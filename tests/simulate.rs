@@ -376,14 +376,37 @@ fn carla_cells_cast_together_equal_cells_cast_alone() {
 fn carla_far_side_wall_fools_the_argus_rule_at_once() {
     // A wall across the road in ARGUS's region: its foot (below the road
     // threshold) becomes road, the wall above a "vehicle": detection on the
-    // first callback, long before the car is in range.
-    let r = carla_grid(Detector::Argus, false, true);
-    let s = short_carla();
-    let first_tick_tta = (s.carla.spawn_distance_m + 0.5 * s.vehicle_length_m
+    // first callback, while the car is still beyond the trace (spawned
+    // 102–112 m out); without the wall, detection waits for a ground ring.
+    let tta = |far_side: bool| {
+        let mut scenario = Scenario::default();
+        scenario.carla.far_side_buildings = far_side;
+        let config = SimConfig {
+            models: vec![ModelKind::Argus],
+            variants: vec![Variant::Baseline],
+            fog_pcts: vec![0],
+            trials: 1,
+            scenario,
+            geometry: Geometry::Carla,
+            detector: Detector::Argus,
+            arrival: Arrival::ArgusCentre,
+            ..SimConfig::default()
+        };
+        sim::run(&config, &|| {}).unwrap().rows[0]
+            .tta_median_s
+            .unwrap()
+    };
+    let s = Scenario::default();
+    let first_tick = (s.carla.spawn_distance_m + s.start_offset_m[0] + 0.5 * s.vehicle_length_m
         - s.conflict_half_width_m)
-        / s.speed_m_s();
-    let row = r.row(ModelKind::Argus, "baseline", 0).unwrap();
-    assert!(row.tta_median_s.unwrap() > first_tick_tta - 0.1, "{row:?}");
+        / s.speed_m_s()
+        - s.carla.tick_s;
+    let (wall, open) = (tta(true), tta(false));
+    assert!(
+        wall >= first_tick - 1e-9,
+        "wall {wall} vs first tick {first_tick}"
+    );
+    assert!(open < 6.5, "open {open}");
 }
 
 #[test]
