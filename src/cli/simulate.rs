@@ -5,7 +5,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, Variant, FOG_LEVELS_PCT};
+use gaze_lidar::sim::{
+    self, Arrival, Detector, Geometry, KOfN, ModelKind, Scenario, SimConfig, Variant,
+    FOG_LEVELS_PCT,
+};
 
 use super::io::{read_text, validate_paths, warn, Outputs, MAX_CONFIG_BYTES};
 use super::{emit, CliError};
@@ -44,6 +47,18 @@ pub struct Args {
     /// Scenario TOML (defaults: the paper's scene).
     #[arg(long)]
     scenario: Option<PathBuf>,
+    /// Sensor geometry: `planar` (one horizontal channel, the lightweight
+    /// default) or `carla` (CARLA's 64-channel 3D ray-cast LiDAR over a road).
+    #[arg(long, value_enum, default_value_t = Geometry::Planar)]
+    geometry: Geometry,
+    /// Detector of the car from the right: `first-return` (any point on it)
+    /// or `argus` (the paper code's road-mask rule; needs `--geometry carla`).
+    #[arg(long, value_enum, default_value_t = Detector::FirstReturn)]
+    detector: Detector,
+    /// Arrival: `front` (the front reaches the conflict line) or
+    /// `argus-centre` (the centre does, as the paper's code).
+    #[arg(long, value_enum, default_value_t = Arrival::Front)]
+    arrival: Arrival,
     /// Detection rule k-of-n frames, e.g. `2/3` (paper: first return, `1/1`).
     #[arg(long, default_value = "1/1")]
     detect: String,
@@ -59,6 +74,12 @@ pub struct Args {
     /// Write the reproduction report (Markdown) to this file.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// With `--report`: also run the paper's pipeline (`--geometry carla
+    /// --detector argus --arrival argus-centre --model argus`, the paper's
+    /// four variants and fog levels) with this many trials per cell and add
+    /// its column and section to the report (0: none).
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
+    paper_pipeline_trials: i64,
     /// Also write the rows as JSON (`{"rows": [...]}`) to this file.
     #[arg(long)]
     export_json: Option<PathBuf>,
@@ -149,6 +170,17 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
     }
     let detection = parse_k_of_n(&a.detect)?;
+    if !(0..=100_000).contains(&a.paper_pipeline_trials) {
+        return Err(CliError::input(format!(
+            "--paper-pipeline-trials: {} must lie in 0..=100000",
+            a.paper_pipeline_trials
+        )));
+    }
+    if a.detector == Detector::Argus && a.geometry != Geometry::Carla {
+        return Err(CliError::input(
+            "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)",
+        ));
+    }
     let variants = if a.variant.is_empty() {
         Variant::PAPER.to_vec()
     } else {
@@ -199,6 +231,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         scenario,
         detection,
         brute_force: a.brute_force,
+        geometry: a.geometry,
+        detector: a.detector,
+        arrival: a.arrival,
         #[cfg(feature = "solver")]
         optimizer,
         ..SimConfig::default()
@@ -252,7 +287,28 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         );
     }
     if let Some(path) = &a.report {
-        outputs.add(path, sim::report::render(&result, &config));
+        let pipeline = if a.paper_pipeline_trials > 0 {
+            let pc = SimConfig {
+                models: vec![ModelKind::Argus],
+                variants: Variant::PAPER.to_vec(),
+                fog_pcts: FOG_LEVELS_PCT.to_vec(),
+                trials: a.paper_pipeline_trials as usize,
+                geometry: Geometry::Carla,
+                detector: Detector::Argus,
+                arrival: Arrival::ArgusCentre,
+                ..config.clone()
+            };
+            let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
+            Some((r, pc))
+        } else {
+            None
+        };
+        let md = sim::report::render_with_pipeline(
+            &result,
+            &config,
+            pipeline.as_ref().map(|(r, c)| (r, c)),
+        );
+        outputs.add(path, md);
     }
     let plots = match &a.plots {
         Some(dir) => Some(stage_plots(&result, &config, dir)?),

@@ -270,30 +270,20 @@ impl Parser {
     }
 }
 
-/// Rotates vector `v` by the unit quaternion `q = (x, y, z, w)`.
+/// Rotates vector `v` (HMD frame) by the head orientation `q = (x, y, z, w)`
+/// (normalised first; a zero or non-finite quaternion gives NaN), with
+/// nalgebra's unit quaternion: the frame change from head to vehicle.
 fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    use nalgebra::{Quaternion, UnitQuaternion, Vector3};
     let [x, y, z, w] = q;
-    let n = (x * x + y * y + z * z + w * w).sqrt();
-    if n.is_nan() || n <= 0.0 {
+    let raw = Quaternion::new(w, x, y, z);
+    let n = raw.norm();
+    if n.is_nan() || n <= 0.0 || !n.is_finite() {
         return [f64::NAN; 3];
     }
-    let (x, y, z, w) = (x / n, y / n, z / n, w / n);
-    // v' = v + 2w (u × v) + 2 u × (u × v), u = (x, y, z).
-    let c1 = [
-        y * v[2] - z * v[1],
-        z * v[0] - x * v[2],
-        x * v[1] - y * v[0],
-    ];
-    let c2 = [
-        y * c1[2] - z * c1[1],
-        z * c1[0] - x * c1[2],
-        x * c1[1] - y * c1[0],
-    ];
-    [
-        v[0] + 2.0 * (w * c1[0] + c2[0]),
-        v[1] + 2.0 * (w * c1[1] + c2[1]),
-        v[2] + 2.0 * (w * c1[2] + c2[2]),
-    ]
+    let head = UnitQuaternion::from_quaternion(raw);
+    let out = head * Vector3::new(v[0], v[1], v[2]);
+    [out.x, out.y, out.z]
 }
 
 #[cfg(test)]

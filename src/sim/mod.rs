@@ -12,6 +12,7 @@
 //! variant and fog level sees the same draws (paired comparison), and the
 //! results are bit-identical whatever the number of threads.
 
+pub mod carla;
 pub mod plots;
 pub mod report;
 pub mod returns;
@@ -136,6 +137,93 @@ impl Variant {
     }
 }
 
+/// The sensor geometry of the simulation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Geometry {
+    /// One horizontal channel in a top view, scaled by the channel count
+    /// (the lightweight default).
+    #[default]
+    Planar,
+    /// CARLA's 3D ray-cast LiDAR: every channel over the vertical field of
+    /// view, a mount above a flat road, boxes with heights, CARLA's drop-off.
+    Carla,
+}
+
+/// When the car from the right counts as detected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Detector {
+    /// Any returned point on the car (k-of-n frames; `carla`: ticks).
+    #[default]
+    FirstReturn,
+    /// ARGUS's rule: road mask from ground returns, a vehicle point above a
+    /// road cell in its region (`carla` geometry only).
+    Argus,
+}
+
+/// When a car arrives (TTA is measured to this moment).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Arrival {
+    /// Its front reaches |y| = `conflict_half_width_m`.
+    #[default]
+    Front,
+    /// Its centre reaches |y| = `conflict_half_width_m` (ARGUS: the
+    /// actor's location reaching world x ≤ 1.75 m).
+    ArgusCentre,
+}
+
+impl Geometry {
+    /// Name as on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Planar => "planar",
+            Self::Carla => "carla",
+        }
+    }
+}
+
+impl Detector {
+    /// Name as on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::FirstReturn => "first-return",
+            Self::Argus => "argus",
+        }
+    }
+}
+
+impl Arrival {
+    /// Name as on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Front => "front",
+            Self::ArgusCentre => "argus-centre",
+        }
+    }
+
+    /// Distance the car travels after its front reaches the conflict line
+    /// before it arrives, m.
+    #[must_use]
+    pub fn extra_distance_m(self, vehicle_length_m: f64) -> f64 {
+        match self {
+            Self::Front => 0.0,
+            Self::ArgusCentre => 0.5 * vehicle_length_m,
+        }
+    }
+}
+
+/// Whether a configuration is the paper's own pipeline (CARLA geometry,
+/// ARGUS's detector and arrival).
+#[must_use]
+pub fn is_paper_pipeline(geometry: Geometry, detector: Detector, arrival: Arrival) -> bool {
+    geometry == Geometry::Carla && detector == Detector::Argus && arrival == Arrival::ArgusCentre
+}
+
 /// What to run.
 #[derive(Debug, Clone)]
 pub struct SimConfig {
@@ -158,6 +246,12 @@ pub struct SimConfig {
     pub detection: KOfN,
     /// Disable culling (reference path).
     pub brute_force: bool,
+    /// Sensor geometry.
+    pub geometry: Geometry,
+    /// Detector of the car from the right.
+    pub detector: Detector,
+    /// Arrival rule.
+    pub arrival: Arrival,
     /// Bins of the closed-form profiles.
     pub bins: usize,
     /// The sensor and driver model of the closed-form variants (regions,
@@ -179,6 +273,9 @@ impl Default for SimConfig {
             scenario: Scenario::default(),
             detection: KOfN::default(),
             brute_force: false,
+            geometry: Geometry::Planar,
+            detector: Detector::FirstReturn,
+            arrival: Arrival::Front,
             bins: 360,
             sensor: presets::paper(),
         }
@@ -315,6 +412,12 @@ pub struct Row {
     pub variant: &'static str,
     /// Fog, % (paper label).
     pub fog_pct: u32,
+    /// Sensor geometry.
+    pub geometry: Geometry,
+    /// Detector.
+    pub detector: Detector,
+    /// Arrival rule.
+    pub arrival: Arrival,
     /// Trials.
     pub trials: usize,
     /// Trials where the right car was detected before arrival.
@@ -339,6 +442,10 @@ pub struct Row {
     pub hybrid_tta_median_s: Option<f64>,
     /// Left car: median hybrid TTA, s.
     pub left_hybrid_tta_median_s: Option<f64>,
+    /// ARGUS's density metric: points per trial in its kept half-plane at
+    /// azimuths below gaze − 30° (all channels, ground included; planar:
+    /// the simulated channel × channels); median.
+    pub argus_density_points: f64,
 }
 
 /// All rows and per-trial records.
@@ -510,6 +617,15 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
             config.trials
         )));
     }
+    if config.detector == Detector::Argus && config.geometry != Geometry::Carla {
+        return Err(SimError::Argument(
+            "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)"
+                .into(),
+        ));
+    }
+    if config.geometry == Geometry::Carla {
+        config.scenario.validate_carla()?;
+    }
     let fogs: Vec<FogLevel> = config
         .fog_pcts
         .iter()
@@ -526,10 +642,31 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
         }
     }
     let table = OptTable::build(config)?;
+    let opt_sensor = table.as_ref().map(|t| t.sensor(&config.sensor));
+    let sensor_of = |v: Variant| sensor_for(v, opt_sensor.as_ref(), &config.sensor);
+    let records = match config.geometry {
+        Geometry::Planar => run_planar(config, &fogs, table.as_ref(), &sensor_of, tick)?,
+        Geometry::Carla => run_carla(config, &fogs, table.as_ref(), &sensor_of, tick)?,
+    };
+    let rows = rows_of(config, &records, &sensor_of);
+    Ok(GridResult {
+        rows,
+        trials: records,
+    })
+}
+
+/// The planar geometry: one job per (model, variant, fog, trial).
+fn run_planar<'s>(
+    config: &SimConfig,
+    fogs: &[FogLevel],
+    table: Option<&OptTable>,
+    sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
+    tick: &(dyn Fn() + Sync),
+) -> Result<Vec<TrialRecord>, SimError> {
     let mut jobs = Vec::new();
     for &model in &config.models {
         for &variant in &config.variants {
-            for &fog in &fogs {
+            for &fog in fogs {
                 for trial in 0..config.trials {
                     jobs.push(Job {
                         model,
@@ -542,10 +679,7 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
         }
     }
     let statics = config.scenario.static_boxes();
-    let opt_sensor = table.as_ref().map(|t| t.sensor(&config.sensor));
-    let sensor_of = |v: Variant| sensor_for(v, opt_sensor.as_ref(), &config.sensor);
-    let records: Result<Vec<TrialRecord>, SimError> = jobs
-        .par_iter()
+    jobs.par_iter()
         .map(|job| {
             let d = draw(config.seed, job.trial, &config.scenario);
             let sensor = sensor_of(job.variant);
@@ -555,7 +689,7 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
                 job.variant,
                 d.gaze_deg,
                 config.bins,
-                table.as_ref(),
+                table,
             )?;
             let regions = sensor.focus.regions(d.gaze_deg);
             let model = ReturnModel::new(
@@ -574,6 +708,9 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
                 driver_range_m: job.fog.mor_m,
                 detection: config.detection,
                 brute_force: config.brute_force,
+                arrival: config.arrival,
+                ego_yaw_deg: config.scenario.carla.ego_yaw_deg,
+                gaze_deg: d.gaze_deg,
             };
             let outcome = trial::run_trial(&setup, &d);
             tick();
@@ -585,8 +722,139 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
                 outcome,
             })
         })
+        .collect()
+}
+
+/// The `carla` geometry: per trial, every cell planned, cells sharing a
+/// timeline cast together ([`carla::run_group`]); records in the planar order.
+fn run_carla<'s>(
+    config: &SimConfig,
+    fogs: &[FogLevel],
+    table: Option<&OptTable>,
+    sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
+    tick: &(dyn Fn() + Sync),
+) -> Result<Vec<TrialRecord>, SimError> {
+    let statics = config.scenario.carla_static_boxes();
+    let per_trial: Result<Vec<Vec<TrialRecord>>, SimError> = (0..config.trials)
+        .into_par_iter()
+        .map(|trial| {
+            let d = draw(config.seed, trial, &config.scenario);
+            // (model, variant) plans, then one cell per fog level.
+            struct Plan {
+                model: ModelKind,
+                variant: Variant,
+                profile: CertifiedProfile,
+                rof_keep: f64,
+                regions: crate::model::acuity::Regions,
+                models: Vec<(FogLevel, ReturnModel)>,
+            }
+            let mut plans = Vec::new();
+            for &model in &config.models {
+                for &variant in &config.variants {
+                    let sensor = sensor_of(variant);
+                    let (profile, rof_keep) = plan_variant(
+                        &config.sensor,
+                        model,
+                        variant,
+                        d.gaze_deg,
+                        config.bins,
+                        table,
+                    )?;
+                    let models = fogs
+                        .iter()
+                        .map(|&fog| {
+                            (
+                                fog,
+                                ReturnModel::new(
+                                    model,
+                                    fog,
+                                    sensor.lidar.rated_range_m,
+                                    sensor.lidar.reference_reflectivity,
+                                ),
+                            )
+                        })
+                        .collect();
+                    plans.push(Plan {
+                        model,
+                        variant,
+                        profile,
+                        rof_keep,
+                        regions: sensor.focus.regions(d.gaze_deg),
+                        models,
+                    });
+                }
+            }
+            // Group the plans by timeline (first-seen order).
+            let mut groups: Vec<Vec<usize>> = Vec::new();
+            for (i, plan) in plans.iter().enumerate() {
+                let same = groups.iter_mut().find(|g| {
+                    carla::same_timeline(plans[g[0]].profile.profile(), plan.profile.profile())
+                });
+                match same {
+                    Some(g) => g.push(i),
+                    None => groups.push(vec![i]),
+                }
+            }
+            let mut out = Vec::new();
+            for g in &groups {
+                let mut specs = Vec::new();
+                let mut keys = Vec::new();
+                for &i in g {
+                    let plan = &plans[i];
+                    for (fog, model) in &plan.models {
+                        specs.push(carla::CellSpec {
+                            profile: plan.profile.profile(),
+                            rof_keep: plan.rof_keep,
+                            regions: &plan.regions,
+                            model,
+                            driver_range_m: fog.mor_m,
+                        });
+                        keys.push((plan.model, plan.variant, fog.fog_pct));
+                    }
+                }
+                let setup = carla::GroupSetup {
+                    scenario: &config.scenario,
+                    statics: &statics,
+                    cells: &specs,
+                    detector: config.detector,
+                    arrival: config.arrival,
+                    detection: config.detection,
+                    brute_force: config.brute_force,
+                    gaze_deg: d.gaze_deg,
+                };
+                let outcomes = carla::run_group(&setup, &d);
+                for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
+                    tick();
+                    out.push(TrialRecord {
+                        model,
+                        variant: variant.name(),
+                        fog_pct,
+                        trial,
+                        outcome,
+                    });
+                }
+            }
+            Ok(out)
+        })
         .collect();
-    let records = records?;
+    // The planar order: model, variant, fog, trial.
+    let rank = |r: &TrialRecord| {
+        let m = config.models.iter().position(|&x| x == r.model);
+        let v = config.variants.iter().position(|x| x.name() == r.variant);
+        let f = config.fog_pcts.iter().position(|&x| x == r.fog_pct);
+        (m, v, f, r.trial)
+    };
+    let mut records: Vec<TrialRecord> = per_trial?.into_iter().flatten().collect();
+    records.sort_by_key(rank);
+    Ok(records)
+}
+
+/// The rows of the table from the records (in the planar order).
+fn rows_of<'s>(
+    config: &SimConfig,
+    records: &[TrialRecord],
+    sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
+) -> Vec<Row> {
     let mut rows = Vec::new();
     for chunk in records.chunks(config.trials) {
         let first = &chunk[0];
@@ -595,7 +863,11 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
         } else {
             Variant::Baseline
         };
-        let channels = f64::from(sensor_of(variant).lidar.channels);
+        // Planar: one channel stands for all; carla: every channel is cast.
+        let scale = match config.geometry {
+            Geometry::Planar => f64::from(sensor_of(variant).lidar.channels),
+            Geometry::Carla => 1.0,
+        };
         let right: Vec<f64> = chunk.iter().filter_map(|r| r.outcome.tta_s[1]).collect();
         let left: Vec<f64> = chunk.iter().filter_map(|r| r.outcome.tta_s[0]).collect();
         let hybrid_r: Vec<f64> = chunk
@@ -612,13 +884,20 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
             .collect();
         let dens_acc: Vec<f64> = chunk
             .iter()
-            .map(|r| r.outcome.density_pts_per_deg_s() * channels * r.outcome.duration_s)
+            .map(|r| r.outcome.density_pts_per_deg_s() * scale * r.outcome.duration_s)
+            .collect();
+        let argus_dens: Vec<f64> = chunk
+            .iter()
+            .map(|r| r.outcome.argus_roi_points as f64 * scale)
             .collect();
         let q = quartiles(&right);
         rows.push(Row {
             model: first.model,
             variant: first.variant,
             fog_pct: first.fog_pct,
+            geometry: config.geometry,
+            detector: config.detector,
+            arrival: config.arrival,
             trials: chunk.len(),
             detected: right.len(),
             tta_median_s: q.map(|q| q[1]),
@@ -630,12 +909,10 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
             left_detected: left.len(),
             hybrid_tta_median_s: quartiles(&hybrid_r).map(|q| q[1]),
             left_hybrid_tta_median_s: quartiles(&hybrid_l).map(|q| q[1]),
+            argus_density_points: quartiles(&argus_dens).map_or(0.0, |q| q[1]),
         });
     }
-    Ok(GridResult {
-        rows,
-        trials: records,
-    })
+    rows
 }
 
 #[cfg(test)]

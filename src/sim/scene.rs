@@ -24,8 +24,12 @@
 //! 100 m rated range is not the limit in clear air (as in the paper, where
 //! all four LiDARs agree without fog).
 
+use nalgebra::Point3;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
+
+use super::carla::geometry::StaticBox;
+pub use super::carla::params::CarlaParams;
 
 /// Slowest vehicle speed accepted, km/h.
 pub const MIN_SPEED_KMH: f64 = 1.0;
@@ -72,6 +76,8 @@ pub struct Scenario {
     pub vehicle_reflectivity: f64,
     /// Lambertian reflectivity of the buildings.
     pub building_reflectivity: f64,
+    /// The `carla` geometry's parameters (table `[carla]`; ignored by `planar`).
+    pub carla: CarlaParams,
 }
 
 impl Default for Scenario {
@@ -92,6 +98,7 @@ impl Default for Scenario {
             gaze_jitter_deg: 2.0,
             vehicle_reflectivity: 0.1,
             building_reflectivity: 0.3,
+            carla: CarlaParams::default(),
         }
     }
 }
@@ -251,6 +258,16 @@ impl Scenario {
                 "must lie in [1, 500] km/h (a slower car makes a trial simulate hours of pulses)",
             );
         }
+        self.carla
+            .validate()
+            .or_else(|(field, value, reason)| bad(field, value, reason))?;
+        if self.carla.spawn_distance_m <= self.conflict_half_width_m + self.vehicle_length_m {
+            return bad(
+                "carla.spawn_distance_m",
+                self.carla.spawn_distance_m,
+                "must exceed conflict_half_width_m + vehicle_length_m",
+            );
+        }
         let t = self.max_duration_s();
         if t.is_nan() || t > MAX_SIMULATED_S {
             return Err(ScenarioError::Duration {
@@ -268,6 +285,68 @@ impl Scenario {
     pub fn max_duration_s(&self) -> f64 {
         (self.bend_distance_m + self.start_offset_m[1] - self.conflict_half_width_m)
             / self.speed_m_s()
+    }
+
+    /// Checks the `carla` geometry's trial length (checked only when that
+    /// geometry runs, so planar scenarios validate as before).
+    pub fn validate_carla(&self) -> Result<(), ScenarioError> {
+        let t = self.carla_max_duration_s();
+        if t.is_nan() || t > MAX_SIMULATED_S {
+            return Err(ScenarioError::Duration {
+                seconds: t,
+                max: MAX_SIMULATED_S,
+            });
+        }
+        Ok(())
+    }
+
+    /// The longest simulated time of a `carla` trial (front arrival, or the
+    /// centre's, half a length later), s.
+    #[must_use]
+    pub fn carla_max_duration_s(&self) -> f64 {
+        (self.carla.spawn_distance_m + self.start_offset_m[1] + 0.5 * self.vehicle_length_m
+            - self.conflict_half_width_m)
+            / self.speed_m_s()
+    }
+
+    /// The static boxes of the `carla` geometry: the corner blocks (and,
+    /// with `carla.far_side_buildings`, a far-side frontage) as buildings
+    /// `carla.building_height_m` tall, lining the main road to
+    /// `carla.road_half_length_m`; no bend, no occluder.
+    #[must_use]
+    pub fn carla_static_boxes(&self) -> Vec<StaticBox> {
+        let far_edge = self.near_edge_x_m + 2.0 * self.lane_width_m;
+        let half_stem = 0.5 * self.stem_width_m + self.sidewalk_m;
+        let l = self.carla.road_half_length_m;
+        let h = self.carla.building_height_m;
+        let depth = 40.0;
+        let b = |x0: f64, x1: f64, y0: f64, y1: f64| StaticBox {
+            min: Point3::new(x0.min(x1), y0.min(y1), 0.0),
+            max: Point3::new(x0.max(x1), y0.max(y1), h),
+        };
+        let mut boxes = vec![
+            b(
+                self.corner_front_x_m - depth,
+                self.corner_front_x_m,
+                half_stem,
+                l,
+            ),
+            b(
+                self.corner_front_x_m - depth,
+                self.corner_front_x_m,
+                -l,
+                -half_stem,
+            ),
+        ];
+        if self.carla.far_side_buildings {
+            boxes.push(b(
+                far_edge + self.sidewalk_m,
+                far_edge + self.sidewalk_m + depth,
+                -l,
+                l,
+            ));
+        }
+        boxes
     }
 
     /// Vehicle speed, m/s.

@@ -69,6 +69,11 @@ pub struct TrialOutcome {
     pub duration_s: f64,
     /// Frames simulated.
     pub frames: u64,
+    /// ARGUS's density count: returned points in its kept half-plane at
+    /// azimuths below gaze − 30° (all simulated channels, ground included).
+    pub argus_roi_points: u64,
+    /// Channels the simulation cast (planar: 1, standing for all).
+    pub channels_simulated: u32,
 }
 
 impl TrialOutcome {
@@ -115,7 +120,7 @@ fn arc_of(points: &[(f64, f64)]) -> Arc {
 }
 
 /// An object's culling arc; a box around the origin gets the full circle.
-fn cull_arc(boxes: &[Aabb]) -> Arc {
+pub(crate) fn cull_arc(boxes: &[Aabb]) -> Arc {
     if boxes.iter().any(Aabb::contains_origin) {
         return Arc {
             start_deg: 0.0,
@@ -147,6 +152,12 @@ pub struct TrialSetup<'a> {
     pub detection: KOfN,
     /// Disable culling (reference path for tests).
     pub brute_force: bool,
+    /// When a car arrives.
+    pub arrival: super::Arrival,
+    /// ARGUS's half-plane: the ego's world yaw, degrees.
+    pub ego_yaw_deg: f64,
+    /// This trial's gaze, degrees (ARGUS's density region).
+    pub gaze_deg: f64,
 }
 
 /// Runs one trial.
@@ -168,7 +179,8 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
         -(sc.bend_distance_m + draw.start_offset_m[1]),
     ];
     let dir = [-1.0, 1.0];
-    let t_conflict = [(front0[0] - ch) / v, (-ch - front0[1]) / v];
+    let extra = setup.arrival.extra_distance_m(len);
+    let t_conflict = [(front0[0] - ch + extra) / v, (-ch - front0[1] + extra) / v];
     let t_end = t_conflict[0].max(t_conflict[1]);
     let car_box = |j: usize, t: f64| -> Aabb {
         let front = front0[j] + dir[j] * v * t;
@@ -187,6 +199,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
     let mut hit_frames: [Vec<u64>; 2] = [Vec::new(), Vec::new()];
     let mut roi_points = 0u64;
     let mut roi_pulses = 0u64;
+    let mut argus_roi_points = 0u64;
     let mut keep_acc = 0.0f64;
     let mut current_frame = u64::MAX;
     let mut car_arcs = [static_arcs[0]; 2];
@@ -290,6 +303,11 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
             keep_acc -= 1.0;
         }
         roi_points += u64::from(in_roi);
+        argus_roi_points += u64::from(super::carla::argus::in_density_region(
+            az,
+            setup.gaze_deg,
+            setup.ego_yaw_deg,
+        ));
         if let Some(j) = car {
             if detected_at[j].is_none() && t <= t_conflict[j] {
                 let frames_hit = &mut hit_frames[j];
@@ -324,5 +342,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
         roi_width_deg: setup.regions.roi.measure_deg(),
         duration_s: n_pulses as f64 / pulse_rate,
         frames,
+        argus_roi_points,
+        channels_simulated: 1,
     }
 }
