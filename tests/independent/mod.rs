@@ -59,7 +59,7 @@ pub fn recheck(p: &Profile) -> Vec<String> {
                 out.push(format!("bin {i}: |accel| {a} rad/s² > {a_max}"));
             }
             let next = &p.bins[(i + 1) % n];
-            if (next.spin_start_rad_s - w1).abs() > SLACK * w1 {
+            if (next.spin_start_rad_s - w1).abs() > SLACK * w1.max(1.0) {
                 out.push(format!("bin {i}: spin steps to the next bin"));
             }
         }
