@@ -451,7 +451,8 @@ fn eye_safety_violation_names_rule_and_ratio() {
 fn sensor_limits_are_enforced_naming_the_key() {
     let p = uniform();
     assert!(certify_for_sensor(p.clone(), &sensor()).is_ok());
-    let cases: Vec<(&str, Box<dyn Fn(&mut Profile)>)> = vec![
+    type Change = Box<dyn Fn(&mut Profile)>;
+    let cases: Vec<(&str, Change)> = vec![
         ("power_w_min", Box::new(|p| p.limits.power_w_min = 0.4e-4)),
         ("power_w_max", Box::new(|p| p.limits.power_w_max = 2.1e-4)),
         (
