@@ -1,7 +1,6 @@
 //! Issue 3 acceptance: AEL figures, per-azimuth exposure, check integration.
 
 mod common;
-#[allow(dead_code)]
 mod reference;
 
 use common::{assert_bad_input, run, stdout};

@@ -2,7 +2,6 @@
 
 mod common;
 mod independent;
-#[allow(dead_code)]
 mod reference;
 
 use common::{run, stdout};

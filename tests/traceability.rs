@@ -490,12 +490,12 @@ fn covers(body: &[Tok]) -> (BTreeSet<String>, BTreeSet<String>) {
         let Some(end) = matching(body, open, ('(', ')')) else {
             continue;
         };
-        let strs = body[open..end].iter().filter_map(|t| match t {
+        let mut strs = body[open..end].iter().filter_map(|t| match t {
             Tok::Str(s) => Some(s.clone()),
             _ => None,
         });
         if name == "cover" {
-            covered.extend(strs.last());
+            covered.extend(strs.next_back());
         } else {
             asserted.extend(strs);
         }
