@@ -325,7 +325,25 @@ fn structure_header_and_limits_are_validated() {
     }
     let mut p = uniform();
     p.average_power_w = -1e-9;
-    assert!(keys(&check(&p)).contains(&"average_power_w"));
+    assert!(
+        check(&p).iter().any(|x| matches!(
+            x,
+            Violation::Header {
+                field: "average_power_w",
+                ..
+            }
+        )),
+        "{:?}",
+        check(&p)
+    );
+    // Equal minimum and maximum limits are valid (a fixed power, a fixed spin).
+    let mut p = uniform();
+    p.limits.power_slew_w_per_deg_max = None;
+    p.limits.power_w_min = POWER_W;
+    p.limits.power_w_max = POWER_W;
+    p.limits.spin_rad_s_min = TAU * FRAME_HZ;
+    p.limits.spin_rad_s_max = TAU * FRAME_HZ;
+    assert_eq!(check(&p), vec![]);
     p.average_power_w = 0.0;
     p.bins.iter_mut().for_each(|b| b.power_w = 0.0);
     p.limits.power_w_min = 0.0;
