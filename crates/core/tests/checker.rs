@@ -566,3 +566,45 @@ fn summarize_list_shows_five_and_counts_the_rest() {
     assert_eq!(summarize_list(&items[..5]), "1; 2; 3; 4; 5");
     assert_eq!(summarize_list::<u32>(&[]), "");
 }
+
+/// The bin-count limit is inclusive: 10⁶ bins are structurally admissible
+/// (a broken field, not the count, is reported), 10⁶ + 1 are refused by count
+/// before anything else is evaluated.
+#[test]
+fn bin_count_limit_is_inclusive() {
+    use gaze_lidar_core::checker::MAX_PROFILE_BINS;
+    let many = |n: usize| {
+        let mut p = uniform();
+        let w = 360.0 / n as f64;
+        let b = p.bins[0].clone();
+        p.bins = (0..n)
+            .map(|i| Bin {
+                start_deg: w * i as f64,
+                width_deg: w,
+                ..b.clone()
+            })
+            .collect();
+        p
+    };
+    let mut p = many(MAX_PROFILE_BINS);
+    p.bins[0].power_w = f64::NAN; // keeps the check structural (fast)
+    let v = check(&p);
+    assert!(
+        v.iter().all(|x| matches!(
+            x,
+            Violation::BinField {
+                field: "power_w",
+                ..
+            }
+        )),
+        "{:?}",
+        &v[..v.len().min(3)]
+    );
+    let p = many(MAX_PROFILE_BINS + 1);
+    assert_eq!(
+        check(&p),
+        vec![Violation::BinCount {
+            count: MAX_PROFILE_BINS + 1
+        }]
+    );
+}
