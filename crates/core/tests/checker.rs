@@ -222,6 +222,11 @@ fn acceleration_and_spin_steps() {
             .any(|x| matches!(x, Violation::SpinStep { bin: 0, .. })),
         "{v:?}"
     );
+    // A step within the relative tolerance (1e-9 of the spin) is not one.
+    let mut q = make(w1, 1e12);
+    q.bins[1].spin_start_rad_s = w1 * (1.0 + 1e-10);
+    q.frame_rate_hz = 1.0 / q.bins.iter().map(Bin::dwell_time_s).sum::<f64>();
+    assert_eq!(check(&q), vec![]);
     // Without an acceleration limit, a step is allowed.
     p.limits.spin_accel_rad_s2_max = None;
     assert_eq!(check(&p), vec![]);
@@ -303,6 +308,12 @@ fn frame_period_must_match_the_frame_rate() {
     let v = check(&p);
     assert!(keys(&v).contains(&"frame_rate_hz"), "{v:?}");
     p.frame_rate_hz = FRAME_HZ * (1.0 + 1e-12);
+    assert_eq!(check(&p), vec![]);
+    // The tolerance is relative (1e-9 of the period): 5e-9 off is refused,
+    // 5e-10 off is not.
+    p.frame_rate_hz = FRAME_HZ * (1.0 + 5e-9);
+    assert_eq!(keys(&check(&p)), vec!["frame_rate_hz"]);
+    p.frame_rate_hz = FRAME_HZ * (1.0 + 5e-10);
     assert_eq!(check(&p), vec![]);
 }
 
