@@ -619,3 +619,41 @@ fn bin_count_limit_is_inclusive() {
         }]
     );
 }
+
+/// A broken header stops the physical checks (their numbers would mean
+/// nothing); a sensor mismatch or a missing eye-safety block does not.
+#[test]
+fn structural_violations_stop_evaluation_and_sensor_ones_do_not() {
+    let mut p = uniform();
+    p.limits.power_slew_w_per_deg_max = None;
+    p.average_power_w = 1.0;
+    p.bins[2].power_w = 3e-4; // above power_w_max
+    p.format = "gaze-lidar/profile@0".into();
+    assert_eq!(keys(&check(&p)), vec!["format"]);
+    p.format = PROFILE_FORMAT.to_owned();
+    assert_eq!(keys(&check(&p)), vec!["power_w_max"]);
+    // Against a sensor with a stricter average budget: both are reported.
+    let v = check_with(&p, &CheckOptions::for_sensor(&sensor()));
+    assert!(keys(&v).contains(&"average_power_w"), "{v:?}");
+    assert!(keys(&v).contains(&"power_w_max"), "{v:?}");
+    // Missing eye safety, opted out: the limits are still checked.
+    p.limits.eye_safety = None;
+    let v = check_with(&p, &CheckOptions::declared().allow_missing_eye_safety(true));
+    assert_eq!(keys(&v), vec!["power_w_max"]);
+}
+
+/// The sensor requires eye-safety parameters even when the caller opted
+/// out of them for declared-limit checks.
+#[test]
+fn the_sensor_requires_eye_safety_even_with_the_opt_out() {
+    let mut p = uniform();
+    p.limits.eye_safety = None;
+    let strict = sensor();
+    let opts = CheckOptions::for_sensor(&strict).allow_missing_eye_safety(true);
+    assert_eq!(check_with(&p, &opts), vec![Violation::EyeSafetyMissing]);
+    // A sensor without eye-safety parameters does not require them.
+    let mut s = sensor();
+    s.limits.eye_safety = None;
+    let opts = CheckOptions::for_sensor(&s).allow_missing_eye_safety(true);
+    assert_eq!(check_with(&p, &opts), vec![]);
+}
