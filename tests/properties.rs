@@ -2,14 +2,15 @@
 //! profiles certify, rotate with the gaze, meet eq. 4 and eq. 6, round-trip
 //! through JSON, and quantize into valid firmware tables.
 
-use gaze_lidar::checker::certify;
-use gaze_lidar::firmware::{check_table, FirmwareConfig, FirmwareTable};
+use gaze_lidar::firmware::{FirmwareConfig, FirmwareTable};
 use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::model::presets;
 use gaze_lidar::planner::{closed_form, Mode};
 use gaze_lidar::profile::kinematics::Timeline;
 use gaze_lidar::profile::Profile;
 use proptest::prelude::*;
+
+mod independent;
 
 fn mode() -> impl Strategy<Value = Mode> {
     prop_oneof![
@@ -43,8 +44,9 @@ proptest! {
         p.lidar.average_power_w *= budget_scale;
         p.lidar.frame_rate_hz = frame_hz;
         let c = closed_form(&p, m, Some(gaze), bins).unwrap();
-        // An independent re-check of the same profile agrees.
-        prop_assert!(certify(c.profile().clone()).is_ok());
+        // Within every declared limit, recomputed independently of the checker.
+        let broken = independent::recheck(c.profile());
+        prop_assert!(broken.is_empty(), "{:?}", broken);
         let s = c.summary();
         let avg = if angle { s.average_power_angle_w } else { s.average_power_time_w };
         prop_assert!((avg / p.lidar.average_power_w - 1.0).abs() < 1e-9);
@@ -101,11 +103,55 @@ proptest! {
             Err(gaze_lidar::firmware::FirmwareError::Quantize(_)) => return Ok(()),
             Err(e) => panic!("{e}"),
         };
-        prop_assert!(check_table(&t).is_empty());
+        // Not `check_table` (`from_certified` returns only tables it
+        // accepts): the integer limits restated independently.
+        let broken = independent::recheck_table(&t);
+        prop_assert!(broken.is_empty(), "{:?}", broken);
         prop_assert_eq!(t.bins.iter().map(|b| b.dwell_ticks).sum::<u64>(), t.frame_ticks);
         for (b, fw) in c.profile().bins.iter().zip(&t.bins) {
             prop_assert!((fw.dwell_ticks as f64 - b.dwell_time_s() * cfg.tick_hz as f64).abs() < 1.0);
             prop_assert!(f64::from(fw.power_code) * t.power_w_per_code <= b.power_w);
         }
     }
+}
+
+/// The independent re-checks used above can fail: each broken limit of a
+/// certified profile and of its table is found.
+#[test]
+fn independent_rechecks_find_broken_limits() {
+    let c = closed_form(&presets::paper(), Mode::Joint, Some(90.0), 360).unwrap();
+    assert!(independent::recheck(c.profile()).is_empty());
+    let mut p = c.profile().clone();
+    p.bins[7].power_w = p.limits.power_w_max * 1.001;
+    assert!(
+        !independent::recheck(&p).is_empty(),
+        "power above power_w_max"
+    );
+    let mut p = c.profile().clone();
+    p.average_power_w *= 0.99;
+    assert!(!independent::recheck(&p).is_empty(), "average above budget");
+    let mut p = c.profile().clone();
+    p.bins[3].spin_start_rad_s *= 1.01;
+    assert!(!independent::recheck(&p).is_empty(), "turn period off");
+    let cfg = FirmwareConfig {
+        tick_hz: 80_000_000,
+        power_w_per_code: None,
+    };
+    let t = FirmwareTable::from_certified(&c, &cfg).unwrap();
+    assert!(independent::recheck_table(&t).is_empty());
+    let mut bad = t.clone();
+    bad.bins[5].dwell_ticks += 1;
+    assert!(!independent::recheck_table(&bad).is_empty(), "frame ticks");
+    let mut bad = t.clone();
+    bad.bins[5].power_code = bad.bins[5].power_code_cap + 1;
+    assert!(
+        !independent::recheck_table(&bad).is_empty(),
+        "code above cap"
+    );
+    let mut bad = t;
+    bad.limits.window_energy_max = 0;
+    assert!(
+        !independent::recheck_table(&bad).is_empty(),
+        "window energy"
+    );
 }

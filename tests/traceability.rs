@@ -1,6 +1,9 @@
 //! Keeps `specs/traceability.toml` honest: every named check, harness, test
 //! and fuzz target exists; every listed harness is a Kani proof; every proof
-//! harness backs a requirement.
+//! harness backs a requirement; every named test and harness exercises the
+//! API its requirement is about (its body calls one of the requirement's
+//! `api` names, directly or through a helper defined in the same file); and
+//! every harness is gated so that plain `cargo kani` resolves.
 
 use serde::Deserialize;
 use std::collections::BTreeSet;
@@ -20,6 +23,8 @@ struct Requirement {
     kani: Vec<String>,
     tests: Vec<String>,
     fuzz: Vec<String>,
+    /// The functions (or `cli:SUBCOMMAND`) the requirement is about.
+    api: Vec<String>,
 }
 
 fn root() -> PathBuf {
@@ -134,4 +139,458 @@ fn traceability_table_is_honest() {
         "proof harnesses backing no requirement: {untraced:?}"
     );
     assert!(fuzz_targets.len() >= 4, "at least 4 fuzz targets traced");
+}
+
+// ---------------------------------------------------------------------------
+// "The named test exercises the API": a small Rust tokenizer, brace matching
+// and a call search through same-file helpers.
+
+#[derive(Debug, Clone, PartialEq)]
+enum Tok {
+    Ident(String),
+    Str(String),
+    Punct(char),
+}
+
+/// Tokens of Rust source: identifiers, string literal contents and single
+/// punctuation characters; comments, numbers, char literals and lifetimes
+/// are dropped (enough to find calls and match braces).
+fn tokenize(src: &str) -> Vec<Tok> {
+    let c: Vec<char> = src.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < c.len() {
+        let ch = c[i];
+        if ch.is_whitespace() {
+            i += 1;
+        } else if ch == '/' && c.get(i + 1) == Some(&'/') {
+            while i < c.len() && c[i] != '\n' {
+                i += 1;
+            }
+        } else if ch == '/' && c.get(i + 1) == Some(&'*') {
+            let mut depth = 0;
+            while i < c.len() {
+                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
+                    depth += 1;
+                    i += 2;
+                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+        } else if ch == 'r' && matches!(c.get(i + 1), Some('"') | Some('#')) && {
+            let mut j = i + 1;
+            while c.get(j) == Some(&'#') {
+                j += 1;
+            }
+            c.get(j) == Some(&'"')
+        } {
+            // Raw string r#"…"#.
+            let mut j = i + 1;
+            let mut hashes = 0;
+            while c[j] == '#' {
+                hashes += 1;
+                j += 1;
+            }
+            j += 1;
+            let start = j;
+            loop {
+                if j >= c.len() {
+                    break;
+                }
+                if c[j] == '"' && (0..hashes).all(|k| c.get(j + 1 + k) == Some(&'#')) {
+                    break;
+                }
+                j += 1;
+            }
+            out.push(Tok::Str(c[start..j.min(c.len())].iter().collect()));
+            i = j + 1 + hashes;
+        } else if ch == '"' {
+            let mut j = i + 1;
+            let mut text = String::new();
+            while j < c.len() && c[j] != '"' {
+                if c[j] == '\\' {
+                    j += 1;
+                }
+                if j < c.len() {
+                    text.push(c[j]);
+                }
+                j += 1;
+            }
+            out.push(Tok::Str(text));
+            i = j + 1;
+        } else if ch == '\'' {
+            // Char literal ('x', '\n', '\u{..}') or lifetime ('a).
+            if c.get(i + 1) == Some(&'\\') {
+                let mut j = i + 2;
+                while j < c.len() && c[j] != '\'' {
+                    j += 1;
+                }
+                i = j + 1;
+            } else if c.get(i + 2) == Some(&'\'') {
+                i += 3;
+            } else {
+                i += 1;
+                while i < c.len() && (c[i].is_alphanumeric() || c[i] == '_') {
+                    i += 1;
+                }
+            }
+        } else if ch.is_alphabetic() || ch == '_' {
+            let mut j = i;
+            while j < c.len() && (c[j].is_alphanumeric() || c[j] == '_') {
+                j += 1;
+            }
+            out.push(Tok::Ident(c[i..j].iter().collect()));
+            i = j;
+        } else if ch.is_ascii_digit() {
+            while i < c.len() && (c[i].is_alphanumeric() || c[i] == '_' || c[i] == '.') {
+                // Stop at a method call on a literal (`1.0.max(…)` is rare; `0..n` is not).
+                if c[i] == '.' && c.get(i + 1) == Some(&'.') {
+                    break;
+                }
+                i += 1;
+            }
+        } else {
+            out.push(Tok::Punct(ch));
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Index of the token matching the opener at `open` (`(`/`)` or `{`/`}`).
+fn matching(toks: &[Tok], open: usize, (o, cl): (char, char)) -> Option<usize> {
+    let mut depth = 0usize;
+    for (k, t) in toks.iter().enumerate().skip(open) {
+        if *t == Tok::Punct(o) {
+            depth += 1;
+        } else if *t == Tok::Punct(cl) {
+            depth -= 1;
+            if depth == 0 {
+                return Some(k);
+            }
+        }
+    }
+    None
+}
+
+/// Every `fn NAME … { body }` of a file: name → body tokens (a test inside
+/// `proptest!` is found the same way).
+fn fn_bodies(toks: &[Tok]) -> Vec<(String, Vec<Tok>)> {
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k + 1 < toks.len() {
+        if toks[k] == Tok::Ident("fn".into()) {
+            if let Tok::Ident(name) = &toks[k + 1] {
+                // The parameter list, then the body's opening brace.
+                let Some(p) = (k + 2..toks.len()).find(|&j| toks[j] == Tok::Punct('(')) else {
+                    break;
+                };
+                let Some(pe) = matching(toks, p, ('(', ')')) else {
+                    break;
+                };
+                let next = (pe + 1..toks.len())
+                    .find(|&j| matches!(toks[j], Tok::Punct('{') | Tok::Punct(';')));
+                if let Some(b) = next.filter(|&j| toks[j] == Tok::Punct('{')) {
+                    if let Some(be) = matching(toks, b, ('{', '}')) {
+                        out.push((name.clone(), toks[b + 1..be].to_vec()));
+                    }
+                }
+            }
+        }
+        k += 1;
+    }
+    out
+}
+
+/// Names called in a body: `name(`, `name::<…>(` and `name!(` (macros),
+/// each also as `module::name` when called through its module path.
+fn calls(body: &[Tok]) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for (k, t) in body.iter().enumerate() {
+        if let Tok::Ident(name) = t {
+            let next = body.get(k + 1);
+            let turbofish = next == Some(&Tok::Punct(':'))
+                && body.get(k + 2) == Some(&Tok::Punct(':'))
+                && body.get(k + 3) == Some(&Tok::Punct('<'));
+            if next == Some(&Tok::Punct('(')) || next == Some(&Tok::Punct('!')) || turbofish {
+                out.insert(name.clone());
+                // Also as `module::name` (an api entry may be qualified).
+                if k >= 3 && body[k - 1] == Tok::Punct(':') && body[k - 2] == Tok::Punct(':') {
+                    if let Tok::Ident(module) = &body[k - 3] {
+                        out.insert(format!("{module}::{name}"));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether function `func` of the source `src` exercises one of `api`:
+/// calls one of the names (or, for `cli:SUB`, passes the string literal
+/// `SUB`), directly or through functions defined in the same source.
+/// `None` when `src` defines no such function.
+fn exercises(src: &str, func: &str, api: &[String]) -> Option<bool> {
+    let toks = tokenize(src);
+    let bodies = fn_bodies(&toks);
+    let body_of = |name: &str| -> Vec<&Vec<Tok>> {
+        bodies
+            .iter()
+            .filter(|(n, _)| n == name)
+            .map(|(_, b)| b)
+            .collect()
+    };
+    if body_of(func).is_empty() {
+        return None;
+    }
+    let mut seen = BTreeSet::new();
+    let mut todo = vec![func.to_owned()];
+    while let Some(f) = todo.pop() {
+        if !seen.insert(f.clone()) {
+            continue;
+        }
+        for body in body_of(&f) {
+            let called = calls(body);
+            for a in api {
+                let hit = match a.strip_prefix("cli:") {
+                    Some(sub) => body.iter().any(|t| *t == Tok::Str(sub.to_owned())),
+                    None => called.contains(a),
+                };
+                if hit {
+                    return Some(true);
+                }
+            }
+            todo.extend(called.into_iter().filter(|c| !body_of(c).is_empty()));
+        }
+    }
+    Some(false)
+}
+
+#[test]
+fn named_tests_exercise_their_requirements_api() {
+    let text = std::fs::read_to_string(root().join("specs/traceability.toml")).unwrap();
+    let spec: Spec = toml::from_str(&text).unwrap();
+    let mut harness_src = Vec::new();
+    rust_files(&root().join("src"), &mut harness_src);
+    rust_files(&root().join("crates/core/src"), &mut harness_src);
+    let harness_src: Vec<String> = harness_src
+        .iter()
+        .map(|f| std::fs::read_to_string(f).unwrap())
+        .collect();
+    let mut failures = Vec::new();
+    for r in &spec.requirement {
+        assert!(!r.api.is_empty(), "{}: no api named", r.id);
+        for item in &r.tests {
+            let (file, func) = item.split_once("::").unwrap();
+            let src = std::fs::read_to_string(root().join(file)).unwrap();
+            match exercises(&src, func, &r.api) {
+                Some(true) => {}
+                Some(false) => failures.push(format!("{}: {item} calls none of {:?}", r.id, r.api)),
+                None => failures.push(format!("{}: {item}: no fn body found", r.id)),
+            }
+        }
+        for h in &r.kani {
+            let found: Vec<bool> = harness_src
+                .iter()
+                .filter_map(|src| exercises(src, h, &r.api))
+                .collect();
+            if !found.contains(&true) {
+                failures.push(format!("{}: harness {h} calls none of {:?}", r.id, r.api));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The matcher can fail: a test that does not call the API (only mentions
+/// it in a comment, a string or a helper it never calls) is caught; direct
+/// calls, calls through same-file helpers, method calls, turbofish calls
+/// and `cli:` subcommands are found.
+#[test]
+fn api_matcher_rejects_tests_that_do_not_call_the_api() {
+    let src = r####"
+        fn helper(p: &Profile) -> bool {
+            // certify(p) would be nice
+            check_table(&table_of(p)).is_empty()
+        }
+        fn unused_helper() { certify(p()); }
+        fn table_of(p: &Profile) -> Table { Table::new('{', "}{") }
+        #[test]
+        fn only_mentions() {
+            let s = "certify(x)"; /* certify(y) */
+            let certify_count = 3;
+            assert_eq!(s.len(), certify_count);
+        }
+        #[test]
+        fn via_helper() { assert!(helper(&p())); }
+        #[test]
+        fn method_call() { let v = x.certify(); }
+        #[test]
+        fn turbofish() { let v = certify::<u8>(x); }
+        #[test]
+        fn qualified() { sim::run(&c); }
+        #[test]
+        fn raw_string_brace() { let s = r#"{"#; certify(s); }
+        #[test]
+        fn cli() { run(&["check", "--preset", "paper"], None); }
+        proptest! {
+            #[test]
+            fn prop(x in 0u8..4) { prop_assert!(x < 4); }
+        }
+    "####;
+    let api = |names: &[&str]| names.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    assert_eq!(
+        exercises(src, "only_mentions", &api(&["certify"])),
+        Some(false)
+    );
+    assert_eq!(
+        exercises(src, "via_helper", &api(&["certify"])),
+        Some(false)
+    );
+    assert_eq!(
+        exercises(src, "via_helper", &api(&["check_table"])),
+        Some(true)
+    );
+    assert_eq!(
+        exercises(src, "method_call", &api(&["certify"])),
+        Some(true)
+    );
+    assert_eq!(exercises(src, "turbofish", &api(&["certify"])), Some(true));
+    assert_eq!(
+        exercises(src, "raw_string_brace", &api(&["certify"])),
+        Some(true)
+    );
+    assert_eq!(exercises(src, "cli", &api(&["cli:check"])), Some(true));
+    assert_eq!(exercises(src, "qualified", &api(&["sim::run"])), Some(true));
+    assert_eq!(exercises(src, "cli", &api(&["sim::run"])), Some(false));
+    assert_eq!(exercises(src, "cli", &api(&["cli:profile"])), Some(false));
+    assert_eq!(exercises(src, "prop", &api(&["certify"])), Some(false));
+    assert_eq!(exercises(src, "missing", &api(&["certify"])), None);
+}
+
+/// Messages of the `cover!(cond, "msg")` calls and of the
+/// `assert_covered(&["msg", …])` calls in a body.
+fn covers(body: &[Tok]) -> (BTreeSet<String>, BTreeSet<String>) {
+    let (mut covered, mut asserted) = (BTreeSet::new(), BTreeSet::new());
+    for k in 0..body.len() {
+        let Tok::Ident(name) = &body[k] else { continue };
+        let open = if name == "cover" && body.get(k + 1) == Some(&Tok::Punct('!')) {
+            k + 2
+        } else if name == "assert_covered" {
+            k + 1
+        } else {
+            continue;
+        };
+        let Some(end) = matching(body, open, ('(', ')')) else {
+            continue;
+        };
+        let mut strs = body[open..end].iter().filter_map(|t| match t {
+            Tok::Str(s) => Some(s.clone()),
+            _ => None,
+        });
+        if name == "cover" {
+            covered.extend(strs.next_back());
+        } else {
+            asserted.extend(strs);
+        }
+    }
+    (covered, asserted)
+}
+
+/// Kani gating (specs/verification.md): plain `cargo kani -p gaze-lidar-core`
+/// builds the library without dev-dependencies, so a harness may name
+/// bolero only through `for_all!` (bolero in its `cfg(not(kani))` branch);
+/// every harness is `#[cfg_attr(kani, kani::proof)]` on the test itself; every
+/// harness has a `cover!` and asserts under `cargo test` that each of its
+/// covers was hit (no harness passes vacuously).
+#[test]
+fn kani_harnesses_are_gated_and_covered() {
+    let mut files = Vec::new();
+    rust_files(&root().join("src"), &mut files);
+    rust_files(&root().join("crates/core/src"), &mut files);
+    let mut problems = Vec::new();
+    let mut harnesses = 0;
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let rel = f.strip_prefix(root()).unwrap().display().to_string();
+        if !rel.ends_with("verification.rs") && text.contains("bolero::") {
+            problems.push(format!(
+                "{rel}: names bolero outside for_all! (breaks plain cargo kani)"
+            ));
+        }
+        if !text.contains("kani::proof") {
+            continue;
+        }
+        let lines: Vec<&str> = text.lines().collect();
+        let bodies = fn_bodies(&tokenize(&text));
+        for (i, l) in lines.iter().enumerate() {
+            if !l.contains("kani::proof") || !l.trim_start().starts_with("#[") {
+                continue;
+            }
+            harnesses += 1;
+            if !l.trim_start().starts_with("#[cfg_attr(kani, kani::proof") {
+                problems.push(format!(
+                    "{rel}:{}: not #[cfg_attr(kani, kani::proof…)]",
+                    i + 1
+                ));
+            }
+            let attrs: Vec<&str> = lines[i..]
+                .iter()
+                .take_while(|l| !l.trim_start().starts_with("fn "))
+                .copied()
+                .collect();
+            if !attrs
+                .iter()
+                .any(|a| a.contains("#[cfg_attr(not(kani), test)]"))
+            {
+                problems.push(format!(
+                    "{rel}:{}: harness is not a test under cargo test",
+                    i + 1
+                ));
+            }
+            let Some(name) = lines[i..].iter().find_map(|l| {
+                l.trim_start()
+                    .strip_prefix("fn ")
+                    .map(|r| r.split('(').next().unwrap_or("").to_owned())
+            }) else {
+                problems.push(format!("{rel}:{}: no fn after kani::proof", i + 1));
+                continue;
+            };
+            let Some((_, body)) = bodies.iter().find(|(n, _)| *n == name) else {
+                problems.push(format!("{rel}: {name}: no body"));
+                continue;
+            };
+            let (covered, asserted) = covers(body);
+            if covered.is_empty() {
+                problems.push(format!("{rel}: {name}: no cover! (vacuity unchecked)"));
+            }
+            for m in covered.difference(&asserted) {
+                problems.push(format!("{rel}: {name}: cover \"{m}\" never asserted hit"));
+            }
+        }
+    }
+    assert!(harnesses >= 10, "found only {harnesses} harnesses");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The gating check can fail: a cover that is never asserted is found.
+#[test]
+fn cover_check_finds_unasserted_covers() {
+    let src = r#"
+        fn h() {
+            for_all!(u8, |x| { cover!(x > 3, "big"); cover!(x == 0, "zero"); });
+            #[cfg(not(kani))]
+            crate::verification::assert_covered(&["big"]);
+        }
+    "#;
+    let bodies = fn_bodies(&tokenize(src));
+    let (covered, asserted) = covers(&bodies[0].1);
+    let missing: Vec<_> = covered.difference(&asserted).cloned().collect();
+    assert_eq!(missing, vec!["zero".to_owned()]);
 }

@@ -1,9 +1,14 @@
 //! Profile JSON parse + check: never panics; whatever certifies also
-//! quantizes into a firmware table that passes the integer checker.
+//! is within its limits by an independent recomputation, and a table it
+//! quantizes into is within its integer limits, restated independently (not
+//! `check_table`, which `from_certified` has already run).
 #![no_main]
 
+#[path = "../../tests/independent/mod.rs"]
+mod independent;
+
 use gaze_lidar::checker::certify;
-use gaze_lidar::firmware::{check_table, FirmwareConfig, FirmwareTable};
+use gaze_lidar::firmware::{FirmwareConfig, FirmwareTable};
 use gaze_lidar::profile::Profile;
 use libfuzzer_sys::fuzz_target;
 
@@ -15,8 +20,11 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     if let Ok(c) = certify(profile) {
+        let broken = independent::recheck(c.profile());
+        assert!(broken.is_empty(), "{broken:?}");
         if let Ok(t) = FirmwareTable::from_certified(&c, &FirmwareConfig::default()) {
-            assert!(check_table(&t).is_empty());
+            let broken = independent::recheck_table(&t);
+            assert!(broken.is_empty(), "{broken:?}");
         }
     }
 });

@@ -217,7 +217,7 @@ impl FrameClock {
 #[cfg(any(kani, test))]
 mod verification {
     use super::*;
-    use crate::verification::cover;
+    use crate::verification::{cover, for_all};
 
     fn kind(k: u8) -> SampleKind {
         match k % 3 {
@@ -235,60 +235,62 @@ mod verification {
     #[cfg_attr(kani, kani::proof, kani::unwind(7))]
     #[cfg_attr(not(kani), test)]
     fn adaptive_only_with_fresh_recovered_gaze() {
-        bolero::check!()
-            .with_type::<([(u16, u8, bool); 6], u16, u8, u64)>()
-            .cloned()
-            .for_each(|(events, timeout, recover, start)| {
-                let config = FailSafeConfig {
-                    timeout_us: u64::from(timeout),
-                    recover_samples: u32::from(recover % 6),
-                };
-                let mut m = FailSafe::new(config);
-                let mut t = start;
-                let mut run = 0u32;
-                let mut last_fix: Option<u64> = None;
-                for &(dt, k, frame) in &events {
-                    // Time never goes backwards; saturates instead of wrapping.
-                    t = t.saturating_add(u64::from(dt));
-                    if frame {
-                        let s = m.at_frame(t);
-                        let fresh = last_fix.is_some_and(|lf| t - lf <= config.timeout_us);
-                        if s == State::Adaptive {
-                            cover!(true, "adaptive at a frame");
-                            assert!(fresh, "adaptive on stale gaze");
-                            assert!(run >= config.recover_samples);
+        for_all!(([(u16, u8, bool); 6], u16, u8, u64), |(
+            events,
+            timeout,
+            recover,
+            start,
+        )| {
+            let config = FailSafeConfig {
+                timeout_us: u64::from(timeout),
+                recover_samples: u32::from(recover % 6),
+            };
+            let mut m = FailSafe::new(config);
+            let mut t = start;
+            let mut run = 0u32;
+            let mut last_fix: Option<u64> = None;
+            for &(dt, k, frame) in &events {
+                // Time never goes backwards; saturates instead of wrapping.
+                t = t.saturating_add(u64::from(dt));
+                if frame {
+                    let s = m.at_frame(t);
+                    let fresh = last_fix.is_some_and(|lf| t - lf <= config.timeout_us);
+                    if s == State::Adaptive {
+                        cover!(true, "adaptive at a frame");
+                        assert!(fresh, "adaptive on stale gaze");
+                        assert!(run >= config.recover_samples);
+                    }
+                    if !fresh {
+                        cover!(last_fix.is_some(), "stale gaze forces fail-safe");
+                        cover!(
+                            last_fix.is_some() && run > 0 && m.valid_run() == run,
+                            "stale fixation with valid samples since"
+                        );
+                        assert_eq!(s, State::FailSafe);
+                    }
+                } else {
+                    m.on_sample(t, kind(k));
+                    match kind(k) {
+                        SampleKind::Fixation => {
+                            run = run.saturating_add(1);
+                            last_fix = Some(t);
                         }
-                        if !fresh {
-                            cover!(last_fix.is_some(), "stale gaze forces fail-safe");
-                            cover!(
-                                last_fix.is_some() && run > 0 && m.valid_run() == run,
-                                "stale fixation with valid samples since"
-                            );
-                            assert_eq!(s, State::FailSafe);
+                        SampleKind::Saccade => {
+                            cover!(last_fix.is_some(), "saccade holds a fixation");
+                            run = run.saturating_add(1);
                         }
-                    } else {
-                        m.on_sample(t, kind(k));
-                        match kind(k) {
-                            SampleKind::Fixation => {
-                                run = run.saturating_add(1);
-                                last_fix = Some(t);
-                            }
-                            SampleKind::Saccade => {
-                                cover!(last_fix.is_some(), "saccade holds a fixation");
-                                run = run.saturating_add(1);
-                            }
-                            SampleKind::Invalid => {
-                                cover!(true, "invalid sample");
-                                run = 0;
-                                last_fix = None;
-                                assert_eq!(m.state(), State::FailSafe);
-                            }
+                        SampleKind::Invalid => {
+                            cover!(true, "invalid sample");
+                            run = 0;
+                            last_fix = None;
+                            assert_eq!(m.state(), State::FailSafe);
                         }
                     }
-                    assert_eq!(m.valid_run(), run);
-                    assert_eq!(m.last_fixation_us(), last_fix);
                 }
-            });
+                assert_eq!(m.valid_run(), run);
+                assert_eq!(m.last_fixation_us(), last_fix);
+            }
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&[
             "adaptive at a frame",
@@ -304,26 +306,23 @@ mod verification {
     #[cfg_attr(kani, kani::proof, kani::unwind(10))]
     #[cfg_attr(not(kani), test)]
     fn recovers_after_enough_valid_samples() {
-        bolero::check!()
-            .with_type::<(u8, u16, u64)>()
-            .cloned()
-            .for_each(|(recover, step, start)| {
-                let recover = u32::from(recover % 8);
-                let step = u64::from(step % 1000) + 1;
-                let config = FailSafeConfig {
-                    timeout_us: 1000,
-                    recover_samples: recover,
-                };
-                let mut m = FailSafe::new(config);
-                let mut t = start;
-                m.on_sample(t, SampleKind::Invalid);
-                for _ in 0..recover.max(1) {
-                    t = t.saturating_add(step);
-                    m.on_sample(t, SampleKind::Fixation);
-                }
-                cover!(recover > 1, "multi-sample hysteresis");
-                assert_eq!(m.at_frame(t), State::Adaptive);
-            });
+        for_all!((u8, u16, u64), |(recover, step, start)| {
+            let recover = u32::from(recover % 8);
+            let step = u64::from(step % 1000) + 1;
+            let config = FailSafeConfig {
+                timeout_us: 1000,
+                recover_samples: recover,
+            };
+            let mut m = FailSafe::new(config);
+            let mut t = start;
+            m.on_sample(t, SampleKind::Invalid);
+            for _ in 0..recover.max(1) {
+                t = t.saturating_add(step);
+                m.on_sample(t, SampleKind::Fixation);
+            }
+            cover!(recover > 1, "multi-sample hysteresis");
+            assert_eq!(m.at_frame(t), State::Adaptive);
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["multi-sample hysteresis"]);
     }
@@ -340,63 +339,66 @@ mod verification {
     #[cfg_attr(kani, kani::proof, kani::unwind(8))]
     #[cfg_attr(not(kani), test)]
     fn frame_clock_bounds_gaze_age_and_work() {
-        bolero::check!()
-            .with_type::<([(u16, u8); 6], u16, u8, u8, u8)>()
-            .cloned()
-            .for_each(|(samples, period, timeout, gap, recover)| {
-                let period = u64::from(period % 200) + 1;
-                let timeout = u64::from(timeout);
-                let max_gap = u64::from(gap % 4);
-                let config = FailSafeConfig {
-                    timeout_us: timeout,
-                    recover_samples: u32::from(recover % 3),
-                };
-                let mut m = FailSafe::new(config);
-                let mut clock = FrameClock::new(period, max_gap);
-                // The sample clock, relative to the current origin.
-                let mut origin = 0u64;
-                let mut t = 0u64;
-                let mut last_start: Option<u64> = None;
-                for &(dt, k) in &samples {
-                    // Gaps from none to several periods (jumps beyond max_gap).
-                    t = t.saturating_add(u64::from(dt % 1024));
-                    let mut rel = t - origin;
-                    let mut emitted = 0u64;
-                    loop {
-                        match clock.due(rel) {
-                            Due::Nothing => break,
-                            Due::Frame(start) => {
-                                assert!(start <= rel);
-                                if let Some(prev) = last_start {
-                                    assert_eq!(start, prev + period, "a period without a frame");
-                                }
-                                last_start = Some(start);
-                                emitted += 1;
-                                if m.at_frame(start) == State::Adaptive {
-                                    cover!(true, "adaptive frame on the clock");
-                                    let lf = m.last_fixation_us().unwrap();
-                                    // Age at the frame's end.
-                                    assert!(start + period - lf <= timeout + period);
-                                }
+        for_all!(([(u16, u8); 6], u16, u8, u8, u8), |(
+            samples,
+            period,
+            timeout,
+            gap,
+            recover,
+        )| {
+            let period = u64::from(period % 200) + 1;
+            let timeout = u64::from(timeout);
+            let max_gap = u64::from(gap % 4);
+            let config = FailSafeConfig {
+                timeout_us: timeout,
+                recover_samples: u32::from(recover % 3),
+            };
+            let mut m = FailSafe::new(config);
+            let mut clock = FrameClock::new(period, max_gap);
+            // The sample clock, relative to the current origin.
+            let mut origin = 0u64;
+            let mut t = 0u64;
+            let mut last_start: Option<u64> = None;
+            for &(dt, k) in &samples {
+                // Gaps from none to several periods (jumps beyond max_gap).
+                t = t.saturating_add(u64::from(dt % 1024));
+                let mut rel = t - origin;
+                let mut emitted = 0u64;
+                loop {
+                    match clock.due(rel) {
+                        Due::Nothing => break,
+                        Due::Frame(start) => {
+                            assert!(start <= rel);
+                            if let Some(prev) = last_start {
+                                assert_eq!(start, prev + period, "a period without a frame");
                             }
-                            Due::Jump { frames } => {
-                                cover!(true, "timestamp jump");
-                                assert!(frames > max_gap + 1);
-                                // One fail-safe frame, then resynchronize.
-                                m = FailSafe::new(config);
-                                clock = FrameClock::new(period, max_gap);
-                                origin = t;
-                                rel = 0;
-                                last_start = None;
-                                emitted = 0;
+                            last_start = Some(start);
+                            emitted += 1;
+                            if m.at_frame(start) == State::Adaptive {
+                                cover!(true, "adaptive frame on the clock");
+                                let lf = m.last_fixation_us().unwrap();
+                                // Age at the frame's end.
+                                assert!(start + period - lf <= timeout + period);
                             }
                         }
+                        Due::Jump { frames } => {
+                            cover!(true, "timestamp jump");
+                            assert!(frames > max_gap + 1);
+                            // One fail-safe frame, then resynchronize.
+                            m = FailSafe::new(config);
+                            clock = FrameClock::new(period, max_gap);
+                            origin = t;
+                            rel = 0;
+                            last_start = None;
+                            emitted = 0;
+                        }
                     }
-                    cover!(emitted > 1, "a gap produces its frames");
-                    assert!(emitted <= max_gap + 1);
-                    m.on_sample(rel, kind(k));
                 }
-            });
+                cover!(emitted > 1, "a gap produces its frames");
+                assert!(emitted <= max_gap + 1);
+                m.on_sample(rel, kind(k));
+            }
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&[
             "adaptive frame on the clock",

@@ -1,10 +1,16 @@
 //! Support for the proof harnesses.
 //!
 //! Every harness is one function body run two ways: as a Kani proof over
-//! symbolic inputs (`#[cfg(kani)] #[kani::proof]`, machine-checked only
+//! symbolic inputs (`#[cfg_attr(kani, kani::proof)]`, machine-checked only
 //! where Kani is installed — it is not on the machines this crate is
 //! developed on) and as an ordinary test over random inputs (bolero, under
 //! `cargo test`). See `specs/verification.md`.
+//!
+//! [`for_all!`](crate::for_all) draws the harness input: `kani::any()` under
+//! Kani, `bolero::check!()` otherwise. bolero is a dev-dependency, so it is
+//! named only in the `cfg(not(kani))` branch: plain `cargo kani -p
+//! gaze-lidar-core` (which builds the library, without dev-dependencies)
+//! resolves, and so does `cargo kani --tests`.
 //!
 //! [`cover!`](crate::cover) pairs every assumption with a reachability check:
 //! under Kani it is `kani::cover!`; under `cargo test` it records hits so a
@@ -53,3 +59,25 @@ macro_rules! cover {
     }};
 }
 pub use crate::cover;
+
+/// Runs a harness body on one input (the Kani branch of [`for_all!`]; a
+/// function so that the closure's argument type is inferred from `T`).
+#[doc(hidden)]
+pub fn run_once<T, F: FnOnce(T)>(input: T, body: F) {
+    body(input)
+}
+
+/// `for_all!(T, |x| body)`: the body for every `x: T`. Under Kani `x` is
+/// `kani::any()` (symbolic: the proof covers every value); under `cargo
+/// test` bolero feeds random values (bolero is a dev-dependency and is named
+/// only in this branch).
+#[macro_export]
+macro_rules! for_all {
+    ($ty:ty, $body:expr $(,)?) => {{
+        #[cfg(kani)]
+        $crate::verification::run_once::<$ty, _>(kani::any(), $body);
+        #[cfg(not(kani))]
+        bolero::check!().with_type::<$ty>().cloned().for_each($body);
+    }};
+}
+pub use crate::for_all;

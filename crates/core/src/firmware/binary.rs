@@ -216,40 +216,37 @@ pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
 #[cfg(any(kani, test))]
 mod verification {
     use super::*;
-    use crate::verification::cover;
+    use crate::verification::{cover, for_all};
 
     /// REQ-IN-3: decoding any byte string never panics; whatever decodes
     /// has a consistent length.
     #[cfg_attr(kani, kani::proof, kani::unwind(4))]
     #[cfg_attr(not(kani), test)]
     fn decode_never_panics() {
-        bolero::check!()
-            .with_type::<([u8; 136], u8)>()
-            .cloned()
-            .for_each(|(raw, len)| {
-                let mut bytes = raw.to_vec();
-                // Make the valid-header path reachable from random bytes.
-                if len % 2 == 0 {
-                    bytes[0..4].copy_from_slice(MAGIC);
-                    bytes[4..6].copy_from_slice(&VERSION.to_le_bytes());
-                    bytes[6] %= 2;
-                    bytes[7] = 0;
-                    bytes[24..32].copy_from_slice(&1.0f64.to_le_bytes());
-                    bytes[60..64].copy_from_slice(&1u32.to_le_bytes());
-                    // Eye-safety fields absent: all zero (flag byte 7 is 0).
-                    bytes[72..96].fill(0);
+        for_all!(([u8; 136], u8), |(raw, len)| {
+            let mut bytes = raw.to_vec();
+            // Make the valid-header path reachable from random bytes.
+            if len % 2 == 0 {
+                bytes[0..4].copy_from_slice(MAGIC);
+                bytes[4..6].copy_from_slice(&VERSION.to_le_bytes());
+                bytes[6] %= 2;
+                bytes[7] = 0;
+                bytes[24..32].copy_from_slice(&1.0f64.to_le_bytes());
+                bytes[60..64].copy_from_slice(&1u32.to_le_bytes());
+                // Eye-safety fields absent: all zero (flag byte 7 is 0).
+                bytes[72..96].fill(0);
+            }
+            let len = usize::from(len) % (bytes.len() + 1);
+            match decode(&bytes[..len]) {
+                Ok(t) => {
+                    cover!(true, "a record decodes");
+                    assert_eq!(HEADER_LEN + RECORD_LEN * t.bins.len(), len);
+                    // Only the exact layout decodes: re-encoding gives the input back.
+                    assert_eq!(encode(&t), &bytes[..len]);
                 }
-                let len = usize::from(len) % (bytes.len() + 1);
-                match decode(&bytes[..len]) {
-                    Ok(t) => {
-                        cover!(true, "a record decodes");
-                        assert_eq!(HEADER_LEN + RECORD_LEN * t.bins.len(), len);
-                        // Only the exact layout decodes: re-encoding gives the input back.
-                        assert_eq!(encode(&t), &bytes[..len]);
-                    }
-                    Err(_) => cover!(true, "garbage is rejected"),
-                }
-            });
+                Err(_) => cover!(true, "garbage is rejected"),
+            }
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["a record decodes", "garbage is rejected"]);
     }
@@ -258,70 +255,72 @@ mod verification {
     #[cfg_attr(kani, kani::proof, kani::unwind(4))]
     #[cfg_attr(not(kani), test)]
     fn encode_decode_round_trip() {
-        bolero::check!()
-            .with_type::<([(u32, u64, u32); 3], u8, u64, bool)>()
-            .cloned()
-            .for_each(|(raw, n, frame_ticks, angle)| {
-                let n = 1 + usize::from(n % 3);
-                let bins: Vec<FwBin> = raw[..n]
-                    .iter()
-                    .map(|&(w, ticks, code)| FwBin {
-                        start_deg: 0.0,
-                        width_mdeg: w % 1_000_000,
-                        dwell_ticks: ticks,
-                        power_code: code,
-                        dwell_ticks_min: ticks / 2,
-                        dwell_ticks_max: ticks,
-                        power_code_cap: code / 3,
-                    })
-                    .collect();
-                let t = FirmwareTable {
-                    format: FIRMWARE_FORMAT.to_owned(),
-                    tick_hz: 80_000_000,
-                    frame_ticks,
-                    power_w_per_code: 0.25,
-                    power_accounting: if angle {
-                        PowerAccounting::Angle
-                    } else {
-                        PowerAccounting::Time
-                    },
-                    pulse_rate_hz: 0.0,
-                    eye_safety: None,
-                    limits: IntLimits {
-                        power_code_min: 1,
-                        power_code_max: 4095,
-                        energy_budget: frame_ticks,
-                        window_bins: 2,
-                        window_energy_max: 7,
-                    },
-                    bins,
-                };
-                let back = decode(&encode(&t)).expect("an encoded table decodes");
-                cover!(n == 3, "three records");
-                assert_eq!(back.limits, t.limits);
-                assert_eq!(back.frame_ticks, t.frame_ticks);
-                assert_eq!(back.power_accounting, t.power_accounting);
-                for (a, b) in back.bins.iter().zip(&t.bins) {
-                    assert_eq!(
-                        (
-                            a.width_mdeg,
-                            a.dwell_ticks,
-                            a.power_code,
-                            a.dwell_ticks_min,
-                            a.dwell_ticks_max,
-                            a.power_code_cap
-                        ),
-                        (
-                            b.width_mdeg,
-                            b.dwell_ticks,
-                            b.power_code,
-                            b.dwell_ticks_min,
-                            b.dwell_ticks_max,
-                            b.power_code_cap
-                        )
-                    );
-                }
-            });
+        for_all!(([(u32, u64, u32); 3], u8, u64, bool), |(
+            raw,
+            n,
+            frame_ticks,
+            angle,
+        )| {
+            let n = 1 + usize::from(n % 3);
+            let bins: Vec<FwBin> = raw[..n]
+                .iter()
+                .map(|&(w, ticks, code)| FwBin {
+                    start_deg: 0.0,
+                    width_mdeg: w % 1_000_000,
+                    dwell_ticks: ticks,
+                    power_code: code,
+                    dwell_ticks_min: ticks / 2,
+                    dwell_ticks_max: ticks,
+                    power_code_cap: code / 3,
+                })
+                .collect();
+            let t = FirmwareTable {
+                format: FIRMWARE_FORMAT.to_owned(),
+                tick_hz: 80_000_000,
+                frame_ticks,
+                power_w_per_code: 0.25,
+                power_accounting: if angle {
+                    PowerAccounting::Angle
+                } else {
+                    PowerAccounting::Time
+                },
+                pulse_rate_hz: 0.0,
+                eye_safety: None,
+                limits: IntLimits {
+                    power_code_min: 1,
+                    power_code_max: 4095,
+                    energy_budget: frame_ticks,
+                    window_bins: 2,
+                    window_energy_max: 7,
+                },
+                bins,
+            };
+            let back = decode(&encode(&t)).expect("an encoded table decodes");
+            cover!(n == 3, "three records");
+            assert_eq!(back.limits, t.limits);
+            assert_eq!(back.frame_ticks, t.frame_ticks);
+            assert_eq!(back.power_accounting, t.power_accounting);
+            for (a, b) in back.bins.iter().zip(&t.bins) {
+                assert_eq!(
+                    (
+                        a.width_mdeg,
+                        a.dwell_ticks,
+                        a.power_code,
+                        a.dwell_ticks_min,
+                        a.dwell_ticks_max,
+                        a.power_code_cap
+                    ),
+                    (
+                        b.width_mdeg,
+                        b.dwell_ticks,
+                        b.power_code,
+                        b.dwell_ticks_min,
+                        b.dwell_ticks_max,
+                        b.power_code_cap
+                    )
+                );
+            }
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["three records"]);
     }

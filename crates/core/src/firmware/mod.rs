@@ -140,68 +140,65 @@ pub struct FirmwareTable {
 #[cfg(any(kani, test))]
 mod verification {
     use super::*;
-    use crate::verification::cover;
+    use crate::verification::{cover, for_all};
 
     /// REQ-FW-6: whatever the quantizer returns passes the integer checker's
     /// frame and dwell rules (quantizer and checker agree).
     #[cfg_attr(kani, kani::proof, kani::unwind(6))]
     #[cfg_attr(not(kani), test)]
     fn quantizer_output_passes_integer_frame_and_dwell_checks() {
-        bolero::check!()
-            .with_type::<([(u8, u8, u8, u8); 4], u8, u16)>()
-            .cloned()
-            .for_each(|(raw, n, total)| {
-                let n = 1 + usize::from(n % 4);
-                let targets: Vec<TickTarget> = raw[..n]
-                    .iter()
-                    .map(|&(floor, frac, min, span)| TickTarget {
-                        floor: u64::from(floor),
-                        frac: u32::from(frac) << 24,
-                        min: u64::from(min),
-                        max: u64::from(min) + u64::from(span),
-                    })
-                    .collect();
-                let Ok(ticks) = apportion(&targets, u64::from(total % 1100)) else {
-                    return;
-                };
-                cover!(true, "apportioned table checked");
-                let bins = targets
-                    .iter()
-                    .zip(&ticks)
-                    .enumerate()
-                    .map(|(i, (t, &d))| FwBin {
-                        start_deg: 0.0,
-                        width_mdeg: if i == 0 { FULL_TURN_MDEG } else { 0 },
-                        dwell_ticks: d,
-                        power_code: 0,
-                        dwell_ticks_min: t.min,
-                        dwell_ticks_max: t.max,
-                        power_code_cap: 0,
-                    })
-                    .collect();
-                let table = FirmwareTable {
-                    format: FIRMWARE_FORMAT.to_owned(),
-                    tick_hz: 1,
-                    frame_ticks: u64::from(total % 1100),
-                    power_w_per_code: 1.0,
-                    power_accounting: PowerAccounting::Time,
-                    pulse_rate_hz: 0.0,
-                    eye_safety: None,
-                    limits: IntLimits {
-                        power_code_min: 0,
-                        power_code_max: 0,
-                        energy_budget: 0,
-                        window_bins: 1,
-                        window_energy_max: 0,
-                    },
-                    bins,
-                };
-                assert!(
-                    check_integer(&table).is_empty(),
-                    "{:?}",
-                    check_integer(&table)
-                );
-            });
+        for_all!(([(u8, u8, u8, u8); 4], u8, u16), |(raw, n, total)| {
+            let n = 1 + usize::from(n % 4);
+            let targets: Vec<TickTarget> = raw[..n]
+                .iter()
+                .map(|&(floor, frac, min, span)| TickTarget {
+                    floor: u64::from(floor),
+                    frac: u32::from(frac) << 24,
+                    min: u64::from(min),
+                    max: u64::from(min) + u64::from(span),
+                })
+                .collect();
+            let Ok(ticks) = apportion(&targets, u64::from(total % 1100)) else {
+                return;
+            };
+            cover!(true, "apportioned table checked");
+            let bins = targets
+                .iter()
+                .zip(&ticks)
+                .enumerate()
+                .map(|(i, (t, &d))| FwBin {
+                    start_deg: 0.0,
+                    width_mdeg: if i == 0 { FULL_TURN_MDEG } else { 0 },
+                    dwell_ticks: d,
+                    power_code: 0,
+                    dwell_ticks_min: t.min,
+                    dwell_ticks_max: t.max,
+                    power_code_cap: 0,
+                })
+                .collect();
+            let table = FirmwareTable {
+                format: FIRMWARE_FORMAT.to_owned(),
+                tick_hz: 1,
+                frame_ticks: u64::from(total % 1100),
+                power_w_per_code: 1.0,
+                power_accounting: PowerAccounting::Time,
+                pulse_rate_hz: 0.0,
+                eye_safety: None,
+                limits: IntLimits {
+                    power_code_min: 0,
+                    power_code_max: 0,
+                    energy_budget: 0,
+                    window_bins: 1,
+                    window_energy_max: 0,
+                },
+                bins,
+            };
+            assert!(
+                check_integer(&table).is_empty(),
+                "{:?}",
+                check_integer(&table)
+            );
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["apportioned table checked"]);
     }

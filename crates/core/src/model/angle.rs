@@ -541,25 +541,22 @@ mod tests {
 #[cfg(any(kani, test))]
 mod verification {
     use super::*;
-    use crate::verification::cover;
+    use crate::verification::{cover, for_all};
 
     /// REQ-IDX-1: cyclic neighbours stay in bounds for every bin count and index.
     #[cfg_attr(kani, kani::proof)]
     #[cfg_attr(not(kani), test)]
     fn neighbours_in_bounds() {
-        bolero::check!()
-            .with_type::<(usize, usize, bool)>()
-            .cloned()
-            .for_each(|(i, n, last)| {
-                let n = n.max(1);
-                // `last` steers random testing to the wrap-around edge.
-                let i = if last { n - 1 } else { i % n };
-                cover!(n > 1 && i == n - 1, "last bin wraps to the first");
-                let (nx, pv) = (next_index(i, n), prev_index(i, n));
-                assert!(nx < n && pv < n);
-                assert_eq!(prev_index(nx, n), i);
-                assert_eq!(next_index(pv, n), i);
-            });
+        for_all!((usize, usize, bool), |(i, n, last)| {
+            let n = n.max(1);
+            // `last` steers random testing to the wrap-around edge.
+            let i = if last { n - 1 } else { i % n };
+            cover!(n > 1 && i == n - 1, "last bin wraps to the first");
+            let (nx, pv) = (next_index(i, n), prev_index(i, n));
+            assert!(nx < n && pv < n);
+            assert_eq!(prev_index(nx, n), i);
+            assert_eq!(next_index(pv, n), i);
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["last bin wraps to the first"]);
     }
@@ -569,18 +566,17 @@ mod verification {
     #[cfg_attr(kani, kani::proof)]
     #[cfg_attr(not(kani), test)]
     fn rotate_in_bounds_and_modular() {
-        bolero::check!()
-            .with_type::<(usize, usize, usize)>()
-            .cloned()
-            .for_each(|(i, shift, n)| {
-                let n = n.max(1);
-                let i = i % n;
-                let r = rotate_index(i, shift, n);
-                cover!(shift > usize::MAX - n, "shift near usize::MAX");
-                assert!(r < n);
-                let expected = ((i as u128 + shift as u128) % n as u128) as usize;
-                assert_eq!(r, expected);
-            });
+        for_all!((usize, usize, usize), |(i, shift, n)| {
+            let n = n.max(1);
+            let i = i % n;
+            let r = rotate_index(i, shift, n);
+            cover!(shift > usize::MAX - n, "shift near usize::MAX");
+            assert!(r < n);
+            let expected = ((i as u128 + shift as u128) % n as u128) as usize;
+            assert_eq!(r, expected);
+        });
+        #[cfg(not(kani))]
+        crate::verification::assert_covered(&["shift near usize::MAX"]);
     }
 
     /// REQ-IDX-3: rotating by `s` then by `n − s mod n` is the identity (the
@@ -588,16 +584,13 @@ mod verification {
     #[cfg_attr(kani, kani::proof)]
     #[cfg_attr(not(kani), test)]
     fn rotate_inverse() {
-        bolero::check!()
-            .with_type::<(usize, usize, usize)>()
-            .cloned()
-            .for_each(|(i, shift, n)| {
-                let n = n.max(1);
-                let i = i % n;
-                let back = n - shift % n;
-                cover!(shift % n != 0, "non-trivial rotation");
-                assert_eq!(rotate_index(rotate_index(i, shift, n), back, n), i);
-            });
+        for_all!((usize, usize, usize), |(i, shift, n)| {
+            let n = n.max(1);
+            let i = i % n;
+            let back = n - shift % n;
+            cover!(shift % n != 0, "non-trivial rotation");
+            assert_eq!(rotate_index(rotate_index(i, shift, n), back, n), i);
+        });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["non-trivial rotation"]);
     }
