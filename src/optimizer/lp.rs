@@ -17,7 +17,9 @@ use good_lp::{
 use std::f64::consts::TAU;
 
 use super::{OptError, Problem};
-use crate::eye_safety::ael::{self, Band, APERTURE_DISTANCE_MM, T2_S, TIME_BASE_S};
+use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
+use crate::eye_safety::bound::{max_pulses_in, passes_in_window, Laser};
+use crate::eye_safety::exposure;
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning, CircularSet};
 use crate::model::lidar::PowerAccounting;
 use crate::planner::Mode;
@@ -37,6 +39,9 @@ const ACCEL_SHARE: f64 = 0.8;
 /// Relative margin on eye-safety power caps (covers spin variation within a
 /// bin once the continuous spin profile is rebuilt).
 const CAP_MARGIN: f64 = 1e-3;
+/// Relative margin below `K/f_p` for a dwell that holds at most `K` pulses
+/// (well above the model's count margin, `bound::COUNT_MARGIN`).
+const DWELL_COUNT_MARGIN: f64 = 1e-6;
 /// Dwell-step iterations when the acceleration limit is finite.
 const SLP_ROUNDS: usize = 5;
 
@@ -107,51 +112,41 @@ fn sqrt_chords(lo: f64, hi: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Eye-safety windows: for every bin edge, the pass window starting and
-/// ending there, as (bin, covered fraction) lists.
+/// Eye-safety windows for the LP: for every bin edge, the pass window
+/// starting and ending there, as (bin, covered fraction) lists, with the
+/// limits taken from the one eye-safety model ([`Laser`]): the LP's linear
+/// constraints are that model's rules inverted at fixed counts, and the
+/// solved profile is then fitted to the model's sound bound
+/// (`fit_to_eye_safety_bound`) and certified by the checker.
 struct Eye {
     windows: Vec<Vec<(usize, f64)>>,
-    /// Single-pulse AEL at the effective pulse duration, J.
-    ael_single_j: f64,
-    /// Pulses per effective pulse.
-    group: f64,
-    /// Passes within T_max = min(T2, time base).
-    passes_tmax: f64,
-    /// Largest energy per pass from the T2 and time-base rules, J.
+    laser: Laser,
+    frame_s: f64,
+    /// Largest energy per pass the multi-pass rules (T2 train and time
+    /// base) allow with every pass at that energy, J.
     pass_energy_max_j: f64,
-    band: Band,
 }
 
 fn eye(problem: &Problem, g: &Grid) -> Result<Option<Eye>, OptError> {
     let Some(params) = &problem.lidar.limits.eye_safety else {
         return Ok(None);
     };
-    let bad = |e: String| OptError::Invalid {
-        field: "limits.eye_safety".into(),
-        reason: e,
-    };
-    let band = params.validate().map_err(|e| bad(e.to_string()))?;
-    let lambda = params.wavelength_nm;
-    let f_p = problem.lidar.pulse_rate_hz;
-    let f_frame = problem.lidar.frame_rate_hz;
-    let pass_deg = ((band.aperture_mm() + params.beam_diameter_mm) / APERTURE_DISTANCE_MM)
-        .to_degrees()
-        .min(360.0);
-    let passes = |t: f64| (t * f_frame).floor() + 1.0;
-    let group = if band == Band::RetinalNir {
-        (band.t_i_s() * f_p).ceil().max(1.0)
+    let laser =
+        exposure::laser(params, problem.lidar.pulse_rate_hz).map_err(|e| OptError::Invalid {
+            field: "limits.eye_safety".into(),
+            reason: e.to_string(),
+        })?;
+    let pass_deg = exposure::pass_angle_deg(params, &laser);
+    let frame_s = 1.0 / problem.lidar.frame_rate_hz;
+    // Energy is linear in the pass energy, and no pass delivers more than
+    // its energy whatever the power: the model's ratio at 1 J per pass with
+    // an unbounded peak power inverts to the cap.
+    let (ratio_per_j, _) = laser.multi_pass_ratio(frame_s, 1.0, f64::MAX);
+    let pass_energy_max_j = if ratio_per_j > 0.0 {
+        1.0 / ratio_per_j
     } else {
-        1.0
+        f64::INFINITY
     };
-    let t_eff = if group > 1.0 {
-        band.t_i_s()
-    } else {
-        params.pulse_duration_s
-    };
-    let ael_single_j = ael::ael_j(lambda, t_eff).map_err(|e| bad(e.to_string()))?;
-    let pass_energy_max_j = (ael::ael_j(lambda, T2_S).map_err(|e| bad(e.to_string()))?
-        / passes(T2_S))
-    .min(ael::ael_j(lambda, TIME_BASE_S).map_err(|e| bad(e.to_string()))? / passes(TIME_BASE_S));
     let mut windows = Vec::with_capacity(2 * g.n);
     for &e in &g.start_deg {
         for start in [e, e - pass_deg] {
@@ -179,31 +174,31 @@ fn eye(problem: &Problem, g: &Grid) -> Result<Option<Eye>, OptError> {
     }
     Ok(Some(Eye {
         windows,
-        ael_single_j,
-        group,
-        passes_tmax: passes(T2_S.min(TIME_BASE_S)),
+        laser,
+        frame_s,
         pass_energy_max_j,
-        band,
     }))
 }
 
 impl Eye {
-    /// C5 for a window of dwell `t_w`.
-    fn c5(&self, f_p: f64, t_w: f64) -> f64 {
-        ael::c5(
-            self.band,
-            f_p * t_w * self.passes_tmax / self.group,
-            T2_S.min(TIME_BASE_S),
+    /// The model's single-pulse ratio per watt for a pass of dwell `t_w`:
+    /// the most pulses such a pass holds, and the most passes meeting a
+    /// T2 window ([`passes_in_window`]).
+    fn single_ratio_per_w(&self, t_w: f64) -> f64 {
+        let f_p = self.laser.pulse_rate_hz;
+        self.laser.single_pulse_ratio(
+            1.0 / f_p,
+            max_pulses_in(t_w, f_p),
+            passes_in_window(T2_S.min(TIME_BASE_S), t_w, self.frame_s),
         )
     }
 
     /// Per-bin power caps from the single-pulse rule at the given dwells, W.
-    fn power_caps(&self, f_p: f64, t: &[f64]) -> Vec<f64> {
+    fn power_caps(&self, t: &[f64]) -> Vec<f64> {
         let mut cap = vec![f64::INFINITY; t.len()];
         for w in &self.windows {
             let t_w: f64 = w.iter().map(|&(j, f)| f * t[j]).sum();
-            let allowed =
-                self.c5(f_p, t_w) * self.ael_single_j / self.group * f_p * (1.0 - CAP_MARGIN);
+            let allowed = (1.0 - CAP_MARGIN) / self.single_ratio_per_w(t_w);
             for &(j, _) in w {
                 cap[j] = cap[j].min(allowed);
             }
@@ -211,23 +206,39 @@ impl Eye {
         cap
     }
 
-    /// Largest window dwell at which the single-pulse rule holds for powers `p`, s.
-    fn window_dwell_max(&self, f_p: f64, w: &[(usize, f64)], p: &[f64]) -> Result<f64, OptError> {
+    /// Largest window dwell at which the single-pulse rule holds for powers
+    /// `p`, s: the most pulses per pass `K` the model allows at the window's
+    /// highest power (the ratio grows with `K`: C5 falls and the T2 window
+    /// meets more passes), found by bisection, as a dwell that cannot hold
+    /// more than `K` pulses (`⌊t·f_p⌋ + 1 ≤ K` for `t < K/f_p`, less the
+    /// model's count margin). Counts and passes are those
+    /// [`Self::power_caps`] uses, so a dwell that met the caps meets this.
+    fn window_dwell_max(&self, w: &[(usize, f64)], p: &[f64]) -> Result<f64, OptError> {
+        let f_p = self.laser.pulse_rate_hz;
         let p_max = w.iter().map(|&(j, _)| p[j]).fold(0.0, f64::max);
-        let c = p_max * self.group / f_p / self.ael_single_j;
-        if c > 1.0 {
+        let dwell_of = |k: f64| k / f_p * (1.0 - DWELL_COUNT_MARGIN);
+        let ratio = |k: f64| p_max * self.single_ratio_per_w(dwell_of(k));
+        if ratio(1.0) > 1.0 {
             return Err(OptError::Infeasible(format!(
-                "eye safety: {:.4e} W gives {:.3e} J per pulse, above the single-pulse AEL {:.3e} J at any spin",
+                "eye safety: {:.4e} W gives {:.3e} J per pulse, above the single-pulse limit at any spin",
                 p_max,
                 p_max / f_p,
-                self.ael_single_j
             )));
         }
-        if c <= 0.4 || self.band != Band::RetinalNir {
+        let k_turn = max_pulses_in(self.frame_s, f_p);
+        if ratio(k_turn) <= 1.0 {
             return Ok(f64::INFINITY);
         }
-        let n_max = (5.0 / c).powi(4).max(600.0);
-        Ok(n_max * self.group / (f_p * self.passes_tmax))
+        let (mut lo, mut hi) = (1.0_f64, k_turn); // ratio(lo) ≤ 1 < ratio(hi)
+        while hi - lo > 1.0 {
+            let mid = ((lo + hi) / 2.0).floor();
+            if ratio(mid) <= 1.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Ok(dwell_of(lo))
     }
 }
 
@@ -264,10 +275,9 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
     }
     if let Some(e) = eye {
         // The most lenient single-pulse cap: the fastest spin everywhere.
-        let f_p = lid.pulse_rate_hz;
         let t_fast: Vec<f64> = vec![TAU / l.spin_rad_s_max / problem.bins as f64; problem.bins];
         let cap = e
-            .power_caps(f_p, &t_fast)
+            .power_caps(&t_fast)
             .into_iter()
             .fold(f64::INFINITY, f64::min);
         if cap < l.power_w_min {
@@ -354,10 +364,7 @@ fn power_step(
     let l = &lid.limits;
     let p_mean = lid.average_power_w;
     let period: f64 = t.iter().sum();
-    let caps = eye.map_or_else(
-        || vec![f64::INFINITY; g.n],
-        |e| e.power_caps(lid.pulse_rate_hz, t),
-    );
+    let caps = eye.map_or_else(|| vec![f64::INFINITY; g.n], |e| e.power_caps(t));
     let lam = problem.objective.range_weight;
     let levels = &problem.levels.power_w;
     let mut vars = ProblemVariables::new();
@@ -574,9 +581,8 @@ fn dwell_step(
         }
     }
     if let Some(e) = eye {
-        let f_p = lid.pulse_rate_hz;
         for w in &e.windows {
-            let t_max = e.window_dwell_max(f_p, w, p)?;
+            let t_max = e.window_dwell_max(w, p)?;
             let mut dwell = Expression::from(0.0);
             let mut en = Expression::from(0.0);
             for &(j, f) in w {

@@ -276,132 +276,10 @@ pub fn table3_j(band: Band, c4: f64, t_s: f64) -> f64 {
     }
 }
 
-/// The Class 1 figures the `ael` command reports.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AelReport {
-    /// Wavelength, nm.
-    pub wavelength_nm: f64,
-    /// Band used.
-    pub band: Band,
-    /// Pulse duration, s.
-    pub pulse_duration_s: f64,
-    /// Single-pulse AEL (no C5), J.
-    pub single_pulse_ael_j: f64,
-    /// Long-exposure average-power AEL at the 100 s time base, W.
-    pub average_power_ael_w: f64,
-    /// C4.
-    pub c4: f64,
-    /// C6 (small source).
-    pub c6: f64,
-    /// C7.
-    pub c7: f64,
-    /// T2, s (retinal band).
-    pub t2_s: f64,
-    /// T_i, s.
-    pub t_i_s: f64,
-    /// Time base, s.
-    pub time_base_s: f64,
-    /// Condition 3 aperture diameter, mm.
-    pub aperture_diameter_mm: f64,
-    /// Condition 3 aperture distance, mm.
-    pub aperture_distance_mm: f64,
-    /// With a pulse rate: figures for a stationary (non-scanning, e.g.
-    /// stalled) beam with all pulses entering the aperture.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub stationary_beam: Option<StationaryBeam>,
-}
-
-/// AEL figures for a stationary beam at a given pulse rate.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct StationaryBeam {
-    /// Pulse rate, Hz.
-    pub pulse_rate_hz: f64,
-    /// Effective pulses within min(T2, time base).
-    pub pulses_in_t_max: f64,
-    /// C5 for those pulses.
-    pub c5: f64,
-    /// Per-pulse AEL with C5, J.
-    pub per_pulse_ael_j: f64,
-    /// Highest mean power meeting every rule, W.
-    pub max_average_power_w: f64,
-}
-
-/// Computes the `ael` report for a wavelength, pulse duration and optional pulse rate.
-pub fn ael_report(
-    wavelength_nm: f64,
-    pulse_duration_s: f64,
-    pulse_rate_hz: Option<f64>,
-) -> Result<AelReport, AelError> {
-    let band = Band::of(wavelength_nm)?;
-    let single = ael_j(wavelength_nm, pulse_duration_s)?;
-    let average_power_ael_w = ael_j(wavelength_nm, TIME_BASE_S)? / TIME_BASE_S;
-    let stationary_beam = match pulse_rate_hz {
-        None => None,
-        Some(rate) => {
-            if !(rate.is_finite() && rate > 0.0) {
-                return Err(AelError::Duration {
-                    what: "pulse_rate_hz (as 1/period)",
-                    value: rate,
-                    reason: "must be finite and > 0",
-                });
-            }
-            let t_max = T2_S.min(TIME_BASE_S);
-            let group = (band.t_i_s() * rate).max(1.0);
-            let n = t_max * rate / group;
-            let c5 = c5(band, n, t_max);
-            let t_eff = if group > 1.0 {
-                band.t_i_s()
-            } else {
-                pulse_duration_s
-            };
-            let per_pulse = c5 * ael_j(wavelength_nm, t_eff)? / group;
-            let limit_from_pulse = per_pulse * rate;
-            let limit_from_tbase = average_power_ael_w;
-            let limit_from_t2 = ael_j(wavelength_nm, t_max)? / t_max;
-            Some(StationaryBeam {
-                pulse_rate_hz: rate,
-                pulses_in_t_max: n,
-                c5,
-                per_pulse_ael_j: per_pulse,
-                max_average_power_w: limit_from_pulse.min(limit_from_tbase).min(limit_from_t2),
-            })
-        }
-    };
-    Ok(AelReport {
-        wavelength_nm,
-        band,
-        pulse_duration_s,
-        single_pulse_ael_j: single,
-        average_power_ael_w,
-        c4: c4(wavelength_nm),
-        c6: c6(),
-        c7: c7(wavelength_nm),
-        t2_s: T2_S,
-        t_i_s: band.t_i_s(),
-        time_base_s: TIME_BASE_S,
-        aperture_diameter_mm: band.aperture_mm(),
-        aperture_distance_mm: APERTURE_DISTANCE_MM,
-        stationary_beam,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
-
-    #[test]
-    fn design_figures() {
-        let r = ael_report(905.0, 5e-9, None).unwrap();
-        assert_relative_eq!(r.single_pulse_ael_j, 1.98e-7, max_relative = 0.02);
-        assert_relative_eq!(r.average_power_ael_w, 1.0e-3, max_relative = 0.02);
-        assert_relative_eq!(r.c4, 2.570, max_relative = 1e-3);
-        let r = ael_report(850.0, 5e-9, None).unwrap();
-        assert_relative_eq!(r.average_power_ael_w, 7.8e-4, max_relative = 0.02);
-        let r = ael_report(1550.0, 5e-9, None).unwrap();
-        assert_relative_eq!(r.single_pulse_ael_j, 8e-3, max_relative = 0.02);
-        assert_relative_eq!(r.average_power_ael_w, 1e-2, max_relative = 0.02);
-    }
 
     #[test]
     fn breakpoints_are_continuous() {
@@ -441,14 +319,5 @@ mod tests {
         assert_relative_eq!(c5(Band::RetinalNir, 10_000.0, 10.0), 0.5);
         assert_eq!(c5(Band::RetinalNir, 1e9, 10.0), 0.4);
         assert_eq!(c5(Band::Ir1500, 1e9, 10.0), 1.0);
-    }
-
-    #[test]
-    fn stationary_beam_is_stricter_than_single_pulse() {
-        let r = ael_report(905.0, 5e-9, Some(7812.5)).unwrap();
-        let s = r.stationary_beam.unwrap();
-        assert_eq!(s.c5, 0.4);
-        assert!(s.per_pulse_ael_j < r.single_pulse_ael_j);
-        assert!(s.max_average_power_w <= r.average_power_ael_w);
     }
 }

@@ -1,6 +1,8 @@
 //! Eye safety (IEC 60825-1:2014, Class 1) for a pulsed, scanned beam.
 //!
 //! - [`ael`]: the accessible emission limits and correction factors.
+//! - [`bound`]: the sound bound every rule is evaluated by.
+//! - [`report`]: the figures of the `ael` command, from the same model.
 //! - [`exposure`]: the exposure of a stationary measurement aperture placed
 //!   at every azimuth around a spinning head running a profile, against
 //!   those limits. Concentrating power or slowing the spin in a sector raises
@@ -12,12 +14,14 @@
 pub mod ael;
 pub mod bound;
 pub mod exposure;
+pub mod report;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-pub use ael::{ael_report, AelError, AelReport};
+pub use ael::AelError;
 pub use exposure::{evaluate_profile, evaluate_segments, ExposureReport, Rule};
+pub use report::{ael_report, AelReport, StationaryBeam};
 
 /// Laser and optics parameters the eye-safety check needs; stored in a
 /// profile's `limits.eye_safety` so any tool can re-check a profile from the file.
