@@ -23,7 +23,12 @@ use gaze_lidar::eye_safety::exposure::evaluate_profile_with;
 fn library(c: &mut Criterion) {
     let mut g = c.benchmark_group("check");
     g.sample_size(10).sampling_mode(SamplingMode::Flat);
-    for n in [10_000usize, 100_000] {
+    let sizes: &[usize] = if std::env::args().any(|a| a == "--bench") {
+        &[10_000, 100_000]
+    } else {
+        &[10_000]
+    };
+    for &n in sizes {
         for (name, r) in [("smooth", Roughness::Smooth), ("rough", Roughness::Rough)] {
             let p = big_profile(n, r);
             assert!(
@@ -68,7 +73,13 @@ fn cli_check(path: &PathBuf) -> Duration {
 }
 
 fn cli(c: &mut Criterion) {
-    let n = 1_000_000usize;
+    // `cargo bench` passes `--bench`; under `cargo test --all-targets` the
+    // bench runs once as a smoke test, on a small file.
+    let n = if std::env::args().any(|a| a == "--bench") {
+        1_000_000usize
+    } else {
+        20_000
+    };
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     let mut g = c.benchmark_group("cli_check");
     g.sample_size(10)

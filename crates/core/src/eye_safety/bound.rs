@@ -34,6 +34,13 @@
 //! passes the same argument in the number of passes `q` leaves the first and
 //! last `q` of each row.
 //!
+//! **Search.** The checker finds the same supremum by branch and bound
+//! ([`Search::Pruned`]): linear sweeps give every cell's end values and a
+//! cheap upper bound of its figures, and every window walk an upper bound of
+//! its ratio; only cells and walks whose bound can still change the result
+//! are evaluated exactly. [`Search::Exhaustive`] evaluates everything and is
+//! tested bit-identical (`specs/eye_safety.md`, "Search").
+//!
 //! **Rounding.** Every count that is a floor is taken as
 //! `⌊x·(1 + 1e-9) + 1e-9⌋`, so a count that sits on an integer is taken
 //! as the larger one and a perturbation of the inputs by 1e-12 cannot
@@ -51,8 +58,9 @@ pub const COUNT_MARGIN: f64 = 1e-9;
 /// float rounding in the bound can never land it below the true supremum.
 pub const RATIO_MARGIN: f64 = 1e-9;
 
-/// Envelope pieces a window walk visits before it falls back to the
-/// `P̂`-slope bound (sound, looser); bounds the work on very fine profiles.
+/// Envelope pieces a window walk visits before it continues with the slope
+/// of the hottest piece within its reach (sound, looser); bounds the work on
+/// very fine profiles.
 pub const WALK_MAX_PIECES: usize = 96;
 
 /// `⌊x⌋` rounded up when `x` is within [`COUNT_MARGIN`] of the next integer.
