@@ -15,6 +15,14 @@ if ! installed libclang-dev; then
   need+=(libclang-dev)
 fi
 command -v c++ >/dev/null 2>&1 || need+=(g++)
+# The Python package (`pip install ./python`) needs CPython 3.9+ with venv
+# and pip (maturin and numpy come from PyPI at install time). Debian's own
+# python3 ships venv separately.
+if ! command -v python3 >/dev/null 2>&1; then
+  need+=(python3 python3-venv python3-pip)
+elif ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
+  need+=(python3-venv)
+fi
 if [ ${#need[@]} -gt 0 ]; then
   echo "setup: installing ${need[*]}" >&2
   SUDO=""

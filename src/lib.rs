@@ -40,6 +40,7 @@ pub mod model;
 #[cfg(feature = "solver")]
 pub mod optimizer;
 pub mod planner;
+pub mod pointcloud;
 pub mod profile;
 pub mod sim;
 #[cfg(any(test, kani))]

@@ -302,6 +302,44 @@ impl<P: FramePlanner> GazeStream<P> {
         self.discard_history();
     }
 
+    /// Replay: runs the frame clock up to `t_s` on the gaze clock, handing
+    /// `emit` every frame that starts at or before it (each decided from the
+    /// samples absorbed so far). Returns `t_s` on the frame clock (µs), or
+    /// `None` when `t_s` lies before the clock's origin by less than a period.
+    fn advance(
+        &mut self,
+        t_s: f64,
+        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
+    ) -> Result<Option<u64>, GazeError> {
+        let period_s = self.clock.period_us() as f64 * 1e-6;
+        let origin = *self.origin_s.get_or_insert(t_s);
+        let mut rel = t_s - origin;
+        if rel < -period_s || !rel.is_finite() {
+            // Time ran backwards (a clock reset): restart at this time.
+            self.resync(t_s, 0);
+            rel = 0.0;
+        } else if rel < 0.0 {
+            // Before the clock's origin (reordered by less than a period).
+            return Ok(None);
+        }
+        let mut now_us = to_us(rel);
+        loop {
+            match self.clock.due(now_us) {
+                Due::Nothing => break,
+                Due::Frame(start_us) => {
+                    let origin = self.origin_s.unwrap_or(t_s);
+                    let f = self.frame(origin + start_us as f64 * 1e-6, start_us)?;
+                    emit(f)?;
+                }
+                Due::Jump { frames } => {
+                    self.resync(t_s, frames);
+                    now_us = 0;
+                }
+            }
+        }
+        Ok(Some(now_us))
+    }
+
     /// Replay: feeds one sample, handing `emit` the frames that start at or
     /// before it (decided from the samples before it), in order. At most
     /// `max_gap_frames + 1` frames per sample.
@@ -315,39 +353,51 @@ impl<P: FramePlanner> GazeStream<P> {
             self.stats.outliers += 1;
             return Ok(());
         }
-        let period_s = self.clock.period_us() as f64 * 1e-6;
-        let origin = *self.origin_s.get_or_insert(sample.t_s);
-        let mut rel = sample.t_s - origin;
-        if rel < -period_s || !rel.is_finite() {
-            // Time ran backwards (a clock reset): restart at this sample.
-            self.resync(sample.t_s, 0);
-            rel = 0.0;
-        } else if rel < 0.0 {
-            // Before the clock's origin (reordered by less than a period):
-            // too old for any frame still to come.
-            self.stats.samples += 1;
-            self.stats.outliers += 1;
-            self.last_t_s = Some(sample.t_s);
-            return Ok(());
-        }
-        let mut now_us = to_us(rel);
-        loop {
-            match self.clock.due(now_us) {
-                Due::Nothing => break,
-                Due::Frame(start_us) => {
-                    let origin = self.origin_s.unwrap_or(sample.t_s);
-                    let f = self.frame(origin + start_us as f64 * 1e-6, start_us)?;
-                    emit(f)?;
-                }
-                Due::Jump { frames } => {
-                    self.resync(sample.t_s, frames);
-                    now_us = 0;
-                }
+        let now_us = self.advance(sample.t_s, emit)?;
+        self.last_t_s = Some(sample.t_s);
+        match now_us {
+            Some(now_us) => self.absorb(sample, now_us),
+            None => {
+                // Too old for any frame still to come.
+                self.stats.samples += 1;
+                self.stats.outliers += 1;
             }
         }
-        self.last_t_s = Some(sample.t_s);
-        self.absorb(sample, now_us);
         Ok(())
+    }
+
+    /// Replay without a sample: the frame clock reads `now_s` (gaze clock),
+    /// and every frame that starts at or before it is handed to `emit`, as
+    /// [`push_each`](Self::push_each) would for a sample at `now_s` — so a
+    /// silent tracker still gets one frame per period, fail-safe once the
+    /// held fixation is older than the timeout. The first call (before any
+    /// sample) starts the frame clock at `now_s`. `now_s` must be finite.
+    pub fn tick_each(
+        &mut self,
+        now_s: f64,
+        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
+    ) -> Result<(), GazeError> {
+        if !now_s.is_finite() {
+            return Err(GazeError::Config {
+                field: "now_s",
+                reason: format!("{now_s} is not a finite time in seconds"),
+            });
+        }
+        if self.advance(now_s, emit)?.is_some() {
+            self.last_t_s = Some(now_s);
+        }
+        Ok(())
+    }
+
+    /// Replay: [`tick_each`](Self::tick_each) collecting the frames (at most
+    /// `max_gap_frames + 1`).
+    pub fn tick(&mut self, now_s: f64) -> Result<Vec<Frame>, GazeError> {
+        let mut frames = Vec::new();
+        self.tick_each(now_s, &mut |f| {
+            frames.push(f);
+            Ok(())
+        })?;
+        Ok(frames)
     }
 
     /// Replay: [`push_each`](Self::push_each) collecting the frames (at most
@@ -496,6 +546,48 @@ mod tests {
             gaze_deg,
             valid: true,
         }
+    }
+
+    #[test]
+    fn tick_runs_the_frame_clock_through_silence() {
+        // Ticks at the frame rate after 100 ms of fixations: adaptive frames
+        // until the fixation is older than the timeout, then fail-safe; the
+        // same frames as one late sample would have produced.
+        let feed = |st: &mut GazeStream<ClosedFormPlanner>| {
+            let mut frames = Vec::new();
+            for k in 0..21 {
+                frames.extend(st.push(&s(f64::from(k) * 0.005, 90.0)).unwrap());
+            }
+            frames
+        };
+        let mut ticked = stream();
+        let mut frames = feed(&mut ticked);
+        for k in 1..=10 {
+            frames.extend(ticked.tick(0.1 + f64::from(k) * 0.05).unwrap());
+        }
+        let mut pushed = stream();
+        let mut reference = feed(&mut pushed);
+        reference.extend(pushed.push(&s(0.6, 90.0)).unwrap());
+        let states = |f: &[Frame]| f.iter().map(|f| (f.t_s, f.state)).collect::<Vec<_>>();
+        assert_eq!(states(&frames), states(&reference));
+        assert_eq!(frames.len(), 13, "frames at 0, 0.05, …, 0.6");
+        assert_eq!(
+            frames[3].state,
+            State::Adaptive,
+            "0.15 s: fixation 50 ms old"
+        );
+        assert_eq!(
+            frames[4].state,
+            State::Adaptive,
+            "0.20 s: 100 ms, not older"
+        );
+        assert_eq!(frames[5].state, State::FailSafe, "0.25 s: stale");
+        assert!(frames[5..].iter().all(|f| f.state == State::FailSafe));
+        assert!(frames[5].profile.profile().gaze_deg.is_none());
+        assert!(ticked.tick(f64::NAN).is_err());
+        // A tick before any sample starts the clock: one fail-safe frame.
+        let f = stream().tick(3.0).unwrap();
+        assert_eq!(states(&f), vec![(3.0, State::FailSafe)]);
     }
 
     #[test]

@@ -32,9 +32,7 @@ extern crate alloc;
 
 #[cfg(feature = "std")]
 pub mod checker;
-#[cfg(feature = "std")]
 pub mod eye_safety;
-#[cfg(feature = "std")]
 pub mod firmware;
 pub mod model;
 #[cfg(feature = "std")]

@@ -11,16 +11,24 @@
 //! The figures must be checked against the standard by a vendor before use
 //! (see [`ael`]).
 
+#[cfg(feature = "std")]
 pub mod ael;
+#[cfg(feature = "std")]
 pub mod bound;
+#[cfg(feature = "std")]
 pub mod exposure;
+#[cfg(feature = "std")]
 pub mod report;
 
 use serde::{Deserialize, Serialize};
+#[cfg(feature = "std")]
 use thiserror::Error;
 
+#[cfg(feature = "std")]
 pub use ael::AelError;
+#[cfg(feature = "std")]
 pub use exposure::{evaluate_profile, evaluate_segments, ExposureReport, Rule};
+#[cfg(feature = "std")]
 pub use report::{ael_report, AelReport, StationaryBeam};
 
 /// Laser and optics parameters the eye-safety check needs; stored in a
@@ -37,6 +45,7 @@ pub struct EyeSafetyParams {
 }
 
 /// Errors evaluating eye safety.
+#[cfg(feature = "std")]
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum EyeSafetyError {
     /// From the AEL tables.
@@ -54,6 +63,7 @@ pub enum EyeSafetyError {
     },
 }
 
+#[cfg(feature = "std")]
 impl EyeSafetyParams {
     /// Validates the parameters (band, durations, beam size).
     pub fn validate(&self) -> Result<ael::Band, EyeSafetyError> {

@@ -24,10 +24,13 @@
 //!
 //! [`decode`] never panics and rejects anything that is not exactly this layout.
 
+use alloc::borrow::ToOwned;
+use alloc::vec::Vec;
+
 use thiserror::Error;
 
 use super::{FirmwareTable, FwBin, IntLimits, FIRMWARE_FORMAT, MAX_TABLE_BINS};
-use crate::model::lidar::PowerAccounting;
+use crate::model::accounting::PowerAccounting;
 
 /// Header size, bytes.
 pub const HEADER_LEN: usize = 96;

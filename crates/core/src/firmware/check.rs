@@ -1,12 +1,17 @@
 //! The integer checker for firmware tables: re-verifies a table against its
-//! integer limits with exact integer arithmetic (u128 sums, no floats).
+//! integer limits and Class 1 eye safety as it will run, with exact integer
+//! arithmetic (u128 sums, no floats; builds without `std`).
+
+use alloc::string::{String, ToString};
+use alloc::vec::Vec;
+use core::fmt;
 
 use serde::Serialize;
-use std::fmt;
 
+use super::eye::{self, IntEyeLimits};
 use super::{FirmwareTable, FULL_TURN_MDEG, MAX_TABLE_BINS};
-use crate::model::angle::rotate_index;
-use crate::model::lidar::PowerAccounting;
+use crate::model::accounting::PowerAccounting;
+use crate::model::index::rotate_index;
 
 /// One violated integer requirement.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
@@ -118,29 +123,65 @@ impl fmt::Display for FwViolation {
 }
 
 /// Every violation of `table` as it will run: the integer rules of
-/// [`check_integer`] and Class 1 eye safety, evaluated by the one eye-safety
-/// model on the quantized table itself (dwell from ticks, power from codes;
-/// see [`super::as_run_segments`]). A table without eye-safety parameters
-/// is rejected: it is not Class 1 evidence.
+/// [`check_integer`] and Class 1 eye safety evaluated **in integers on the
+/// quantized table itself** ([`eye::evaluate`]: dwell from ticks, pulse
+/// counts as maxima over every clock phase, energy from codes) against
+/// integer limits derived once from the one eye-safety model and rounded
+/// down ([`IntEyeLimits::derive`]). A table without eye-safety parameters is
+/// rejected: it is not Class 1 evidence.
+#[cfg(feature = "std")]
 #[must_use]
 pub fn check_table(table: &FirmwareTable) -> Vec<FwViolation> {
+    let v = check_integer(table);
+    if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+        return v;
+    }
+    match IntEyeLimits::derive(table) {
+        Ok(limits) => {
+            let mut v = v;
+            v.extend(eye_violation(table, &limits));
+            v
+        }
+        Err(eye::DeriveError::Missing) => {
+            let mut v = v;
+            v.push(FwViolation::EyeSafetyMissing);
+            v
+        }
+        Err(e) => {
+            let mut v = v;
+            v.push(FwViolation::EyeSafetyParams {
+                reason: e.to_string(),
+            });
+            v
+        }
+    }
+}
+
+/// As [`check_table`] against integer eye-safety limits given by the caller
+/// (a sensor's firmware holds the limits of its own laser, derived on a host
+/// with [`IntEyeLimits::derive`]); no floating point.
+#[must_use]
+pub fn check_table_with(table: &FirmwareTable, limits: &IntEyeLimits) -> Vec<FwViolation> {
     let mut v = check_integer(table);
     if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
         return v;
     }
-    match super::table_exposure(table) {
-        None => v.push(FwViolation::EyeSafetyMissing),
-        Some(Ok(r)) if r.worst_ratio <= 1.0 => {}
-        Some(Ok(r)) => v.push(FwViolation::EyeSafety {
-            ratio_ppm: (r.worst_ratio * 1e6).ceil() as u64,
-            azimuth_mdeg: (r.worst_azimuth_deg * 1000.0).round() as u32,
-            rule: r.binding_rule.to_string(),
+    v.extend(eye_violation(table, limits));
+    v
+}
+
+fn eye_violation(table: &FirmwareTable, limits: &IntEyeLimits) -> Option<FwViolation> {
+    match eye::evaluate(table, limits) {
+        Ok(r) if r.class1 => None,
+        Ok(r) => Some(FwViolation::EyeSafety {
+            ratio_ppm: r.worst_ratio_ppm,
+            azimuth_mdeg: r.azimuth_mdeg,
+            rule: r.rule.to_string(),
         }),
-        Some(Err(e)) => v.push(FwViolation::EyeSafetyParams {
+        Err(e) => Some(FwViolation::EyeSafetyParams {
             reason: e.to_string(),
         }),
     }
-    v
 }
 
 /// Every integer violation of `table` (frame, coverage, dwell bounds, codes,

@@ -2,6 +2,8 @@
 //! apportionment. Pure integer code, no allocation tricks: the part of the
 //! crate the Kani harnesses point at.
 
+use alloc::vec::Vec;
+
 use thiserror::Error;
 
 /// One bin's ideal dwell in ticks, as `floor + frac / 2^32`, with the
@@ -122,6 +124,7 @@ pub fn apportion(targets: &[TickTarget], total: u64) -> Result<Vec<u64>, Quantiz
 /// at the boundaries (a float quotient that rounds across an integer is
 /// corrected): `code·step <= value < (code+1)·step`. `None` if it does not
 /// fit a `u32` or the inputs are not finite and non-negative.
+#[cfg(feature = "std")]
 #[must_use]
 pub fn floor_code(value: f64, step: f64) -> Option<u32> {
     if !(value.is_finite() && step.is_finite() && value >= 0.0 && step > 0.0) {

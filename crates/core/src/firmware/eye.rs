@@ -1,0 +1,1137 @@
+//! Class 1 eye safety of a firmware table **as it will run**, in exact
+//! integer arithmetic (no floating point: builds without `std`).
+//!
+//! The table runs bin `i` at constant spin: it sweeps `width_mdeg[i]` in
+//! exactly `dwell_ticks[i] / tick_hz` seconds at code `power_code[i]`. A pulse
+//! fired at code `c` carries `c · q` joules, `q = power_w_per_code / f_p` (the
+//! *energy quantum*), so every energy below is an integer number of quanta and
+//! every limit is an integer number of quanta **rounded down**
+//! ([`IntEyeLimits`], derived once from the one eye-safety model by
+//! [`IntEyeLimits::derive`], `std` only). The argument is in
+//! `specs/eye_safety.md` ("Firmware tables: the integer check").
+//!
+//! Per aperture *cell* (azimuths between consecutive breakpoints, where a pass
+//! edge meets a bin edge; breakpoints are integer millidegrees):
+//! - every bin the pass can touch gets an integer cap on the pulses it can
+//!   contribute, `⌊τ_k · f⌋ + 1` with `τ_k` its largest exact rational dwell
+//!   inside the pass over the cell; the pass holds at most `K = ⌊τ · f⌋ + 1`
+//!   pulses, `τ` the largest exact rational pass duration over the cell
+//!   (linear on a cell, so at a cell end); `f` is the pulse rate rounded up
+//!   to a millihertz;
+//! - `G(k)`, the most quanta any `k` pulses of the pass can carry, is the
+//!   greedy sum of the hottest capped bins (an upper bound of any `k`
+//!   consecutive pulses, whatever the clock phase);
+//! - rule 1: the hottest code `≤ pulse_code_max`; rule 2 within a pass:
+//!   `G(k) ≤` the limit of the `k`-pulse bucket; several passes: `G(K) ≤
+//!   pass_energy_max`. All sums are `u128`.
+
+use alloc::vec::Vec;
+use core::fmt;
+
+use serde::{Deserialize, Serialize};
+
+use super::{FirmwareTable, FULL_TURN_MDEG, MAX_TABLE_BINS};
+
+/// Largest `tick_hz` the integer evaluation accepts (2^34 Hz ≈ 17 GHz).
+pub const MAX_TICK_HZ: u64 = 1 << 34;
+/// Largest `frame_ticks` the integer evaluation accepts (2^44 ≈ 1.8·10^13).
+pub const MAX_FRAME_TICKS: u64 = 1 << 44;
+/// Largest pulse rate the integer evaluation accepts, millihertz (2^40 mHz ≈ 1.1 GHz).
+pub const MAX_PULSE_RATE_MILLIHZ: u64 = 1 << 40;
+/// Most pulses one turn may hold (`frame_ticks · f / tick_hz`): keeps every
+/// pulse count within `u64` (2^40 ≈ 1.1·10^12).
+pub const MAX_PULSES_PER_TURN: u64 = 1 << 40;
+/// Millihertz per hertz.
+pub const MILLIHZ_PER_HZ: u64 = 1000;
+
+/// The rule an integer check belongs to (the same rules as
+/// `eye_safety::Rule`, named by the window they bound).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum IntRule {
+    /// Each pulse (or `T_i` group) against the C5-corrected single-pulse AEL.
+    SinglePulse,
+    /// Pulse-train energy within one pass.
+    PassTrain,
+    /// Pulse-train energy over several passes, up to T2 = 10 s.
+    T2Train,
+    /// Pulse-train energy over several passes, beyond T2 up to the 100 s time base.
+    TimeBase,
+}
+
+impl fmt::Display for IntRule {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::SinglePulse => "single-pulse energy (C5-corrected)",
+            Self::PassTrain => "pulse-train energy within one pass",
+            Self::T2Train => "pulse-train energy over several passes (up to T2 = 10 s)",
+            Self::TimeBase => "average power over the 100 s time base",
+        })
+    }
+}
+
+/// The energy limit of windows holding `pulses_from ..` pulses of one pass
+/// (up to the next bucket's `pulses_from`, exclusive).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TrainLimit {
+    /// Fewest pulses in the bucket (the first bucket starts at 1).
+    pub pulses_from: u64,
+    /// Most quanta any window holding that many pulses may receive:
+    /// `⌊AEL_inf((pulses_from − 1)/f_p) / q⌋`.
+    pub energy_max_quanta: u64,
+}
+
+/// Integer Class 1 limits of a table's timing, in energy quanta
+/// (`power_w_per_code / pulse_rate_hz` joules). The table is checked against
+/// them by [`evaluate`]; they are valid for a table whose timing they were
+/// derived for (tick rate, frame, pass arc, pulse rate) and whose passes are no
+/// longer and hold no more pulses than stated here — [`evaluate`] checks that.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct IntEyeLimits {
+    /// Timer frequency, Hz.
+    pub tick_hz: u64,
+    /// Ticks per revolution.
+    pub frame_ticks: u64,
+    /// Pulse rate rounded up, millihertz (for pulse counts).
+    pub pulse_rate_millihz_ceil: u64,
+    /// Pass arc (aperture + beam seen from 100 mm) rounded up, millidegrees.
+    pub pass_arc_mdeg: u32,
+    /// Longest pass the limits allow, ticks.
+    pub pass_ticks_max: u64,
+    /// Most pulses in one pass the limits allow (C5 is taken at this count).
+    pub pulses_per_pass_max: u64,
+    /// Largest code of any pulse (rule 1, C5 and `T_i` groups included).
+    pub pulse_code_max: u64,
+    /// Within-pass buckets by pulse count, increasing, the first at 1 pulse.
+    pub train: Vec<TrainLimit>,
+    /// Most quanta one pass may carry so that every window over several
+    /// passes, up to the time base, stays within its AEL.
+    pub pass_energy_max_quanta: u64,
+    /// The rule binding `pass_energy_max_quanta`.
+    pub pass_energy_rule: IntRule,
+}
+
+/// Why a table could not be evaluated (it is then not Class 1 evidence).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IntEyeError {
+    /// A value is outside the bounds the integer evaluation is proved for.
+    #[error("{field} = {value}: {reason}")]
+    Bounds {
+        /// Field.
+        field: &'static str,
+        /// Value.
+        value: u64,
+        /// Why.
+        reason: &'static str,
+    },
+    /// The limits were derived for another timing, or for shorter passes.
+    #[error(
+        "eye-safety limits do not apply to this table: {field} is {found}, limits allow {allowed}"
+    )]
+    Mismatch {
+        /// Field.
+        field: &'static str,
+        /// Table's value.
+        found: u64,
+        /// Limits' value.
+        allowed: u64,
+    },
+    /// An intermediate did not fit `u128` (cannot happen within the bounds;
+    /// see the `eye_sums_never_overflow_within_format_bounds` harness).
+    #[error("integer overflow in the eye-safety evaluation")]
+    Overflow,
+}
+
+/// The verdict of [`evaluate`].
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[non_exhaustive]
+pub struct IntEyeReport {
+    /// Largest energy / limit over every check, parts per million, rounded up
+    /// (≤ 1,000,000 is Class 1).
+    pub worst_ratio_ppm: u64,
+    /// The rule of the worst check.
+    pub rule: IntRule,
+    /// Aperture azimuth (centre of the pass arc) of the worst check, millidegrees.
+    pub azimuth_mdeg: u32,
+    /// Whether every check holds (energy ≤ limit everywhere).
+    pub class1: bool,
+}
+
+/// Timing of a table that the limits depend on: the longest pass and the
+/// most pulses in one pass, over every aperture azimuth.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PassTiming {
+    /// Longest pass, ticks, rounded up.
+    pub pass_ticks_max: u64,
+    /// Most pulses in one pass.
+    pub pulses_per_pass_max: u64,
+}
+
+/// An exact non-negative rational `num / den` (den > 0).
+#[derive(Debug, Clone, Copy)]
+struct Ratio {
+    num: u128,
+    den: u128,
+}
+
+impl Ratio {
+    fn add_int(self, x: u128) -> Result<Self, IntEyeError> {
+        let num = x
+            .checked_mul(self.den)
+            .and_then(|v| v.checked_add(self.num))
+            .ok_or(IntEyeError::Overflow)?;
+        Ok(Self { num, den: self.den })
+    }
+
+    fn add_frac(self, num: u128, den: u128) -> Result<Self, IntEyeError> {
+        let a = self.num.checked_mul(den).ok_or(IntEyeError::Overflow)?;
+        let b = num.checked_mul(self.den).ok_or(IntEyeError::Overflow)?;
+        Ok(Self {
+            num: a.checked_add(b).ok_or(IntEyeError::Overflow)?,
+            den: self.den.checked_mul(den).ok_or(IntEyeError::Overflow)?,
+        })
+    }
+
+    fn max(self, o: Self) -> Result<Self, IntEyeError> {
+        let l = self.num.checked_mul(o.den).ok_or(IntEyeError::Overflow)?;
+        let r = o.num.checked_mul(self.den).ok_or(IntEyeError::Overflow)?;
+        Ok(if l >= r { self } else { o })
+    }
+
+    fn ceil(self) -> u128 {
+        self.num.div_ceil(self.den)
+    }
+}
+
+/// The pulse-rate and tick constants of the counting: `⌊τ_ticks · f_mHz / (1000 · tick_hz)⌋ + 1`.
+#[derive(Debug, Clone, Copy)]
+struct Clock {
+    millihz: u128,
+    tick_hz: u128,
+}
+
+impl Clock {
+    /// Most pulses in a closed interval of `t.num / t.den` ticks, any phase.
+    fn pulses_in(self, t: Ratio) -> Result<u128, IntEyeError> {
+        let num = t
+            .num
+            .checked_mul(self.millihz)
+            .ok_or(IntEyeError::Overflow)?;
+        let den = t
+            .den
+            .checked_mul(u128::from(MILLIHZ_PER_HZ) * self.tick_hz)
+            .ok_or(IntEyeError::Overflow)?;
+        Ok(num / den + 1)
+    }
+}
+
+/// One aperture cell: the positions `[a0, a1]` (integer millidegrees) of
+/// the start of the pass arc.
+struct Cell<'a> {
+    a0: i64,
+    /// Largest pass duration over the cell, ticks.
+    tau: Ratio,
+    /// Most pulses in a pass over the cell.
+    pulses: u128,
+    /// Hottest code of any bin the pass can touch over the cell.
+    hottest: u32,
+    /// `Σ code × pulse cap` over the bins the pass can touch.
+    energy_all: u128,
+    /// `(code, pulse cap)` of the touched bins not wholly inside the pass
+    /// at both cell ends (at most a few).
+    edge_bins: &'a [(u32, u128)],
+    /// `(code, pulse cap)` of the touched bins wholly inside the pass at
+    /// both cell ends (their cap is all of their dwell).
+    middle_bins: &'a [(u32, u128)],
+}
+/// Validates the bounds under which every intermediate fits `u128`.
+fn check_bounds(table: &FirmwareTable, millihz: u64, arc_mdeg: u32) -> Result<(), IntEyeError> {
+    let b = |field, value, reason| {
+        Err(IntEyeError::Bounds {
+            field,
+            value,
+            reason,
+        })
+    };
+    let n = table.bins.len();
+    if n == 0 || n > MAX_TABLE_BINS {
+        return b("bins", n as u64, "a table holds 1 to 36,000 bins");
+    }
+    if table.tick_hz == 0 || table.tick_hz > MAX_TICK_HZ {
+        return b("tick_hz", table.tick_hz, "must lie in 1..=2^34");
+    }
+    if table.frame_ticks == 0 || table.frame_ticks > MAX_FRAME_TICKS {
+        return b("frame_ticks", table.frame_ticks, "must lie in 1..=2^44");
+    }
+    if millihz == 0 || millihz > MAX_PULSE_RATE_MILLIHZ {
+        return b(
+            "pulse_rate_hz (mHz)",
+            millihz,
+            "must lie in 1 mHz..=2^40 mHz",
+        );
+    }
+    let per_turn = u128::from(table.frame_ticks) * u128::from(millihz)
+        / (u128::from(MILLIHZ_PER_HZ) * u128::from(table.tick_hz));
+    if per_turn >= u128::from(MAX_PULSES_PER_TURN) {
+        return b(
+            "pulses per turn",
+            u64::try_from(per_turn).unwrap_or(u64::MAX),
+            "a turn may hold fewer than 2^40 pulses",
+        );
+    }
+    if arc_mdeg == 0 || arc_mdeg >= FULL_TURN_MDEG / 2 {
+        return b(
+            "pass arc (mdeg)",
+            u64::from(arc_mdeg),
+            "the aperture pass must be shorter than half a turn",
+        );
+    }
+    let ticks: u128 = table.bins.iter().map(|x| u128::from(x.dwell_ticks)).sum();
+    if ticks != u128::from(table.frame_ticks) {
+        return b(
+            "dwell_ticks",
+            u64::try_from(ticks).unwrap_or(u64::MAX),
+            "must sum to frame_ticks (the table's timing is undefined otherwise)",
+        );
+    }
+    let width: u128 = table.bins.iter().map(|x| u128::from(x.width_mdeg)).sum();
+    if width != u128::from(FULL_TURN_MDEG) {
+        return b(
+            "width_mdeg",
+            u64::try_from(width).unwrap_or(u64::MAX),
+            "must sum to 360,000",
+        );
+    }
+    if table
+        .bins
+        .iter()
+        .any(|x| x.width_mdeg > 0 && x.dwell_ticks == 0)
+    {
+        return b("dwell_ticks", 0, "a bin with width needs a positive dwell");
+    }
+    Ok(())
+}
+
+/// Walks every aperture cell of the table, in azimuth order, calling `visit`.
+///
+/// Bins wholly inside the pass at both cell ends are summed through prefix
+/// sums (their dwell and `code × cap`) and their hottest code through a
+/// sliding-window maximum, so a cell costs O(1) beyond its few edge bins.
+fn for_each_cell(
+    table: &FirmwareTable,
+    clock: Clock,
+    arc_mdeg: u32,
+    mut visit: impl FnMut(&Cell<'_>) -> Result<(), IntEyeError>,
+) -> Result<(), IntEyeError> {
+    let w_turn = i64::from(FULL_TURN_MDEG);
+    let h = i64::from(arc_mdeg);
+    let n = table.bins.len();
+    // Bin intervals on the unrolled line, three turns: [-W, 2W).
+    let mut iv: Vec<(i64, i64, usize)> = Vec::with_capacity(3 * n);
+    let mut starts: Vec<i64> = Vec::with_capacity(2 * n);
+    for turn in -1..=1i64 {
+        let mut s = 0i64;
+        for (k, b) in table.bins.iter().enumerate() {
+            let e = s + i64::from(b.width_mdeg);
+            iv.push((s + turn * w_turn, e + turn * w_turn, k));
+            if turn == 0 {
+                starts.push(s);
+                starts.push((s - h).rem_euclid(w_turn));
+            }
+            s = e;
+        }
+    }
+    starts.sort_unstable();
+    starts.dedup();
+    let full_cap: Vec<u128> = table
+        .bins
+        .iter()
+        .map(|b| {
+            clock.pulses_in(Ratio {
+                num: u128::from(b.dwell_ticks),
+                den: 1,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    // Per unrolled entry: (code, full cap); prefix sums of dwell and code × cap.
+    let full: Vec<(u32, u128)> = iv
+        .iter()
+        .map(|&(_, _, k)| (table.bins[k].power_code, full_cap[k]))
+        .collect();
+    let mut pre_ticks: Vec<u128> = Vec::with_capacity(iv.len() + 1);
+    let mut pre_energy: Vec<u128> = Vec::with_capacity(iv.len() + 1);
+    pre_ticks.push(0);
+    pre_energy.push(0);
+    for (i, &(_, _, k)) in iv.iter().enumerate() {
+        let t = pre_ticks[i] + u128::from(table.bins[k].dwell_ticks);
+        let e = u128::from(full[i].0)
+            .checked_mul(full[i].1)
+            .and_then(|x| x.checked_add(pre_energy[i]))
+            .ok_or(IntEyeError::Overflow)?;
+        pre_ticks.push(t);
+        pre_energy.push(e);
+    }
+    let m = starts.len();
+    // starts holds 0 and W − h ≠ 0, so m ≥ 2 and every cell is shorter than a turn.
+    let (mut lo, mut hi, mut mid_lo, mut mid_hi) = (0usize, 0usize, 0usize, 0usize);
+    // Sliding maximum of the code over the touched entries [lo, hi).
+    let mut hot: alloc::collections::VecDeque<usize> = alloc::collections::VecDeque::new();
+    let mut edges: Vec<(u32, u128)> = Vec::new();
+    for j in 0..m {
+        let a0 = starts[j];
+        let a1 = if j + 1 < m { starts[j + 1] } else { w_turn };
+        let reach = a1 + h;
+        while lo < iv.len() && iv[lo].1 < a0 {
+            lo += 1;
+        }
+        while hi < iv.len() && iv[hi].0 <= reach {
+            while hot.back().is_some_and(|&b| full[b].0 <= full[hi].0) {
+                hot.pop_back();
+            }
+            hot.push_back(hi);
+            hi += 1;
+        }
+        while hot.front().is_some_and(|&f| f < lo) {
+            hot.pop_front();
+        }
+        // Wholly inside at both ends: start ≥ a1 and end ≤ a0 + h.
+        while mid_lo < iv.len() && iv[mid_lo].0 < a1 {
+            mid_lo += 1;
+        }
+        while mid_hi < iv.len() && iv[mid_hi].1 <= a0 + h {
+            mid_hi += 1;
+        }
+        let mid_start = mid_lo.clamp(lo, hi);
+        let mid_end = mid_hi.clamp(mid_start, hi);
+        let mut tau0 = Ratio { num: 0, den: 1 };
+        let mut tau1 = Ratio { num: 0, den: 1 };
+        let mid_ticks = pre_ticks[mid_end] - pre_ticks[mid_start];
+        tau0 = tau0.add_int(mid_ticks)?;
+        tau1 = tau1.add_int(mid_ticks)?;
+        let mut energy_all = pre_energy[mid_end] - pre_energy[mid_start];
+        edges.clear();
+        for &(s, e, k) in iv[lo..mid_start].iter().chain(&iv[mid_end..hi]) {
+            let b = &table.bins[k];
+            let d = u128::from(b.dwell_ticks);
+            let w = e - s;
+            let overlap = |a: i64| (e.min(a + h) - s.max(a)).max(0);
+            let inside = |a: i64| s <= a + h && e >= a;
+            // Largest overlap at a cell end (the overlap is linear on a cell).
+            let mut x_max: Option<i64> = None;
+            for (a, tau) in [(a0, &mut tau0), (a1, &mut tau1)] {
+                if !inside(a) {
+                    continue;
+                }
+                let x = overlap(a);
+                x_max = Some(x_max.map_or(x, |m| m.max(x)));
+                if w == 0 || x == w {
+                    *tau = tau.add_int(d)?;
+                } else if x > 0 {
+                    *tau = tau.add_frac((x as u128) * d, w as u128)?;
+                }
+            }
+            // Pulses this bin can contribute: all of its dwell, a part, or
+            // one (touched at an edge: the code at a boundary instant is
+            // ambiguous). A bin touched only strictly inside the cell cannot
+            // occur (the touched set is constant on a cell); it would get one.
+            let cap = match x_max {
+                Some(x) if w == 0 || x == w => full_cap[k],
+                Some(x) if x > 0 => clock.pulses_in(Ratio {
+                    num: (x as u128) * d,
+                    den: w as u128,
+                })?,
+                _ => 1,
+            };
+            energy_all = u128::from(b.power_code)
+                .checked_mul(cap)
+                .and_then(|x| x.checked_add(energy_all))
+                .ok_or(IntEyeError::Overflow)?;
+            edges.push((b.power_code, cap));
+        }
+        let tau = tau0.max(tau1)?;
+        visit(&Cell {
+            a0,
+            tau,
+            pulses: clock.pulses_in(tau)?,
+            hottest: hot.front().map_or(0, |&f| full[f].0),
+            energy_all,
+            edge_bins: &edges,
+            middle_bins: &full[mid_start..mid_end],
+        })?;
+    }
+    Ok(())
+}
+
+fn clock_of(table: &FirmwareTable, millihz: u64) -> Clock {
+    Clock {
+        millihz: u128::from(millihz),
+        tick_hz: u128::from(table.tick_hz),
+    }
+}
+
+/// The longest pass and the most pulses in one pass, over every aperture
+/// azimuth, for a pass arc of `arc_mdeg` and a pulse rate of `millihz`
+/// (rounded up) — what [`IntEyeLimits::derive`] needs from the table.
+pub fn pass_timing(
+    table: &FirmwareTable,
+    millihz: u64,
+    arc_mdeg: u32,
+) -> Result<PassTiming, IntEyeError> {
+    check_bounds(table, millihz, arc_mdeg)?;
+    let mut t = PassTiming {
+        pass_ticks_max: 0,
+        pulses_per_pass_max: 0,
+    };
+    for_each_cell(table, clock_of(table, millihz), arc_mdeg, |c| {
+        let ticks = u64::try_from(c.tau.ceil()).map_err(|_| IntEyeError::Overflow)?;
+        let pulses = u64::try_from(c.pulses).map_err(|_| IntEyeError::Overflow)?;
+        t.pass_ticks_max = t.pass_ticks_max.max(ticks);
+        t.pulses_per_pass_max = t.pulses_per_pass_max.max(pulses);
+        Ok(())
+    })?;
+    Ok(t)
+}
+
+/// `⌈energy · 10^6 / limit⌉`, saturating.
+fn ratio_ppm(energy: u128, limit: u64) -> u64 {
+    if energy == 0 {
+        return 0;
+    }
+    if limit == 0 {
+        return u64::MAX;
+    }
+    energy.checked_mul(1_000_000).map_or(u64::MAX, |x| {
+        u64::try_from(x.div_ceil(u128::from(limit))).unwrap_or(u64::MAX)
+    })
+}
+
+/// Evaluates `table` as it will run against `limits`, in integers.
+///
+/// Every bin touching a pass is capped by its own pulse count, the pass by
+/// its total; `G(k)` takes the hottest pulses first, so it bounds the energy
+/// of any `k` pulses of the pass (see the module docs). Errors when the
+/// table is outside the integer bounds or the limits were derived for
+/// another timing.
+pub fn evaluate(table: &FirmwareTable, limits: &IntEyeLimits) -> Result<IntEyeReport, IntEyeError> {
+    let mismatch = |field, found, allowed| IntEyeError::Mismatch {
+        field,
+        found,
+        allowed,
+    };
+    if table.tick_hz != limits.tick_hz {
+        return Err(mismatch("tick_hz", table.tick_hz, limits.tick_hz));
+    }
+    if table.frame_ticks != limits.frame_ticks {
+        return Err(mismatch(
+            "frame_ticks",
+            table.frame_ticks,
+            limits.frame_ticks,
+        ));
+    }
+    check_bounds(table, limits.pulse_rate_millihz_ceil, limits.pass_arc_mdeg)?;
+    if limits.train.first().map(|t| t.pulses_from) != Some(1)
+        || limits.train.windows(2).any(|w| {
+            w[0].pulses_from >= w[1].pulses_from || w[0].energy_max_quanta > w[1].energy_max_quanta
+        })
+    {
+        return Err(IntEyeError::Bounds {
+            field: "train",
+            value: limits.train.len() as u64,
+            reason: "buckets must start at 1 pulse, their counts increase and their limits never decrease",
+        });
+    }
+    let clock = clock_of(table, limits.pulse_rate_millihz_ceil);
+    let half = limits.pass_arc_mdeg / 2;
+    let mut t = Tracker {
+        worst: (0, 1),
+        report: IntEyeReport {
+            worst_ratio_ppm: 0,
+            rule: IntRule::SinglePulse,
+            azimuth_mdeg: 0,
+            class1: true,
+        },
+    };
+    let mut sorted: Vec<(u32, u128)> = Vec::new();
+    for_each_cell(table, clock, limits.pass_arc_mdeg, |c| {
+        if c.tau.num > u128::from(limits.pass_ticks_max) * c.tau.den {
+            return Err(mismatch(
+                "pass duration (ticks)",
+                u64::try_from(c.tau.ceil()).unwrap_or(u64::MAX),
+                limits.pass_ticks_max,
+            ));
+        }
+        if c.pulses > u128::from(limits.pulses_per_pass_max) {
+            return Err(mismatch(
+                "pulses per pass",
+                u64::try_from(c.pulses).unwrap_or(u64::MAX),
+                limits.pulses_per_pass_max,
+            ));
+        }
+        let azimuth = (c.a0 + i64::from(half)).rem_euclid(i64::from(FULL_TURN_MDEG)) as u32;
+        t.note(
+            azimuth,
+            u128::from(c.hottest),
+            limits.pulse_code_max,
+            IntRule::SinglePulse,
+        );
+        let k_max = c.pulses;
+        // The bucket ends `to` of every train check, then the pass.
+        let buckets = limits
+            .train
+            .iter()
+            .enumerate()
+            .take_while(|(_, t)| u128::from(t.pulses_from) <= k_max)
+            .map(|(j, t)| {
+                let to = limits
+                    .train
+                    .get(j + 1)
+                    .map_or(k_max, |n| (u128::from(n.pulses_from) - 1).min(k_max));
+                (to, t.energy_max_quanta)
+            });
+        // A quick upper bound first: G(k) ≤ min(Σ code × cap, k × hottest).
+        // If no check can beat the worst ratio so far with it, the exact
+        // greedy cannot either (it is never larger), and the cell is done.
+        let hot = u128::from(c.hottest);
+        let loose = |k: u128| c.energy_all.min(k.saturating_mul(hot));
+        let mut loose_worst = (loose(k_max), limits.pass_energy_max_quanta);
+        for (to, lim) in buckets.clone() {
+            if ratio_greater((loose(to), lim), loose_worst) {
+                loose_worst = (loose(to), lim);
+            }
+        }
+        if !ratio_greater(loose_worst, t.worst) {
+            return Ok(());
+        }
+        sorted.clear();
+        sorted.extend_from_slice(c.edge_bins);
+        sorted.extend_from_slice(c.middle_bins);
+        sorted.sort_unstable_by_key(|x| core::cmp::Reverse(x.0));
+        // G(k) by a walk over the hottest-first bins.
+        let mut walk = Greedy {
+            bins: &sorted,
+            at: 0,
+            used_in_bin: 0,
+            pulses: 0,
+            energy: 0,
+        };
+        for (to, lim) in buckets {
+            let g = walk.energy_up_to(to)?;
+            t.note(azimuth, g, lim, IntRule::PassTrain);
+            if walk.exhausted() && g <= u128::from(lim) {
+                // G is flat from here and the limits only grow.
+                break;
+            }
+        }
+        let e_pass = walk.energy_up_to(k_max)?;
+        t.note(
+            azimuth,
+            e_pass,
+            limits.pass_energy_max_quanta,
+            limits.pass_energy_rule,
+        );
+        Ok(())
+    })?;
+    t.report.worst_ratio_ppm = ratio_ppm(t.worst.0, t.worst.1);
+    Ok(t.report)
+}
+
+/// The worst check so far: `(energy, limit)` compared exactly by
+/// cross-multiplication, with its rule and azimuth.
+struct Tracker {
+    worst: (u128, u64),
+    report: IntEyeReport,
+}
+
+impl Tracker {
+    fn note(&mut self, azimuth_mdeg: u32, energy: u128, limit: u64, rule: IntRule) {
+        if energy > u128::from(limit) {
+            self.report.class1 = false;
+        }
+        if ratio_greater((energy, limit), self.worst) {
+            self.worst = (energy, limit);
+            self.report.rule = rule;
+            self.report.azimuth_mdeg = azimuth_mdeg;
+        }
+    }
+}
+
+/// Whether `a.0 / a.1 > b.0 / b.1` (a zero limit with energy is infinite).
+fn ratio_greater(a: (u128, u64), b: (u128, u64)) -> bool {
+    let ((ea, la), (eb, lb)) = (a, b);
+    if ea == 0 {
+        return false;
+    }
+    if la == 0 {
+        return !(lb == 0 && eb > 0);
+    }
+    if eb == 0 {
+        return true;
+    }
+    if lb == 0 {
+        return false;
+    }
+    match (
+        ea.checked_mul(u128::from(lb)),
+        eb.checked_mul(u128::from(la)),
+    ) {
+        (Some(x), Some(y)) => x > y,
+        _ => ratio_ppm(ea, la) > ratio_ppm(eb, lb),
+    }
+}
+
+/// `G(k)`: the most quanta `k` pulses can carry when bin `i` (hottest
+/// first) holds at most `cap_i` pulses at its code; `k` only grows.
+struct Greedy<'a> {
+    bins: &'a [(u32, u128)],
+    at: usize,
+    used_in_bin: u128,
+    pulses: u128,
+    energy: u128,
+}
+
+impl Greedy<'_> {
+    fn energy_up_to(&mut self, k: u128) -> Result<u128, IntEyeError> {
+        while self.pulses < k && self.at < self.bins.len() {
+            let (code, cap) = self.bins[self.at];
+            let take = (cap - self.used_in_bin).min(k - self.pulses);
+            self.energy = u128::from(code)
+                .checked_mul(take)
+                .and_then(|e| e.checked_add(self.energy))
+                .ok_or(IntEyeError::Overflow)?;
+            self.pulses += take;
+            self.used_in_bin += take;
+            if self.used_in_bin == cap {
+                self.at += 1;
+                self.used_in_bin = 0;
+            }
+        }
+        Ok(self.energy)
+    }
+
+    fn exhausted(&self) -> bool {
+        self.at >= self.bins.len()
+    }
+}
+
+/// Deriving the integer limits from the one eye-safety model (floating
+/// point, once per table timing; every limit rounded down).
+#[cfg(feature = "std")]
+mod derive {
+    use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
+    use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
+    use crate::eye_safety::bound::Laser;
+    use crate::eye_safety::exposure::{laser, pass_angle_deg};
+    use crate::eye_safety::EyeSafetyError;
+    use crate::firmware::FirmwareTable;
+
+    /// Relative head-room every limit loses before it is rounded down, so
+    /// float rounding in the AEL and the quotient can never raise it.
+    pub const LIMIT_MARGIN: f64 = 1e-9;
+    /// Within-pass buckets hold one pulse count each up to this count, then
+    /// grow by `1/EXACT_PULSE_BUCKETS` of their start (≤ 0.4 % looser).
+    pub const EXACT_PULSE_BUCKETS: u64 = 256;
+    /// Most multi-pass window counts the derivation walks (frame periods
+    /// shorter than 100 s / 10^7 are refused).
+    pub const MAX_PASS_WINDOWS: u64 = 10_000_000;
+
+    /// Why integer limits could not be derived.
+    #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+    #[non_exhaustive]
+    pub enum DeriveError {
+        /// The table has no eye-safety parameters.
+        #[error("the table has no eye-safety parameters (not Class 1 evidence)")]
+        Missing,
+        /// The parameters or the pulse rate are invalid.
+        #[error(transparent)]
+        Params(#[from] EyeSafetyError),
+        /// The table is outside the integer evaluation's bounds.
+        #[error(transparent)]
+        Int(#[from] IntEyeError),
+        /// A derived quantity is out of range.
+        #[error("{field}: {reason}")]
+        Range {
+            /// Which quantity.
+            field: &'static str,
+            /// Why.
+            reason: &'static str,
+        },
+    }
+
+    /// `⌈f · 1000⌉` exactly for a finite positive `f` (the residual of the
+    /// product is exact through a fused multiply-add).
+    pub fn millihz_ceil(f_hz: f64) -> Option<u64> {
+        let x = f_hz * MILLIHZ_PER_HZ as f64;
+        if !(x.is_finite() && x > 0.0 && x < 1.8e19) {
+            return None;
+        }
+        let residual = f_hz.mul_add(MILLIHZ_PER_HZ as f64, -x);
+        let c = x.ceil();
+        let c = if c == x && residual > 0.0 { c + 1.0 } else { c };
+        Some(c as u64)
+    }
+
+    /// `AEL_inf(t) = inf AEL` over `[t, 100 s]`: each Table 3 row grows with
+    /// `t`, so it is the AEL at `t` or at a row edge after it (the table steps
+    /// down at 5 µs in 700–1050 nm).
+    fn ael_inf(laser: &Laser, t_s: f64) -> f64 {
+        let mut v = laser.ael_j(t_s);
+        for row in laser.rows() {
+            for e in [row.t_lo_s, row.t_hi_s] {
+                if e > t_s && e <= TIME_BASE_S {
+                    v = v.min(laser.ael_j(e));
+                }
+            }
+        }
+        v
+    }
+
+    impl IntEyeLimits {
+        /// Derives the integer limits of `table`'s timing from the one
+        /// eye-safety model (`eye_safety::bound::Laser`: Table 3 rows, C5 and
+        /// `T_i` groups of rule 1): every limit is the model's AEL for the
+        /// shortest window that can hold the counted pulses, divided by the
+        /// energy quantum and rounded down after a `LIMIT_MARGIN` cut.
+        pub fn derive(table: &FirmwareTable) -> Result<Self, DeriveError> {
+            let params = table.eye_safety.as_ref().ok_or(DeriveError::Missing)?;
+            let f_p = table.pulse_rate_hz;
+            let laser = laser(params, f_p)?;
+            let millihz = millihz_ceil(f_p).ok_or(DeriveError::Range {
+                field: "pulse_rate_hz",
+                reason: "must be finite and > 0",
+            })?;
+            let arc = (pass_angle_deg(params, &laser) * 1000.0 * (1.0 + 1e-12)).ceil();
+            if !(arc >= 1.0 && arc < f64::from(u32::MAX)) {
+                return Err(DeriveError::Range {
+                    field: "pass arc",
+                    reason: "out of range",
+                });
+            }
+            let arc_mdeg = arc as u32;
+            let timing = pass_timing(table, millihz, arc_mdeg)?;
+            let step = table.power_w_per_code;
+            if !(step.is_finite() && step > 0.0) {
+                return Err(DeriveError::Range {
+                    field: "power_w_per_code",
+                    reason: "must be finite and > 0",
+                });
+            }
+            let quantum_j = step / f_p;
+            let to_quanta = |energy_j: f64| -> u64 {
+                let x = energy_j / quantum_j * (1.0 - LIMIT_MARGIN);
+                if x >= 1.8e19 {
+                    u64::MAX
+                } else if x > 0.0 {
+                    x.floor() as u64
+                } else {
+                    0
+                }
+            };
+            let k_max = timing.pulses_per_pass_max;
+            let tick_hz = table.tick_hz as f64;
+            // Rule 1: C5 at the most pulses any T2 window can meet.
+            let t2_ticks = (T2_S * tick_hz).ceil() as u128;
+            let passes_t2 =
+                (t2_ticks + u128::from(timing.pass_ticks_max)) / u128::from(table.frame_ticks) + 1;
+            let per_code = laser.single_pulse_ratio(quantum_j, k_max as f64, passes_t2 as f64);
+            let pulse_code_max = if per_code > 0.0 {
+                let x = (1.0 - LIMIT_MARGIN) / per_code;
+                if x >= 1.8e19 {
+                    u64::MAX
+                } else {
+                    x.floor() as u64
+                }
+            } else {
+                u64::MAX
+            };
+            // Rule 2 within a pass: k pulses span at least (k − 1)/f_p.
+            let mut train = Vec::new();
+            let mut k: u64 = 1;
+            loop {
+                let t = (k - 1) as f64 / f_p * (1.0 - 1e-12);
+                train.push(TrainLimit {
+                    pulses_from: k,
+                    energy_max_quanta: to_quanta(ael_inf(&laser, t)),
+                });
+                if k >= k_max {
+                    break;
+                }
+                k += if k < EXACT_PULSE_BUCKETS {
+                    1
+                } else {
+                    k / EXACT_PULSE_BUCKETS
+                };
+            }
+            // Rule 2 over m ≥ 2 passes: such a window lasts at least
+            // (m − 1)·T_f − τ_max and receives at most m pass energies.
+            let frame = u128::from(table.frame_ticks);
+            let tau = u128::from(timing.pass_ticks_max);
+            let tb_ticks = (TIME_BASE_S * tick_hz).ceil() as u128;
+            let m_last = (tb_ticks + tau) / frame + 2;
+            if m_last > u128::from(MAX_PASS_WINDOWS) {
+                return Err(DeriveError::Range {
+                    field: "frame_ticks",
+                    reason: "frame period too short for the multi-pass evaluation (over 10^7 passes in 100 s)",
+                });
+            }
+            let mut pass_energy_max_quanta = u64::MAX;
+            let mut pass_energy_rule = IntRule::TimeBase;
+            for m in 2..=m_last {
+                let span = ((m - 1) * frame).saturating_sub(tau);
+                let t = span as f64 / tick_hz * (1.0 - 1e-12);
+                if t > TIME_BASE_S {
+                    break;
+                }
+                let per_pass = to_quanta(ael_inf(&laser, t)) / (m as u64);
+                if per_pass < pass_energy_max_quanta {
+                    pass_energy_max_quanta = per_pass;
+                    pass_energy_rule = if t <= T2_S {
+                        IntRule::T2Train
+                    } else {
+                        IntRule::TimeBase
+                    };
+                }
+            }
+            Ok(Self {
+                tick_hz: table.tick_hz,
+                frame_ticks: table.frame_ticks,
+                pulse_rate_millihz_ceil: millihz,
+                pass_arc_mdeg: arc_mdeg,
+                pass_ticks_max: timing.pass_ticks_max,
+                pulses_per_pass_max: k_max,
+                pulse_code_max,
+                train,
+                pass_energy_max_quanta,
+                pass_energy_rule,
+            })
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+pub use derive::{millihz_ceil, DeriveError, EXACT_PULSE_BUCKETS, LIMIT_MARGIN};
+
+#[cfg(any(kani, test))]
+mod verification {
+    use super::*;
+    use crate::firmware::{FwBin, IntLimits, FIRMWARE_FORMAT};
+    use crate::model::accounting::PowerAccounting;
+    use crate::verification::cover;
+    use alloc::borrow::ToOwned;
+
+    /// Up to three raw bins: (width, dwell, code).
+    type RawBins = [(u32, u64, u32); 3];
+
+    /// A table within the format's and the evaluation's bounds: widths sum to
+    /// 360,000 mdeg, dwells (each ≥ 1) to `frame_ticks ≤ MAX_FRAME_TICKS`.
+    fn table(raw: &RawBins, n: usize, tick_hz: u64, frame_ticks: u64) -> FirmwareTable {
+        let mut width_left = FULL_TURN_MDEG;
+        let mut ticks_left = frame_ticks;
+        let bins = (0..n)
+            .map(|i| {
+                let (w, d, code) = raw[i];
+                let last = i + 1 == n;
+                let bins_after = (n - 1 - i) as u64;
+                let width_mdeg = if last {
+                    width_left
+                } else {
+                    w % (width_left + 1)
+                };
+                let dwell_ticks = if last {
+                    ticks_left
+                } else {
+                    1 + d % (ticks_left - bins_after)
+                };
+                width_left -= width_mdeg;
+                ticks_left -= dwell_ticks;
+                FwBin {
+                    start_deg: 0.0,
+                    width_mdeg,
+                    dwell_ticks,
+                    power_code: code,
+                    dwell_ticks_min: 0,
+                    dwell_ticks_max: u64::MAX,
+                    power_code_cap: u32::MAX,
+                }
+            })
+            .collect();
+        FirmwareTable {
+            format: FIRMWARE_FORMAT.to_owned(),
+            tick_hz,
+            frame_ticks,
+            power_w_per_code: 1.0,
+            power_accounting: PowerAccounting::Time,
+            pulse_rate_hz: 1.0,
+            eye_safety: None,
+            limits: IntLimits {
+                power_code_min: 0,
+                power_code_max: u32::MAX,
+                energy_budget: u64::MAX,
+                window_bins: 1,
+                window_energy_max: u64::MAX,
+            },
+            bins,
+        }
+    }
+
+    fn limits(
+        t: &FirmwareTable,
+        millihz: u64,
+        arc_mdeg: u32,
+        l: (u64, u64, u64, u64),
+    ) -> IntEyeLimits {
+        let (code_max, e1, split, e_pass) = l;
+        IntEyeLimits {
+            tick_hz: t.tick_hz,
+            frame_ticks: t.frame_ticks,
+            pulse_rate_millihz_ceil: millihz,
+            pass_arc_mdeg: arc_mdeg,
+            pass_ticks_max: u64::MAX,
+            pulses_per_pass_max: u64::MAX,
+            pulse_code_max: code_max,
+            train: alloc::vec![
+                TrainLimit {
+                    pulses_from: 1,
+                    energy_max_quanta: e1,
+                },
+                TrainLimit {
+                    pulses_from: 2 + split,
+                    energy_max_quanta: e1.saturating_add(split),
+                },
+            ],
+            pass_energy_max_quanta: e_pass,
+            pass_energy_rule: IntRule::T2Train,
+        }
+    }
+
+    type OverflowInput = (RawBins, u8, u64, u64, u64, u32, u8, (u64, u64, u64, u64));
+
+    fn no_overflow(input: OverflowInput) {
+        let (raw, n, tick, frame, millihz, arc, extreme, l) = input;
+        let n = 1 + usize::from(n % 3);
+        // Bounds of the evaluation (`check_bounds`): every value within them.
+        let mut tick_hz = 1 + tick % MAX_TICK_HZ;
+        let mut frame_ticks = n as u64 + frame % (MAX_FRAME_TICKS - n as u64 + 1);
+        let mut millihz = 1 + millihz % MAX_PULSE_RATE_MILLIHZ;
+        let mut raw = raw;
+        if extreme % 2 == 1 {
+            // The corner that maximizes every product: the fastest tick,
+            // the longest frame, the fastest pulse clock, the largest codes.
+            tick_hz = MAX_TICK_HZ;
+            frame_ticks = MAX_FRAME_TICKS;
+            millihz = MAX_PULSE_RATE_MILLIHZ;
+            for r in &mut raw {
+                r.2 = u32::MAX;
+            }
+        }
+        // The joint bound: fewer than MAX_PULSES_PER_TURN pulses per turn.
+        let allowed =
+            (u128::from(MAX_PULSES_PER_TURN) * u128::from(MILLIHZ_PER_HZ) * u128::from(tick_hz)
+                - 1)
+                / u128::from(frame_ticks);
+        // ≥ 62 mHz even at 1 Hz ticks and the longest frame.
+        millihz = millihz
+            .min(u64::try_from(allowed).unwrap_or(u64::MAX))
+            .max(1);
+        let arc_mdeg = 1 + arc % (FULL_TURN_MDEG / 2 - 1);
+        let t = table(&raw, n, tick_hz, frame_ticks);
+        let lim = limits(&t, millihz, arc_mdeg, l);
+        match evaluate(&t, &lim) {
+            Ok(r) => {
+                cover!(
+                    extreme % 2 == 1 && n == 3,
+                    "extreme three-bin table evaluated"
+                );
+                cover!(!r.class1, "a table over its limits evaluated");
+                cover!(r.class1, "a table within its limits evaluated");
+            }
+            Err(e) => panic!("a table within the bounds must evaluate: {e}"),
+        }
+        let timing = pass_timing(&t, millihz, arc_mdeg);
+        assert!(timing.is_ok(), "{timing:?}");
+    }
+
+    /// REQ-FW-5: the integer eye-safety sums (rational pass durations,
+    /// pulse counts, `code × count` window sums in `u128`) never overflow for
+    /// any table within the format's bounds: 1–36,000 bins (the evaluation
+    /// is per cell, so three bins exercise every product), any `u32` code,
+    /// `frame_ticks ≤ 2^44`, `tick_hz ≤ 2^34`, pulse rate ≤ 2^40 mHz and
+    /// fewer than 2^40 pulses per turn.
+    #[cfg_attr(kani, kani::proof, kani::unwind(8))]
+    #[cfg_attr(not(kani), test)]
+    fn eye_sums_never_overflow_within_format_bounds() {
+        #[cfg(kani)]
+        no_overflow(kani::any());
+        #[cfg(not(kani))]
+        {
+            bolero::check!()
+                .with_type::<OverflowInput>()
+                .cloned()
+                .for_each(no_overflow);
+            crate::verification::assert_covered(&[
+                "extreme three-bin table evaluated",
+                "a table over its limits evaluated",
+                "a table within its limits evaluated",
+            ]);
+        }
+    }
+
+    type RotationInput = ([(u16, u16, u16); 3], u8, u8, u16, u16, (u16, u16, u8, u16));
+
+    fn rotation_keeps_verdict(input: RotationInput) {
+        let (raw, n, shift, millihz, arc, (code_max, e1, split, e_pass)) = input;
+        let n = 1 + usize::from(n % 3);
+        let raw3: RawBins = [0, 1, 2].map(|i| {
+            (
+                u32::from(raw[i].0) * 8,
+                u64::from(raw[i].1),
+                u32::from(raw[i].2 % 64),
+            )
+        });
+        let t = table(&raw3, n, 1000, 3 + 100 * n as u64);
+        let millihz = 1_000 + u64::from(millihz) * 100;
+        let arc_mdeg = 1 + u32::from(arc) * 2;
+        let l = (
+            u64::from(code_max % 80),
+            u64::from(e1 % 400),
+            u64::from(split % 8),
+            u64::from(e_pass % 2000),
+        );
+        let mut rotated = t.clone();
+        rotated.bins.rotate_left(usize::from(shift) % n);
+        cover!(
+            usize::from(shift) % n != 0,
+            "a table rotated by a non-zero shift"
+        );
+        let a = evaluate(&t, &limits(&t, millihz, arc_mdeg, l)).expect("within bounds");
+        let b = evaluate(&rotated, &limits(&rotated, millihz, arc_mdeg, l)).expect("within bounds");
+        cover!(!a.class1 && n == 3, "a rejected three-bin table rotated");
+        cover!(a.class1 && n == 3, "an accepted three-bin table rotated");
+        assert_eq!(a.class1, b.class1);
+        assert_eq!(a.worst_ratio_ppm, b.worst_ratio_ppm);
+    }
+
+    /// REQ-FW-5: a cyclic rotation of a table (where the turn starts) keeps
+    /// the integer eye-safety verdict and its worst ratio: the aperture cells
+    /// are the same arcs, shifted.
+    #[cfg_attr(kani, kani::proof, kani::unwind(8))]
+    #[cfg_attr(not(kani), test)]
+    fn rotation_keeps_integer_verdict() {
+        #[cfg(kani)]
+        rotation_keeps_verdict(kani::any());
+        #[cfg(not(kani))]
+        {
+            bolero::check!()
+                .with_type::<RotationInput>()
+                .cloned()
+                .for_each(rotation_keeps_verdict);
+            crate::verification::assert_covered(&[
+                "a table rotated by a non-zero shift",
+                "a rejected three-bin table rotated",
+                "an accepted three-bin table rotated",
+            ]);
+        }
+    }
+}

@@ -1,0 +1,271 @@
+"""Type stubs of gaze_lidar's native module (the Rust crates via pyo3).
+
+Conventions: angles in degrees in the vehicle frame ISO 8855 (x forward,
+y left, z up), azimuth counter-clockwise from straight ahead in [0, 360);
+SI units elsewhere, the unit in each name. Errors: ValueError for bad input
+(the message starts with the argument or field), Infeasible for a request
+that cannot be met, Rejected for a profile that fails the checker.
+"""
+
+from typing import Any, Literal, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+PRESETS: list[str]
+"""Preset names accepted by `preset=` ("paper", "vls128")."""
+
+class Infeasible(Exception):
+    """The request is well-formed but cannot be met; the message names the limit."""
+
+class Rejected(Exception):
+    """A profile failed the checker.
+
+    violations: every violated limit, one line each (as `gaze-lidar check`).
+    """
+
+    violations: list[str]
+
+class Profile:
+    """A certified scan profile (`gaze-lidar/profile@1`).
+
+    Every Profile has passed the checker against its declared limits
+    (power budget, frame period, power and spin bounds, motor acceleration,
+    power slew, Class 1 eye safety). Arrays are fresh float64 copies, one
+    entry per bin, bins in azimuth order tiling [0, 360).
+    """
+
+    @property
+    def start_deg(self) -> npt.NDArray[np.float64]:
+        """Bin start azimuths, degrees."""
+    @property
+    def width_deg(self) -> npt.NDArray[np.float64]:
+        """Bin widths, degrees (sum 360)."""
+    @property
+    def power_w(self) -> npt.NDArray[np.float64]:
+        """Laser power per bin (mean optical output while scanning it), W."""
+    @property
+    def spin_start_rad_s(self) -> npt.NDArray[np.float64]:
+        """Spin at each bin's start, rad/s."""
+    @property
+    def spin_end_rad_s(self) -> npt.NDArray[np.float64]:
+        """Spin at each bin's end, rad/s (constant angular acceleration within a bin)."""
+    @property
+    def dwell_s(self) -> npt.NDArray[np.float64]:
+        """Time spent in each bin, s (sums to the frame period)."""
+    @property
+    def in_rof(self) -> npt.NDArray[np.bool_]:
+        """Whether each bin lies in the driver's region of focus."""
+    @property
+    def gaze_deg(self) -> float | None:
+        """The gaze azimuth the profile was built for; None for the uniform baseline."""
+    @property
+    def mode(self) -> str | None:
+        """How it was made, e.g. "closed-form range" or "optimized joint"."""
+    @property
+    def frame_rate_hz(self) -> float:
+        """Nominal revolutions per second."""
+    @property
+    def pulse_rate_hz(self) -> float:
+        """Laser firing rate per channel, Hz."""
+    @property
+    def average_power_w(self) -> float:
+        """The average power budget P̄, W."""
+    @property
+    def power_accounting(self) -> Literal["time", "angle"]:
+        """How the budget is averaged: over time (energy per frame) or over angle (eq. 4)."""
+    @property
+    def limits(self) -> dict[str, Any]:
+        """The declared limits (profile@1 `limits`)."""
+    @property
+    def summary(self) -> dict[str, Any]:
+        """The checker's figures: average_power_angle_w, average_power_time_w,
+        energy_per_frame_j, frame_period_s, max_spin_accel_rad_s2 (None for a
+        spin step), rof_width_deg, power_w_range, spin_rad_s_range."""
+    def to_json(self) -> str:
+        """The profile as `gaze-lidar/profile@1` JSON (what `gaze-lidar check` reads)."""
+    @staticmethod
+    def from_json(text: str) -> Profile:
+        """Parses profile@1 JSON and certifies it against its declared limits.
+
+        Raises ValueError for malformed JSON (line:column and field named)
+        and Rejected when a limit is violated.
+        """
+    def firmware(self, tick_hz: int = 80_000_000, power_w_per_code: float | None = None) -> dict[str, Any]:
+        """Integer firmware tables (`gaze-lidar/firmware@1`), conservatively rounded.
+
+        Scalars: format, tick_hz, frame_ticks, power_w_per_code,
+        power_accounting, pulse_rate_hz, limits (dict), eye_safety (dict or
+        None). numpy arrays, one entry per bin: start_deg (float64),
+        width_mdeg (uint32), dwell_ticks (uint64, summing to frame_ticks),
+        power_code (uint32), dwell_ticks_min, dwell_ticks_max (uint64),
+        power_code_cap (uint32). power_w_per_code defaults to
+        limits.power_w_max / 4095.
+        """
+    def firmware_json(self, tick_hz: int = 80_000_000, power_w_per_code: float | None = None) -> str:
+        """The firmware table as `gaze-lidar/firmware@1` JSON."""
+    def __len__(self) -> int:
+        """Number of bins."""
+
+def profile(
+    preset: str = "paper",
+    mode: Literal["baseline", "range", "resolution", "joint"] = "range",
+    gaze_deg: float | None = 90.0,
+    bins: int = 360,
+    accounting: Literal["time", "angle"] | None = None,
+) -> Profile:
+    """The paper's closed-form controller (eq. 3–6), certified.
+
+    mode "baseline" ignores gaze_deg (the uniform, fail-safe profile); the
+    others need it. bins: 4..=36000 equal bins (region boundaries are added
+    as edges). accounting overrides the preset's power accounting.
+    Raises ValueError (e.g. "gaze_deg: NaN is not a finite azimuth …"),
+    Infeasible, or Rejected (e.g. a spin step on a motor with an
+    acceleration limit).
+    """
+
+def optimize(config_toml: str, gaze_deg: float) -> Profile:
+    """The optimizer's certified profile (good_lp + HiGHS) for a TOML
+    configuration as `gaze-lidar profile --config` reads it (see
+    examples/configs/). Releases the GIL while solving.
+    Raises ValueError for a bad key (named), Infeasible naming the limit."""
+
+class Verdict:
+    """The checker's verdict on a profile@1 file. Truthy when certified."""
+
+    certified: bool
+    violations: list[str]
+    """One line per violated limit, as `gaze-lidar check` prints them."""
+    limits: list[str]
+    """The profile@1 key each violation is about (e.g. "power_w_max", "eye_safety")."""
+    worst_ratio: float | None
+    """Worst eye-safety exposure / Class 1 limit (> 1 fails); None when not evaluated."""
+    binding_rule: str | None
+    """The IEC 60825-1 rule that binds at the worst azimuth."""
+    worst_azimuth_deg: float | None
+    """Azimuth of the worst eye-safety exposure."""
+    def __bool__(self) -> bool: ...
+
+def check(profile_json: str, preset: str | None = None, *, no_eye_safety: bool = False) -> Verdict:
+    """Verifies profile@1 JSON against its declared limits; with preset, also
+    against that sensor (a declared limit looser than the sensor's is a
+    violation). A file without eye-safety parameters is rejected unless
+    no_eye_safety=True. Raises ValueError when the JSON does not parse."""
+
+class Frame:
+    """One LiDAR frame of a GazeStream."""
+
+    t_s: float
+    """Frame start on the gaze clock, s."""
+    state: Literal["adaptive", "fail_safe"]
+    @property
+    def profile(self) -> Profile:
+        """The certified profile the LiDAR runs during this frame."""
+    @property
+    def gaze_deg(self) -> float | None:
+        """The gaze the profile was built for; None in fail-safe."""
+
+class GazeStream:
+    """Gaze samples in, one certified profile per LiDAR frame out.
+
+    The frame clock drives the fail-safe (the CLI's `stream` rules): frame k
+    starts at t0 + k·T (t0 the first sample or tick, T the frame period);
+    a frame is adaptive only if the newest fixation is no older than
+    timeout_ms when it is decided, and after a loss only once
+    recover_samples consecutive valid samples arrived; otherwise it runs the
+    uniform baseline. A timestamp jump of more than max_gap_frames periods
+    emits one fail-safe frame and restarts the clock.
+
+    With config_toml, frames are planned by the optimizer's fast path
+    (mode overrides the objective); otherwise by the preset's closed form.
+    """
+
+    def __init__(
+        self,
+        preset: str = "paper",
+        mode: Literal["range", "resolution", "joint", "baseline"] = "range",
+        timeout_ms: float = 100.0,
+        *,
+        bins: int = 360,
+        recover_samples: int = 4,
+        saccade_deg_s: float = 30.0,
+        max_gap_frames: int = 200,
+        config_toml: str | None = None,
+    ) -> None: ...
+    def push(self, t_s: float, gaze_deg: float, valid: bool = True) -> list[Frame]:
+        """Feeds one tracker sample (gaze clock t_s); returns the frames that
+        start at or before it, each decided from the samples before it.
+        valid=False (or a non-finite gaze) means the tracker lost the eyes."""
+    def tick(self, now_s: float) -> list[Frame]:
+        """Runs the frame clock to now_s without a sample: the frames due by
+        then, fail-safe once the last fixation is older than the timeout.
+        Call it on each LiDAR frame so silence still yields frames."""
+    @property
+    def period_s(self) -> float:
+        """The frame period on the frame clock (rounded to a microsecond), s."""
+    @property
+    def stats(self) -> dict[str, int]:
+        """samples, invalid, outliers, frames, fail_safe_frames, resyncs, plan_fallbacks."""
+    def notices(self) -> list[str]:
+        """Warnings since the last call (clock jumps, planning fallbacks), one line each."""
+
+def apply_profile(
+    profile: Profile,
+    points: npt.NDArray[np.float32] | npt.NDArray[np.float64],
+    *,
+    rated_range_m: float,
+    model: Literal["physical", "argus"] = "physical",
+    fog_mor_m: float | None = None,
+    seed: int = 0,
+    frame: Literal["carla", "iso8855"] = "carla",
+    cloud_spin_rad_s: float | None = None,
+) -> npt.NDArray[np.bool_]:
+    """Which points a sensor running `profile` would return: a bool mask.
+
+    points: N x 4 float32 in CARLA's layout (x, y, z, intensity; sensor
+    frame, metres); N x 3 and float64 are accepted too. Azimuth: the crate's
+    convention; with frame="carla" (x forward, y right, z up: left-handed)
+    it is atan2(-y, x), with frame="iso8855" (y left) atan2(y, x).
+
+    Range: a point at distance sqrt(x²+y²+z²) is kept if the profile's power
+    at its azimuth, P(β)/P̄, detects a normal-incidence target of the
+    reference reflectivity there with P_D ≥ ½ — the simulator's return
+    model: "physical" (range equation calibrated so the uniform baseline
+    reaches rated_range_m in clear air; fog as extinction 2.996/fog_mor_m)
+    or "argus" (the paper code's intensity model: hard 100 m; fog_mor_m only
+    None, 200 or 100, the paper's levels). The intensity column is not used.
+
+    Density: relative to the spin the cloud was recorded at
+    (cloud_spin_rad_s, default the uniform 2π·frame_rate_hz), a point at
+    azimuth β survives with probability min(1, ω_cloud/ω(β)), from seeded
+    draws (one per point, in order): same seed, same mask.
+
+    Vectorized in Rust (no Python loop); the GIL is released for contiguous
+    float32 input.
+    """
+
+def azimuth_deg(
+    points: npt.NDArray[np.float32] | npt.NDArray[np.float64],
+    frame: Literal["carla", "iso8855"] = "carla",
+) -> npt.NDArray[np.float64]:
+    """Azimuth of each point in the crate's convention, degrees in [0, 360),
+    exactly as apply_profile maps the frame (atan2(-y, x) for CARLA)."""
+
+def simulate(
+    model: Literal["argus", "physical"] | Sequence[str] = "argus",
+    trials: int = 10,
+    seed: int = 1,
+    **options: Any,
+) -> list[dict[str, Any]]:
+    """The paper's T-intersection experiment (`gaze-lidar simulate`): one
+    row per model × variant × fog level, as a dict (model, variant, fog_pct,
+    trials, detected, tta_median_s, tta_q1_s, tta_q3_s,
+    density_median_pts_per_deg, density_median_pts_per_deg_s,
+    left_tta_median_s, left_detected, hybrid_tta_median_s,
+    left_hybrid_tta_median_s). Same seed, same rows.
+
+    options: variants (list of "baseline", "range", "resolution", "joint",
+    "optimized"), fog_pct (list of 0, 25, 50), detect ("k/n"), bins,
+    preset, scenario_toml (TOML text), optimizer_toml (TOML text, with the
+    "optimized" variant). Releases the GIL while it runs.
+    """

@@ -1,0 +1,970 @@
+//! `gaze_lidar._native`: the Python bindings of the `gaze-lidar` crates.
+//!
+//! A thin layer: every number comes from the crates' public API (planner,
+//! optimizer, checker, eye-safety model, firmware tables, gaze stream,
+//! simulator, point-cloud filter); this file only converts arguments and
+//! results and maps errors to exceptions with the CLI's one-line messages:
+//! `ValueError` for bad input, `Infeasible` for a request that cannot be met,
+//! `Rejected` for a profile that fails the checker.
+
+use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use gaze_lidar::checker::{certify_with, CertifiedProfile, CheckOptions, Violation};
+use gaze_lidar::eye_safety::evaluate_profile;
+use gaze_lidar::firmware::{FirmwareConfig, FirmwareError, FirmwareTable};
+use gaze_lidar::gaze::{
+    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeError, GazeSample, Notice,
+    State, StreamConfig,
+};
+use gaze_lidar::model::lidar::PowerAccounting;
+use gaze_lidar::model::presets::{self, Preset};
+use gaze_lidar::planner::{closed_form, validate_gaze, Mode, PlanError};
+use gaze_lidar::pointcloud::{keep_mask, CloudFrame, CloudOptions};
+use gaze_lidar::profile::{Profile as CoreProfile, Region};
+use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, Variant, FOG_LEVELS_PCT};
+
+create_exception!(
+    gaze_lidar,
+    Infeasible,
+    PyException,
+    "The request is well-formed but cannot be met (the message names the limit)."
+);
+create_exception!(
+    gaze_lidar,
+    Rejected,
+    PyException,
+    "A profile failed the checker; `violations` lists every violated limit (one line each)."
+);
+
+fn value_error(message: impl Into<String>) -> PyErr {
+    PyValueError::new_err(message.into())
+}
+
+fn rejected(py: Python<'_>, message: String, violations: &[Violation]) -> PyErr {
+    let err = Rejected::new_err(message);
+    let lines: Vec<String> = violations.iter().map(ToString::to_string).collect();
+    // Best effort: the message already says it all.
+    let _ = err.value(py).setattr("violations", lines);
+    err
+}
+
+fn plan_error(py: Python<'_>, e: PlanError) -> PyErr {
+    match e {
+        PlanError::InvalidInput { field, reason } => {
+            value_error(format!("{}: {reason}", field.replace('-', "_")))
+        }
+        PlanError::Infeasible(_) => Infeasible::new_err(e.to_string()),
+        PlanError::Rejected(ref r) => rejected(py, e.to_string(), &r.violations),
+    }
+}
+
+fn opt_error(py: Python<'_>, e: gaze_lidar::optimizer::OptError) -> PyErr {
+    use gaze_lidar::optimizer::OptError;
+    match e {
+        OptError::Invalid { .. } => value_error(e.to_string()),
+        OptError::Rejected(ref r) => rejected(py, e.to_string(), &r.violations),
+        OptError::Infeasible(_) | OptError::Solver(_) => Infeasible::new_err(e.to_string()),
+    }
+}
+
+fn gaze_error(py: Python<'_>, e: GazeError) -> PyErr {
+    match e {
+        GazeError::Plan(p) => plan_error(py, p),
+        GazeError::Optimizer(o) => opt_error(py, o),
+        other if other.is_input_error() => value_error(other.to_string()),
+        other => Infeasible::new_err(other.to_string()),
+    }
+}
+
+fn json_value<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+fn to_py_json<'py, T: serde::Serialize>(py: Python<'py>, v: &T) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(v).map_err(|e| value_error(e.to_string()))?;
+    json_value(py, &text)
+}
+
+fn preset_of(name: &str) -> PyResult<Preset> {
+    presets::preset(name).map_err(|e| value_error(format!("preset: {e}")))
+}
+
+fn mode_of(name: &str) -> PyResult<Mode> {
+    Mode::ALL
+        .into_iter()
+        .find(|m| m.name() == name)
+        .ok_or_else(|| {
+            value_error(format!(
+                "mode: '{name}' is not one of baseline, range, resolution, joint"
+            ))
+        })
+}
+
+fn seed_of(seed: i128) -> PyResult<u64> {
+    u64::try_from(seed).map_err(|_| value_error(format!("seed: {seed} must lie in 0..=2**64-1")))
+}
+
+fn finite(field: &str, v: f64) -> PyResult<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(value_error(format!("{field}: {v} is not a finite number")))
+    }
+}
+
+/// A certified scan profile (`gaze-lidar/profile@1`): per-bin numpy arrays,
+/// the checker's summary, JSON and firmware tables.
+#[pyclass(frozen, module = "gaze_lidar", name = "Profile")]
+pub struct PyProfile {
+    inner: CertifiedProfile,
+}
+
+impl PyProfile {
+    fn column<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&gaze_lidar::profile::Bin) -> f64,
+    ) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.profile().bins.iter().map(f).collect())
+    }
+
+    fn firmware_table(
+        &self,
+        tick_hz: i128,
+        power_w_per_code: Option<f64>,
+    ) -> PyResult<FirmwareTable> {
+        let tick_hz = u64::try_from(tick_hz)
+            .map_err(|_| value_error(format!("tick_hz: {tick_hz} must lie in 1..=1e10")))?;
+        let cfg = FirmwareConfig {
+            tick_hz,
+            power_w_per_code,
+        };
+        FirmwareTable::from_certified(&self.inner, &cfg).map_err(|e| match e {
+            FirmwareError::Config { .. } => value_error(format!("firmware: {e}")),
+            other => Infeasible::new_err(format!("firmware: {other}")),
+        })
+    }
+}
+
+#[pymethods]
+impl PyProfile {
+    /// Bin start azimuths, degrees (ISO 8855, counter-clockwise from ahead).
+    #[getter]
+    fn start_deg<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |b| b.start_deg)
+    }
+    /// Bin widths, degrees.
+    #[getter]
+    fn width_deg<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |b| b.width_deg)
+    }
+    /// Laser power per bin, W.
+    #[getter]
+    fn power_w<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |b| b.power_w)
+    }
+    /// Spin at each bin's start, rad/s.
+    #[getter]
+    fn spin_start_rad_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |b| b.spin_start_rad_s)
+    }
+    /// Spin at each bin's end, rad/s.
+    #[getter]
+    fn spin_end_rad_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |b| b.spin_end_rad_s)
+    }
+    /// Dwell time per bin, s.
+    #[getter]
+    fn dwell_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, gaze_lidar::profile::Bin::dwell_time_s)
+    }
+    /// Whether each bin lies in the driver's region of focus.
+    #[getter]
+    fn in_rof<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        PyArray1::from_vec(
+            py,
+            self.inner
+                .profile()
+                .bins
+                .iter()
+                .map(|b| b.region == Some(Region::Rof))
+                .collect(),
+        )
+    }
+    /// Gaze azimuth the profile was built for, degrees; None for the baseline.
+    #[getter]
+    fn gaze_deg(&self) -> Option<f64> {
+        self.inner.profile().gaze_deg
+    }
+    /// How it was made (e.g. "closed-form range").
+    #[getter]
+    fn mode(&self) -> Option<String> {
+        self.inner.profile().mode.clone()
+    }
+    /// Nominal revolutions per second, Hz.
+    #[getter]
+    fn frame_rate_hz(&self) -> f64 {
+        self.inner.profile().frame_rate_hz
+    }
+    /// Laser firing rate per channel, Hz.
+    #[getter]
+    fn pulse_rate_hz(&self) -> f64 {
+        self.inner.profile().pulse_rate_hz
+    }
+    /// The average power budget, W.
+    #[getter]
+    fn average_power_w(&self) -> f64 {
+        self.inner.profile().average_power_w
+    }
+    /// "time" or "angle".
+    #[getter]
+    fn power_accounting(&self) -> String {
+        self.inner.profile().power_accounting.to_string()
+    }
+    /// The declared limits (profile@1 `limits`), as a dict.
+    #[getter]
+    fn limits<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py_json(py, &self.inner.profile().limits)
+    }
+    /// The checker's figures (average powers, frame period, ranges …), as a dict.
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py_json(py, self.inner.summary())
+    }
+    /// The profile as `gaze-lidar/profile@1` JSON.
+    fn to_json(&self) -> PyResult<String> {
+        self.inner
+            .profile()
+            .to_json()
+            .map_err(|e| value_error(e.to_string()))
+    }
+    /// Parses profile@1 JSON and certifies it against its declared limits.
+    #[staticmethod]
+    fn from_json(py: Python<'_>, text: &str) -> PyResult<Self> {
+        let p = CoreProfile::from_json(text, "<json>").map_err(|e| value_error(e.to_string()))?;
+        certify_with(p, &CheckOptions::declared())
+            .map(|inner| Self { inner })
+            .map_err(|r| rejected(py, r.to_string(), &r.violations))
+    }
+    /// Integer firmware tables: a dict of scalars and numpy integer arrays.
+    #[pyo3(signature = (tick_hz=80_000_000, power_w_per_code=None))]
+    fn firmware<'py>(
+        &self,
+        py: Python<'py>,
+        tick_hz: i128,
+        power_w_per_code: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let t = self.firmware_table(tick_hz, power_w_per_code)?;
+        let d = PyDict::new(py);
+        d.set_item("format", &t.format)?;
+        d.set_item("tick_hz", t.tick_hz)?;
+        d.set_item("frame_ticks", t.frame_ticks)?;
+        d.set_item("power_w_per_code", t.power_w_per_code)?;
+        d.set_item("power_accounting", t.power_accounting.to_string())?;
+        d.set_item("pulse_rate_hz", t.pulse_rate_hz)?;
+        d.set_item("limits", to_py_json(py, &t.limits)?)?;
+        d.set_item("eye_safety", to_py_json(py, &t.eye_safety)?)?;
+        let b = &t.bins;
+        d.set_item(
+            "start_deg",
+            PyArray1::from_vec(py, b.iter().map(|b| b.start_deg).collect()),
+        )?;
+        d.set_item(
+            "width_mdeg",
+            PyArray1::from_vec(py, b.iter().map(|b| b.width_mdeg).collect()),
+        )?;
+        d.set_item(
+            "dwell_ticks",
+            PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks).collect()),
+        )?;
+        d.set_item(
+            "power_code",
+            PyArray1::from_vec(py, b.iter().map(|b| b.power_code).collect()),
+        )?;
+        d.set_item(
+            "dwell_ticks_min",
+            PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks_min).collect()),
+        )?;
+        d.set_item(
+            "dwell_ticks_max",
+            PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks_max).collect()),
+        )?;
+        d.set_item(
+            "power_code_cap",
+            PyArray1::from_vec(py, b.iter().map(|b| b.power_code_cap).collect()),
+        )?;
+        Ok(d)
+    }
+    /// The firmware table as `gaze-lidar/firmware@1` JSON.
+    #[pyo3(signature = (tick_hz=80_000_000, power_w_per_code=None))]
+    fn firmware_json(&self, tick_hz: i128, power_w_per_code: Option<f64>) -> PyResult<String> {
+        self.firmware_table(tick_hz, power_w_per_code)?
+            .to_json()
+            .map_err(|e| value_error(e.to_string()))
+    }
+    fn __len__(&self) -> usize {
+        self.inner.profile().bins.len()
+    }
+    fn __repr__(&self) -> String {
+        let p = self.inner.profile();
+        format!(
+            "<gaze_lidar.Profile {} bins, gaze_deg={}, mode={}>",
+            p.bins.len(),
+            p.gaze_deg.map_or("None".to_owned(), |g| g.to_string()),
+            p.mode.as_deref().unwrap_or("?")
+        )
+    }
+}
+
+/// The certified closed-form profile (the paper's controllers, eq. 3–6).
+#[pyfunction]
+#[pyo3(signature = (preset="paper", mode="range", gaze_deg=Some(90.0), bins=360, accounting=None))]
+fn profile(
+    py: Python<'_>,
+    preset: &str,
+    mode: &str,
+    gaze_deg: Option<f64>,
+    bins: i64,
+    accounting: Option<&str>,
+) -> PyResult<PyProfile> {
+    let mut preset = preset_of(preset)?;
+    let mode = mode_of(mode)?;
+    if let Some(acc) = accounting {
+        preset.lidar.power_accounting = match acc {
+            "time" => PowerAccounting::Time,
+            "angle" => PowerAccounting::Angle,
+            other => {
+                return Err(value_error(format!(
+                    "accounting: '{other}' is not one of time, angle"
+                )))
+            }
+        };
+    }
+    if let Some(g) = gaze_deg {
+        validate_gaze(g).map_err(|e| plan_error(py, e))?;
+    }
+    let gaze = match (mode, gaze_deg) {
+        (Mode::Baseline, _) => None,
+        (_, Some(g)) => Some(g),
+        (m, None) => {
+            return Err(value_error(format!(
+                "gaze_deg: required for mode {}",
+                m.name()
+            )))
+        }
+    };
+    let bins = usize::try_from(bins)
+        .map_err(|_| value_error(format!("bins: {bins} must lie in [4, 36000]")))?;
+    closed_form(&preset, mode, gaze, bins)
+        .map(|inner| PyProfile { inner })
+        .map_err(|e| plan_error(py, e))
+}
+
+/// The optimizer's certified profile (good_lp + HiGHS) for a TOML configuration.
+#[pyfunction]
+fn optimize(py: Python<'_>, config_toml: &str, gaze_deg: f64) -> PyResult<PyProfile> {
+    use gaze_lidar::optimizer::OptimizerConfig;
+    validate_gaze(gaze_deg).map_err(|e| plan_error(py, e))?;
+    let problem = OptimizerConfig::from_toml(config_toml, "config_toml")
+        .and_then(|c| c.problem())
+        .map_err(|e| opt_error(py, e))?;
+    py.detach(|| gaze_lidar::optimizer::optimize(&problem, gaze_deg))
+        .map(|inner| PyProfile { inner })
+        .map_err(|e| opt_error(py, e))
+}
+
+/// The checker's verdict on a profile@1 file.
+#[pyclass(frozen, module = "gaze_lidar", name = "Verdict")]
+pub struct Verdict {
+    /// Whether every limit holds.
+    #[pyo3(get)]
+    certified: bool,
+    /// One line per violated limit (empty when certified).
+    #[pyo3(get)]
+    violations: Vec<String>,
+    /// The limit each violation is about (profile@1 key), in the same order.
+    #[pyo3(get)]
+    limits: Vec<String>,
+    /// Worst eye-safety exposure / Class 1 limit (> 1 fails); None when not evaluated.
+    #[pyo3(get)]
+    worst_ratio: Option<f64>,
+    /// The eye-safety rule that binds at the worst azimuth.
+    #[pyo3(get)]
+    binding_rule: Option<String>,
+    /// Azimuth of the worst eye-safety exposure, degrees.
+    #[pyo3(get)]
+    worst_azimuth_deg: Option<f64>,
+}
+
+#[pymethods]
+impl Verdict {
+    fn __bool__(&self) -> bool {
+        self.certified
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "<gaze_lidar.Verdict certified={} violations={}>",
+            if self.certified { "True" } else { "False" },
+            self.violations.len()
+        )
+    }
+}
+
+/// Verifies profile@1 JSON against its declared limits (and a preset's sensor).
+#[pyfunction]
+#[pyo3(signature = (profile_json, preset=None, *, no_eye_safety=false))]
+fn check(profile_json: &str, preset: Option<&str>, no_eye_safety: bool) -> PyResult<Verdict> {
+    let profile = CoreProfile::from_json(profile_json, "profile_json")
+        .map_err(|e| value_error(e.to_string()))?;
+    let sensor = preset.map(preset_of).transpose()?;
+    let opts = match &sensor {
+        Some(s) => CheckOptions::for_sensor(&s.lidar),
+        None => CheckOptions::declared(),
+    }
+    .allow_missing_eye_safety(no_eye_safety);
+    Ok(match certify_with(profile.clone(), &opts) {
+        Ok(_) => {
+            let eye = profile
+                .limits
+                .eye_safety
+                .as_ref()
+                .and_then(|p| evaluate_profile(&profile, p).ok());
+            Verdict {
+                certified: true,
+                violations: Vec::new(),
+                limits: Vec::new(),
+                worst_ratio: eye.as_ref().map(|r| r.worst_ratio),
+                binding_rule: eye.as_ref().map(|r| r.binding_rule.to_string()),
+                worst_azimuth_deg: eye.as_ref().map(|r| r.worst_azimuth_deg),
+            }
+        }
+        Err(rej) => {
+            let eye = rej.violations.iter().find_map(|v| match v {
+                Violation::EyeSafety {
+                    azimuth_deg,
+                    rule,
+                    ratio,
+                } => Some((*ratio, rule.clone(), *azimuth_deg)),
+                _ => None,
+            });
+            Verdict {
+                certified: false,
+                violations: rej.violations.iter().map(ToString::to_string).collect(),
+                limits: rej
+                    .violations
+                    .iter()
+                    .map(|v| v.limit_key().to_owned())
+                    .collect(),
+                worst_ratio: eye.as_ref().map(|e| e.0),
+                binding_rule: eye.as_ref().map(|e| e.1.clone()),
+                worst_azimuth_deg: eye.as_ref().map(|e| e.2),
+            }
+        }
+    })
+}
+
+/// One LiDAR frame of a gaze stream.
+#[pyclass(frozen, module = "gaze_lidar", name = "Frame")]
+pub struct PyFrame {
+    /// Frame start on the gaze clock, s.
+    #[pyo3(get)]
+    t_s: f64,
+    /// "adaptive" or "fail_safe".
+    #[pyo3(get)]
+    state: &'static str,
+    profile: Py<PyProfile>,
+}
+
+#[pymethods]
+impl PyFrame {
+    /// The certified profile the LiDAR runs during this frame.
+    #[getter]
+    fn profile(&self, py: Python<'_>) -> Py<PyProfile> {
+        self.profile.clone_ref(py)
+    }
+    /// The gaze the profile was built for, degrees; None in fail-safe.
+    #[getter]
+    fn gaze_deg(&self) -> Option<f64> {
+        self.profile.get().inner.profile().gaze_deg
+    }
+    fn __repr__(&self) -> String {
+        format!("<gaze_lidar.Frame t_s={} state={}>", self.t_s, self.state)
+    }
+}
+
+/// Gaze samples in, one certified profile per LiDAR frame out (fail-safe on loss).
+#[pyclass(unsendable, module = "gaze_lidar", name = "GazeStream")]
+pub struct PyGazeStream {
+    inner: gaze_lidar::gaze::GazeStream<Box<dyn FramePlanner>>,
+}
+
+fn frames(py: Python<'_>, frames: Vec<gaze_lidar::gaze::Frame>) -> PyResult<Vec<PyFrame>> {
+    frames
+        .into_iter()
+        .map(|f| {
+            Ok(PyFrame {
+                t_s: f.t_s,
+                state: match f.state {
+                    State::Adaptive => "adaptive",
+                    State::FailSafe => "fail_safe",
+                },
+                profile: Py::new(py, PyProfile { inner: f.profile })?,
+            })
+        })
+        .collect()
+}
+
+#[pymethods]
+impl PyGazeStream {
+    #[new]
+    #[pyo3(signature = (preset="paper", mode="range", timeout_ms=100.0, *, bins=360, recover_samples=4, saccade_deg_s=30.0, max_gap_frames=200, config_toml=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        preset: &str,
+        mode: &str,
+        timeout_ms: f64,
+        bins: i64,
+        recover_samples: i64,
+        saccade_deg_s: f64,
+        max_gap_frames: i64,
+        config_toml: Option<&str>,
+    ) -> PyResult<Self> {
+        if !(timeout_ms.is_finite() && timeout_ms > 0.0 && timeout_ms < 1e7) {
+            return Err(value_error(format!(
+                "timeout_ms: {timeout_ms} must be finite, > 0 and < 1e7"
+            )));
+        }
+        if !(saccade_deg_s.is_finite() && saccade_deg_s > 0.0) {
+            return Err(value_error(format!(
+                "saccade_deg_s: {saccade_deg_s} must be finite and > 0"
+            )));
+        }
+        let max_gap_frames = u64::try_from(max_gap_frames)
+            .ok()
+            .filter(|&m| m <= 1_000_000)
+            .ok_or_else(|| {
+                value_error(format!(
+                    "max_gap_frames: {max_gap_frames} must lie in 0..=1000000"
+                ))
+            })?;
+        let recover_samples = u32::try_from(recover_samples).map_err(|_| {
+            value_error(format!(
+                "recover_samples: {recover_samples} must lie in 0..=4294967295"
+            ))
+        })?;
+        let mode = mode_of(mode)?;
+        let planner: Box<dyn FramePlanner> = match config_toml {
+            Some(text) => {
+                use gaze_lidar::optimizer::OptimizerConfig;
+                let mut problem = OptimizerConfig::from_toml(text, "config_toml")
+                    .and_then(|c| c.problem())
+                    .map_err(|e| opt_error(py, e))?;
+                problem.objective.mode = mode;
+                Box::new(
+                    gaze_lidar::gaze::OptimizerPlanner::new(problem)
+                        .map_err(|e| gaze_error(py, e))?,
+                )
+            }
+            None => {
+                let bins = usize::try_from(bins)
+                    .ok()
+                    .filter(|b| {
+                        (gaze_lidar::model::angle::MIN_BINS..=gaze_lidar::model::angle::MAX_BINS)
+                            .contains(b)
+                    })
+                    .ok_or_else(|| value_error(format!("bins: {bins} must lie in [4, 36000]")))?;
+                let preset = preset_of(preset)?;
+                // Plan once now: an impossible request fails here, not at the first frame.
+                closed_form(&preset, mode, Some(0.0), bins).map_err(|e| plan_error(py, e))?;
+                Box::new(ClosedFormPlanner { preset, mode, bins })
+            }
+        };
+        let filter = FilterConfig {
+            saccade_deg_s,
+            ..FilterConfig::default()
+        };
+        let failsafe = FailSafeConfig {
+            timeout_us: (timeout_ms * 1000.0) as u64,
+            recover_samples,
+        };
+        let config = StreamConfig { max_gap_frames };
+        Ok(Self {
+            inner: gaze_lidar::gaze::GazeStream::with_config(planner, filter, failsafe, config),
+        })
+    }
+
+    /// Feeds one gaze sample (gaze clock `t_s`); returns the frames that
+    /// start at or before it, each decided from the samples before it.
+    #[pyo3(signature = (t_s, gaze_deg, valid=true))]
+    fn push(
+        &mut self,
+        py: Python<'_>,
+        t_s: f64,
+        gaze_deg: f64,
+        valid: bool,
+    ) -> PyResult<Vec<PyFrame>> {
+        finite("t_s", t_s)?;
+        let sample = GazeSample {
+            t_s,
+            gaze_deg,
+            valid,
+        };
+        let out = self.inner.push(&sample).map_err(|e| gaze_error(py, e))?;
+        frames(py, out)
+    }
+
+    /// Runs the frame clock to `now_s` without a sample: the frames due by
+    /// then (fail-safe once the last fixation is older than the timeout).
+    fn tick(&mut self, py: Python<'_>, now_s: f64) -> PyResult<Vec<PyFrame>> {
+        finite("now_s", now_s)?;
+        let out = self.inner.tick(now_s).map_err(|e| gaze_error(py, e))?;
+        frames(py, out)
+    }
+
+    /// The frame period on the frame clock, s.
+    #[getter]
+    fn period_s(&self) -> f64 {
+        self.inner.period_us() as f64 * 1e-6
+    }
+
+    /// Counters: samples, invalid, outliers, frames, fail_safe_frames, resyncs, plan_fallbacks.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.inner.stats();
+        let d = PyDict::new(py);
+        d.set_item("samples", s.samples)?;
+        d.set_item("invalid", s.invalid)?;
+        d.set_item("outliers", s.outliers)?;
+        d.set_item("frames", s.frames)?;
+        d.set_item("fail_safe_frames", s.fail_safe_frames)?;
+        d.set_item("resyncs", s.resyncs)?;
+        d.set_item("plan_fallbacks", s.plan_fallbacks)?;
+        Ok(d)
+    }
+
+    /// Warnings since the last call (clock jumps, planning fallbacks), one line each.
+    fn notices(&mut self) -> Vec<String> {
+        self.inner
+            .take_notices()
+            .into_iter()
+            .map(|n| match n {
+                Notice::Resync { from_s, to_s, frames } => format!(
+                    "gaze clock jumped from {from_s} s to {to_s} s ({frames} frames due): one fail-safe frame, frame clock restarted, gaze history discarded"
+                ),
+                Notice::PlanFallback { gaze_deg, error } => format!(
+                    "no certified adaptive profile for gaze {gaze_deg}°, baseline instead: {error}"
+                ),
+                Notice::Late { frames } => format!("output ran late, {frames} frame(s) skipped"),
+            })
+            .collect()
+    }
+}
+
+fn model_of(name: &str) -> PyResult<ModelKind> {
+    match name {
+        "physical" => Ok(ModelKind::Physical),
+        "argus" => Ok(ModelKind::Argus),
+        other => Err(value_error(format!(
+            "model: '{other}' is not one of physical, argus"
+        ))),
+    }
+}
+
+fn cloud_frame(frame: &str) -> PyResult<CloudFrame> {
+    match frame {
+        "carla" => Ok(CloudFrame::Carla),
+        "iso8855" => Ok(CloudFrame::Iso8855),
+        other => Err(value_error(format!(
+            "frame: '{other}' is not one of carla, iso8855"
+        ))),
+    }
+}
+
+/// Something computed from a cloud's x, y, z, generic over the iterator so
+/// that the per-point loop is monomorphized and inlined for each layout.
+trait PointsVisitor: Sync {
+    type Out: Send;
+    fn visit<I: ExactSizeIterator<Item = [f64; 3]>>(&self, xyz: I) -> Self::Out;
+}
+
+struct KeepVisitor<'a> {
+    certified: &'a CertifiedProfile,
+    opts: &'a CloudOptions,
+}
+
+impl PointsVisitor for KeepVisitor<'_> {
+    type Out = Result<Vec<bool>, gaze_lidar::pointcloud::CloudError>;
+    fn visit<I: ExactSizeIterator<Item = [f64; 3]>>(&self, xyz: I) -> Self::Out {
+        keep_mask(self.certified, xyz, self.opts)
+    }
+}
+
+struct AzimuthVisitor(CloudFrame);
+
+impl PointsVisitor for AzimuthVisitor {
+    type Out = Vec<f64>;
+    fn visit<I: ExactSizeIterator<Item = [f64; 3]>>(&self, xyz: I) -> Self::Out {
+        xyz.map(|[x, y, _]| self.0.azimuth_deg(x, y)).collect()
+    }
+}
+
+/// Hands `v` the x, y, z of an N×3 or N×4 float32/float64 array (a flat
+/// slice when contiguous, with the GIL released).
+fn with_points<'py, V: PointsVisitor>(points: &Bound<'py, PyAny>, v: V) -> PyResult<V::Out> {
+    let shape_error = |dtype: String, shape: Vec<usize>| {
+        value_error(format!(
+            "points: expected an N×4 float32 array (x, y, z, intensity; N×3 and float64 also accepted), got dtype {dtype} and shape {shape:?}"
+        ))
+    };
+    let py = points.py();
+    if let Ok(a) = points.extract::<PyReadonlyArray2<'py, f32>>() {
+        let shape = a.shape().to_vec();
+        if !(shape[1] == 3 || shape[1] == 4) {
+            return Err(shape_error("float32".into(), shape));
+        }
+        let w = shape[1];
+        return Ok(match a.as_slice() {
+            Ok(flat) => py.detach(|| {
+                v.visit(
+                    flat.chunks_exact(w)
+                        .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])]),
+                )
+            }),
+            Err(_) => v.visit(
+                a.as_array()
+                    .rows()
+                    .into_iter()
+                    .map(|r| [f64::from(r[0]), f64::from(r[1]), f64::from(r[2])]),
+            ),
+        });
+    }
+    if let Ok(a) = points.extract::<PyReadonlyArray2<'py, f64>>() {
+        let shape = a.shape().to_vec();
+        if !(shape[1] == 3 || shape[1] == 4) {
+            return Err(shape_error("float64".into(), shape));
+        }
+        return Ok(v.visit(a.as_array().rows().into_iter().map(|r| [r[0], r[1], r[2]])));
+    }
+    let dtype = points
+        .getattr("dtype")
+        .map(|d| d.to_string())
+        .unwrap_or_else(|_| points.get_type().to_string());
+    let shape = points
+        .getattr("shape")
+        .and_then(|s| s.extract::<Vec<usize>>())
+        .unwrap_or_default();
+    Err(shape_error(dtype, shape))
+}
+
+/// Azimuth of each point in the crate's convention (ISO 8855, degrees
+/// counter-clockwise from ahead, in [0, 360)), as `apply_profile` sees it.
+#[pyfunction]
+#[pyo3(signature = (points, frame="carla"))]
+fn azimuth_deg<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    frame: &str,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let frame = cloud_frame(frame)?;
+    let az = with_points(points, AzimuthVisitor(frame))?;
+    Ok(PyArray1::from_vec(py, az))
+}
+
+/// Which points of an N×4 (x, y, z, intensity) cloud a sensor running
+/// `profile` would return: a numpy bool mask.
+#[pyfunction]
+#[pyo3(signature = (profile, points, *, rated_range_m, model="physical", fog_mor_m=None, seed=0, frame="carla", cloud_spin_rad_s=None))]
+#[allow(clippy::too_many_arguments)]
+fn apply_profile<'py>(
+    py: Python<'py>,
+    profile: &Bound<'py, PyProfile>,
+    points: &Bound<'py, PyAny>,
+    rated_range_m: f64,
+    model: &str,
+    fog_mor_m: Option<f64>,
+    seed: i128,
+    frame: &str,
+    cloud_spin_rad_s: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let opts = CloudOptions {
+        rated_range_m,
+        model: model_of(model)?,
+        fog_mor_m,
+        seed: seed_of(seed)?,
+        frame: cloud_frame(frame)?,
+        cloud_spin_rad_s,
+    };
+    let certified = &profile.get().inner;
+    let mask = with_points(
+        points,
+        KeepVisitor {
+            certified,
+            opts: &opts,
+        },
+    )?;
+    mask.map(|m| PyArray1::from_vec(py, m))
+        .map_err(|e| value_error(e.to_string()))
+}
+
+/// `model=`: one return model or a list of them.
+#[derive(FromPyObject)]
+enum Models {
+    One(String),
+    Many(Vec<String>),
+}
+
+const SIM_OPTIONS: &[&str] = &[
+    "variants",
+    "fog_pct",
+    "detect",
+    "bins",
+    "preset",
+    "scenario_toml",
+    "optimizer_toml",
+];
+
+/// The paper's intersection experiment: the table rows (one dict per
+/// model × variant × fog level).
+#[pyfunction]
+#[pyo3(signature = (model=Models::One("argus".to_owned()), trials=10, seed=1, **options))]
+fn simulate<'py>(
+    py: Python<'py>,
+    model: Models,
+    trials: i64,
+    seed: i128,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let models = match model {
+        Models::One(name) => vec![model_of(&name)?],
+        Models::Many(names) => names.iter().map(|n| model_of(n)).collect::<PyResult<_>>()?,
+    };
+    if !(1..=100_000).contains(&trials) {
+        return Err(value_error(format!(
+            "trials: {trials} must lie in 1..=100000"
+        )));
+    }
+    let mut config = SimConfig {
+        models,
+        trials: trials as usize,
+        seed: seed_of(seed)?,
+        ..SimConfig::default()
+    };
+    if let Some(opts) = options {
+        for (k, v) in opts.iter() {
+            let key: String = k.extract()?;
+            let wrong = |what: &str| value_error(format!("{key}: expected {what}"));
+            match key.as_str() {
+                "variants" => {
+                    let names: Vec<String> =
+                        v.extract().map_err(|_| wrong("a list of variant names"))?;
+                    config.variants = names
+                        .iter()
+                        .map(|n| {
+                            [Variant::Baseline, Variant::Range, Variant::Resolution, Variant::Joint, Variant::Optimized]
+                                .into_iter()
+                                .find(|x| x.name() == n)
+                                .ok_or_else(|| value_error(format!(
+                                    "variants: '{n}' is not one of baseline, range, resolution, joint, optimized"
+                                )))
+                        })
+                        .collect::<PyResult<_>>()?;
+                }
+                "fog_pct" => {
+                    let levels: Vec<u32> = v
+                        .extract()
+                        .map_err(|_| wrong("a list of fog levels in %"))?;
+                    for f in &levels {
+                        if !FOG_LEVELS_PCT.contains(f) {
+                            return Err(value_error(format!(
+                                "fog_pct: {f} is not one of the paper's levels 0, 25, 50"
+                            )));
+                        }
+                    }
+                    config.fog_pcts = levels;
+                }
+                "detect" => {
+                    let s: String = v.extract().map_err(|_| wrong("'k/n'"))?;
+                    let bad =
+                        || value_error(format!("detect: '{s}' is not k/n with 1 <= k <= n <= 100"));
+                    let (k, n) = s.split_once('/').ok_or_else(bad)?;
+                    let k: u32 = k.trim().parse().map_err(|_| bad())?;
+                    let n: u32 = n.trim().parse().map_err(|_| bad())?;
+                    if k == 0 || k > n || n > 100 {
+                        return Err(bad());
+                    }
+                    config.detection = KOfN { k, n };
+                }
+                "bins" => {
+                    let b: usize = v.extract().map_err(|_| wrong("an integer"))?;
+                    config.bins = b;
+                }
+                "preset" => {
+                    let name: String = v.extract().map_err(|_| wrong("a preset name"))?;
+                    config.sensor = preset_of(&name)?;
+                }
+                "scenario_toml" => {
+                    let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
+                    config.scenario = Scenario::from_toml(&text, "scenario_toml")
+                        .map_err(|e| value_error(e.to_string()))?;
+                }
+                "optimizer_toml" => {
+                    use gaze_lidar::optimizer::OptimizerConfig;
+                    let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
+                    let problem = OptimizerConfig::from_toml(&text, "optimizer_toml")
+                        .and_then(|c| c.problem())
+                        .map_err(|e| opt_error(py, e))?;
+                    config.optimizer = Some(problem);
+                }
+                other => {
+                    return Err(value_error(format!(
+                        "{other}: unknown option (known: {})",
+                        SIM_OPTIONS.join(", ")
+                    )))
+                }
+            }
+        }
+    }
+    if config.optimizer.is_some() && !config.variants.contains(&Variant::Optimized) {
+        return Err(value_error(
+            "optimizer_toml: configures the optimized variant: add 'optimized' to variants",
+        ));
+    }
+    let result = py.detach(|| sim::run(&config, &|| {})).map_err(|e| {
+        if e.is_input_error() {
+            value_error(e.to_string())
+        } else {
+            Infeasible::new_err(e.to_string())
+        }
+    })?;
+    let json = sim::table::render_json(&result).map_err(|e| value_error(e.to_string()))?;
+    json_value(py, &json)?.get_item("rows")
+}
+
+/// The native half of `gaze_lidar`: certified profiles, the checker, the
+/// gaze stream, point-cloud filtering and the simulator (see `_native.pyi`).
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("Infeasible", py.get_type::<Infeasible>())?;
+    m.add("Rejected", py.get_type::<Rejected>())?;
+    m.add_class::<PyProfile>()?;
+    m.add_class::<Verdict>()?;
+    m.add_class::<PyFrame>()?;
+    m.add_class::<PyGazeStream>()?;
+    m.add_function(wrap_pyfunction!(profile, m)?)?;
+    m.add_function(wrap_pyfunction!(optimize, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(apply_profile, m)?)?;
+    m.add_function(wrap_pyfunction!(azimuth_deg, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add(
+        "PRESETS",
+        PyList::new(py, presets::PRESET_NAMES.iter().copied())?,
+    )?;
+    Ok(())
+}

@@ -1,0 +1,11 @@
+import pathlib
+
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="session")
+def repo():
+    """The repository root (examples/ and configs live there)."""
+    return REPO
