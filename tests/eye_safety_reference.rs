@@ -15,9 +15,13 @@
 //! `GAZE_LIDAR_REF_SEED=<u64>` picks another deterministic case stream;
 //! `GAZE_LIDAR_REF_PHASES=<n>` the number of uniformly spread clock phases.
 
+#[path = "../benches/common/big_profile.rs"]
+mod big_profile;
 mod common;
 mod reference;
 
+use gaze_lidar::eye_safety::bound::Search;
+use gaze_lidar::eye_safety::exposure::evaluate_profile_with;
 use gaze_lidar::eye_safety::{evaluate_profile, EyeSafetyParams};
 use gaze_lidar::profile::Profile;
 use proptest::prelude::*;
@@ -313,6 +317,47 @@ impl Stats {
         }
         self.max = self.max.max(q);
     }
+}
+
+/// The branch and bound (the default) against the exhaustive search over
+/// every cell and window walk: the same report, bit for bit, on random
+/// profiles of every kind the differential test draws.
+#[test]
+fn pruned_search_is_bit_identical_to_exhaustive() {
+    let mut runner = TestRunner::new(Config {
+        cases: 300,
+        ..Config::default()
+    });
+    runner
+        .run(&spec_strategy(), |spec| {
+            let p = build(&spec);
+            let params = params_of(&p);
+            let pruned = evaluate_profile_with(&p, &params, Search::Pruned);
+            let exhaustive = evaluate_profile_with(&p, &params, Search::Exhaustive);
+            match (pruned, exhaustive) {
+                (Ok(a), Ok(b)) => {
+                    prop_assert_eq!(a.worst_ratio.to_bits(), b.worst_ratio.to_bits());
+                    prop_assert_eq!(a.binding_rule, b.binding_rule);
+                    prop_assert_eq!(a, b);
+                }
+                (a, b) => prop_assert_eq!(a.err(), b.err()),
+            }
+            Ok(())
+        })
+        .unwrap();
+}
+
+/// The same on the `check` benchmark's rough workload (power ripple and
+/// in-bin acceleration on every bin), where the pruning skips almost every
+/// cell and walk.
+#[test]
+fn pruned_search_is_bit_identical_on_a_rough_5000_bin_profile() {
+    let p = big_profile::big_profile(5000, big_profile::Roughness::Rough);
+    let params = p.limits.eye_safety.clone().unwrap();
+    let a = evaluate_profile_with(&p, &params, Search::Pruned).unwrap();
+    let b = evaluate_profile_with(&p, &params, Search::Exhaustive).unwrap();
+    assert_eq!(a.worst_ratio.to_bits(), b.worst_ratio.to_bits());
+    assert_eq!(a, b);
 }
 
 #[test]

@@ -4,7 +4,6 @@ use clap::ValueEnum;
 use std::path::PathBuf;
 
 use gaze_lidar::checker::{certify_with, summarize, CheckOptions};
-use gaze_lidar::eye_safety::evaluate_profile;
 use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::profile::Profile;
 
@@ -80,18 +79,15 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     let mut out = Stdout::new();
     match certify_with(profile.clone(), &opts) {
         Ok(c) => {
-            let eye = profile
-                .limits
-                .eye_safety
-                .as_ref()
-                .and_then(|p| evaluate_profile(&profile, p).ok());
+            // The evaluation the checker certified with (not a second run).
+            let eye = c.eye_safety();
             match a.format {
                 Format::Json => {
                     let v = serde_json::json!({
                         "certified": true, "violations": [], "summary": c.summary(),
                         "eye_safety_evaluated": eye.is_some(),
                         "sensor": sensor.as_ref().map(|s| s.name.clone()),
-                        "eye_safety": eye.as_ref().map(|r| serde_json::json!({
+                        "eye_safety": eye.map(|r| serde_json::json!({
                             "worst_azimuth_deg": r.worst_azimuth_deg, "binding_rule": r.binding_rule,
                             "worst_ratio": r.worst_ratio, "margin": r.margin,
                             "stalled_rotor_ratio": r.stalled_rotor_ratio,
@@ -106,7 +102,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                         profile.bins.len(), s.average_power_angle_w, s.average_power_time_w,
                         profile.average_power_w, profile.power_accounting, s.frame_period_s, s.max_spin_accel_rad_s2.map_or("∞ (steps)".to_owned(), |a| format!("{a:.4e}"))
                     ))?;
-                    match &eye {
+                    match eye {
                         Some(r) => out.line(format_args!(
                             "eye safety: Class 1 at every azimuth; worst {:.3}° ({}), {:.1} % of the limit (margin {:.2}×)",
                             r.worst_azimuth_deg, r.binding_rule, 100.0 * r.worst_ratio, r.margin
@@ -116,7 +112,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 }
             }
             out.finish()?;
-            if let Some(r) = &eye {
+            if let Some(r) = eye {
                 if r.stalled_rotor_ratio > 1.0 {
                     warn(format_args!(
                         "warning: a stalled rotor with the laser firing reaches {:.0} % of the Class 1 limit: the product needs a stall interlock",

@@ -406,6 +406,10 @@ pub struct Rejected {
 #[serde(transparent)]
 pub struct CertifiedProfile {
     profile: Profile,
+    /// The eye-safety evaluation that certified it (`None` only when the
+    /// caller opted out of eye safety and the file has no parameters).
+    #[serde(skip)]
+    eye_safety: Option<ExposureReport>,
 }
 
 impl CertifiedProfile {
@@ -423,6 +427,14 @@ impl CertifiedProfile {
             .summary
             .as_ref()
             .expect("certify() sets the summary")
+    }
+
+    /// The eye-safety evaluation the certificate rests on (the one the
+    /// checker ran; `None` when eye safety was opted out of and the file
+    /// has no parameters).
+    #[must_use]
+    pub fn eye_safety(&self) -> Option<&ExposureReport> {
+        self.eye_safety.as_ref()
     }
 
     /// Gives the profile back (it stays certified only as long as unchanged).
@@ -695,18 +707,28 @@ fn check_limits(p: &Profile, s: &Summary, v: &mut Vec<Violation>) {
     }
 }
 
-fn check_eye_safety(p: &Profile, opts: &CheckOptions<'_>, v: &mut Vec<Violation>) {
+fn check_eye_safety(
+    p: &Profile,
+    opts: &CheckOptions<'_>,
+    v: &mut Vec<Violation>,
+) -> Option<ExposureReport> {
     let Some(params) = &p.limits.eye_safety else {
         if !opts.allow_missing_eye_safety {
             v.push(Violation::EyeSafetyMissing);
         }
-        return;
+        return None;
     };
     match eye_safety::evaluate_profile(p, params) {
-        Ok(report) => v.extend(eye_safety_violation(&report)),
-        Err(e) => v.push(Violation::EyeSafetyParams {
-            reason: e.to_string(),
-        }),
+        Ok(report) => {
+            v.extend(eye_safety_violation(&report));
+            Some(report)
+        }
+        Err(e) => {
+            v.push(Violation::EyeSafetyParams {
+                reason: e.to_string(),
+            });
+            None
+        }
     }
 }
 
@@ -869,17 +891,26 @@ pub fn check(profile: &Profile) -> Vec<Violation> {
 /// its declared limits and whatever `opts` adds.
 #[must_use]
 pub fn check_with(profile: &Profile, opts: &CheckOptions<'_>) -> Vec<Violation> {
+    check_and_evaluate(profile, opts).0
+}
+
+/// [`check_with`], keeping the eye-safety evaluation it ran.
+fn check_and_evaluate(
+    profile: &Profile,
+    opts: &CheckOptions<'_>,
+) -> (Vec<Violation>, Option<ExposureReport>) {
     let mut v = Vec::new();
     check_header(profile, &mut v);
     if let Some(sensor) = opts.sensor {
         check_against_sensor(profile, sensor, &mut v);
     }
+    let mut report = None;
     if check_structure(profile, &mut v) && !v.iter().any(is_structural) {
         let s = summarize(profile);
         check_limits(profile, &s, &mut v);
-        check_eye_safety(profile, opts, &mut v);
+        report = check_eye_safety(profile, opts, &mut v);
     }
-    v
+    (v, report)
 }
 
 /// Violations after which the profile cannot be evaluated further.
@@ -905,12 +936,15 @@ pub fn certify_with(
     mut profile: Profile,
     opts: &CheckOptions<'_>,
 ) -> Result<CertifiedProfile, Rejected> {
-    let violations = check_with(&profile, opts);
+    let (violations, eye_safety) = check_and_evaluate(&profile, opts);
     if !violations.is_empty() {
         return Err(Rejected { violations });
     }
     profile.summary = Some(summarize(&profile));
-    Ok(CertifiedProfile { profile })
+    Ok(CertifiedProfile {
+        profile,
+        eye_safety,
+    })
 }
 
 /// Certifies a profile: the only way to obtain a [`CertifiedProfile`].

@@ -34,12 +34,22 @@
 //! passes the same argument in the number of passes `q` leaves the first and
 //! last `q` of each row.
 //!
+//! **Search.** The checker finds the same supremum by branch and bound
+//! ([`Search::Pruned`]): linear sweeps give every cell's end values and a
+//! cheap upper bound of its figures, and every window walk an upper bound of
+//! its ratio; only cells and walks whose bound can still change the result
+//! are evaluated exactly. [`Search::Exhaustive`] evaluates everything and is
+//! tested bit-identical (`specs/eye_safety.md`, "Search").
+//!
 //! **Rounding.** Every count that is a floor is taken as
 //! `⌊x·(1 + 1e-9) + 1e-9⌋`, so a count that sits on an integer is taken
 //! as the larger one and a perturbation of the inputs by 1e-12 cannot
 //! lower it ([`COUNT_MARGIN`]).
 
+use std::collections::VecDeque;
+
 use super::ael::{self, Band, Row};
+use crate::profile::kinematics::{BinMotion, Timeline};
 
 /// Relative margin by which every floor-count is rounded up (see module docs).
 pub const COUNT_MARGIN: f64 = 1e-9;
@@ -48,8 +58,9 @@ pub const COUNT_MARGIN: f64 = 1e-9;
 /// float rounding in the bound can never land it below the true supremum.
 pub const RATIO_MARGIN: f64 = 1e-9;
 
-/// Envelope pieces a window walk visits before it falls back to the
-/// `P̂`-slope bound (sound, looser); bounds the work on very fine profiles.
+/// Envelope pieces a window walk visits before it continues with the slope
+/// of the hottest piece within its reach (sound, looser); bounds the work on
+/// very fine profiles.
 pub const WALK_MAX_PIECES: usize = 96;
 
 /// `⌊x⌋` rounded up when `x` is within [`COUNT_MARGIN`] of the next integer.
@@ -127,9 +138,19 @@ impl Laser {
 
     /// Rule 1 ratio for pulses (or groups) of at most `pulse_energy_j` each
     /// (one pulse; the group is applied here), with at most `per_pass`
-    /// pulses in any pass and `passes_t2` passes meeting any T2 window.
+    /// pulses in any pass and `passes_t2` passes meeting any T2 window:
+    /// `pulse_energy_j ×` [`Self::single_pulse_ratio_per_j`].
     #[must_use]
     pub fn single_pulse_ratio(&self, pulse_energy_j: f64, per_pass: f64, passes_t2: f64) -> f64 {
+        pulse_energy_j * self.single_pulse_ratio_per_j(per_pass, passes_t2)
+    }
+
+    /// Rule 1 ratio per joule of pulse energy. Nondecreasing in both counts:
+    /// C5 falls as the pulse count grows, and the `T_i` group grows with the
+    /// pulses per pass until it reaches its cap, after which the number of
+    /// groups grows.
+    #[must_use]
+    pub fn single_pulse_ratio_per_j(&self, per_pass: f64, passes_t2: f64) -> f64 {
         let t_max = ael::T2_S.min(ael::TIME_BASE_S);
         let g = self.group(per_pass);
         // C5 = 1 for pulses longer than T_i (2014 small-source rule).
@@ -141,11 +162,11 @@ impl Laser {
             }
         };
         let n_pulses = per_pass * passes_t2;
-        let single = pulse_energy_j / (c5_of(n_pulses) * self.ael_j(self.pulse_duration_s));
+        let single = 1.0 / (c5_of(n_pulses) * self.ael_j(self.pulse_duration_s));
         if g > 1.0 {
             // Greedy grouping from the first pulse: ⌈K/g⌉ groups per pass.
             let n_groups = (per_pass / g).ceil() * passes_t2;
-            let group = g * pulse_energy_j / (c5_of(n_groups) * self.ael_j(self.band.t_i_s()));
+            let group = g / (c5_of(n_groups) * self.ael_j(self.band.t_i_s()));
             single.max(group)
         } else {
             single
@@ -311,7 +332,8 @@ impl std::fmt::Display for Rule {
 }
 
 /// A bin as the bound sees it: start angle (deg), width (deg), power (W),
-/// spin² at its start (rad²/s²) and its constant angular acceleration.
+/// and the spin at its two edges (constant angular acceleration between;
+/// the kinematics are [`BinMotion`]'s, shared with profile bins).
 #[derive(Debug, Clone, Copy)]
 pub struct Seg {
     /// Start azimuth, deg.
@@ -326,100 +348,30 @@ pub struct Seg {
     pub spin_end_rad_s: f64,
 }
 
-impl Seg {
-    fn accel(&self) -> f64 {
-        (self.spin_end_rad_s.powi(2) - self.spin_start_rad_s.powi(2))
-            / (2.0 * self.width_deg.to_radians())
+impl BinMotion for Seg {
+    fn start_deg(&self) -> f64 {
+        self.start_deg
     }
-
-    fn dwell_s(&self) -> f64 {
-        2.0 * self.width_deg.to_radians() / (self.spin_start_rad_s + self.spin_end_rad_s)
+    fn width_deg(&self) -> f64 {
+        self.width_deg
     }
-
-    /// Time to advance `x_deg` into the bin (exact, constant acceleration).
-    fn time_into_s(&self, x_deg: f64) -> f64 {
-        let x = x_deg.clamp(0.0, self.width_deg).to_radians();
-        if x <= 0.0 {
-            return 0.0;
-        }
-        let w_x = (self.spin_start_rad_s.powi(2) + 2.0 * self.accel() * x)
-            .max(0.0)
-            .sqrt();
-        2.0 * x / (self.spin_start_rad_s + w_x)
+    fn spin_start_rad_s(&self) -> f64 {
+        self.spin_start_rad_s
     }
-
-    /// Angle (deg) advanced `t_s` after entering the bin.
-    fn angle_after_deg(&self, t_s: f64) -> f64 {
-        let t = t_s.clamp(0.0, self.dwell_s());
-        let x = self.spin_start_rad_s * t + 0.5 * self.accel() * t * t;
-        x.to_degrees().clamp(0.0, self.width_deg)
+    fn spin_end_rad_s(&self) -> f64 {
+        self.spin_end_rad_s
     }
-
-    /// ω² at `x_deg` into the bin as `a + b·x_deg`.
-    fn spin_sq_line(&self) -> (f64, f64) {
-        (
-            self.spin_start_rad_s.powi(2),
-            2.0 * self.accel() * std::f64::consts::PI / 180.0,
-        )
+    fn power_w(&self) -> f64 {
+        self.power_w
     }
 }
 
-/// The exact timeline of one revolution, extended periodically.
-struct Clock<'a> {
-    segs: &'a [Seg],
-    cum_s: Vec<f64>,
-    frame_s: f64,
-}
-
-impl<'a> Clock<'a> {
-    fn new(segs: &'a [Seg]) -> Self {
-        let mut cum_s = Vec::with_capacity(segs.len() + 1);
-        let mut t = 0.0;
-        cum_s.push(0.0);
-        for s in segs {
-            t += s.dwell_s();
-            cum_s.push(t);
-        }
-        Self {
-            segs,
-            cum_s,
-            frame_s: t,
-        }
-    }
-
-    /// Bin containing the wrapped azimuth `a` in `[0, 360)`.
-    fn bin_of(&self, a: f64) -> usize {
-        self.segs
-            .partition_point(|s| s.start_deg <= a)
-            .saturating_sub(1)
-            .min(self.segs.len() - 1)
-    }
-
-    /// Splits an unwrapped azimuth into (turns, bin, offset into bin in deg).
-    fn locate(&self, theta_deg: f64) -> (f64, usize, f64) {
-        let k = (theta_deg / 360.0).floor();
-        let a = theta_deg - 360.0 * k;
-        let i = self.bin_of(a);
-        (k, i, a - self.segs[i].start_deg)
-    }
-
-    /// Time at which the head reaches the unwrapped azimuth `theta_deg`.
-    fn time_at(&self, theta_deg: f64) -> f64 {
-        let (k, i, x) = self.locate(theta_deg);
-        k * self.frame_s + self.cum_s[i] + self.segs[i].time_into_s(x)
-    }
-
-    /// Unwrapped azimuth at unwrapped time `t_s`.
-    fn angle_at(&self, t_s: f64) -> f64 {
-        let k = (t_s / self.frame_s).floor();
-        let t = t_s - k * self.frame_s;
-        let i = self
-            .cum_s
-            .partition_point(|&c| c <= t)
-            .saturating_sub(1)
-            .min(self.segs.len() - 1);
-        360.0 * k + self.segs[i].start_deg + self.segs[i].angle_after_deg(t - self.cum_s[i])
-    }
+/// `ω²` at `x_deg` into `seg` as `a + b·x_deg` (linear: constant acceleration).
+fn spin_sq_line(seg: &Seg) -> (f64, f64) {
+    (
+        seg.spin_start_rad_s.powi(2),
+        2.0 * seg.accel_rad_s2() * std::f64::consts::PI / 180.0,
+    )
 }
 
 /// The max-filtered power `P̄` over one period, as pieces `[t_k, t_{k+1})`
@@ -435,10 +387,11 @@ struct Envelope {
 }
 
 impl Envelope {
-    fn new(clock: &Clock<'_>, delta_s: f64) -> Self {
-        let n = clock.segs.len();
-        let frame_s = clock.frame_s;
-        let p_max = clock.segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
+    fn new(tl: &Timeline<'_, Seg>, delta_s: f64) -> Self {
+        let segs = tl.bins();
+        let n = segs.len();
+        let frame_s = tl.period_s();
+        let p_max = segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
         if delta_s >= frame_s {
             return Self {
                 t_s: vec![0.0, frame_s],
@@ -449,11 +402,16 @@ impl Envelope {
         }
         // Candidate breakpoints: bin starts and bin starts + Δ (wrapped).
         let mut cand: Vec<f64> = Vec::with_capacity(2 * n + 1);
-        for i in 0..n {
-            cand.push(clock.cum_s[i]);
-            let s = clock.cum_s[i] + delta_s;
-            cand.push(if s >= frame_s { s - frame_s } else { s });
-        }
+        cand.extend((0..n).map(|i| tl.bin_start_time_s(i)));
+        cand.extend((0..n).map(|i| {
+            let s = tl.bin_start_time_s(i) + delta_s;
+            if s >= frame_s {
+                s - frame_s
+            } else {
+                s
+            }
+        }));
+        // Increasing runs (the second wraps once): a merge, nearly linear.
         cand.sort_by(f64::total_cmp);
         cand.dedup();
         if cand[0] > 0.0 {
@@ -461,10 +419,10 @@ impl Envelope {
         }
         // Sliding-window maximum over the unrolled bins (3 periods: bin
         // index k covers [cum(k mod n) + (k div n − 1)·T_f, ...)).
-        let start_of = |k: usize| clock.cum_s[k % n] + ((k / n) as f64 - 1.0) * frame_s;
-        let end_of = |k: usize| clock.cum_s[k % n + 1] + ((k / n) as f64 - 1.0) * frame_s;
-        let power = |k: usize| clock.segs[k % n].power_w;
-        let mut deque: std::collections::VecDeque<usize> = std::collections::VecDeque::new();
+        let start_of = |k: usize| tl.bin_start_time_s(k % n) + ((k / n) as f64 - 1.0) * frame_s;
+        let end_of = |k: usize| tl.bin_start_time_s(k % n + 1) + ((k / n) as f64 - 1.0) * frame_s;
+        let power = |k: usize| segs[k % n].power_w;
+        let mut deque: VecDeque<usize> = VecDeque::new();
         let mut next_in = 0usize; // next bin to push
         let m = cand.len();
         let mut p_w = Vec::with_capacity(m);
@@ -507,23 +465,59 @@ impl Envelope {
         self.p_w.len()
     }
 
+    /// `∫ P̄` over one period, J.
+    fn total_j(&self) -> f64 {
+        self.cum_j[self.pieces()]
+    }
+
     /// For unwrapped `t`: whole periods before it, its offset in the
     /// period, and the piece containing that offset.
     fn locate(&self, t: f64) -> (f64, f64, usize) {
+        let (k, r) = self.split(t);
+        (k, r, self.piece_of(r))
+    }
+
+    /// As [`Self::locate`], searching forward from piece `*hint` (the piece
+    /// of an earlier offset in the same period): the same piece, in amortised
+    /// constant time for increasing times.
+    fn locate_from(&self, t: f64, hint: &mut usize) -> (f64, f64, usize) {
+        let (k, r) = self.split(t);
+        let m = self.pieces();
+        let mut j = (*hint).min(m - 1);
+        if self.t_s[j] > r {
+            j = self.piece_of(r);
+        } else {
+            while j + 1 < m && self.t_s[j + 1] <= r {
+                j += 1;
+            }
+        }
+        *hint = j;
+        (k, r, j)
+    }
+
+    fn split(&self, t: f64) -> (f64, f64) {
+        if (0.0..self.frame_s).contains(&t) {
+            // The common case, without a call to `floor` (same result).
+            return (0.0, t);
+        }
         let k = (t / self.frame_s).floor();
-        let r = t - k * self.frame_s;
-        let j = self
-            .t_s
+        (k, t - k * self.frame_s)
+    }
+
+    fn piece_of(&self, r: f64) -> usize {
+        self.t_s
             .partition_point(|&c| c <= r)
             .saturating_sub(1)
-            .min(self.pieces() - 1);
-        (k, r, j)
+            .min(self.pieces() - 1)
+    }
+
+    fn integral_at(&self, (k, r, j): (f64, f64, usize)) -> f64 {
+        k * self.total_j() + self.cum_j[j] + self.p_w[j] * (r - self.t_s[j])
     }
 
     /// `∫₀^t P̄` for unwrapped `t`.
     fn integral_to(&self, t: f64) -> f64 {
-        let (k, r, j) = self.locate(t);
-        k * self.cum_j[self.pieces()] + self.cum_j[j] + self.p_w[j] * (r - self.t_s[j])
+        self.integral_at(self.locate(t))
     }
 
     /// `P̄` on the piece containing unwrapped `t`.
@@ -538,9 +532,63 @@ impl Envelope {
         self.t_s[idx.rem_euclid(m) as usize] + k as f64 * self.frame_s
     }
 
+    /// Unwrapped index of the piece containing unwrapped `t`.
+    fn unwrapped_piece(&self, t: f64, hint: &mut usize) -> i64 {
+        let (k, _, j) = self.locate_from(t, hint);
+        k as i64 * self.pieces() as i64 + j as i64
+    }
+
     fn p_of(&self, idx: i64) -> f64 {
         self.p_w[idx.rem_euclid(self.pieces() as i64) as usize]
     }
+}
+
+/// Maximum of a periodic sequence over index windows `[lo, hi]` whose ends
+/// never decrease from one query to the next (monotone deque): amortised
+/// constant time per query.
+struct SlidingMax {
+    deque: VecDeque<i64>,
+    next: Option<i64>,
+}
+
+impl SlidingMax {
+    fn new() -> Self {
+        Self {
+            deque: VecDeque::new(),
+            next: None,
+        }
+    }
+
+    /// `max value(k)` for `k` in `[lo, hi]` (`lo ≤ hi`; both ends at least
+    /// those of the previous query).
+    fn max_over(&mut self, lo: i64, hi: i64, value: impl Fn(i64) -> f64) -> f64 {
+        while self.deque.front().is_some_and(|&k| k < lo) {
+            self.deque.pop_front();
+        }
+        let mut next = self.next.map_or(lo, |n| n.max(lo));
+        while next <= hi {
+            let v = value(next);
+            while self.deque.back().is_some_and(|&k| value(k) <= v) {
+                self.deque.pop_back();
+            }
+            self.deque.push_back(next);
+            next += 1;
+        }
+        self.next = Some(next);
+        self.deque.front().map_or(0.0, |&k| value(k))
+    }
+}
+
+/// Which cells and window walks [`evaluate_with`] evaluates exactly.
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Search {
+    /// Branch and bound: a cell or walk is evaluated only while its cheap
+    /// upper bound could still change the result (the default).
+    Pruned,
+    /// Every cell and every walk (the reference the pruned search is
+    /// tested bit-identical against).
+    Exhaustive,
 }
 
 /// The result of the bound.
@@ -565,114 +613,44 @@ pub struct Bound {
     pub worst_window_s: f64,
 }
 
+/// Slack, relative to a turn's time or envelope energy, added to the cheap
+/// bounds of float differences (times, envelope integrals) so they stay
+/// above the exact evaluation's rounding (a few units in the last place of
+/// those totals).
+const PRUNE_SLACK: f64 = 1e-12;
+
 /// Evaluates the bound for bins `segs` (validated: cover [0, 360) in order,
 /// positive spins), half pass angle `half_deg`, and `laser`.
 #[must_use]
 pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
-    let clock = Clock::new(segs);
-    let n = segs.len();
+    evaluate_with(segs, half_deg, laser, Search::Pruned)
+}
+
+/// [`evaluate`] with a choice of search; both searches return bit-identical
+/// results (the pruned one skips only what provably cannot change them).
+#[doc(hidden)]
+#[must_use]
+pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search) -> Bound {
+    let tl = Timeline::from_bins(segs);
     let delta = 1.0 / laser.pulse_rate_hz;
-    let frame_s = clock.frame_s;
-    let env = Envelope::new(&clock, delta);
-    let h = half_deg.min(180.0);
+    let frame_s = tl.period_s();
+    let env = Envelope::new(&tl, delta);
     let p_hat = segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
-
-    // φ-cells: azimuths where a pass edge, or a pass edge shifted by Δ in
-    // time, meets a bin edge.
-    let mut cuts: Vec<f64> = Vec::with_capacity(4 * n + 1);
-    let wrap = |a: f64| {
-        let w = a.rem_euclid(360.0);
-        if w >= 360.0 {
-            0.0
-        } else {
-            w
-        }
-    };
-    for (seg, &t) in segs.iter().zip(&clock.cum_s) {
-        let a = seg.start_deg;
-        cuts.push(wrap(a + h));
-        cuts.push(wrap(a - h));
-        cuts.push(wrap(clock.angle_at(t + delta) + h));
-        cuts.push(wrap(clock.angle_at(t + frame_s - delta) - h));
-    }
-    cuts.sort_by(f64::total_cmp);
-    cuts.dedup();
-    let tau = |phi: f64| clock.time_at(phi + h) - clock.time_at(phi - h);
-    let energy = |phi: f64| {
-        env.integral_to(clock.time_at(phi + h) + delta) - env.integral_to(clock.time_at(phi - h))
-    };
-    let passes_t2 = |tau_s: f64| passes_in_window(ael::T2_S.min(ael::TIME_BASE_S), tau_s, frame_s);
-
-    let mut single = (0.0f64, 0.0f64); // (ratio, azimuth)
-    let mut e_max = (0.0f64, 0.0f64); // (energy, azimuth)
-    let mut tau_max = 0.0f64;
-    let m = cuts.len();
-    for c in 0..m {
-        let u = cuts[c];
-        let v = if c + 1 < m {
-            cuts[c + 1]
-        } else {
-            cuts[0] + 360.0
-        };
-        // Stationary points of τ and E inside (u, v).
-        let mid = 0.5 * (u + v);
-        let (_, jr, _) = clock.locate(mid + h);
-        let (_, jl, _) = clock.locate(mid - h);
-        let (ar, br) = segs[jr].spin_sq_line();
-        let (al, bl) = segs[jl].spin_sq_line();
-        // ω²(φ ± h) as a + b·φ.
-        let right = (
-            ar + br * (mid + h - anchor(&clock, mid + h, jr)) - br * mid,
-            br,
-        );
-        let left = (
-            al + bl * (mid - h - anchor(&clock, mid - h, jl)) - bl * mid,
-            bl,
-        );
-        let pr = env.power_at(clock.time_at(mid + h) + delta);
-        let pl = env.power_at(clock.time_at(mid - h));
-        let mut pts = vec![u, v];
-        for (wr, wl) in [(1.0, 1.0), (pr, pl)] {
-            // wr²·ω²(φ − h) = wl²·ω²(φ + h)
-            let den = wr * wr * left.1 - wl * wl * right.1;
-            if den != 0.0 {
-                let phi = (wl * wl * right.0 - wr * wr * left.0) / den;
-                if phi > u && phi < v {
-                    pts.push(phi);
-                }
-            }
-        }
-        let mut cell_tau = 0.0f64;
-        let mut cell_e = (0.0f64, u);
-        for &phi in &pts {
-            cell_tau = cell_tau.max(tau(phi));
-            let e = energy(phi);
-            if e > cell_e.0 {
-                cell_e = (e, phi);
-            }
-        }
-        tau_max = tau_max.max(cell_tau);
-        // Rule 1 on the cell: the hottest bin touching the closed union arc.
-        let p_cell = max_power_touching(&clock, u - h, v + h);
-        let per_pass = max_pulses_in(cell_tau, laser.pulse_rate_hz);
-        // A pass also holds at most `per_pass` pulses of at most `p_cell·Δ`.
-        let e_cell = cell_e.0.min(per_pass * p_cell * delta);
-        if e_cell > e_max.0 {
-            e_max = (e_cell, wrap(cell_e.1));
-        }
-        let r = laser.single_pulse_ratio(p_cell * delta, per_pass, passes_t2(cell_tau));
-        if r > single.0 {
-            single = (r, wrap(mid));
-        }
-    }
+    let cells = Cells::new(&tl, &env, half_deg.min(180.0), laser);
+    let best = cells.search(search);
 
     // Rule 2 within one revolution: window walks over envelope breakpoints.
-    let (pass_ratio, pass_window) =
-        within_pass(&env, laser, e_max.0, p_hat, (tau_max + delta).min(frame_s));
+    let walks = Walks {
+        env: &env,
+        laser,
+        e_pass: best.e_max.0,
+        l_max: (best.tau_max + delta).min(frame_s),
+    };
+    let (pass_ratio, pass_window) = walks.search(search);
     // Rule 2 over several passes, up to the time base.
-    let (multi_ratio, multi_window) = laser.multi_pass_ratio(frame_s, e_max.0, p_hat);
+    let (multi_ratio, multi_window) = laser.multi_pass_ratio(frame_s, best.e_max.0, p_hat);
     let multi_rule = Rule::for_duration(multi_window, frame_s);
-    let mut ratios = [single.0, pass_ratio, 0.0, 0.0];
+    let mut ratios = [best.single.0, pass_ratio, 0.0, 0.0];
     match multi_rule {
         Rule::TimeBase => ratios[3] = multi_ratio,
         _ => ratios[2] = multi_ratio,
@@ -681,7 +659,7 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
     let tb = ael::TIME_BASE_S;
     let l = tb + delta;
     let q = (l / frame_s).floor();
-    let e_tb = q * e_max.0 + e_max.0.min(p_hat * (l - q * frame_s));
+    let e_tb = q * best.e_max.0 + best.e_max.0.min(p_hat * (l - q * frame_s));
     ratios[3] = ratios[3].max(e_tb / laser.ael_j(tb));
     for r in &mut ratios {
         *r *= 1.0 + RATIO_MARGIN;
@@ -701,11 +679,15 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
     Bound {
         worst_ratio: r_best,
         binding_rule: rules[k_best],
-        worst_azimuth_deg: if k_best == 0 { single.1 } else { e_max.1 },
+        worst_azimuth_deg: if k_best == 0 {
+            best.single.1
+        } else {
+            best.e_max.1
+        },
         ratios,
-        max_pass_duration_s: tau_max,
-        max_pulses_per_pass: max_pulses_in(tau_max, laser.pulse_rate_hz),
-        max_pass_energy_j: e_max.0,
+        max_pass_duration_s: best.tau_max,
+        max_pulses_per_pass: max_pulses_in(best.tau_max, laser.pulse_rate_hz),
+        max_pass_energy_j: best.e_max.0,
         worst_window_s: if k_best == 1 {
             pass_window
         } else {
@@ -714,101 +696,569 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
     }
 }
 
-/// Azimuth of the start of bin `j` on the same turn as `theta`.
-fn anchor(clock: &Clock<'_>, theta: f64, j: usize) -> f64 {
-    let (k, _, _) = clock.locate(theta);
-    360.0 * k + clock.segs[j].start_deg
-}
-
-/// Highest power of the bins meeting the closed unwrapped arc `[lo, hi]`
-/// (bins touched at an edge included, within 1e-9°).
-fn max_power_touching(clock: &Clock<'_>, lo: f64, hi: f64) -> f64 {
-    let snap = 1e-9;
-    let n = clock.segs.len();
-    let (k, mut i, _) = clock.locate(lo - snap);
-    let mut pos = 360.0 * k + clock.segs[i].start_deg;
-    let mut p = 0.0f64;
-    for _ in 0..=n {
-        p = p.max(clock.segs[i].power_w);
-        pos += clock.segs[i].width_deg;
-        if pos > hi + snap {
-            break;
-        }
-        i = if i + 1 == n { 0 } else { i + 1 };
+/// `a` wrapped into `[0, 360)`.
+fn wrap360(a: f64) -> f64 {
+    let w = a.rem_euclid(360.0);
+    if w >= 360.0 {
+        0.0
+    } else {
+        w
     }
-    p
 }
 
-/// Rule 2 for windows shorter than one revolution: the supremum of
-/// `min(E⁺, ∫ P̄ over L)/AEL(T)`, `T = L − Δ`, over window starts at envelope
-/// up-steps and window ends at down-steps (where the best placement of a
-/// fixed-length window lies; one walk from the first breakpoint covers a
-/// constant envelope), walking breakpoint to breakpoint up to `l_max` (a
-/// pass plus one pulse spacing). Beyond the pass energy `E⁺` or `l_max`
-/// the energy is at most `E⁺`.
-fn within_pass(env: &Envelope, laser: &Laser, e_pass: f64, p_hat: f64, l_max: f64) -> (f64, f64) {
-    let delta = 1.0 / laser.pulse_rate_hz;
-    let frame_s = env.frame_s;
-    let t_end = (frame_s - delta).max(0.0);
-    let m = env.pieces() as i64;
-    let mut best = (0.0f64, 0.0f64);
-    let mut truncated_at = f64::INFINITY;
-    let mut take = |r: (f64, f64)| {
-        if r.0 > best.0 {
-            best = r;
-        }
-    };
-    for i in 0..m {
-        let up = env.p_of(i) > env.p_of(i - 1);
-        let down = env.p_of(i) < env.p_of(i - 1);
-        let mut dirs: Vec<i64> = Vec::with_capacity(2);
-        if up || i == 0 {
-            dirs.push(1);
-        }
-        if down {
-            dirs.push(-1);
-        }
-        for dir in dirs {
-            let b0 = env.bp(i);
-            let (mut e, mut l, mut steps, mut idx) = (0.0f64, 0.0f64, 0usize, i);
-            loop {
-                let (next_idx, piece_p) = if dir > 0 {
-                    (idx + 1, env.p_of(idx))
-                } else {
-                    (idx - 1, env.p_of(idx - 1))
+/// Snap (deg) by which the arc a cell's pulses can come from is widened, so
+/// bins touched at an edge count.
+const TOUCH_SNAP_DEG: f64 = 1e-9;
+
+/// One cell's exact figures.
+#[derive(Debug, Clone, Copy)]
+struct CellExact {
+    /// Largest pass duration over the cell, s.
+    tau_s: f64,
+    /// Largest pass energy (envelope and pulse-count bounds), J, and the
+    /// azimuth (wrapped) where the envelope bound peaks.
+    e: (f64, f64),
+    /// Rule 1 ratio of the cell (before the margin).
+    single: f64,
+}
+
+/// The azimuth cells between consecutive breakpoints. One sweep in azimuth
+/// order gives, per cell, the hottest bin touching its union arc, `τ` and
+/// `E` at its ends, whether `τ` or `E` can have a stationary point inside
+/// (a pass edge in a bin with angular acceleration), and a cheap upper bound
+/// of each figure for the branch and bound.
+struct Cells<'a> {
+    tl: &'a Timeline<'a, Seg>,
+    env: &'a Envelope,
+    laser: &'a Laser,
+    h: f64,
+    delta: f64,
+    cuts: Vec<f64>,
+    /// `τ` and `E` at each cut, `[0, len]`.
+    tau_pt: Vec<f64>,
+    e_pt: Vec<f64>,
+    /// Highest power of the bins touching each cell's union arc, W.
+    p_cell: Vec<f64>,
+    /// Whether a pass edge crosses a bin with angular acceleration.
+    curved: Vec<bool>,
+    /// Upper bounds of each cell's `tau_s`, `e.0` and `single` (the exact
+    /// figures for cells that are not curved).
+    tau_ub: Vec<f64>,
+    e_ub: Vec<f64>,
+    single_ub: Vec<f64>,
+    per_j: PerJouleCache,
+}
+
+/// The three maxima over cells: Rule 1 (ratio, azimuth), pass energy
+/// (J, azimuth), pass duration (s).
+struct CellBest {
+    single: (f64, f64),
+    e_max: (f64, f64),
+    tau_max: f64,
+}
+
+impl<'a> Cells<'a> {
+    fn new(tl: &'a Timeline<'a, Seg>, env: &'a Envelope, h: f64, laser: &'a Laser) -> Self {
+        let segs = tl.bins();
+        let n = segs.len();
+        let delta = 1.0 / laser.pulse_rate_hz;
+        let frame_s = tl.period_s();
+        // φ-cells: azimuths where a pass edge, or a pass edge shifted by Δ in
+        // time, meets a bin edge.
+        let mut cuts: Vec<f64> = Vec::with_capacity(4 * n + 1);
+        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg + h)));
+        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg - h)));
+        let mut hint = 0;
+        cuts.extend((0..n).map(|i| {
+            let t = tl.bin_start_time_s(i) + delta;
+            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) + h)
+        }));
+        let mut hint = 0;
+        cuts.extend((0..n).map(|i| {
+            let t = tl.bin_start_time_s(i) + frame_s - delta;
+            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) - h)
+        }));
+        // Four runs, each increasing but for one wrap: a merge, nearly linear.
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let m = cuts.len();
+        let mut cells = Self {
+            tl,
+            env,
+            laser,
+            h,
+            delta,
+            cuts,
+            tau_pt: Vec::with_capacity(m + 1),
+            e_pt: Vec::with_capacity(m + 1),
+            p_cell: Vec::with_capacity(m),
+            curved: Vec::with_capacity(m),
+            tau_ub: Vec::with_capacity(m),
+            e_ub: Vec::with_capacity(m),
+            single_ub: Vec::with_capacity(m),
+            per_j: PerJouleCache::default(),
+        };
+        cells.sweep();
+        cells
+    }
+
+    fn len(&self) -> usize {
+        self.cuts.len()
+    }
+
+    /// Cut `c` for `c` in `[0, len]`, the last one a turn after the first.
+    fn cut(&self, c: usize) -> f64 {
+        cut_of(&self.cuts, c)
+    }
+
+    /// The sweep (all positions nondecrease with the cell, so every lookup
+    /// is a forward step: linear time overall). A cell whose pass edges both
+    /// cross bins of constant spin has its exact figures here (at its ends).
+    /// Otherwise (curved), over `φ ∈ [u, v]`:
+    /// `dτ/dφ = 1/ω(φ + h) − 1/ω(φ − h)` and
+    /// `dE/dφ = P̄_r/ω(φ + h) − P̄_l/ω(φ − h)`, with the envelope pieces
+    /// `P̄_r`, `P̄_l` fixed over the cell and `ω` monotone along each edge's
+    /// bin (`ω²` is linear there), so each figure exceeds the larger of its
+    /// end values by at most the cell width times the smaller of its
+    /// largest forward and backward slopes: the bounds. Rule 1 grows with
+    /// the pulse and pass counts (C5 falls with the count).
+    fn sweep(&mut self) {
+        let tl = self.tl;
+        let env = self.env;
+        let segs = tl.bins();
+        let n = segs.len() as i64;
+        let (h, delta) = (self.h, self.delta);
+        let frame_s = tl.period_s();
+        let f_p = self.laser.pulse_rate_hz;
+        let t2 = ael::T2_S.min(ael::TIME_BASE_S);
+        let e_slack = PRUNE_SLACK * env.total_j();
+        let t_slack = PRUNE_SLACK * frame_s;
+        let mut window = SlidingMax::new();
+        let mut hints = [0usize; 8];
+        // Times of the pass edges at cut `c`, envelope integrals there and
+        // the envelope's power at each edge.
+        let cuts = &self.cuts;
+        let at_cut = |c: usize, hints: &mut [usize; 8]| {
+            let [h0, h1, h2, h3, ..] = hints;
+            let theta = cut_of(cuts, c);
+            let t_lo = tl.time_at_unwrapped_from_s(theta - h, h0);
+            let t_hi = tl.time_at_unwrapped_from_s(theta + h, h1);
+            let at_lo = env.locate_from(t_lo, h2);
+            let at_hi = env.locate_from(t_hi + delta, h3);
+            (
+                t_lo,
+                t_hi,
+                env.integral_at(at_lo),
+                env.integral_at(at_hi),
+                env.p_w[at_lo.2],
+                env.p_w[at_hi.2],
+            )
+        };
+        let mut prev = at_cut(0, &mut hints);
+        self.tau_pt.push(prev.1 - prev.0);
+        self.e_pt.push(prev.3 - prev.2);
+        for c in 0..cuts.len() {
+            let next = at_cut(c + 1, &mut hints);
+            self.tau_pt.push(next.1 - next.0);
+            self.e_pt.push(next.3 - next.2);
+            let (u, v) = (cut_of(cuts, c), cut_of(cuts, c + 1));
+            let [.., h4, h5, h6, h7] = &mut hints;
+            let lo = unwrapped_bin(tl, u - h - TOUCH_SNAP_DEG, h4);
+            let hi = unwrapped_bin(tl, v + h + TOUCH_SNAP_DEG, h5);
+            let p = window.max_over(lo, hi.max(lo), |k| segs[k.rem_euclid(n) as usize].power_w);
+            let mid = 0.5 * (u + v);
+            let right = tl.locate_unwrapped_from(mid + h, h6);
+            let left = tl.locate_unwrapped_from(mid - h, h7);
+            let (seg_r, seg_l) = (&segs[right.1], &segs[left.1]);
+            let curved = spin_sq_line(seg_r).1 != 0.0 || spin_sq_line(seg_l).1 != 0.0;
+            self.p_cell.push(p);
+            self.curved.push(curved);
+            let ends = ends(cuts, &self.tau_pt, &self.e_pt, c);
+            let (tau, e) = if curved {
+                // ω at both ends of each edge's arc, on that edge's bin.
+                let spin = |seg: &Seg, k: f64, theta: f64| {
+                    let (a, b) = spin_sq_line(seg);
+                    let x = (theta - (360.0 * k + seg.start_deg)).clamp(0.0, seg.width_deg);
+                    (a + b * x).max(0.0).sqrt()
                 };
-                let seg_end = (env.bp(next_idx) - b0).abs().min(l_max);
-                if seg_end > delta {
-                    let l0 = l.max(delta);
-                    let e0 = e + piece_p * (l0 - l);
-                    take(laser.linear_capped_max(l0 - delta, seg_end - delta, e0, piece_p, e_pass));
+                let (wr_u, wr_v) = (spin(seg_r, right.0, u + h), spin(seg_r, right.0, v + h));
+                let (wl_u, wl_v) = (spin(seg_l, left.0, u - h), spin(seg_l, left.0, v - h));
+                let (wr_min, wr_max) = (wr_u.min(wr_v), wr_u.max(wr_v));
+                let (wl_min, wl_max) = (wl_u.min(wl_v), wl_u.max(wl_v));
+                let (pr_min, pr_max) = (prev.5.min(next.5), prev.5.max(next.5));
+                let (pl_min, pl_max) = (prev.4.min(next.4), prev.4.max(next.4));
+                let width_rad = (v - u).to_radians();
+                let rise = |fwd: f64, back: f64| width_rad * fwd.max(0.0).min(back.max(0.0));
+                let tau = ends.tau_s
+                    + rise(1.0 / wr_min - 1.0 / wl_max, 1.0 / wl_min - 1.0 / wr_max)
+                    + t_slack;
+                let e = ends.e.0
+                    + rise(
+                        pr_max / wr_min - pl_min / wl_max,
+                        pl_max / wl_min - pr_min / wr_max,
+                    )
+                    + e_slack;
+                (tau, e)
+            } else {
+                (ends.tau_s, ends.e.0)
+            };
+            let per_pass = max_pulses_in(tau, f_p);
+            let passes = passes_in_window(t2, tau, frame_s);
+            self.tau_ub.push(tau);
+            self.e_ub.push(e.min(per_pass * p * delta));
+            let per_j = self.per_j.get(self.laser, per_pass, passes);
+            self.single_ub.push(p * delta * per_j);
+            prev = next;
+        }
+    }
+
+    /// Unwrapped time of the head at unwrapped azimuth `theta`.
+    fn time_at(&self, theta: f64) -> f64 {
+        self.tl.time_at_unwrapped_s(theta)
+    }
+
+    /// `ω²(φ + off)` over the cell containing `mid + off`, as `a + b·φ`.
+    fn spin_sq_at(&self, mid: f64, off: f64) -> (f64, f64) {
+        let (k, j, _) = self.tl.locate_unwrapped(mid + off);
+        let seg = &self.tl.bins()[j];
+        let (a, b) = spin_sq_line(seg);
+        let anchor = 360.0 * k + seg.start_deg;
+        (a + b * (off - anchor), b)
+    }
+
+    /// The exact figures of cell `c`: `τ` and `E` at the cell ends and at
+    /// their stationary points inside (see the module docs), the pulse count
+    /// from the cell's largest `τ`, and Rule 1.
+    fn exact(&self, c: usize) -> CellExact {
+        let (u, v) = (self.cut(c), self.cut(c + 1));
+        let CellExact {
+            tau_s: mut cell_tau,
+            e: mut cell_e,
+            ..
+        } = ends(&self.cuts, &self.tau_pt, &self.e_pt, c);
+        if self.curved[c] {
+            let mid = 0.5 * (u + v);
+            let right = self.spin_sq_at(mid, self.h);
+            let left = self.spin_sq_at(mid, -self.h);
+            let pr = self.env.power_at(self.time_at(mid + self.h) + self.delta);
+            let pl = self.env.power_at(self.time_at(mid - self.h));
+            for (wr, wl) in [(1.0, 1.0), (pr, pl)] {
+                // wr²·ω²(φ − h) = wl²·ω²(φ + h)
+                let den = wr * wr * left.1 - wl * wl * right.1;
+                if den != 0.0 {
+                    let phi = (wl * wl * right.0 - wr * wr * left.0) / den;
+                    if phi > u && phi < v {
+                        let t_lo = self.time_at(phi - self.h);
+                        let t_hi = self.time_at(phi + self.h);
+                        cell_tau = cell_tau.max(t_hi - t_lo);
+                        let e =
+                            self.env.integral_to(t_hi + self.delta) - self.env.integral_to(t_lo);
+                        if e > cell_e.0 {
+                            cell_e = (e, phi);
+                        }
+                    }
                 }
-                e += piece_p * (seg_end - l);
-                l = seg_end;
-                steps += 1;
-                if e >= e_pass || l >= l_max {
-                    // From here on the window holds at most E⁺.
-                    let t_c = if e >= e_pass && piece_p > 0.0 {
-                        (l - (e - e_pass) / piece_p - delta).max(0.0)
-                    } else {
-                        (l - delta).max(0.0)
-                    };
-                    take(laser.linear_capped_max(t_c, t_end.max(t_c), e_pass, 0.0, e_pass));
-                    break;
+            }
+        }
+        let p = self.p_cell[c];
+        let per_pass = max_pulses_in(cell_tau, self.laser.pulse_rate_hz);
+        let passes = passes_in_window(
+            ael::T2_S.min(ael::TIME_BASE_S),
+            cell_tau,
+            self.tl.period_s(),
+        );
+        CellExact {
+            tau_s: cell_tau,
+            // A pass also holds at most `per_pass` pulses of at most `p·Δ`.
+            e: (cell_e.0.min(per_pass * p * self.delta), wrap360(cell_e.1)),
+            single: p * self.delta * self.per_j.peek(self.laser, per_pass, passes),
+        }
+    }
+
+    /// The three maxima, each with the first cell (in azimuth order)
+    /// attaining it.
+    fn search(&self, search: Search) -> CellBest {
+        let mid_of = |c: usize| wrap360(0.5 * (self.cut(c) + self.cut(c + 1)));
+        match search {
+            Search::Exhaustive => {
+                let mut best = CellBest {
+                    single: (0.0, 0.0),
+                    e_max: (0.0, 0.0),
+                    tau_max: 0.0,
+                };
+                for c in 0..self.len() {
+                    let x = self.exact(c);
+                    best.tau_max = best.tau_max.max(x.tau_s);
+                    if x.e.0 > best.e_max.0 {
+                        best.e_max = x.e;
+                    }
+                    if x.single > best.single.0 {
+                        best.single = (x.single, mid_of(c));
+                    }
                 }
-                if steps >= WALK_MAX_PIECES {
-                    truncated_at = truncated_at.min((l - delta).max(0.0));
-                    break;
+                best
+            }
+            Search::Pruned => {
+                let done = std::cell::RefCell::new(std::collections::HashMap::new());
+                let eval = |c: usize| *done.borrow_mut().entry(c).or_insert_with(|| self.exact(c));
+                let single = first_max(&self.single_ub, |c| eval(c).single);
+                let e = first_max(&self.e_ub, |c| eval(c).e.0);
+                let tau = first_max(&self.tau_ub, |c| eval(c).tau_s);
+                CellBest {
+                    single: single.map_or((0.0, 0.0), |(r, c)| (r, mid_of(c))),
+                    e_max: e.map_or((0.0, 0.0), |(e, c)| (e, eval(c).e.1)),
+                    tau_max: tau.map_or(0.0, |x| x.0),
                 }
-                idx = next_idx;
             }
         }
     }
-    if truncated_at.is_finite() {
-        // Beyond a truncated walk: the slope bound min(E⁺, P̂·L) over all
-        // longer windows (sound, looser).
-        let t0 = truncated_at;
-        take(laser.linear_capped_max(t0, t_end.max(t0), p_hat * (t0 + delta), p_hat, e_pass));
+}
+
+/// Unwrapped index (`turn·n + bin`) of the bin holding unwrapped `theta`.
+fn unwrapped_bin(tl: &Timeline<'_, Seg>, theta: f64, hint: &mut usize) -> i64 {
+    let (k, i, _) = tl.locate_unwrapped_from(theta, hint);
+    k as i64 * tl.bins().len() as i64 + i as i64
+}
+
+/// Cut `c` for `c` in `[0, len]`, the last one a turn after the first.
+fn cut_of(cuts: &[f64], c: usize) -> f64 {
+    let m = cuts.len();
+    if c < m {
+        cuts[c]
+    } else {
+        cuts[c - m] + 360.0
     }
-    best
+}
+
+/// `τ` and the envelope `E` (with its azimuth, the first maximum) over the
+/// two ends of cell `c`, from their values at the cuts.
+fn ends(cuts: &[f64], tau_pt: &[f64], e_pt: &[f64], c: usize) -> CellExact {
+    let mut tau = 0.0f64;
+    let mut e = (0.0f64, cut_of(cuts, c));
+    for k in [c, c + 1] {
+        tau = tau.max(tau_pt[k]);
+        if e_pt[k] > e.0 {
+            e = (e_pt[k], cut_of(cuts, k));
+        }
+    }
+    CellExact {
+        tau_s: tau,
+        e,
+        single: 0.0,
+    }
+}
+
+/// Branch and bound for the largest positive `exact(c)` and the first cell
+/// attaining it, given `ub[c] ≥ exact(c)` for every cell (`None` if nothing
+/// is positive): cells are evaluated in decreasing order of their bound
+/// (ties by index) until the next bound can neither exceed the best value
+/// nor tie it at a smaller index.
+fn first_max(ub: &[f64], mut exact: impl FnMut(usize) -> f64) -> Option<(f64, usize)> {
+    let top = (0..ub.len()).max_by(|&a, &b| ub[a].total_cmp(&ub[b]).then(b.cmp(&a)))?;
+    let mut best = (exact(top), top);
+    let beats = |x: f64, c: usize, best: (f64, usize)| x > best.0 || (x == best.0 && c < best.1);
+    let mut order: Vec<usize> = (0..ub.len()).filter(|&c| beats(ub[c], c, best)).collect();
+    order.sort_unstable_by(|&a, &b| ub[b].total_cmp(&ub[a]).then(a.cmp(&b)));
+    for c in order {
+        if !beats(ub[c], c, best) {
+            break;
+        }
+        let x = exact(c);
+        if beats(x, c, best) {
+            best = (x, c);
+        }
+    }
+    (best.0 > 0.0).then_some(best)
+}
+
+/// [`Laser::single_pulse_ratio_per_j`] for the few distinct (pulse count,
+/// pass count) pairs a profile has (a memo: the same value as a fresh call).
+#[derive(Default)]
+struct PerJouleCache {
+    last: Option<((f64, f64), f64)>,
+    map: std::collections::HashMap<(u64, u64), f64>,
+}
+
+impl PerJouleCache {
+    fn get(&mut self, laser: &Laser, per_pass: f64, passes: f64) -> f64 {
+        if let Some((key, v)) = self.last {
+            if key == (per_pass, passes) {
+                return v;
+            }
+        }
+        let v = *self
+            .map
+            .entry((per_pass.to_bits(), passes.to_bits()))
+            .or_insert_with(|| laser.single_pulse_ratio_per_j(per_pass, passes));
+        self.last = Some(((per_pass, passes), v));
+        v
+    }
+
+    /// As [`Self::get`] without memoizing a new pair.
+    fn peek(&self, laser: &Laser, per_pass: f64, passes: f64) -> f64 {
+        self.map
+            .get(&(per_pass.to_bits(), passes.to_bits()))
+            .copied()
+            .unwrap_or_else(|| laser.single_pulse_ratio_per_j(per_pass, passes))
+    }
+}
+
+/// The best (ratio, window duration) seen: larger ratio, ties to the
+/// shorter window, so the result does not depend on evaluation order.
+#[derive(Debug, Clone, Copy)]
+struct Best(f64, f64);
+
+impl Best {
+    fn take(&mut self, (r, t): (f64, f64)) {
+        if r > self.0 || (r == self.0 && t < self.1) {
+            *self = Self(r, t);
+        }
+    }
+}
+
+/// Rule 2 for windows shorter than one revolution (see [`Walks::search`]).
+struct Walks<'a> {
+    env: &'a Envelope,
+    laser: &'a Laser,
+    /// The largest pass energy `E⁺`, J.
+    e_pass: f64,
+    /// Longest window a walk follows: a pass plus one pulse spacing, s.
+    l_max: f64,
+}
+
+impl Walks<'_> {
+    /// The supremum of `min(E⁺, ∫ P̄ over L)/AEL(T)`, `T = L − Δ`, over
+    /// windows shorter than a turn: window starts at envelope up-steps and
+    /// window ends at down-steps (where the best placement of a
+    /// fixed-length window lies; one walk from the first breakpoint covers a
+    /// constant envelope), walking breakpoint to breakpoint up to `l_max`.
+    /// Windows of `l_max` or more hold at most `E⁺`.
+    ///
+    /// Pruned: a walk's windows hold at most `min(E⁺, p·L)` with `p` the
+    /// highest `P̄` it can reach within `l_max`, so its ratio is at most
+    /// `G(p) = sup_T min(E⁺, p·(T + Δ))/AEL(T)`, nondecreasing in `p`; walks
+    /// are followed in decreasing `p` until `G(p)` falls below the best.
+    fn search(&self, search: Search) -> (f64, f64) {
+        let env = self.env;
+        let laser = self.laser;
+        let delta = 1.0 / laser.pulse_rate_hz;
+        let t_end = (env.frame_s - delta).max(0.0);
+        let t_walk = self.l_max - delta;
+        let mut best = Best(0.0, 0.0);
+        // Windows of at least `l_max` (and shorter than a turn).
+        let t0 = t_walk.max(0.0);
+        best.take(laser.linear_capped_max(t0, t_end.max(t0), self.e_pass, 0.0, self.e_pass));
+        if t_walk <= 0.0 {
+            return (best.0, best.1);
+        }
+        let walks = self.walks();
+        match search {
+            Search::Exhaustive => {
+                for &(i, dir, p_span) in &walks {
+                    self.walk(i, dir, p_span, &mut best);
+                }
+            }
+            Search::Pruned => {
+                let mut order: Vec<usize> = (0..walks.len()).collect();
+                order.sort_unstable_by(|&a, &b| walks[b].2.total_cmp(&walks[a].2).then(a.cmp(&b)));
+                let mut g = (f64::NAN, 0.0);
+                for k in order {
+                    let (i, dir, p_span) = walks[k];
+                    if g.0 != p_span {
+                        let (r, _) = laser.linear_capped_max(
+                            0.0,
+                            t_walk,
+                            p_span * delta,
+                            p_span,
+                            self.e_pass,
+                        );
+                        g = (p_span, r * (1.0 + PRUNE_SLACK));
+                    }
+                    if g.1 < best.0 {
+                        break;
+                    }
+                    self.walk(i, dir, p_span, &mut best);
+                }
+            }
+        }
+        (best.0, best.1)
+    }
+
+    /// Every walk: (start piece, direction, highest `P̄` within `l_max` of
+    /// its start in its direction).
+    fn walks(&self) -> Vec<(i64, i64, f64)> {
+        let env = self.env;
+        let m = env.pieces() as i64;
+        let mut out = Vec::new();
+        let (mut fwd, mut back) = (SlidingMax::new(), SlidingMax::new());
+        let (mut h_fwd, mut h_back) = (0usize, 0usize);
+        for i in 0..m {
+            let b0 = env.bp(i);
+            // Pieces i.. up to the one holding b0 + l_max; pieces ..i−1 down
+            // to the one holding b0 − l_max.
+            let j_fwd = env.unwrapped_piece(b0 + self.l_max, &mut h_fwd).max(i);
+            let j_back = env.unwrapped_piece(b0 - self.l_max, &mut h_back).min(i - 1);
+            let p_fwd = fwd.max_over(i, j_fwd, |k| env.p_of(k));
+            let p_back = back.max_over(j_back, i - 1, |k| env.p_of(k));
+            let up = env.p_of(i) > env.p_of(i - 1);
+            let down = env.p_of(i) < env.p_of(i - 1);
+            if up || i == 0 {
+                out.push((i, 1, p_fwd));
+            }
+            if down {
+                out.push((i, -1, p_back));
+            }
+        }
+        out
+    }
+
+    /// One walk from breakpoint `i` in direction `dir`: the window energy is
+    /// linear in `L` between breakpoints; after `WALK_MAX_PIECES` pieces it
+    /// is bounded by the slope `p_span` (the highest `P̄` the walk can reach).
+    fn walk(&self, i: i64, dir: i64, p_span: f64, best: &mut Best) {
+        let env = self.env;
+        let laser = self.laser;
+        let delta = 1.0 / laser.pulse_rate_hz;
+        let e_pass = self.e_pass;
+        let l_max = self.l_max;
+        let t_walk = l_max - delta;
+        let b0 = env.bp(i);
+        let (mut e, mut l, mut idx) = (0.0f64, 0.0f64, i);
+        for _ in 0..WALK_MAX_PIECES {
+            let (next_idx, piece_p) = if dir > 0 {
+                (idx + 1, env.p_of(idx))
+            } else {
+                (idx - 1, env.p_of(idx - 1))
+            };
+            let seg_end = (env.bp(next_idx) - b0).abs().min(l_max);
+            if seg_end > delta {
+                let l0 = l.max(delta);
+                let e0 = e + piece_p * (l0 - l);
+                best.take(laser.linear_capped_max(
+                    l0 - delta,
+                    seg_end - delta,
+                    e0,
+                    piece_p,
+                    e_pass,
+                ));
+            }
+            e += piece_p * (seg_end - l);
+            l = seg_end;
+            if e >= e_pass || l >= l_max {
+                // From here on the window holds at most E⁺.
+                let t_c = if e >= e_pass && piece_p > 0.0 {
+                    (l - (e - e_pass) / piece_p - delta).max(0.0)
+                } else {
+                    (l - delta).max(0.0)
+                };
+                best.take(laser.linear_capped_max(t_c, t_walk.max(t_c), e_pass, 0.0, e_pass));
+                return;
+            }
+            idx = next_idx;
+        }
+        // Truncated: longer windows gain at most `p_span` per second.
+        let l0 = l.max(delta);
+        let e0 = e + p_span * (l0 - l);
+        best.take(laser.linear_capped_max(l0 - delta, t_walk, e0, p_span, e_pass));
+    }
 }

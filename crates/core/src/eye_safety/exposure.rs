@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use super::ael::{self, APERTURE_DISTANCE_MM};
 pub use super::bound::Rule;
-use super::bound::{self, Laser, Seg};
+use super::bound::{self, Laser, Search, Seg};
 use super::{EyeSafetyError, EyeSafetyParams};
 use crate::profile::Profile;
 
@@ -109,12 +109,33 @@ pub fn evaluate_profile(
     evaluate_segments(&segments(profile), params, profile.pulse_rate_hz)
 }
 
+/// [`evaluate_profile`] with a choice of search (see [`bound::Search`]):
+/// the branch and bound and the exhaustive search give identical reports;
+/// the exhaustive one is kept as the reference for tests and benchmarks.
+#[doc(hidden)]
+pub fn evaluate_profile_with(
+    profile: &Profile,
+    params: &EyeSafetyParams,
+    search: Search,
+) -> Result<ExposureReport, EyeSafetyError> {
+    evaluate_segments_with(&segments(profile), params, profile.pulse_rate_hz, search)
+}
+
 /// As [`evaluate_profile`], for bins given as [`Seg`]s (a firmware table as
 /// it will run, for one).
 pub fn evaluate_segments(
     segs: &[Seg],
     params: &EyeSafetyParams,
     pulse_rate_hz: f64,
+) -> Result<ExposureReport, EyeSafetyError> {
+    evaluate_segments_with(segs, params, pulse_rate_hz, Search::Pruned)
+}
+
+fn evaluate_segments_with(
+    segs: &[Seg],
+    params: &EyeSafetyParams,
+    pulse_rate_hz: f64,
+    search: Search,
 ) -> Result<ExposureReport, EyeSafetyError> {
     let laser = laser(params, pulse_rate_hz)?;
     let pass = pass_angle_deg(params, &laser);
@@ -125,7 +146,7 @@ pub fn evaluate_segments(
             reason: "a profile needs at least one bin",
         });
     }
-    let b = bound::evaluate(segs, 0.5 * pass, &laser);
+    let b = bound::evaluate_with(segs, 0.5 * pass, &laser, search);
     if b.max_pass_duration_s > ael::T_MAX_TABLE_S {
         return Err(ael::AelError::Duration {
             what: "pass duration",

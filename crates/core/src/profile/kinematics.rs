@@ -4,63 +4,153 @@
 //! Exact for the profile@1 semantics: within a bin the angular acceleration
 //! is constant, so `ω(x)² = ω_s² + 2ax` and the time to advance `x` radians
 //! is `2x / (ω_s + ω(x))` (stable also as `a → 0`).
+//!
+//! This is the one model of the head's motion: the planner, the simulator and
+//! the eye-safety bound ([`crate::eye_safety::bound`], through
+//! [`Timeline::time_at_unwrapped_s`] and [`Timeline::azimuth_at_unwrapped_deg`])
+//! all call it.
 
 use super::{Bin, Profile};
 use crate::model::angle::{wrap_deg, FULL_TURN_DEG};
 
+/// A bin as the head sweeps it: an arc of the circle run at constant angular
+/// acceleration from `spin_start_rad_s` to `spin_end_rad_s`, at one power.
+/// Implemented by profile bins and by the eye-safety bound's segments (a
+/// firmware table as it runs), so both share the kinematics below.
+pub trait BinMotion {
+    /// Start azimuth, deg.
+    fn start_deg(&self) -> f64;
+    /// Angular width, deg.
+    fn width_deg(&self) -> f64;
+    /// Spin at the start, rad/s.
+    fn spin_start_rad_s(&self) -> f64;
+    /// Spin at the end, rad/s.
+    fn spin_end_rad_s(&self) -> f64;
+    /// Laser power while sweeping the bin, W.
+    fn power_w(&self) -> f64;
+
+    /// Dwell time `t = 2Δθ / (ω_start + ω_end)` (constant acceleration), s.
+    fn dwell_s(&self) -> f64 {
+        2.0 * self.width_deg().to_radians() / (self.spin_start_rad_s() + self.spin_end_rad_s())
+    }
+
+    /// Angular acceleration `a = (ω_end² − ω_start²) / (2Δθ)`, rad/s².
+    fn accel_rad_s2(&self) -> f64 {
+        (self.spin_end_rad_s().powi(2) - self.spin_start_rad_s().powi(2))
+            / (2.0 * self.width_deg().to_radians())
+    }
+
+    /// Time to advance `x_rad` into the bin from its start, s
+    /// (`2x / (ω_s + ω(x))`; 0 for `x ≤ 0`).
+    fn time_into_s(&self, x_rad: f64) -> f64 {
+        if x_rad <= 0.0 {
+            return 0.0;
+        }
+        let w_s = self.spin_start_rad_s();
+        let w_x = (w_s.powi(2) + 2.0 * self.accel_rad_s2() * x_rad)
+            .max(0.0)
+            .sqrt();
+        2.0 * x_rad / (w_s + w_x)
+    }
+
+    /// Angle advanced `t_s` after entering the bin, rad: `x = ω_s t + a t²/2`
+    /// with `t` clamped to the dwell, so the result lies in `[0, width]`.
+    fn angle_into_rad(&self, t_s: f64) -> f64 {
+        let t = t_s.clamp(0.0, self.dwell_s());
+        (self.spin_start_rad_s() * t + 0.5 * self.accel_rad_s2() * t * t)
+            .clamp(0.0, self.width_deg().to_radians())
+    }
+}
+
+impl BinMotion for Bin {
+    fn start_deg(&self) -> f64 {
+        self.start_deg
+    }
+    fn width_deg(&self) -> f64 {
+        self.width_deg
+    }
+    fn spin_start_rad_s(&self) -> f64 {
+        self.spin_start_rad_s
+    }
+    fn spin_end_rad_s(&self) -> f64 {
+        self.spin_end_rad_s
+    }
+    fn power_w(&self) -> f64 {
+        self.power_w
+    }
+}
+
+/// Whole turns below an unwrapped azimuth and the azimuth within the turn.
+fn split_turns(theta_deg: f64) -> (f64, f64) {
+    if (0.0..FULL_TURN_DEG).contains(&theta_deg) {
+        // The common case, without a call to `floor` (same result).
+        return (0.0, theta_deg);
+    }
+    let k = (theta_deg / FULL_TURN_DEG).floor();
+    (k, theta_deg - FULL_TURN_DEG * k)
+}
+
 /// Time to advance `x_rad` into `bin` from its start.
 #[must_use]
 pub fn time_into_bin_s(bin: &Bin, x_rad: f64) -> f64 {
-    if x_rad <= 0.0 {
-        return 0.0;
-    }
-    let a = bin.spin_accel_rad_s2();
-    let w_x = (bin.spin_start_rad_s.powi(2) + 2.0 * a * x_rad)
-        .max(0.0)
-        .sqrt();
-    2.0 * x_rad / (bin.spin_start_rad_s + w_x)
+    bin.time_into_s(x_rad)
 }
 
 /// Angle (rad) advanced `t_s` after entering `bin`: `x = ω_s t + a t²/2`.
 #[must_use]
 pub fn angle_into_bin_rad(bin: &Bin, t_s: f64) -> f64 {
-    let a = bin.spin_accel_rad_s2();
-    (bin.spin_start_rad_s * t_s + 0.5 * a * t_s * t_s).clamp(0.0, bin.width_deg.to_radians())
+    bin.angle_into_rad(t_s)
 }
 
-/// Cumulative time and energy at every bin start of a profile.
+/// Cumulative time and energy at every bin start of a profile (or of any
+/// bins that cover the circle in order, see [`Timeline::from_bins`]).
 #[derive(Debug, Clone)]
-pub struct Timeline<'a> {
-    bins: &'a [Bin],
+pub struct Timeline<'a, B = Bin> {
+    bins: &'a [B],
     /// `cum_time_s[i]` = time from 0° to the start of bin i; last entry = frame period.
     cum_time_s: Vec<f64>,
     /// Same for emitted energy, J.
     cum_energy_j: Vec<f64>,
 }
 
-impl<'a> Timeline<'a> {
+impl<'a> Timeline<'a, Bin> {
     /// Builds the timeline of a structurally valid profile (bins cover the
     /// circle, spins positive; the checker guarantees this).
     #[must_use]
     pub fn new(profile: &'a Profile) -> Self {
-        let n = profile.bins.len();
+        Self::from_bins(&profile.bins)
+    }
+}
+
+impl<'a, B: BinMotion> Timeline<'a, B> {
+    /// Builds the timeline of bins that cover `[0, 360)` in order with
+    /// positive spins (at least one bin).
+    #[must_use]
+    pub fn from_bins(bins: &'a [B]) -> Self {
+        let n = bins.len();
         let mut cum_time_s = Vec::with_capacity(n + 1);
         let mut cum_energy_j = Vec::with_capacity(n + 1);
         let (mut t, mut e) = (0.0, 0.0);
         cum_time_s.push(0.0);
         cum_energy_j.push(0.0);
-        for b in &profile.bins {
-            let dt = b.dwell_time_s();
+        for b in bins {
+            let dt = b.dwell_s();
             t += dt;
-            e += dt * b.power_w;
+            e += dt * b.power_w();
             cum_time_s.push(t);
             cum_energy_j.push(e);
         }
         Self {
-            bins: &profile.bins,
+            bins,
             cum_time_s,
             cum_energy_j,
         }
+    }
+
+    /// Time from 0° to the start of bin `i` (`i = len` gives the period), s.
+    #[must_use]
+    pub fn bin_start_time_s(&self, i: usize) -> f64 {
+        self.cum_time_s[i]
     }
 
     /// Frame period: the time of one revolution, s.
@@ -77,7 +167,7 @@ impl<'a> Timeline<'a> {
 
     /// Bins of the profile.
     #[must_use]
-    pub fn bins(&self) -> &'a [Bin] {
+    pub fn bins(&self) -> &'a [B] {
         self.bins
     }
 
@@ -85,7 +175,7 @@ impl<'a> Timeline<'a> {
     #[must_use]
     pub fn bin_index(&self, azimuth_deg: f64) -> usize {
         self.bins
-            .partition_point(|b| b.start_deg <= azimuth_deg)
+            .partition_point(|b| b.start_deg() <= azimuth_deg)
             .saturating_sub(1)
             .min(self.bins.len() - 1)
     }
@@ -95,14 +185,112 @@ impl<'a> Timeline<'a> {
     pub fn time_energy_at(&self, azimuth_deg: f64) -> (f64, f64) {
         let i = self.bin_index(azimuth_deg);
         let b = &self.bins[i];
-        let x = (azimuth_deg - b.start_deg)
-            .clamp(0.0, b.width_deg)
+        let x = (azimuth_deg - b.start_deg())
+            .clamp(0.0, b.width_deg())
             .to_radians();
-        let dt = time_into_bin_s(b, x);
+        let dt = b.time_into_s(x);
         (
             self.cum_time_s[i] + dt,
-            self.cum_energy_j[i] + dt * b.power_w,
+            self.cum_energy_j[i] + dt * b.power_w(),
         )
+    }
+
+    /// Splits an unwrapped azimuth into (whole turns, bin, offset into that
+    /// bin in deg).
+    #[must_use]
+    pub fn locate_unwrapped(&self, theta_deg: f64) -> (f64, usize, f64) {
+        let (k, a) = split_turns(theta_deg);
+        let i = self.bin_index(a);
+        (k, i, a - self.bins[i].start_deg())
+    }
+
+    /// As [`Self::locate_unwrapped`], searching forward from bin `*hint`
+    /// (then set to the bin found): the same result, in amortised constant
+    /// time for a nondecreasing sequence of azimuths.
+    pub fn locate_unwrapped_from(&self, theta_deg: f64, hint: &mut usize) -> (f64, usize, f64) {
+        let (k, a) = split_turns(theta_deg);
+        let n = self.bins.len();
+        let mut i = (*hint).min(n - 1);
+        if self.bins[i].start_deg() > a {
+            i = self.bin_index(a);
+        } else {
+            // The last bin starting at or before `a`, as `bin_index` finds it.
+            while i + 1 < n && self.bins[i + 1].start_deg() <= a {
+                i += 1;
+            }
+        }
+        *hint = i;
+        (k, i, a - self.bins[i].start_deg())
+    }
+
+    /// Unwrapped time at which the head reaches the unwrapped azimuth
+    /// `theta_deg` (turn `k` of the periodic motion starts at `k·T_f`), s.
+    #[must_use]
+    pub fn time_at_unwrapped_s(&self, theta_deg: f64) -> f64 {
+        self.time_at_located(self.locate_unwrapped(theta_deg))
+    }
+
+    /// As [`Self::time_at_unwrapped_s`] with a forward search from `*hint`
+    /// (see [`Self::locate_unwrapped_from`]): the same value.
+    pub fn time_at_unwrapped_from_s(&self, theta_deg: f64, hint: &mut usize) -> f64 {
+        self.time_at_located(self.locate_unwrapped_from(theta_deg, hint))
+    }
+
+    fn time_at_located(&self, (k, i, x_deg): (f64, usize, f64)) -> f64 {
+        let b = &self.bins[i];
+        k * self.period_s()
+            + self.cum_time_s[i]
+            + b.time_into_s(x_deg.clamp(0.0, b.width_deg()).to_radians())
+    }
+
+    /// Unwrapped azimuth at unwrapped time `t_s`, deg.
+    #[must_use]
+    pub fn azimuth_at_unwrapped_deg(&self, t_s: f64) -> f64 {
+        let (k, t) = self.split_periods(t_s);
+        self.azimuth_at_located(k, t, self.bin_at_time(t))
+    }
+
+    /// As [`Self::azimuth_at_unwrapped_deg`], searching forward from bin
+    /// `*hint` (then set to the bin found): the same value, in amortised
+    /// constant time for a nondecreasing sequence of times.
+    pub fn azimuth_at_unwrapped_from_deg(&self, t_s: f64, hint: &mut usize) -> f64 {
+        let (k, t) = self.split_periods(t_s);
+        let n = self.bins.len();
+        let mut i = (*hint).min(n - 1);
+        if self.cum_time_s[i] > t {
+            i = self.bin_at_time(t);
+        } else {
+            while i + 1 < n && self.cum_time_s[i + 1] <= t {
+                i += 1;
+            }
+        }
+        *hint = i;
+        self.azimuth_at_located(k, t, i)
+    }
+
+    fn split_periods(&self, t_s: f64) -> (f64, f64) {
+        if (0.0..self.period_s()).contains(&t_s) {
+            return (0.0, t_s);
+        }
+        let k = (t_s / self.period_s()).floor();
+        (k, t_s - k * self.period_s())
+    }
+
+    fn azimuth_at_located(&self, k: f64, t: f64, i: usize) -> f64 {
+        let b = &self.bins[i];
+        FULL_TURN_DEG * k
+            + b.start_deg()
+            + b.angle_into_rad(t - self.cum_time_s[i])
+                .to_degrees()
+                .clamp(0.0, b.width_deg())
+    }
+
+    /// Index of the bin the head is in at `t_s` in `[0, period)`.
+    fn bin_at_time(&self, t_s: f64) -> usize {
+        self.cum_time_s
+            .partition_point(|&c| c <= t_s)
+            .saturating_sub(1)
+            .min(self.bins.len() - 1)
     }
 
     /// Time and energy spent sweeping the arc `[lo, lo + width)` (wrapping), width ≤ 360.
@@ -135,11 +323,11 @@ impl<'a> Timeline<'a> {
         let hi = lo_deg + width_deg + snap;
         let mut i = self.bin_index(wrap_deg(a));
         // Unwrapped start of bin i on the same turn as `a`.
-        let mut pos = self.bins[i].start_deg + (a - wrap_deg(a));
+        let mut pos = self.bins[i].start_deg() + (a - wrap_deg(a));
         let mut out = Vec::new();
         for _ in 0..n {
             out.push(i);
-            pos += self.bins[i].width_deg;
+            pos += self.bins[i].width_deg();
             if pos > hi {
                 break;
             }
@@ -154,7 +342,7 @@ impl<'a> Timeline<'a> {
     pub fn max_power_in(&self, lo_deg: f64, width_deg: f64) -> f64 {
         self.bins_touching(lo_deg, width_deg)
             .into_iter()
-            .map(|i| self.bins[i].power_w)
+            .map(|i| self.bins[i].power_w())
             .fold(0.0, f64::max)
     }
 
@@ -162,13 +350,7 @@ impl<'a> Timeline<'a> {
     /// for `t_s` in `[0, period)`.
     #[must_use]
     pub fn azimuth_at(&self, t_s: f64) -> (f64, usize) {
-        let n = self.bins.len();
-        let i = self
-            .cum_time_s
-            .partition_point(|&c| c <= t_s)
-            .saturating_sub(1)
-            .min(n - 1);
-        self.azimuth_in_bin(t_s, i)
+        self.azimuth_in_bin(t_s, self.bin_at_time(t_s))
     }
 
     /// As [`Self::azimuth_at`], searching forward from bin `hint` (the bin of
@@ -189,7 +371,7 @@ impl<'a> Timeline<'a> {
 
     fn azimuth_in_bin(&self, t_s: f64, i: usize) -> (f64, usize) {
         let b = &self.bins[i];
-        let x = angle_into_bin_rad(b, t_s - self.cum_time_s[i]);
-        (wrap_deg(b.start_deg + x.to_degrees()), i)
+        let x = b.angle_into_rad(t_s - self.cum_time_s[i]);
+        (wrap_deg(b.start_deg() + x.to_degrees()), i)
     }
 }

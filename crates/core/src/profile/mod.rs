@@ -50,14 +50,13 @@ impl Bin {
     /// Dwell time `t = 2Δθ / (ω_start + ω_end)` (constant acceleration), s.
     #[must_use]
     pub fn dwell_time_s(&self) -> f64 {
-        2.0 * self.width_deg.to_radians() / (self.spin_start_rad_s + self.spin_end_rad_s)
+        kinematics::BinMotion::dwell_s(self)
     }
 
     /// Angular acceleration `a = (ω_end² − ω_start²) / (2Δθ)`, rad/s².
     #[must_use]
     pub fn spin_accel_rad_s2(&self) -> f64 {
-        (self.spin_end_rad_s.powi(2) - self.spin_start_rad_s.powi(2))
-            / (2.0 * self.width_deg.to_radians())
+        kinematics::BinMotion::accel_rad_s2(self)
     }
 
     /// Centre azimuth, degrees.
