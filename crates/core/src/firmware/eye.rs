@@ -1008,7 +1008,8 @@ mod verification {
 
     type OverflowInput = (RawBins, u8, u64, u64, u64, u32, u8, (u64, u64, u64, u64));
 
-    fn no_overflow(input: OverflowInput) {
+    /// Evaluates one table at the bounds; returns (extreme three-bin table, class 1).
+    fn no_overflow(input: OverflowInput) -> (bool, bool) {
         let (raw, n, tick, frame, millihz, arc, extreme, l) = input;
         let n = 1 + usize::from(n % 3);
         // Bounds of the evaluation (`check_bounds`): every value within them.
@@ -1038,19 +1039,13 @@ mod verification {
         let arc_mdeg = 1 + arc % (FULL_TURN_MDEG / 2 - 1);
         let t = table(&raw, n, tick_hz, frame_ticks);
         let lim = limits(&t, millihz, arc_mdeg, l);
-        match evaluate(&t, &lim) {
-            Ok(r) => {
-                cover!(
-                    extreme % 2 == 1 && n == 3,
-                    "extreme three-bin table evaluated"
-                );
-                cover!(!r.class1, "a table over its limits evaluated");
-                cover!(r.class1, "a table within its limits evaluated");
-            }
+        let class1 = match evaluate(&t, &lim) {
+            Ok(r) => r.class1,
             Err(e) => panic!("a table within the bounds must evaluate: {e}"),
-        }
+        };
         let timing = pass_timing(&t, millihz, arc_mdeg);
         assert!(timing.is_ok(), "{timing:?}");
+        (extreme % 2 == 1 && n == 3, class1)
     }
 
     /// REQ-FW-5: the integer eye-safety sums (rational pass durations,
@@ -1062,14 +1057,14 @@ mod verification {
     #[cfg_attr(kani, kani::proof, kani::unwind(8))]
     #[cfg_attr(not(kani), test)]
     fn eye_sums_never_overflow_within_format_bounds() {
-        #[cfg(kani)]
-        no_overflow(kani::any());
+        crate::for_all!(OverflowInput, |x| {
+            let (extreme3, class1) = no_overflow(x);
+            cover!(extreme3, "extreme three-bin table evaluated");
+            cover!(!class1, "a table over its limits evaluated");
+            cover!(class1, "a table within its limits evaluated");
+        });
         #[cfg(not(kani))]
         {
-            bolero::check!()
-                .with_type::<OverflowInput>()
-                .cloned()
-                .for_each(no_overflow);
             crate::verification::assert_covered(&[
                 "extreme three-bin table evaluated",
                 "a table over its limits evaluated",
@@ -1080,7 +1075,8 @@ mod verification {
 
     type RotationInput = ([(u16, u16, u16); 3], u8, u8, u16, u16, (u16, u16, u8, u16));
 
-    fn rotation_keeps_verdict(input: RotationInput) {
+    /// Returns (non-zero shift, three bins, class 1).
+    fn rotation_keeps_verdict(input: RotationInput) -> (bool, bool, bool) {
         let (raw, n, shift, millihz, arc, (code_max, e1, split, e_pass)) = input;
         let n = 1 + usize::from(n % 3);
         let raw3: RawBins = [0, 1, 2].map(|i| {
@@ -1101,16 +1097,11 @@ mod verification {
         );
         let mut rotated = t.clone();
         rotated.bins.rotate_left(usize::from(shift) % n);
-        cover!(
-            usize::from(shift) % n != 0,
-            "a table rotated by a non-zero shift"
-        );
         let a = evaluate(&t, &limits(&t, millihz, arc_mdeg, l)).expect("within bounds");
         let b = evaluate(&rotated, &limits(&rotated, millihz, arc_mdeg, l)).expect("within bounds");
-        cover!(!a.class1 && n == 3, "a rejected three-bin table rotated");
-        cover!(a.class1 && n == 3, "an accepted three-bin table rotated");
         assert_eq!(a.class1, b.class1);
         assert_eq!(a.worst_ratio_ppm, b.worst_ratio_ppm);
+        (usize::from(shift) % n != 0, n == 3, a.class1)
     }
 
     /// REQ-FW-5: a cyclic rotation of a table (where the turn starts) keeps
@@ -1119,14 +1110,14 @@ mod verification {
     #[cfg_attr(kani, kani::proof, kani::unwind(8))]
     #[cfg_attr(not(kani), test)]
     fn rotation_keeps_integer_verdict() {
-        #[cfg(kani)]
-        rotation_keeps_verdict(kani::any());
+        crate::for_all!(RotationInput, |x| {
+            let (shifted, three, class1) = rotation_keeps_verdict(x);
+            cover!(shifted, "a table rotated by a non-zero shift");
+            cover!(!class1 && three, "a rejected three-bin table rotated");
+            cover!(class1 && three, "an accepted three-bin table rotated");
+        });
         #[cfg(not(kani))]
         {
-            bolero::check!()
-                .with_type::<RotationInput>()
-                .cloned()
-                .for_each(rotation_keeps_verdict);
             crate::verification::assert_covered(&[
                 "a table rotated by a non-zero shift",
                 "a rejected three-bin table rotated",
