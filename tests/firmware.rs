@@ -156,8 +156,6 @@ fn binary_tables_round_trip_and_tampering_is_caught() {
 // ---------------------------------------------------------------------------
 // Eye safety of a table as it will run: the integer check (issue 10, Build 6).
 
-mod reference;
-
 use gaze_lidar::checker::certify;
 use gaze_lidar::eye_safety::{evaluate_profile, EyeSafetyParams};
 use gaze_lidar::firmware::eye::{evaluate, IntEyeLimits};
