@@ -39,9 +39,9 @@ pub fn render(r: &GridResult, config: &SimConfig) -> String {
     render_with_pipeline(r, config, None)
 }
 
-/// The paper's pipeline cell: median (q1–q3) and detections.
-fn pipeline_cell(p: Option<&GridResult>, v: &str, fog: u32) -> String {
-    p.and_then(|p| p.row(ModelKind::Argus, v, fog)).map_or_else(
+/// One result cell: median (q1–q3) and detections, or a dash.
+fn tta_cell(x: Option<&Row>) -> String {
+    x.map_or_else(
         || "—".to_owned(),
         |x| {
             format!(
@@ -54,6 +54,11 @@ fn pipeline_cell(p: Option<&GridResult>, v: &str, fog: u32) -> String {
             )
         },
     )
+}
+
+/// The paper's pipeline cell: median (q1–q3) and detections.
+fn pipeline_cell(p: Option<&GridResult>, v: &str, fog: u32) -> String {
+    tta_cell(p.and_then(|p| p.row(ModelKind::Argus, v, fog)))
 }
 
 /// Renders the Markdown report with, if given, the run of the paper's
@@ -136,21 +141,7 @@ pub fn render_with_pipeline(
     let _ = writeln!(s, "|---:|---|---:|---:|---:|---|");
     for &fog in &config.fog_pcts {
         for v in &config.variants {
-            let cell = |m| {
-                row(r, m, v.name(), fog).map_or_else(
-                    || "—".to_owned(),
-                    |x| {
-                        format!(
-                            "{} ({}–{}), {}/{} det.",
-                            f2(x.tta_median_s),
-                            f2(x.tta_q1_s),
-                            f2(x.tta_q3_s),
-                            x.detected,
-                            x.trials
-                        )
-                    },
-                )
-            };
+            let cell = |m| tta_cell(row(r, m, v.name(), fog));
             let paper_txt = if *v == super::Variant::Baseline {
                 PAPER_TTA.iter().find(|p| p.0 == fog).map_or("", |p| p.1)
             } else {

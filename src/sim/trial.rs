@@ -51,6 +51,41 @@ pub struct TrialDraw {
     pub noise_seed: u64,
 }
 
+/// The two crossing cars of a trial: fronts at t = 0 (the left car drives
+/// −y, the right car +y, each spawned `spawn_distance_m` plus its drawn
+/// offset from the ego lane), driving directions, and the times they arrive
+/// (front at the conflict line plus the arrival rule's extra distance).
+pub(crate) struct Crossing {
+    pub front0_m: [f64; 2],
+    pub dir: [f64; 2],
+    pub t_arrive_s: [f64; 2],
+}
+
+impl TrialDraw {
+    /// The cars of this draw at `speed_m_s` (one model for both geometries).
+    pub(crate) fn crossing(
+        &self,
+        spawn_distance_m: f64,
+        conflict_half_width_m: f64,
+        extra_distance_m: f64,
+        speed_m_s: f64,
+    ) -> Crossing {
+        let front0_m = [
+            spawn_distance_m + self.start_offset_m[0],
+            -(spawn_distance_m + self.start_offset_m[1]),
+        ];
+        let ch = conflict_half_width_m;
+        Crossing {
+            front0_m,
+            dir: [-1.0, 1.0],
+            t_arrive_s: [
+                (front0_m[0] - ch + extra_distance_m) / speed_m_s,
+                (-ch - front0_m[1] + extra_distance_m) / speed_m_s,
+            ],
+        }
+    }
+}
+
 /// What one trial measured. Index 0 is the car from the left, 1 from the right.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TrialOutcome {
@@ -173,14 +208,16 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
     let half_w = 0.5 * sc.vehicle_width_m;
     let len = sc.vehicle_length_m;
     let ch = sc.conflict_half_width_m;
-    // Fronts at t = 0: the left car drives −y, the right car +y.
-    let front0 = [
-        sc.bend_distance_m + draw.start_offset_m[0],
-        -(sc.bend_distance_m + draw.start_offset_m[1]),
-    ];
-    let dir = [-1.0, 1.0];
-    let extra = setup.arrival.extra_distance_m(len);
-    let t_conflict = [(front0[0] - ch + extra) / v, (-ch - front0[1] + extra) / v];
+    let Crossing {
+        front0_m: front0,
+        dir,
+        t_arrive_s: t_conflict,
+    } = draw.crossing(
+        sc.bend_distance_m,
+        ch,
+        setup.arrival.extra_distance_m(len),
+        v,
+    );
     let t_end = t_conflict[0].max(t_conflict[1]);
     let car_box = |j: usize, t: f64| -> Aabb {
         let front = front0[j] + dir[j] * v * t;

@@ -324,16 +324,16 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
     let len = sc.vehicle_length_m;
     let size = Vector3::new(len, sc.vehicle_width_m, p.vehicle_height_m);
     let ch_half = sc.conflict_half_width_m;
-    let front0 = [
-        p.spawn_distance_m + draw.start_offset_m[0],
-        -(p.spawn_distance_m + draw.start_offset_m[1]),
-    ];
-    let dir = [-1.0, 1.0];
-    let extra = setup.arrival.extra_distance_m(len);
-    let t_arrive = [
-        (front0[0] - ch_half + extra) / v,
-        (-ch_half - front0[1] + extra) / v,
-    ];
+    let super::trial::Crossing {
+        front0_m: front0,
+        dir,
+        t_arrive_s: t_arrive,
+    } = draw.crossing(
+        p.spawn_distance_m,
+        ch_half,
+        setup.arrival.extra_distance_m(len),
+        v,
+    );
     let t_end = t_arrive[0].max(t_arrive[1]);
     let pose = |t: f64| -> [PosedBox; 2] {
         std::array::from_fn(|j| {
