@@ -12,28 +12,6 @@ use gaze_lidar::planner::{closed_form, Mode};
 use gaze_lidar::profile::Profile;
 use proptest::prelude::*;
 
-/// The reference evaluator's view of a profile (public fields only).
-fn scan_of(p: &Profile) -> reference::Scan {
-    let es = p.limits.eye_safety.as_ref().expect("eye_safety params");
-    reference::Scan {
-        bins: p
-            .bins
-            .iter()
-            .map(|b| reference::RBin {
-                start_deg: b.start_deg,
-                width_deg: b.width_deg,
-                power_w: b.power_w,
-                w0: b.spin_start_rad_s,
-                w1: b.spin_end_rad_s,
-            })
-            .collect(),
-        pulse_rate_hz: p.pulse_rate_hz,
-        lambda_nm: es.wavelength_nm,
-        pulse_s: es.pulse_duration_s,
-        beam_mm: es.beam_diameter_mm,
-    }
-}
-
 fn ael_json(args: &[&str]) -> serde_json::Value {
     let mut full = vec!["ael", "--format", "json"];
     full.extend_from_slice(args);
@@ -215,7 +193,7 @@ fn every_preset_baseline_and_adaptive_profile_is_class_1() {
                         // concrete pulse train over the limit, and the
                         // checker's bound is not below what it finds.
                         let r = evaluate_profile(p, p.limits.eye_safety.as_ref().unwrap()).unwrap();
-                        let found = reference::Reference::new(&scan_of(p))
+                        let found = reference::Reference::new(&reference::Scan::of_profile(p))
                             .worst(&reference::Effort::default());
                         assert!(found.ratio <= 1.0, "{name} {mode:?} {gaze}: {found}");
                         assert!(

@@ -27,7 +27,7 @@ use gaze_lidar::profile::Profile;
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
-use reference::{ael_j, Band, Clock, Effort, RBin, Reference, RuleKind, Scan, Worst};
+use reference::{ael_j, Band, Clock, Effort, Reference, RuleKind, Scan, Worst};
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -40,27 +40,6 @@ use std::time::Instant;
 /// in the corneal bands, where the envelope keeps one pulse spacing of hot
 /// power per pass. Tighten this as the bound tightens.
 const TIGHT_FACTOR: f64 = 1.35;
-
-fn scan_of(p: &Profile) -> Scan {
-    let es = p.limits.eye_safety.as_ref().expect("eye_safety params");
-    Scan {
-        bins: p
-            .bins
-            .iter()
-            .map(|b| RBin {
-                start_deg: b.start_deg,
-                width_deg: b.width_deg,
-                power_w: b.power_w,
-                w0: b.spin_start_rad_s,
-                w1: b.spin_end_rad_s,
-            })
-            .collect(),
-        pulse_rate_hz: p.pulse_rate_hz,
-        lambda_nm: es.wavelength_nm,
-        pulse_s: es.pulse_duration_s,
-        beam_mm: es.beam_diameter_mm,
-    }
-}
 
 fn params_of(p: &Profile) -> EyeSafetyParams {
     p.limits.eye_safety.clone().expect("eye_safety params")
@@ -388,7 +367,7 @@ fn differential_checker_never_below_reference() {
             locked: spec.locked,
             ..Effort::default()
         };
-        let r_raw = Reference::new(&scan_of(&raw)).worst(&effort);
+        let r_raw = Reference::new(&Scan::of_profile(&raw)).worst(&effort);
         // Energies are linear in power and C5 does not depend on it: scale
         // the powers so that the reference ratio lands on `spec.scale`.
         let k = spec.scale / r_raw.ratio;
@@ -537,7 +516,7 @@ fn reference_matches_closed_form_on_a_uniform_profile() {
         .collect();
     let v = profile_json(f, fp, &bins, (905.0, 5e-9, 8.0));
     let p = Profile::from_json(&v.to_string(), "uniform").unwrap();
-    let r = Reference::new(&scan_of(&p));
+    let r = Reference::new(&Scan::of_profile(&p));
     let c4 = 10f64.powf(0.41);
     let t_f = 1.0 / f;
     let h = 0.5 * (7.0 + 8.0) / 100.0;
@@ -742,7 +721,7 @@ fn constructed() -> Vec<Constructed> {
 fn constructed_cases_true_ratio_and_reference() {
     for c in constructed() {
         let p = load(c.name);
-        let r = Reference::new(&scan_of(&p));
+        let r = Reference::new(&Scan::of_profile(&p));
         let effort = Effort {
             phases: 16,
             locked: c.locked,

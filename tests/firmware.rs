@@ -8,40 +8,6 @@ use common::{run, stdout};
 use gaze_lidar::firmware::{binary, check_table, FirmwareTable};
 use gaze_lidar::profile::Profile;
 
-/// The table as it will run, read by the reference evaluator: constant spin
-/// over each bin's dwell (width / (ticks / tick_hz)), power = code · step.
-fn as_run_scan(t: &FirmwareTable) -> reference::Scan {
-    let es = t
-        .eye_safety
-        .as_ref()
-        .expect("eye-safety params in the table");
-    let mut start_deg = 0.0;
-    let bins = t
-        .bins
-        .iter()
-        .map(|b| {
-            let width_deg = f64::from(b.width_mdeg) / 1000.0;
-            let w = width_deg.to_radians() / (b.dwell_ticks as f64 / t.tick_hz as f64);
-            let bin = reference::RBin {
-                start_deg,
-                width_deg,
-                power_w: f64::from(b.power_code) * t.power_w_per_code,
-                w0: w,
-                w1: w,
-            };
-            start_deg += width_deg;
-            bin
-        })
-        .collect();
-    reference::Scan {
-        bins,
-        pulse_rate_hz: t.pulse_rate_hz,
-        lambda_nm: es.wavelength_nm,
-        pulse_s: es.pulse_duration_s,
-        beam_mm: es.beam_diameter_mm,
-    }
-}
-
 fn profile_and_table(mode: &str, gaze: &str) -> (Profile, FirmwareTable) {
     let t = run(
         &[
@@ -107,7 +73,7 @@ fn paper_tables_are_exact_and_conservative() {
             // it will run.
             let broken = independent::recheck_table(&t);
             assert!(broken.is_empty(), "{mode} {gaze}: {broken:?}");
-            let found = reference::Reference::new(&as_run_scan(&t)).worst(&reference::Effort {
+            let found = reference::Reference::new(&scan_of_table(&t)).worst(&reference::Effort {
                 phases: 4,
                 ..reference::Effort::default()
             });

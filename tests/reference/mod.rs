@@ -140,6 +140,30 @@ pub struct Scan {
     pub beam_mm: f64,
 }
 
+impl Scan {
+    /// A profile's bins and laser as plain numbers (public fields only).
+    pub fn of_profile(p: &gaze_lidar::profile::Profile) -> Self {
+        let es = p.limits.eye_safety.as_ref().expect("eye_safety params");
+        Scan {
+            bins: p
+                .bins
+                .iter()
+                .map(|b| RBin {
+                    start_deg: b.start_deg,
+                    width_deg: b.width_deg,
+                    power_w: b.power_w,
+                    w0: b.spin_start_rad_s,
+                    w1: b.spin_end_rad_s,
+                })
+                .collect(),
+            pulse_rate_hz: p.pulse_rate_hz,
+            lambda_nm: es.wavelength_nm,
+            pulse_s: es.pulse_duration_s,
+            beam_mm: es.beam_diameter_mm,
+        }
+    }
+}
+
 /// Head kinematics: time at every bin start, period.
 struct Head {
     bins: Vec<RBin>,
