@@ -804,3 +804,64 @@ fn check_rejects_constructed_cases_naming_eye_safety() {
         bad.join("\n")
     );
 }
+
+/// Regression (case 145 of seed 101, found by the 10,000-case run): a
+/// free-running 2049 Hz clock at 1450 nm, the aperture's pass ending on a
+/// V-shaped spin minimum. Nine consecutive passes can each hold three
+/// pulses, within `8·T_f + (2 − 8d)·Δ` (`d` the clock's drift per turn in
+/// pulse spacings): fewer seconds than the old multi-pass bound allowed
+/// nine pulse-capped passes (it spent the envelope's partial-period term
+/// on pulse-capped pass energies). The true ratio of that window is computed
+/// here by hand from the bins; the checker must not be below it.
+#[test]
+fn free_clock_nine_passes_regression() {
+    let p = load("regression_free_clock_nine_passes_1450.json");
+    let es = p.limits.eye_safety.clone().unwrap();
+    let fp = p.pulse_rate_hz;
+    let delta = 1.0 / fp;
+    let frame_s: f64 = p
+        .bins
+        .iter()
+        .map(|b| 2.0 * b.width_deg.to_radians() / (b.spin_start_rad_s + b.spin_end_rad_s))
+        .sum();
+    // The pass ends on the edge after bin 8 (the spin minimum), inside bin 8.
+    let b = &p.bins[8];
+    let (w0, w1) = (b.spin_start_rad_s, b.spin_end_rad_s);
+    let d_rad = b.width_deg.to_radians();
+    let a = (w1 * w1 - w0 * w0) / (2.0 * d_rad);
+    let h = 0.5 * (3.5 + es.beam_diameter_mm) / 100.0;
+    let tau = t_into(w0, a, d_rad) - t_into(w0, a, d_rad - 2.0 * h);
+    // Pulse offsets in a pass fall by `d` spacings per turn; a pass holds 3
+    // pulses while its first-pulse offset is at most τ/Δ − 2.
+    let d = (frame_s * fp).fract();
+    assert!(
+        8.0 * d <= tau / delta - 2.0,
+        "nine 3-pulse passes exist: 8d = {}, τ/Δ − 2 = {}",
+        8.0 * d,
+        tau / delta - 2.0
+    );
+    let span = 8.0 * frame_s + (2.0 - 8.0 * d) * delta;
+    assert!(
+        span > 0.35 && span < 10.0,
+        "span {span} in the 1e-2·t J row"
+    );
+    let truth = 27.0 * b.power_w * delta / (1e-2 * span);
+    let checker = evaluate_profile(&p, &es).unwrap();
+    let phi = (b.start_deg + b.width_deg - h.to_degrees()).rem_euclid(360.0);
+    let at = Reference::new(&Scan::of_profile(&p)).worst_at(&[phi], &Effort::default());
+    println!(
+        "true {truth:.6} (span {span:.6} s), reference at {phi:.4}° {:.6}, checker {:.6} ({:?})",
+        at.ratio, checker.worst_ratio, checker.binding_rule
+    );
+    assert!(truth > 1.3, "the window is over the limit: {truth}");
+    assert!(
+        at.ratio <= truth * (1.0 + 1e-9) && at.ratio >= truth * (1.0 - 1e-3),
+        "the reference reaches the hand-computed window: {} vs {truth}",
+        at.ratio
+    );
+    assert!(
+        checker.worst_ratio >= truth,
+        "checker {} below the true ratio {truth}",
+        checker.worst_ratio
+    );
+}

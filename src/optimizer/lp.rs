@@ -18,7 +18,7 @@ use std::f64::consts::TAU;
 
 use super::{OptError, Problem};
 use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
-use crate::eye_safety::bound::{max_pulses_in, passes_in_window, Laser};
+use crate::eye_safety::bound::{max_pulses_in, passes_in_window, Laser, PassFigures};
 use crate::eye_safety::exposure;
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning, CircularSet};
 use crate::model::lidar::PowerAccounting;
@@ -140,8 +140,19 @@ fn eye(problem: &Problem, g: &Grid) -> Result<Option<Eye>, OptError> {
     let frame_s = 1.0 / problem.lidar.frame_rate_hz;
     // Energy is linear in the pass energy, and no pass delivers more than
     // its energy whatever the power: the model's ratio at 1 J per pass with
-    // an unbounded peak power inverts to the cap.
-    let (ratio_per_j, _) = laser.multi_pass_ratio(frame_s, 1.0, f64::MAX);
+    // an unbounded peak power inverts to the cap. The longest pass is the
+    // pass arc at the slowest allowed spin.
+    let slowest_pass_s = pass_deg.to_radians() / problem.lidar.limits.spin_rad_s_min;
+    let pass = PassFigures {
+        envelope_j: 1.0,
+        pulses_j: 1.0,
+        duration_s: if slowest_pass_s.is_finite() {
+            slowest_pass_s.min(frame_s)
+        } else {
+            frame_s
+        },
+    };
+    let (ratio_per_j, _) = laser.multi_pass_ratio(frame_s, pass, f64::MAX);
     let pass_energy_max_j = if ratio_per_j > 0.0 {
         1.0 / ratio_per_j
     } else {

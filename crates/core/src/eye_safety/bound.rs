@@ -210,33 +210,80 @@ impl Laser {
         best
     }
 
-    /// Rule 2 over windows spanning several passes (`T ≥ T_f − Δ`) up to the
-    /// time base, with at most `e_pass_j` per pass and `p_hat_w` the highest
-    /// power: returns (ratio, window duration).
+    /// Rule 2 over windows spanning several passes, up to the time base:
+    /// returns (ratio, window duration). Windows from
+    /// `T_f − max(τ, Δ)` on (where a window can first meet two passes) are
+    /// bounded two ways, each valid for every window, and the smaller
+    /// supremum is returned (`sup min(A, C) ≤ min(sup A, sup C)`):
+    ///
+    /// - **A, envelope:** `q·E + min(E, P̂·r)` with `L = T + Δ = q·T_f + r`
+    ///   and `E` = [`PassFigures::envelope_j`], the integral of the received
+    ///   envelope over one period (see the module docs);
+    /// - **C, pass count:** at most [`passes_in_window`] passes meet a window,
+    ///   each carrying at most [`PassFigures::pulses_j`].
+    ///
+    /// A must use the envelope integral, not the pulse-capped pass energy:
+    /// the pulses of a pass sit anywhere in it, so `m` capped passes can fit
+    /// in `(m − 1)·T_f + r` with `P̂·r` below one capped pass (found by the
+    /// differential test: 9 passes of 3 pulses at 2049 Hz in 0.3563 s).
     #[must_use]
-    pub fn multi_pass_ratio(&self, frame_s: f64, e_pass_j: f64, p_hat_w: f64) -> (f64, f64) {
+    pub fn multi_pass_ratio(&self, frame_s: f64, pass: PassFigures, p_hat_w: f64) -> (f64, f64) {
         let delta = 1.0 / self.pulse_rate_hz;
         let tb = ael::TIME_BASE_S;
-        let t_start = (frame_s - delta).max(0.0);
-        if e_pass_j <= 0.0 || t_start >= tb {
+        let t_start = (frame_s - pass.duration_s.max(delta)).max(0.0);
+        if pass.envelope_j <= 0.0 || pass.pulses_j <= 0.0 || t_start >= tb {
             return (0.0, t_start);
         }
+        let a = self.envelope_family_max(frame_s, pass.envelope_j, p_hat_w, t_start);
+        let c = self.pass_count_max(frame_s, pass, t_start);
+        if a.0 <= c.0 {
+            a
+        } else {
+            c
+        }
+    }
+
+    /// The time-base figure: the smaller of the two multi-pass energy
+    /// bounds over a window of the time base, over its AEL.
+    #[must_use]
+    pub fn time_base_ratio(&self, frame_s: f64, pass: PassFigures, p_hat_w: f64) -> f64 {
+        let delta = 1.0 / self.pulse_rate_hz;
+        let tb = ael::TIME_BASE_S;
+        let e = pass
+            .envelope_energy(tb, frame_s, delta, p_hat_w)
+            .min(pass.count_energy(tb, frame_s));
+        e / self.ael_j(tb)
+    }
+
+    /// `sup A(T)/AEL(T)` over `[t_start, T_b]` (see [`Self::multi_pass_ratio`]):
+    /// within a row of Table 3 (`c·T^p`, `0 ≤ p ≤ 1`) the ratio has no
+    /// interior maximum on a linear piece of `A`, and over the family of
+    /// piece ends `T = q·T_f + r_f − Δ` it is quasi-convex in `q`, so the
+    /// row edges, `t_start`, `T_b` and the first and last two `q` of each
+    /// row and family are every candidate.
+    fn envelope_family_max(
+        &self,
+        frame_s: f64,
+        e_j: f64,
+        p_hat_w: f64,
+        t_start: f64,
+    ) -> (f64, f64) {
+        let delta = 1.0 / self.pulse_rate_hz;
+        let tb = ael::TIME_BASE_S;
         let r_star = if p_hat_w > 0.0 {
-            (e_pass_j / p_hat_w).min(frame_s)
+            (e_j / p_hat_w).min(frame_s)
         } else {
             frame_s
         };
-        // E(T) with L = T + Δ = q·T_f + r.
-        let energy = |t: f64| {
-            let l = t + delta;
-            let q = (l / frame_s).floor();
-            let r = (l - q * frame_s).max(0.0);
-            q * e_pass_j + e_pass_j.min(p_hat_w * r)
+        let fig = PassFigures {
+            envelope_j: e_j,
+            pulses_j: e_j,
+            duration_s: 0.0,
         };
         let mut best = (0.0, t_start);
         let mut consider = |t: f64| {
             if t >= t_start && t <= tb {
-                let r = energy(t) / self.ael_j(t);
+                let r = fig.envelope_energy(t, frame_s, delta, p_hat_w) / self.ael_j(t);
                 if r > best.0 {
                     best = (r, t);
                 }
@@ -254,12 +301,50 @@ impl Laser {
             consider(hi);
             // Family points T = q·T_f + r_f − Δ, r_f ∈ {0, r*}: first and last q in the row.
             for r_f in [0.0, r_star] {
-                let q_lo = ((lo + delta - r_f) / frame_s).ceil().max(1.0);
+                let q_lo = ((lo + delta - r_f) / frame_s).ceil().max(0.0);
                 let q_hi = ((hi + delta - r_f) / frame_s).floor();
                 for q in [q_lo, q_lo + 1.0, q_hi - 1.0, q_hi] {
-                    if q >= 1.0 && q <= q_hi && q >= q_lo {
+                    if q >= 0.0 && q <= q_hi && q >= q_lo {
                         consider(q * frame_s + r_f - delta);
                     }
+                }
+            }
+        }
+        best
+    }
+
+    /// `sup C(T)/AEL(T)` over `[t_start, T_b]`: `C` steps up at
+    /// `T_k = k·T_f − τ` (to `k + 1` passes) and is flat between, where the
+    /// ratio is largest at the step or at a row edge; over the steps of one
+    /// row, `(k + 1)·e/(c·(k·T_f − τ)^p)` is quasi-convex in `k`, so the
+    /// first and last two steps of each row are every candidate.
+    fn pass_count_max(&self, frame_s: f64, pass: PassFigures, t_start: f64) -> (f64, f64) {
+        let tb = ael::TIME_BASE_S;
+        let tau = pass.duration_s.max(0.0);
+        let mut best = (0.0, t_start);
+        let mut consider = |t: f64| {
+            if t >= t_start && t <= tb {
+                let r = pass.count_energy(t, frame_s) / self.ael_j(t);
+                if r > best.0 {
+                    best = (r, t);
+                }
+            }
+        };
+        consider(t_start);
+        consider(tb);
+        for row in self.rows() {
+            let lo = row.t_lo_s.max(t_start);
+            let hi = row.t_hi_s.min(tb);
+            if lo > hi {
+                continue;
+            }
+            consider(lo);
+            consider(hi);
+            let k_lo = ((lo + tau) / frame_s).ceil().max(1.0);
+            let k_hi = ((hi + tau) / frame_s).floor();
+            for k in [k_lo, k_lo + 1.0, k_hi - 1.0, k_hi] {
+                if k >= 1.0 && k >= k_lo && k <= k_hi {
+                    consider(k * frame_s - tau);
                 }
             }
         }
@@ -287,6 +372,40 @@ impl Laser {
         } else {
             (train, Rule::for_duration(t, f64::INFINITY))
         }
+    }
+}
+
+/// What the multi-pass rules know of one aperture's passes, as maxima over
+/// every aperture azimuth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassFigures {
+    /// Largest integral of the received envelope over one pass widened by a
+    /// pulse spacing (`E(φ)` of the module docs), J.
+    pub envelope_j: f64,
+    /// Largest energy the pulses of one pass can carry (the envelope capped
+    /// by the pass's pulse count), J; at most `envelope_j`.
+    pub pulses_j: f64,
+    /// Longest pass, s.
+    pub duration_s: f64,
+}
+
+impl PassFigures {
+    /// Bound A: the energy of the pulses an aperture receives in any window
+    /// of `t_s`, from the envelope's periodicity: `q·E + min(E, P̂·r)`,
+    /// `L = T + Δ = q·T_f + r`.
+    #[must_use]
+    pub fn envelope_energy(&self, t_s: f64, frame_s: f64, delta_s: f64, p_hat_w: f64) -> f64 {
+        let l = t_s + delta_s;
+        let q = (l / frame_s).floor();
+        let r = (l - q * frame_s).max(0.0);
+        q * self.envelope_j + self.envelope_j.min(p_hat_w * r)
+    }
+
+    /// Bound C: at most [`passes_in_window`] passes meet a window of `t_s`,
+    /// each with at most [`Self::pulses_j`].
+    #[must_use]
+    pub fn count_energy(&self, t_s: f64, frame_s: f64) -> f64 {
+        passes_in_window(t_s, self.duration_s.max(0.0), frame_s) * self.pulses_j
     }
 }
 
@@ -648,7 +767,12 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
     };
     let (pass_ratio, pass_window) = walks.search(search);
     // Rule 2 over several passes, up to the time base.
-    let (multi_ratio, multi_window) = laser.multi_pass_ratio(frame_s, best.e_max.0, p_hat);
+    let pass = PassFigures {
+        envelope_j: best.e_env_max,
+        pulses_j: best.e_max.0,
+        duration_s: best.tau_max,
+    };
+    let (multi_ratio, multi_window) = laser.multi_pass_ratio(frame_s, pass, p_hat);
     let multi_rule = Rule::for_duration(multi_window, frame_s);
     let mut ratios = [best.single.0, pass_ratio, 0.0, 0.0];
     match multi_rule {
@@ -656,11 +780,7 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
         _ => ratios[2] = multi_ratio,
     }
     // Also report the time-base figure itself (mean power over 100 s).
-    let tb = ael::TIME_BASE_S;
-    let l = tb + delta;
-    let q = (l / frame_s).floor();
-    let e_tb = q * best.e_max.0 + best.e_max.0.min(p_hat * (l - q * frame_s));
-    ratios[3] = ratios[3].max(e_tb / laser.ael_j(tb));
+    ratios[3] = ratios[3].max(laser.time_base_ratio(frame_s, pass, p_hat));
     for r in &mut ratios {
         *r *= 1.0 + RATIO_MARGIN;
     }
@@ -718,6 +838,9 @@ struct CellExact {
     /// Largest pass energy (envelope and pulse-count bounds), J, and the
     /// azimuth (wrapped) where the envelope bound peaks.
     e: (f64, f64),
+    /// Largest envelope integral over a pass (not capped by the pulse
+    /// count: the periodic bound of [`Laser::multi_pass_ratio`] needs it), J.
+    e_env: f64,
     /// Rule 1 ratio of the cell (before the margin).
     single: f64,
 }
@@ -745,15 +868,17 @@ struct Cells<'a> {
     /// figures for cells that are not curved).
     tau_ub: Vec<f64>,
     e_ub: Vec<f64>,
+    env_ub: Vec<f64>,
     single_ub: Vec<f64>,
     per_j: PerJouleCache,
 }
 
-/// The three maxima over cells: Rule 1 (ratio, azimuth), pass energy
-/// (J, azimuth), pass duration (s).
+/// The maxima over cells: Rule 1 (ratio, azimuth), pass energy
+/// (J, azimuth), envelope integral over a pass (J), pass duration (s).
 struct CellBest {
     single: (f64, f64),
     e_max: (f64, f64),
+    e_env_max: f64,
     tau_max: f64,
 }
 
@@ -795,6 +920,7 @@ impl<'a> Cells<'a> {
             curved: Vec::with_capacity(m),
             tau_ub: Vec::with_capacity(m),
             e_ub: Vec::with_capacity(m),
+            env_ub: Vec::with_capacity(m),
             single_ub: Vec::with_capacity(m),
             per_j: PerJouleCache::default(),
         };
@@ -906,6 +1032,7 @@ impl<'a> Cells<'a> {
             let passes = passes_in_window(t2, tau, frame_s);
             self.tau_ub.push(tau);
             self.e_ub.push(e.min(per_pass * p * delta));
+            self.env_ub.push(e);
             let per_j = self.per_j.get(self.laser, per_pass, passes);
             self.single_ub.push(p * delta * per_j);
             prev = next;
@@ -971,6 +1098,7 @@ impl<'a> Cells<'a> {
             tau_s: cell_tau,
             // A pass also holds at most `per_pass` pulses of at most `p·Δ`.
             e: (cell_e.0.min(per_pass * p * self.delta), wrap360(cell_e.1)),
+            e_env: cell_e.0,
             single: p * self.delta * self.per_j.peek(self.laser, per_pass, passes),
         }
     }
@@ -984,11 +1112,13 @@ impl<'a> Cells<'a> {
                 let mut best = CellBest {
                     single: (0.0, 0.0),
                     e_max: (0.0, 0.0),
+                    e_env_max: 0.0,
                     tau_max: 0.0,
                 };
                 for c in 0..self.len() {
                     let x = self.exact(c);
                     best.tau_max = best.tau_max.max(x.tau_s);
+                    best.e_env_max = best.e_env_max.max(x.e_env);
                     if x.e.0 > best.e_max.0 {
                         best.e_max = x.e;
                     }
@@ -1004,9 +1134,11 @@ impl<'a> Cells<'a> {
                 let single = first_max(&self.single_ub, |c| eval(c).single);
                 let e = first_max(&self.e_ub, |c| eval(c).e.0);
                 let tau = first_max(&self.tau_ub, |c| eval(c).tau_s);
+                let e_env = first_max(&self.env_ub, |c| eval(c).e_env);
                 CellBest {
                     single: single.map_or((0.0, 0.0), |(r, c)| (r, mid_of(c))),
                     e_max: e.map_or((0.0, 0.0), |(e, c)| (e, eval(c).e.1)),
+                    e_env_max: e_env.map_or(0.0, |x| x.0),
                     tau_max: tau.map_or(0.0, |x| x.0),
                 }
             }
@@ -1044,6 +1176,7 @@ fn ends(cuts: &[f64], tau_pt: &[f64], e_pt: &[f64], c: usize) -> CellExact {
     CellExact {
         tau_s: tau,
         e,
+        e_env: e.0,
         single: 0.0,
     }
 }
