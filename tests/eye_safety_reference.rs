@@ -339,6 +339,78 @@ fn pruned_search_is_bit_identical_on_a_rough_5000_bin_profile() {
     assert_eq!(a, b);
 }
 
+/// One differential case's result.
+struct Outcome {
+    class: String,
+    q: f64,
+    sound: bool,
+    tight: bool,
+    label: String,
+    json: String,
+}
+
+/// Build case `case` from `spec`, scale it so the reference lands on
+/// `spec.scale`, and compare the checker with the reference.
+fn one_case(case: usize, spec: &Spec, phases: usize) -> Outcome {
+    let raw = build(spec);
+    let effort = Effort {
+        phases,
+        locked: spec.locked,
+        ..Effort::default()
+    };
+    let r_raw = Reference::new(&Scan::of_profile(&raw)).worst(&effort);
+    // Energies are linear in power and C5 does not depend on it: scale
+    // the powers so that the reference ratio lands on `spec.scale`.
+    let k = spec.scale / r_raw.ratio;
+    let mut p = raw.clone();
+    for b in &mut p.bins {
+        b.power_w *= k;
+    }
+    let reference = r_raw.ratio * k;
+    let report = evaluate_profile(&p, &params_of(&p)).expect("checker evaluates");
+    let q = report.worst_ratio / reference;
+    let sound = report.worst_ratio >= reference * (1.0 - 1e-12);
+    let step = !spec.accel;
+    // Tightness is asserted where the reference plays the worst clock:
+    // phase-locked (the checker bounds every phase, and a free-running
+    // clock with few pulses per pass averages below the per-pass maximum).
+    // Below ~20 kHz a pass holds a handful of pulses and the checker's
+    // envelope (one pulse spacing of hot power per pass) is measurably
+    // looser; those cases are printed, not asserted.
+    let tight = !(step && spec.locked && p.pulse_rate_hz >= 20_000.0)
+        || report.worst_ratio <= reference * TIGHT_FACTOR;
+    let class = format!(
+        "{:>4} nm {} {} {:?}",
+        LAMBDAS[spec.band],
+        if spec.accel { "accel" } else { "step " },
+        if spec.locked { "locked" } else { "free  " },
+        r_raw.rule
+    );
+    let label = format!(
+        "case {case}: {class}, {} bins, f={:.2} Hz, fp={:.0} Hz, hot={:?}, dark={}, checker {:.6} ({:?}) vs reference {}",
+        p.bins.len(),
+        spec.frame_hz,
+        p.pulse_rate_hz,
+        spec.hot.map(|h| h.2),
+        spec.dark.is_some(),
+        report.worst_ratio,
+        report.binding_rule,
+        Worst { ratio: reference, ..r_raw },
+    );
+    Outcome {
+        class,
+        q,
+        sound,
+        tight,
+        json: if sound && tight {
+            String::new()
+        } else {
+            p.to_json().unwrap()
+        },
+        label,
+    }
+}
+
 #[test]
 fn differential_checker_never_below_reference() {
     let cases = env_usize("GAZE_LIDAR_REF_CASES", 500);
@@ -359,63 +431,31 @@ fn differential_checker_never_below_reference() {
     let mut all = Stats::default();
     let mut failures: Vec<(f64, String, String)> = Vec::new();
     let mut untight: Vec<(f64, String, String)> = Vec::new();
-    for case in 0..cases {
-        let spec = strategy.new_tree(&mut runner).expect("case").current();
-        let raw = build(&spec);
-        let effort = Effort {
-            phases,
-            locked: spec.locked,
-            ..Effort::default()
-        };
-        let r_raw = Reference::new(&Scan::of_profile(&raw)).worst(&effort);
-        // Energies are linear in power and C5 does not depend on it: scale
-        // the powers so that the reference ratio lands on `spec.scale`.
-        let k = spec.scale / r_raw.ratio;
-        let mut p = raw.clone();
-        for b in &mut p.bins {
-            b.power_w *= k;
-        }
-        let reference = r_raw.ratio * k;
-        let report = evaluate_profile(&p, &params_of(&p)).expect("checker evaluates");
-        let q = report.worst_ratio / reference;
-        let sound = report.worst_ratio >= reference * (1.0 - 1e-12);
-        let step = !spec.accel;
-        // Tightness is asserted where the reference plays the worst clock:
-        // phase-locked (the checker bounds every phase, and a free-running
-        // clock with few pulses per pass averages below the per-pass maximum).
-        // Below ~20 kHz a pass holds a handful of pulses and the checker's
-        // envelope (one pulse spacing of hot power per pass) is measurably
-        // looser; those cases are printed, not asserted.
-        let tight = !(step && spec.locked && p.pulse_rate_hz >= 20_000.0)
-            || report.worst_ratio <= reference * TIGHT_FACTOR;
-        let class = format!(
-            "{:>4} nm {} {} {:?}",
-            LAMBDAS[spec.band],
-            if spec.accel { "accel" } else { "step " },
-            if spec.locked { "locked" } else { "free  " },
-            r_raw.rule
-        );
-        let label = format!(
-            "case {case}: {class}, {} bins, f={:.2} Hz, fp={:.0} Hz, hot={:?}, dark={}, checker {:.6} ({:?}) vs reference {}",
-            p.bins.len(),
-            spec.frame_hz,
-            p.pulse_rate_hz,
-            spec.hot.map(|h| h.2),
-            spec.dark.is_some(),
-            report.worst_ratio,
-            report.binding_rule,
-            Worst { ratio: reference, ..r_raw },
-        );
+    // Specs are drawn in order from the seeded runner; the cases are then
+    // evaluated in parallel (rayon) and folded in case order, so the output
+    // does not depend on the thread count.
+    let specs: Vec<Spec> = (0..cases)
+        .map(|_| strategy.new_tree(&mut runner).expect("case").current())
+        .collect();
+    let outcomes: Vec<Outcome> = {
+        use rayon::prelude::*;
+        specs
+            .par_iter()
+            .enumerate()
+            .map(|(case, spec)| one_case(case, spec, phases))
+            .collect()
+    };
+    for o in outcomes {
         by_class
-            .entry(class)
+            .entry(o.class)
             .or_default()
-            .add(q, sound, tight, &label);
-        all.add(q, sound, tight, &label);
-        if !sound {
-            failures.push((q, label.clone(), p.to_json().unwrap()));
+            .add(o.q, o.sound, o.tight, &o.label);
+        all.add(o.q, o.sound, o.tight, &o.label);
+        if !o.sound {
+            failures.push((o.q, o.label.clone(), o.json.clone()));
         }
-        if !tight {
-            untight.push((q, label, p.to_json().unwrap()));
+        if !o.tight {
+            untight.push((o.q, o.label, o.json));
         }
     }
     let secs = started.elapsed().as_secs_f64();
