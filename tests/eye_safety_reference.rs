@@ -35,11 +35,13 @@ use std::time::Instant;
 
 /// The reference's view of a profile (read through the public fields only).
 /// How far above the reference the checker may be on phase-locked step
-/// profiles at ≥ 20 kHz. The goal is 1.05; measured today (500 cases) the
-/// checker is within 1.05 on 905 nm and up to ≈ 1.31 on narrow hot sectors
-/// in the corneal bands, where the envelope keeps one pulse spacing of hot
-/// power per pass. Tighten this as the bound tightens.
-const TIGHT_FACTOR: f64 = 1.35;
+/// profiles at ≥ 20 kHz. The goal is 1.05. Measured (1000 cases, default
+/// seed): 239 of 250 such profiles within 1.03, the loosest 1.112 — a
+/// single slow pass, where the within-pass window walks take the hottest
+/// window of the emitted envelope up to the longest pass of any aperture.
+/// It was 1.31 before passes were capped per bin (`pulse_capped_j`).
+/// Tighten this as the bound tightens.
+const TIGHT_FACTOR: f64 = 1.15;
 
 fn params_of(p: &Profile) -> EyeSafetyParams {
     p.limits.eye_safety.clone().expect("eye_safety params")

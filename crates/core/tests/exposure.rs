@@ -200,3 +200,23 @@ fn a_profile_is_read_as_its_segments_at_its_pulse_rate() {
         evaluate_segments(&s, &params(), 20_000.0).unwrap()
     );
 }
+
+/// A pass holds at most `⌊t_b·f_p⌋ + 1` pulses of each bin it crosses: a
+/// lone hot 1° bin that the head crosses in 1.5 pulse spacings gives at most
+/// two hot pulses per pass, whatever the clock phase — 2·P·Δ, where the
+/// envelope alone allows (1.5 + 1)·P·Δ and the pass-wide count
+/// `K·P_max·Δ` thirteen pulses.
+#[test]
+fn pass_energy_is_capped_per_bin() {
+    // 360 bins of 1° at 10 Hz: 1/3600 s per bin = 1.5 Δ at 5400 Hz.
+    let f_p = 5400.0;
+    let s = segs(360, |i| if i == 100 { 1.0 } else { 0.0 });
+    let r = evaluate_segments(&s, &params(), f_p).unwrap();
+    let two_pulses = 2.0 / f_p;
+    assert!(
+        (r.max_pass_energy_j - two_pulses).abs() <= 1e-12 * two_pulses,
+        "pass energy {} J, two hot pulses {} J",
+        r.max_pass_energy_j,
+        two_pulses
+    );
+}

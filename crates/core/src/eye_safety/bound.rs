@@ -826,6 +826,10 @@ fn wrap360(a: f64) -> f64 {
     }
 }
 
+/// Most bins a cell's union arc may touch for the per-bin pulse cap of a
+/// pass to be evaluated (beyond, the cap `K·P_max·Δ` is used).
+pub const PULSE_CAP_MAX_BINS: i64 = 64;
+
 /// Snap (deg) by which the arc a cell's pulses can come from is widened, so
 /// bins touched at an edge count.
 const TOUCH_SNAP_DEG: f64 = 1e-9;
@@ -1094,13 +1098,64 @@ impl<'a> Cells<'a> {
             cell_tau,
             self.tl.period_s(),
         );
+        // A pass also holds at most `per_pass` pulses of at most `p·Δ`, and
+        // at most the pulses each bin's share of it holds (`pulse_capped`).
+        let cap = self
+            .pulse_capped_j(c, per_pass)
+            .unwrap_or(per_pass * p * self.delta);
         CellExact {
             tau_s: cell_tau,
-            // A pass also holds at most `per_pass` pulses of at most `p·Δ`.
-            e: (cell_e.0.min(per_pass * p * self.delta), wrap360(cell_e.1)),
+            e: (cell_e.0.min(cap), wrap360(cell_e.1)),
             e_env: cell_e.0,
             single: p * self.delta * self.per_j.peek(self.laser, per_pass, passes),
         }
+    }
+
+    /// The most energy the pulses of one pass over cell `c` can carry,
+    /// counted per bin: for every φ in the cell, the pass holds at most
+    /// `per_pass` pulses, and bin `b` at most `⌊t_b·f_p⌋ + 1` of them, where
+    /// `t_b` (the head's time in `b ∩ [u − h, v + h]`, the cell's union
+    /// arc) is at least the time the pass at φ spends in `b`. The hottest
+    /// bins first (a knapsack of unit weights: greedy is optimal) gives the
+    /// maximum of `Σ P_b·n_b·Δ` under both caps. Tighter than
+    /// `per_pass · P_max · Δ` where a narrow hot bin holds fewer pulses than
+    /// the pass. `None` when the arc touches more than
+    /// [`PULSE_CAP_MAX_BINS`] bins (the caller keeps the coarser cap).
+    fn pulse_capped_j(&self, c: usize, per_pass: f64) -> Option<f64> {
+        let tl = self.tl;
+        let segs = tl.bins();
+        let n = segs.len() as i64;
+        let (u, v) = (self.cut(c), self.cut(c + 1));
+        let (lo_deg, hi_deg) = (u - self.h - TOUCH_SNAP_DEG, v + self.h + TOUCH_SNAP_DEG);
+        let mut hint = 0;
+        let lo = unwrapped_bin(tl, lo_deg, &mut hint);
+        let hi = unwrapped_bin(tl, hi_deg, &mut hint).max(lo);
+        if hi - lo + 1 > PULSE_CAP_MAX_BINS {
+            return None;
+        }
+        let f_p = self.laser.pulse_rate_hz;
+        let mut bins: Vec<(f64, f64)> = (lo..=hi)
+            .map(|k| {
+                let seg = &segs[k.rem_euclid(n) as usize];
+                let start = 360.0 * k.div_euclid(n) as f64 + seg.start_deg;
+                let a = start.max(lo_deg);
+                let b = (start + seg.width_deg).min(hi_deg);
+                let t_b = (self.time_at(b) - self.time_at(a)).max(0.0);
+                (seg.power_w, max_pulses_in(t_b, f_p))
+            })
+            .collect();
+        bins.sort_unstable_by(|x, y| y.0.total_cmp(&x.0));
+        let mut left = per_pass;
+        let mut e = 0.0;
+        for (p_w, cap) in bins {
+            if left <= 0.0 {
+                break;
+            }
+            let k = cap.min(left);
+            e += p_w * k * self.delta;
+            left -= k;
+        }
+        Some(e)
     }
 
     /// The three maxima, each with the first cell (in azimuth order)
