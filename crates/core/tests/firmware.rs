@@ -899,3 +899,34 @@ fn evaluate_matches_the_specification_at_extreme_magnitudes() {
         );
     }
 }
+
+/// A bin touched by the pass only at the cell's start (its end is the
+/// cell's first azimuth) still lends the pass one pulse at its code (the code
+/// at a boundary instant is ambiguous). Bins, 10 ticks per degree at 1 kHz:
+/// P = [0°, 10°) code 5, Q = [10°, 100°) code 0, R = [100°, 110°) code 9,
+/// S = [110°, 360°) code 0; a 95° pass (950 ticks, 10 pulses at 10 Hz).
+/// In the cell [10°, 15°] the pass holds all of R (100 ticks: 2 pulses) and
+/// touches P at 10°: G(10) = 2·9 + 5 = 23 (centre 10° + 47.5°). Elsewhere at
+/// most 2·5 + 9 = 19 (the cell [0°, 5°]: all of P, R touched at 100°).
+#[test]
+fn a_bin_touched_at_the_cell_start_counts_one_pulse() {
+    let t = table(
+        1000,
+        &[
+            (10_000, 100, 5),
+            (90_000, 900, 0),
+            (10_000, 100, 9),
+            (250_000, 2500, 0),
+        ],
+    );
+    let l = limits(&t, 10_000, 95_000, 100, &[(1, 1000)], 20);
+    let r = evaluate(&t, &l).unwrap();
+    assert_eq!(
+        (r.worst_ratio_ppm, r.rule, r.azimuth_mdeg, r.class1),
+        (1_150_000, IntRule::T2Train, 57_500, false)
+    );
+    assert_eq!(run(&t, &l), oracle(&t, &l));
+    // At 23 quanta per pass: Class 1 exactly.
+    let l = limits(&t, 10_000, 95_000, 100, &[(1, 1000)], 23);
+    assert!(evaluate(&t, &l).unwrap().class1);
+}
