@@ -575,7 +575,7 @@ fn reference_matches_closed_form_on_a_uniform_profile() {
                                                           // Rule 1: N = m10·k pulses within 10 s (no pass is cut: the next pass
                                                           // starts 10.016 s after the first pulse).
     let n = m10 * k;
-    let r1 = e / ((5.0 * n.powf(-0.25)).max(0.4) * 7.7e-8 * c4);
+    let r1 = e / ((5.0 * n.powf(-0.25)).clamp(0.4, 1.0) * 7.7e-8 * c4);
     let cands = [
         ("rule 1", r1),
         ("one pass", passes(1.0)),
@@ -637,7 +637,7 @@ fn rule1_905(e: f64, n: f64) -> f64 {
     let c5 = if n <= 600.0 {
         1.0
     } else {
-        (5.0 * n.powf(-0.25)).max(0.4)
+        (5.0 * n.powf(-0.25)).clamp(0.4, 1.0)
     };
     e / (c5 * 7.7e-8 * C4_905)
 }

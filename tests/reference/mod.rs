@@ -112,7 +112,7 @@ pub fn c5(band: Band, n: f64) -> f64 {
     if band != Band::Nir || n <= 600.0 {
         1.0
     } else {
-        (5.0 * n.powf(-0.25)).max(0.4)
+        (5.0 * n.powf(-0.25)).clamp(0.4, 1.0)
     }
 }
 

@@ -67,17 +67,28 @@ pub fn run_once<T, F: FnOnce(T)>(input: T, body: F) {
     body(input)
 }
 
+/// Random inputs each harness body runs on under `cargo test`: a count, not
+/// bolero's default of one second of wall time, so a loaded machine runs as
+/// many as an idle one and a cover that a test asserts hit is not missed for
+/// lack of time (it was, about one run in twenty, under load).
+#[doc(hidden)]
+pub const FOR_ALL_ITERATIONS: usize = 20_000;
+
 /// `for_all!(T, |x| body)`: the body for every `x: T`. Under Kani `x` is
 /// `kani::any()` (symbolic: the proof covers every value); under `cargo
-/// test` bolero feeds random values (bolero is a dev-dependency and is named
-/// only in this branch).
+/// test` bolero feeds [`FOR_ALL_ITERATIONS`] random values (bolero is a
+/// dev-dependency and is named only in this branch).
 #[macro_export]
 macro_rules! for_all {
     ($ty:ty, $body:expr $(,)?) => {{
         #[cfg(kani)]
         $crate::verification::run_once::<$ty, _>(kani::any(), $body);
         #[cfg(not(kani))]
-        bolero::check!().with_type::<$ty>().cloned().for_each($body);
+        bolero::check!()
+            .with_type::<$ty>()
+            .with_iterations($crate::verification::FOR_ALL_ITERATIONS)
+            .cloned()
+            .for_each($body);
     }};
 }
 pub use crate::for_all;

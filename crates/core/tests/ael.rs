@@ -145,6 +145,15 @@ fn c5_by_hand() {
     // T_max ≤ 0.25 s (inclusive) or N ≤ 600 (inclusive): 1.
     assert_eq!(c5(Band::RetinalNir, 1e4, 0.25), 1.0);
     assert_eq!(c5(Band::RetinalNir, 600.0, 100.0), 1.0);
+    // Never above 1: 5·601^−0.25 = 1.0098 and 5·625^−0.25 = 1 exactly; the
+    // first count where the formula is below 1 is 626 (5/626^0.25 = 0.99960).
+    assert_eq!(c5(Band::RetinalNir, 601.0, 10.0), 1.0);
+    assert_eq!(c5(Band::RetinalNir, 624.0, 10.0), 1.0);
+    assert_relative_eq!(
+        c5(Band::RetinalNir, 626.0, 10.0),
+        0.999_600_6,
+        max_relative = 1e-6
+    );
     // Corneal bands: 1 whatever N.
     assert_eq!(c5(Band::Ir1400, 1e4, 10.0), 1.0);
     assert_eq!(c5(Band::Ir1500, 1e4, 10.0), 1.0);

@@ -131,14 +131,18 @@ pub const T2_S: f64 = 10.0;
 /// C5, the repetitive-pulse correction (clause 4.3 f, 2014 rules), for pulses
 /// no longer than `T_i`, a small source, and `n_pulses` effective pulses
 /// within `T_max = min(T2, time base)`:
-/// 1 if `T_max <= 0.25 s` or `N <= 600`, else `max(0.4, 5 · N^−0.25)`.
+/// 1 if `T_max <= 0.25 s` or `N <= 600`, else `max(0.4, 5 · N^−0.25)`,
+/// and never above 1: `5·N^−0.25` exceeds 1 for 601 ≤ N ≤ 624 (1.0098 at
+/// 601), which would raise the limit as the pulse count grows past 600 and
+/// break "C5 does not rise with N", which the bound's pulse counts rely on.
+/// Capping at 1 is the conservative reading (C5 is a reduction).
 /// Applies to 400–1400 nm only; the corneal bands sum pulses within `T_i`.
 #[must_use]
 pub fn c5(band: Band, n_pulses: f64, t_max_s: f64) -> f64 {
     if band != Band::RetinalNir || t_max_s <= 0.25 || n_pulses <= 600.0 {
         1.0
     } else {
-        (5.0 * n_pulses.powf(-0.25)).max(0.4)
+        (5.0 * n_pulses.powf(-0.25)).clamp(0.4, 1.0)
     }
 }
 

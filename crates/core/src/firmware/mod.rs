@@ -147,18 +147,16 @@ mod verification {
     #[cfg_attr(kani, kani::proof, kani::unwind(6))]
     #[cfg_attr(not(kani), test)]
     fn quantizer_output_passes_integer_frame_and_dwell_checks() {
-        for_all!(([(u8, u8, u8, u8); 4], u8, u16), |(raw, n, total)| {
+        for_all!(([(u8, u8, u8, u8); 4], u8, u16, bool), |(
+            raw,
+            n,
+            total,
+            shaped,
+        )| {
             let n = 1 + usize::from(n % 4);
-            let targets: Vec<TickTarget> = raw[..n]
-                .iter()
-                .map(|&(floor, frac, min, span)| TickTarget {
-                    floor: u64::from(floor),
-                    frac: u32::from(frac) << 24,
-                    min: u64::from(min),
-                    max: u64::from(min) + u64::from(span),
-                })
-                .collect();
-            let Ok(ticks) = apportion(&targets, u64::from(total % 1100)) else {
+            let (targets, frame_ticks) =
+                quantize::verification::targets_and_total(&raw[..n], total, shaped);
+            let Ok(ticks) = apportion(&targets, frame_ticks) else {
                 return;
             };
             cover!(true, "apportioned table checked");
@@ -179,7 +177,7 @@ mod verification {
             let table = FirmwareTable {
                 format: FIRMWARE_FORMAT.to_owned(),
                 tick_hz: 1,
-                frame_ticks: u64::from(total % 1100),
+                frame_ticks,
                 power_w_per_code: 1.0,
                 power_accounting: PowerAccounting::Time,
                 pulse_rate_hz: 0.0,
