@@ -269,7 +269,6 @@ impl Laser {
         t_start: f64,
     ) -> (f64, f64) {
         let delta = 1.0 / self.pulse_rate_hz;
-        let tb = ael::TIME_BASE_S;
         let r_star = if p_hat_w > 0.0 {
             (e_j / p_hat_w).min(frame_s)
         } else {
@@ -280,37 +279,24 @@ impl Laser {
             pulses_j: e_j,
             duration_s: 0.0,
         };
-        let mut best = (0.0, t_start);
-        let mut consider = |t: f64| {
-            if t >= t_start && t <= tb {
-                let r = fig.envelope_energy(t, frame_s, delta, p_hat_w) / self.ael_j(t);
-                if r > best.0 {
-                    best = (r, t);
-                }
-            }
-        };
-        consider(t_start);
-        consider(tb);
-        for row in self.rows() {
-            let lo = row.t_lo_s.max(t_start);
-            let hi = row.t_hi_s.min(tb);
-            if lo > hi {
-                continue;
-            }
-            consider(lo);
-            consider(hi);
-            // Family points T = q·T_f + r_f − Δ, r_f ∈ {0, r*}: first and last q in the row.
-            for r_f in [0.0, r_star] {
-                let q_lo = ((lo + delta - r_f) / frame_s).ceil().max(0.0);
-                let q_hi = ((hi + delta - r_f) / frame_s).floor();
-                for q in [q_lo, q_lo + 1.0, q_hi - 1.0, q_hi] {
-                    if q >= 0.0 && q <= q_hi && q >= q_lo {
-                        consider(q * frame_s + r_f - delta);
+        self.row_sup(
+            t_start,
+            |t| fig.envelope_energy(t, frame_s, delta, p_hat_w),
+            |lo, hi| {
+                // Family points T = q·T_f + r_f − Δ, r_f ∈ {0, r*}: first and last q in the row.
+                let mut ts = Vec::with_capacity(8);
+                for r_f in [0.0, r_star] {
+                    let q_lo = ((lo + delta - r_f) / frame_s).ceil().max(0.0);
+                    let q_hi = ((hi + delta - r_f) / frame_s).floor();
+                    for q in [q_lo, q_lo + 1.0, q_hi - 1.0, q_hi] {
+                        if q >= 0.0 && q <= q_hi && q >= q_lo {
+                            ts.push(q * frame_s + r_f - delta);
+                        }
                     }
                 }
-            }
-        }
-        best
+                ts
+            },
+        )
     }
 
     /// `sup C(T)/AEL(T)` over `[t_start, T_b]`: `C` steps up at
@@ -319,12 +305,36 @@ impl Laser {
     /// row, `(k + 1)·e/(c·(k·T_f − τ)^p)` is quasi-convex in `k`, so the
     /// first and last two steps of each row are every candidate.
     fn pass_count_max(&self, frame_s: f64, pass: PassFigures, t_start: f64) -> (f64, f64) {
-        let tb = ael::TIME_BASE_S;
         let tau = pass.duration_s.max(0.0);
+        self.row_sup(
+            t_start,
+            |t| pass.count_energy(t, frame_s),
+            |lo, hi| {
+                let k_lo = ((lo + tau) / frame_s).ceil().max(1.0);
+                let k_hi = ((hi + tau) / frame_s).floor();
+                [k_lo, k_lo + 1.0, k_hi - 1.0, k_hi]
+                    .into_iter()
+                    .filter(|&k| k >= 1.0 && k >= k_lo && k <= k_hi)
+                    .map(|k| k * frame_s - tau)
+                    .collect()
+            },
+        )
+    }
+
+    /// The largest `energy(T)/AEL(T)` over `T ∈ [t_start, T_b]` among
+    /// `t_start`, `T_b`, every row's edges and the row's own candidates
+    /// `inner(lo, hi)`: (ratio, duration).
+    fn row_sup(
+        &self,
+        t_start: f64,
+        energy: impl Fn(f64) -> f64,
+        inner: impl Fn(f64, f64) -> Vec<f64>,
+    ) -> (f64, f64) {
+        let tb = ael::TIME_BASE_S;
         let mut best = (0.0, t_start);
         let mut consider = |t: f64| {
             if t >= t_start && t <= tb {
-                let r = pass.count_energy(t, frame_s) / self.ael_j(t);
+                let r = energy(t) / self.ael_j(t);
                 if r > best.0 {
                     best = (r, t);
                 }
@@ -340,12 +350,8 @@ impl Laser {
             }
             consider(lo);
             consider(hi);
-            let k_lo = ((lo + tau) / frame_s).ceil().max(1.0);
-            let k_hi = ((hi + tau) / frame_s).floor();
-            for k in [k_lo, k_lo + 1.0, k_hi - 1.0, k_hi] {
-                if k >= 1.0 && k >= k_lo && k <= k_hi {
-                    consider(k * frame_s - tau);
-                }
+            for t in inner(lo, hi) {
+                consider(t);
             }
         }
         best
