@@ -167,10 +167,28 @@ impl ArgusDetector {
         self.mask.index(x, y)
     }
 
+    /// Takes the y of a road point (`z` below the road threshold) whose
+    /// cell the caller keeps: it hands such cells to [`Self::end_tick_with`]
+    /// only if the callback updates the mask (the extent decides that).
+    pub fn road_y(&mut self, y: f64) {
+        self.tick_y = Some(match self.tick_y {
+            None => (y, y),
+            Some((lo, hi)) => (lo.min(y), hi.max(y)),
+        });
+    }
+
     /// Ends a callback: updates the road mask as `GridCache` does and
     /// returns whether the right car was detected in it.
     pub fn end_tick(&mut self) -> bool {
+        self.end_tick_with(|_| {})
+    }
+
+    /// [`Self::end_tick`] where `road_cells` yields (to the function it is
+    /// given) the cells of this callback's road points taken by
+    /// [`Self::road_y`]; it is called only if the mask takes them.
+    pub fn end_tick_with(&mut self, road_cells: impl FnOnce(&mut dyn FnMut(usize))) -> bool {
         let Some((y_lo, y_hi)) = self.tick_y.take() else {
+            self.tick_road.clear();
             self.tick_candidates.clear();
             return false;
         };
@@ -199,6 +217,8 @@ impl ArgusDetector {
             for &i in &self.tick_road {
                 self.mask.insert(i);
             }
+            let mask = &mut self.mask;
+            road_cells(&mut |i| mask.insert(i));
             self.empty = false;
         }
         self.tick_road.clear();

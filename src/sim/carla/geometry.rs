@@ -76,6 +76,24 @@ impl Sensor {
         }
     }
 
+    /// Whether the mount is level and every channel's direction is exactly
+    /// `(cos·cos az, cos·sin az, sin)` of its elevation: then its vertical
+    /// component is the same at every azimuth, bit for bit, and so is the
+    /// distance to the ground plane.
+    #[must_use]
+    pub fn is_level(&self) -> bool {
+        self.mount.rotation == UnitQuaternion::identity()
+            && self
+                .basis
+                .iter()
+                .zip(self.cos_el.iter().zip(&self.sin_el))
+                .all(|([a, b, c], (&co, &si))| {
+                    *a == Vector3::new(co, 0.0, 0.0)
+                        && *b == Vector3::new(0.0, co, 0.0)
+                        && *c == Vector3::new(0.0, 0.0, si)
+                })
+    }
+
     /// The sensor's origin in the road frame.
     #[must_use]
     pub fn origin(&self) -> Point3<f64> {
@@ -123,6 +141,7 @@ pub struct Hit {
 
 /// Entry and exit parameters of the slab `[lo, hi]` along one axis for a ray
 /// starting at `o` with direction component `d`; `None` if parallel outside.
+#[inline]
 fn slab(lo: f64, hi: f64, o: f64, d: f64) -> Option<(f64, f64)> {
     if d == 0.0 {
         if lo <= o && o <= hi {
@@ -139,6 +158,7 @@ fn slab(lo: f64, hi: f64, o: f64, d: f64) -> Option<(f64, f64)> {
 
 /// Slab test against `[lo, hi]` (3 axes): entry distance, the axis entered
 /// and the face value on that axis, if the ray enters at a positive distance.
+#[inline]
 fn slab3(
     lo: &Point3<f64>,
     hi: &Point3<f64>,
@@ -178,10 +198,24 @@ impl StaticBox {
     pub fn ray_hit(&self, o: &Point3<f64>, d: &Vector3<f64>) -> Option<Hit> {
         let (t, axis, face) = slab3(&self.min, &self.max, o, d)?;
         let mut point = o + d * t;
-        point[axis] = face;
+        // The axis by name, not by index: keeps the point in registers.
+        let cos_incidence = match axis {
+            0 => {
+                point.x = face;
+                d.x.abs()
+            }
+            1 => {
+                point.y = face;
+                d.y.abs()
+            }
+            _ => {
+                point.z = face;
+                d.z.abs()
+            }
+        };
         Some(Hit {
             range_m: t,
-            cos_incidence: d[axis].abs(),
+            cos_incidence,
             point,
             surface: Surface::Building,
         })
