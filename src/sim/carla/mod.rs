@@ -113,11 +113,11 @@ fn ray_key(k: u64, channels: usize, ch: usize) -> u64 {
 }
 
 /// The world of one tick: cars posed, with their culling data.
-struct Cars {
+struct Cars<const W: usize> {
     boxes: [PosedBox; 2],
     arcs: [Arc; 2],
     /// The channels that can reach car `j` this tick.
-    chans: [Chans; 2],
+    chans: [Chans<W>; 2],
 }
 
 /// A channel's ground return: the same for every azimuth (a level mount:
@@ -135,24 +135,32 @@ struct GroundRing {
 }
 
 /// The static world and the sensor, with per-channel culling data.
-struct World<'a> {
+struct World<'a, const W: usize> {
     sensor: Sensor,
     origin: Point3<f64>,
     statics: &'a [StaticBox],
     static_arcs: Vec<Arc>,
-    /// `static_may[ch]`: bit b set if channel `ch` can reach box b.
-    static_may: Vec<u64>,
     /// The channels that can reach static box b.
-    static_chans: Vec<Chans>,
+    static_chans: Vec<Chans<W>>,
+    /// Per static box, per channel: its z slab (level sensor: the same at
+    /// every azimuth); `None`: the channel never lies in its height band.
+    static_z: Vec<Vec<Option<(f64, f64)>>>,
+    /// Per channel: the distance along the ray to the ground plane, at any
+    /// distance (level sensor: the same at every azimuth).
+    ground_t: Vec<Option<f64>>,
     /// Horizontal reach of each channel: trace end or ground, m.
     reach_m: Vec<f64>,
     tan_el: Vec<f64>,
+    /// Per range bucket of [`RANGE_BUCKET_M`]: a lower bound of the raw
+    /// intensity `e^(−rate·r)` over the bucket, padded far above `exp`'s
+    /// error (empty if the rate is negative).
+    raw_floor: Vec<f64>,
     /// Per channel: its ground return if the ground lies within the trace.
     ground: Vec<Option<GroundRing>>,
     /// The channels with a ground return.
-    ground_chans: Chans,
+    ground_chans: Chans<W>,
     /// The ground channels subject to the intensity drop-off.
-    ground_dim: Chans,
+    ground_dim: Chans<W>,
     /// The mount is level ([`Sensor::is_level`]): the fast path's ground
     /// rings hold (else every group takes the reference path).
     level: bool,
@@ -165,7 +173,7 @@ struct World<'a> {
     lazy_road: bool,
 }
 
-impl<'a> World<'a> {
+impl<'a, const W: usize> World<'a, W> {
     fn new(sc: &Scenario, statics: &'a [StaticBox]) -> Self {
         let p = &sc.carla;
         let sensor = Sensor::new(
@@ -200,17 +208,6 @@ impl<'a> World<'a> {
             let dist = footprint_distances(b.footprint());
             channel_may_reach(h, tan_el[c], b.heights(), dist, reach_m[c], CULL_PAD_M)
         };
-        let static_may = (0..n)
-            .map(|c| {
-                if statics.len() > 64 {
-                    return u64::MAX;
-                }
-                statics
-                    .iter()
-                    .enumerate()
-                    .fold(0u64, |m, (i, b)| m | (u64::from(may(c, b)) << i))
-            })
-            .collect();
         let static_chans = statics
             .iter()
             .map(|b| {
@@ -221,6 +218,27 @@ impl<'a> World<'a> {
                 s
             })
             .collect();
+        let static_z = statics
+            .iter()
+            .map(|b| {
+                (0..n)
+                    .map(|c| b.z_slab(&origin, sensor.direction(c, 1.0, 0.0).z))
+                    .collect()
+            })
+            .collect();
+        let ground_t = (0..n)
+            .map(|c| {
+                geometry::ground_hit(&origin, &sensor.direction(c, 1.0, 0.0)).map(|g| g.range_m)
+            })
+            .collect();
+        let rate = p.atmosphere_attenuation_rate_per_m;
+        let raw_floor = if rate >= 0.0 && rate.is_finite() && p.range_m.is_finite() {
+            (0..(p.range_m / RANGE_BUCKET_M).ceil() as usize + 1)
+                .map(|i| (-rate * ((i + 1) as f64 * RANGE_BUCKET_M)).exp() * (1.0 - 1e-12))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let alpha = p.dropoff_zero_intensity / p.dropoff_intensity_limit;
         let beta = 1.0 - p.dropoff_zero_intensity;
         let ground: Vec<Option<GroundRing>> = (0..n)
@@ -269,14 +287,16 @@ impl<'a> World<'a> {
             lazy_road,
             statics,
             static_arcs,
-            static_may,
             static_chans,
+            static_z,
+            ground_t,
+            raw_floor,
             reach_m,
             tan_el,
         }
     }
 
-    fn cars(&self, boxes: [PosedBox; 2]) -> Cars {
+    fn cars(&self, boxes: [PosedBox; 2]) -> Cars<W> {
         let h = self.origin.z;
         let mut arcs = [Arc {
             start_deg: 0.0,
@@ -307,46 +327,9 @@ impl<'a> World<'a> {
             .fold(0u64, |m, (i, a)| m | (u64::from(a.contains(az)) << i))
     }
 
-    /// Nearest hit of channel `ch`'s ray (direction `d`) among the ground,
-    /// the statics of `pulse_mask` this channel can reach and the cars whose
-    /// extent contains the azimuth (`car_arc`) and that it can reach.
-    fn cast(
-        &self,
-        ch: usize,
-        d: &Vector3<f64>,
-        pulse_mask: u64,
-        car_arc: [bool; 2],
-        cars: &Cars,
-    ) -> Option<Hit> {
-        let o = &self.origin;
-        let mut best = geometry::ground_hit(o, d);
-        let mask = self.static_may[ch] & pulse_mask;
-        for (i, b) in self.statics.iter().enumerate() {
-            if i < 64 && mask & (1 << i) == 0 {
-                continue;
-            }
-            if let Some(h) = b.ray_hit(o, d) {
-                if best.is_none_or(|x| h.range_m < x.range_m) {
-                    best = Some(h);
-                }
-            }
-        }
-        for (j, &in_arc) in car_arc.iter().enumerate() {
-            if !(in_arc && cars.chans[j].contains(ch)) {
-                continue;
-            }
-            if let Some(h) = cars.boxes[j].ray_hit(o, d, Surface::Vehicle(j)) {
-                if best.is_none_or(|x| h.range_m < x.range_m) {
-                    best = Some(h);
-                }
-            }
-        }
-        best.filter(|h| h.range_m <= self.sensor.range_m)
-    }
-
     /// Nearest hit of the ray from the sensor along `d` among everything
     /// (ground, every static, both cars), at any distance.
-    fn nearest(&self, d: &Vector3<f64>, cars: &Cars) -> Option<Hit> {
+    fn nearest(&self, d: &Vector3<f64>, cars: &Cars<W>) -> Option<Hit> {
         let o = &self.origin;
         let mut best = geometry::ground_hit(o, d);
         for b in self.statics {
@@ -376,15 +359,17 @@ impl<'a> World<'a> {
         grid: &ArgusDetector,
     ) -> (Point3<f64>, Option<usize>) {
         let d = self.sensor.direction(ch, cos_az, sin_az);
-        let point = geometry::ground_hit(&self.origin, &d)
-            .expect("a ground ring meets the ground at every azimuth")
-            .point;
-        let ps = self.sensor.to_sensor(&point);
+        // `geometry::ground_hit`'s point, with its distance known.
+        let t = self.ground_t[ch].unwrap_or(f64::NAN);
+        let o = &self.origin;
+        let ps = self
+            .sensor
+            .to_sensor(&Point3::new(o.x + t * d.x, o.y + t * d.y, 0.0));
         (ps, grid.cell_of(ps.x, ps.y))
     }
 
     /// Nearest hit of the ray from the sensor towards `target` (all objects).
-    fn line_of_sight(&self, target: &Point3<f64>, cars: &Cars) -> Option<Hit> {
+    fn line_of_sight(&self, target: &Point3<f64>, cars: &Cars<W>) -> Option<Hit> {
         self.nearest(&(target - self.origin).normalize(), cars)
     }
 }
@@ -402,13 +387,16 @@ fn physical_returns(p_d: f64, u: impl FnOnce() -> f64) -> bool {
 
 /// A cell's verdict on the ground rings at one power level.
 #[derive(Debug, Clone)]
-struct GroundLevel {
+struct GroundLevel<const W: usize> {
     /// Channels whose ground hit always yields a point.
-    always: Chans,
+    always: Chans<W>,
     /// Channels whose ground hit yields a point when the noise draw is
     /// below `p_d[ch]` (physical, `0 < P_D < 1`).
-    maybe: Chans,
+    maybe: Chans<W>,
     p_d: Vec<f64>,
+    /// ARGUS model: box hits in range buckets below this surely return
+    /// (`power·floor·fog ≥ threshold` over the bucket, within 100 m).
+    sure_bucket: usize,
 }
 
 /// Width of the range buckets of [`Saturation`], m (a power of two: the
@@ -482,7 +470,7 @@ impl Saturation {
 }
 
 /// Per-cell state of a trial.
-struct CellState {
+struct CellState<const W: usize> {
     detected_at: [Option<f64>; 2],
     driver_at: [Option<f64>; 2],
     hit_ticks: [Vec<u64>; 2],
@@ -498,16 +486,16 @@ struct CellState {
     in_rof: bool,
     /// Fast path: the ground verdicts per distinct power ratio and the
     /// level of each bin.
-    levels: Vec<GroundLevel>,
+    levels: Vec<GroundLevel<W>>,
     level_of_bin: Vec<usize>,
     /// Fast path, physical model: saturation of box hits.
     saturation: Option<Saturation>,
     /// Fast path, ARGUS's detector with lazy road cells: this tick's ground
     /// road points as (pulse slot of the tick, channels).
-    deferred: Vec<(usize, Chans)>,
+    deferred: Vec<(usize, Chans<W>)>,
 }
 
-impl CellState {
+impl<const W: usize> CellState<W> {
     fn new(spec: &CellSpec<'_>, setup: &GroupSetup<'_>) -> Self {
         let p = &setup.scenario.carla;
         Self {
@@ -537,7 +525,7 @@ impl CellState {
 
     /// Fills the fast path's ground verdicts (one per distinct power ratio)
     /// and box-hit saturation.
-    fn plan_fast(&mut self, spec: &CellSpec<'_>, world: &World<'_>, sc: &Scenario) {
+    fn plan_fast(&mut self, spec: &CellSpec<'_>, world: &World<'_, W>, sc: &Scenario) {
         let ground_reflectivity = sc.carla.ground_reflectivity;
         self.saturation = Saturation::new(
             spec.model,
@@ -556,10 +544,26 @@ impl CellState {
             .iter()
             .map(|&bits| {
                 let power = f64::from_bits(bits);
+                let sure_bucket = match *spec.model {
+                    ReturnModel::Argus {
+                        fog_factor,
+                        threshold,
+                    } if power >= 0.0 && fog_factor >= 0.0 => {
+                        let in_range = (ARGUS_RANGE_M / RANGE_BUCKET_M).floor() as usize;
+                        world
+                            .raw_floor
+                            .iter()
+                            .take(in_range)
+                            .position(|&f| power * f * fog_factor < threshold)
+                            .unwrap_or(in_range.min(world.raw_floor.len()))
+                    }
+                    _ => 0,
+                };
                 let mut level = GroundLevel {
                     always: Chans::EMPTY,
                     maybe: Chans::EMPTY,
                     p_d: vec![0.0; world.ground.len()],
+                    sure_bucket,
                 };
                 for (ch, g) in world.ground.iter().enumerate() {
                     let Some(g) = g else { continue };
@@ -603,8 +607,10 @@ impl CellState {
 
 /// One pulse of the group: where the head points.
 #[derive(Debug, Clone, Copy)]
-struct Pulse {
+struct Pulse<const W: usize> {
     k: u64,
+    /// The channels surviving CARLA's general drop-off (fast path).
+    survivors: Chans<W>,
     az: f64,
     bin: usize,
     cos_az: f64,
@@ -615,32 +621,180 @@ struct Pulse {
     dens: bool,
 }
 
+/// What a cast ray meets nearest so far ([`PulseCtx::fast_rays`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Near {
+    Nothing,
+    Ground,
+    Static(geometry::Entry),
+    Car(Hit),
+}
+
+/// A box hit as the cells take it: range, incidence, reflectivity, surface
+/// (0 building, 1 vehicle), range bucket, point (road frame).
+#[derive(Debug, Clone, Copy, Default)]
+struct BoxHit {
+    range_m: f64,
+    cos_incidence: f64,
+    reflectivity: f64,
+    surface: usize,
+    bucket: usize,
+    point: Point3<f64>,
+}
+
+/// A pulse's rays on the fast path: the channels returning from the
+/// ground and from boxes (after CARLA's drop-off), those on each car, the
+/// largest range bucket of the box hits, the tick slot (lazy road cells).
+#[derive(Debug, Clone, Copy)]
+struct PulseRays<const W: usize> {
+    ground: Chans<W>,
+    boxes: Chans<W>,
+    car_hits: [Chans<W>; 2],
+    box_max_bucket: usize,
+    lazy_slot: Option<usize>,
+}
+
 /// Reusable per-pulse buffers of the fast path, one slot per channel (the
 /// box-hit slots are this pulse's for the channels of `boxes`).
-struct Scratch {
-    boxes: Chans,
-    /// Box hits: range, raw intensity, incidence, reflectivity, surface
-    /// (0 building, 1 vehicle), range bucket, point.
-    range: Vec<f64>,
+struct Scratch<const W: usize> {
+    boxes: Chans<W>,
+    /// This pulse's statics whose extent contains the azimuth.
+    statics_here: Vec<usize>,
+    /// Per box hit: what the cells need, and the raw intensity if computed.
+    hits: Vec<BoxHit>,
     raw: Vec<f64>,
-    cos: Vec<f64>,
-    refl: Vec<f64>,
-    surface: Vec<usize>,
-    bucket: Vec<usize>,
-    hit_point: Vec<Point3<f64>>,
     noise: Vec<f64>,
-    noise_drawn: Chans,
+    noise_drawn: Chans<W>,
     points: Vec<(Point3<f64>, Option<usize>)>,
-    points_done: Chans,
-    /// This tick's pulses in ARGUS's half-plane: `(cos, sin)` of the azimuth.
-    tick_pulses: Vec<(f64, f64)>,
+    points_done: Chans<W>,
+    /// Box hits whose raw intensity is computed (`raw`).
+    raw_done: Chans<W>,
+    tick: TickPulses<W>,
+}
+
+/// This tick's pulses in ARGUS's half-plane (lazy road cells): their
+/// azimuths and, once asked for, their ground rings' cells (shared by the
+/// cells of the group).
+#[derive(Default)]
+struct TickPulses<const W: usize> {
+    azimuths: Vec<(f64, f64)>,
+    cells: Vec<Option<usize>>,
+    done: Vec<Chans<W>>,
+}
+
+impl<const W: usize> TickPulses<W> {
+    /// A new pulse at azimuth `(cos, sin)`: its slot.
+    fn push(&mut self, cos_az: f64, sin_az: f64) -> usize {
+        self.azimuths.push((cos_az, sin_az));
+        self.azimuths.len() - 1
+    }
+
+    /// The cell of ground ring `ch` at pulse `slot`.
+    fn cell(
+        &mut self,
+        slot: usize,
+        ch: usize,
+        world: &World<'_, W>,
+        grid: &ArgusDetector,
+    ) -> Option<usize> {
+        let n = world.ground.len();
+        if self.done.len() < self.azimuths.len() {
+            self.done.resize(self.azimuths.len(), Chans::EMPTY);
+            self.cells.resize(self.azimuths.len() * n, None);
+        }
+        if !self.done[slot].contains(ch) {
+            let (cos_az, sin_az) = self.azimuths[slot];
+            self.cells[slot * n + ch] = world.ground_point(ch, cos_az, sin_az, grid).1;
+            self.done[slot].insert(ch);
+        }
+        self.cells[slot * n + ch]
+    }
+
+    fn clear(&mut self) {
+        self.azimuths.clear();
+        self.cells.clear();
+        self.done.clear();
+    }
 }
 
 /// Runs one trial for every cell of a group; outcomes in the cells' order.
 #[must_use]
+pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> {
+    run_group_with(setup, draw, &mut TrialRays::default())
+}
+
+/// CARLA's general drop-off of one trial, for every pulse: the channels
+/// whose rays survive it. Its draw depends only on the trial's seed, the
+/// pulse index and the channel, so the groups of a trial with the same
+/// pulse rate and channel count share it ([`run_group_with`]).
+#[derive(Debug, Default)]
+pub struct TrialRays {
+    /// (pulse rate bits, channels, drop-off rate bits, seed) and the
+    /// survivors per pulse.
+    memo: Vec<([u64; 4], Vec<Chans<4>>)>,
+}
+
+impl TrialRays {
+    /// The survivors of the first `n_pulses` pulses.
+    fn survivors(
+        &mut self,
+        pulse_rate_hz: f64,
+        channels: usize,
+        rate: f64,
+        seed: u64,
+        n_pulses: u64,
+    ) -> &[Chans<4>] {
+        let key = [
+            pulse_rate_hz.to_bits(),
+            channels as u64,
+            rate.to_bits(),
+            seed,
+        ];
+        let i = match self.memo.iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                self.memo.push((key, Vec::new()));
+                self.memo.len() - 1
+            }
+        };
+        let kept = &mut self.memo[i].1;
+        let mut all = Chans::EMPTY;
+        for ch in 0..channels {
+            all.insert(ch);
+        }
+        for k in kept.len() as u64..n_pulses {
+            kept.push(
+                all.filter(|ch| !(rate > 0.0 && unit(seed ^ ray_key(k, channels, ch)) < rate)),
+            );
+        }
+        &kept[..n_pulses as usize]
+    }
+}
+
+/// [`run_group`] with the trial's general drop-off shared through `rays`
+/// (the same outcomes).
+#[must_use]
+pub fn run_group_with(
+    setup: &GroupSetup<'_>,
+    draw: &TrialDraw,
+    rays: &mut TrialRays,
+) -> Vec<TrialOutcome> {
+    // Channel sets of one word when they fit (the paper's 64 channels).
+    if setup.scenario.carla.channels <= 64 {
+        run::<1>(setup, draw, rays)
+    } else {
+        run::<4>(setup, draw, rays)
+    }
+}
+
+/// [`run_group_with`] with channel sets of `W` words.
 // Channel and car indices address several parallel arrays at once.
 #[allow(clippy::needless_range_loop)]
-pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> {
+fn run<const W: usize>(
+    setup: &GroupSetup<'_>,
+    draw: &TrialDraw,
+    rays: &mut TrialRays,
+) -> Vec<TrialOutcome> {
     let sc = setup.scenario;
     let p = &sc.carla;
     let Some(first) = setup.cells.first() else {
@@ -688,37 +842,58 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
         noise: mix64(draw.noise_seed ^ 0x6361_726c_616e_6f69),
     };
 
-    let mut cells: Vec<CellState> = setup
+    let mut cells: Vec<CellState<W>> = setup
         .cells
         .iter()
         .map(|c| CellState::new(c, setup))
         .collect();
     let fast = !setup.brute_force && world.level;
+    let survivors: &[Chans<4>] = if fast {
+        rays.survivors(
+            pulse_rate,
+            channels,
+            p.dropoff_general_rate,
+            seeds.general,
+            n_pulses,
+        )
+    } else {
+        &[]
+    };
     if fast {
         for (st, spec) in cells.iter_mut().zip(setup.cells) {
             st.plan_fast(spec, &world, sc);
         }
     }
     let cell_grid = ArgusDetector::new(p);
+    // Cells of one plan share its regions: each pulse tests them once.
+    let region_of: Vec<usize> = setup
+        .cells
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            setup.cells[..i]
+                .iter()
+                .position(|o| std::ptr::eq(o.regions, c.regions))
+                .unwrap_or(i)
+        })
+        .collect();
+    let mut in_regions = vec![(false, false); cells.len()];
     let mut scratch = Scratch {
         boxes: Chans::EMPTY,
-        range: vec![0.0; channels],
+        statics_here: Vec::new(),
+        hits: vec![BoxHit::default(); channels],
         raw: vec![0.0; channels],
-        cos: vec![0.0; channels],
-        refl: vec![0.0; channels],
-        surface: vec![0; channels],
-        bucket: vec![0; channels],
-        hit_point: vec![Point3::origin(); channels],
         noise: vec![0.0; channels],
         noise_drawn: Chans::EMPTY,
         points: vec![(Point3::origin(), None); channels],
         points_done: Chans::EMPTY,
-        tick_pulses: Vec::new(),
+        raw_done: Chans::EMPTY,
+        tick: TickPulses::default(),
     };
 
     // Ends tick `tick` (state time `t`) for every cell.
-    let end_tick = |cells: &mut [CellState],
-                    tick_pulses: &mut Vec<(f64, f64)>,
+    let end_tick = |cells: &mut [CellState<W>],
+                    tick_pulses: &mut TickPulses<W>,
                     tick: u64,
                     t: f64| {
         for st in cells.iter_mut() {
@@ -744,11 +919,8 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
                 let deferred = &st.deferred;
                 let found = det.end_tick_with(|insert| {
                     for &(slot, chans) in deferred {
-                        let (cos_az, sin_az) = tick_pulses[slot];
                         for ch in chans.iter() {
-                            if let (_, Some(cell)) =
-                                world.ground_point(ch, cos_az, sin_az, &cell_grid)
-                            {
+                            if let Some(cell) = tick_pulses.cell(slot, ch, &world, &cell_grid) {
                                 insert(cell);
                             }
                         }
@@ -776,7 +948,7 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
         let tick = (t / tick_s).floor() as u64;
         if tick != current_tick {
             if current_tick != u64::MAX {
-                end_tick(&mut cells, &mut scratch.tick_pulses, current_tick, t_state);
+                end_tick(&mut cells, &mut scratch.tick, current_tick, t_state);
             }
             current_tick = tick;
             t_state = (tick + 1) as f64 * tick_s;
@@ -815,6 +987,9 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
         let half = argus::in_half_plane(az, ego_yaw);
         let pulse = Pulse {
             k,
+            survivors: survivors
+                .get(k as usize)
+                .map_or(Chans::EMPTY, |&x| Chans::narrow(x)),
             az,
             bin,
             cos_az,
@@ -822,9 +997,15 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
             half,
             dens: half && argus::signed_deg(az) < gaze - 30.0,
         };
-        for (st, spec) in cells.iter_mut().zip(setup.cells) {
-            st.in_roi = spec.regions.roi.contains(az);
-            st.in_rof = spec.rof_keep < 1.0 && spec.regions.rof.contains(az);
+        for (i, (st, spec)) in cells.iter_mut().zip(setup.cells).enumerate() {
+            let (roi, rof) = if region_of[i] < i {
+                in_regions[region_of[i]]
+            } else {
+                (spec.regions.roi.contains(az), spec.regions.rof.contains(az))
+            };
+            in_regions[i] = (roi, rof);
+            st.in_roi = roi;
+            st.in_rof = spec.rof_keep < 1.0 && rof;
             st.roi_pulses += u64::from(st.in_roi) * channels as u64;
         }
         let ctx = PulseCtx {
@@ -836,6 +1017,7 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
             grid: &cell_grid,
             t_state,
             t_arrive_right: t_arrive[1],
+            first_return: setup.detector == Detector::FirstReturn,
         };
         if fast {
             ctx.fast(&pulse, &mut cells, &mut scratch);
@@ -844,7 +1026,7 @@ pub fn run_group(setup: &GroupSetup<'_>, draw: &TrialDraw) -> Vec<TrialOutcome> 
         }
     }
     if current_tick != u64::MAX {
-        end_tick(&mut cells, &mut scratch.tick_pulses, current_tick, t_state);
+        end_tick(&mut cells, &mut scratch.tick, current_tick, t_state);
     }
 
     let duration_s = n_pulses as f64 / pulse_rate;
@@ -885,21 +1067,23 @@ struct Seeds {
 }
 
 /// What a pulse's rays need besides the pulse and the cells.
-struct PulseCtx<'w, 'a> {
+struct PulseCtx<'w, 'a, const W: usize> {
     scenario: &'w Scenario,
-    world: &'w World<'a>,
-    cars: &'w Cars,
+    world: &'w World<'a, W>,
+    cars: &'w Cars<W>,
     specs: &'w [CellSpec<'w>],
     seeds: &'w Seeds,
     grid: &'w ArgusDetector,
     t_state: f64,
     t_arrive_right: f64,
+    /// The first-return detector (car hits count anywhere).
+    first_return: bool,
 }
 
-impl PulseCtx<'_, '_> {
+impl<const W: usize> PulseCtx<'_, '_, W> {
     /// The reference: every channel cast against everything, every cell
     /// deciding every hit on its own, one ray at a time.
-    fn reference(&self, pulse: &Pulse, cells: &mut [CellState]) {
+    fn reference(&self, pulse: &Pulse<W>, cells: &mut [CellState<W>]) {
         let world = self.world;
         let p = &self.scenario.carla;
         let channels = world.sensor.elevations_deg.len();
@@ -986,12 +1170,33 @@ impl PulseCtx<'_, '_> {
     /// change, and with lazy road cells ([`World::lazy_road`]) it takes the
     /// ground points' extent from their lowest and highest channel and their
     /// cells only if the tick updates the mask.
-    fn fast(&self, pulse: &Pulse, cells: &mut [CellState], s: &mut Scratch) {
+    fn fast(&self, pulse: &Pulse<W>, cells: &mut [CellState<W>], s: &mut Scratch<W>) {
+        // A pulse none of whose points any cell counts, decimates, feeds to
+        // ARGUS's detector or takes as a car hit (first-return) changes
+        // nothing: skip its rays (their draws are keyed, not sequential).
+        let matters = |st: &CellState<W>| {
+            st.in_roi
+                || st.in_rof
+                || pulse.half && (pulse.dens || st.argus_live(self.t_state, self.t_arrive_right))
+        };
+        if !self.first_return && !cells.iter().any(matters) {
+            return;
+        }
+        let rays = self.fast_rays(pulse, s);
+        self.fast_cells(pulse, &rays, cells, s);
+    }
+
+    /// The fast path's rays of a pulse (shared by the cells): casts, CARLA's
+    /// drop-off, box-hit data into `s`.
+    #[inline(never)]
+    fn fast_rays(&self, pulse: &Pulse<W>, s: &mut Scratch<W>) -> PulseRays<W> {
         let world = self.world;
         let sc = self.scenario;
         let p = &sc.carla;
         let channels = world.ground.len();
         let k = pulse.k;
+        let (cos_az, sin_az) = (pulse.cos_az, pulse.sin_az);
+        let o = &world.origin;
         let alpha = p.dropoff_zero_intensity / p.dropoff_intensity_limit;
         let beta = 1.0 - p.dropoff_zero_intensity;
         let pulse_mask = world.static_mask_at(pulse.az);
@@ -999,10 +1204,12 @@ impl PulseCtx<'_, '_> {
             self.cars.arcs[0].contains(pulse.az),
             self.cars.arcs[1].contains(pulse.az),
         ];
+        s.statics_here.clear();
         let mut cand = Chans::EMPTY;
         for (i, c) in world.static_chans.iter().enumerate() {
             if i >= 64 || pulse_mask >> i & 1 == 1 {
                 cand |= *c;
+                s.statics_here.push(i);
             }
         }
         for (&in_arc, &chans) in car_arc.iter().zip(&self.cars.chans) {
@@ -1011,36 +1218,72 @@ impl PulseCtx<'_, '_> {
             }
         }
         // A ray that can meet nothing returns nothing whatever its draws.
-        let mut alive = Chans::EMPTY;
-        for ch in (world.ground_chans | cand).iter() {
-            let dropped = p.dropoff_general_rate > 0.0
-                && unit(self.seeds.general ^ ray_key(k, channels, ch)) < p.dropoff_general_rate;
-            alive.put(ch, !dropped);
-        }
+        let alive = pulse.survivors & (world.ground_chans | cand);
         let mut ground = alive & !cand;
         let mut boxes = Chans::EMPTY;
+        let mut box_max_bucket = 0;
         let mut car_hits = [Chans::EMPTY; 2];
+        s.raw_done = Chans::EMPTY;
         for ch in (alive & cand).iter() {
-            let d = world.sensor.direction(ch, pulse.cos_az, pulse.sin_az);
-            let Some(hit) = world.cast(ch, &d, pulse_mask, car_arc, self.cars) else {
-                continue;
+            let d = world.sensor.direction(ch, cos_az, sin_az);
+            // [`World::nearest`] within the trace, object by object: ground,
+            // statics in order, cars; a later object replaces an earlier one
+            // only if strictly nearer. Objects the ray cannot reach are left out.
+            let (mut r, mut near) = match world.ground_t[ch] {
+                Some(t) => (t, Near::Ground),
+                None => (f64::INFINITY, Near::Nothing),
             };
-            if hit.surface == Surface::Ground {
-                debug_assert_eq!(
-                    world.ground[ch].map(|g| g.range_m.to_bits()),
-                    Some(hit.range_m.to_bits())
-                );
-                ground.insert(ch);
+            for &i in &s.statics_here {
+                if !world.static_chans[i].contains(ch) {
+                    continue;
+                }
+                let Some(z) = world.static_z[i][ch] else {
+                    continue;
+                };
+                if let Some(e) = world.statics[i].entry(o, &d, z) {
+                    if near == Near::Nothing || e.range_m < r {
+                        (r, near) = (e.range_m, Near::Static(e));
+                    }
+                }
+            }
+            for (j, car) in self.cars.boxes.iter().enumerate() {
+                if !(car_arc[j] && self.cars.chans[j].contains(ch)) {
+                    continue;
+                }
+                if let Some(h) = car.ray_hit(o, &d, Surface::Vehicle(j)) {
+                    if near == Near::Nothing || h.range_m < r {
+                        (r, near) = (h.range_m, Near::Car(h));
+                    }
+                }
+            }
+            if r > world.sensor.range_m {
                 continue;
             }
-            let r = hit.range_m;
-            let raw = (-p.atmosphere_attenuation_rate_per_m * r).exp();
-            if raw <= p.dropoff_intensity_limit
-                && unit(self.seeds.intensity ^ ray_key(k, channels, ch)) >= alpha * raw + beta
-            {
-                continue;
+            let hit = match near {
+                Near::Nothing => continue,
+                Near::Ground => {
+                    ground.insert(ch);
+                    continue;
+                }
+                Near::Static(e) => StaticBox::hit(o, &d, e),
+                Near::Car(h) => h,
+            };
+            let bucket = (r * (1.0 / RANGE_BUCKET_M)) as usize;
+            let raw_floor = world.raw_floor.get(bucket).copied();
+            // The raw intensity is needed for the drop-off unless its floor
+            // is above the limit (then the intensity is too).
+            if !raw_floor.is_some_and(|f| f > p.dropoff_intensity_limit) {
+                let raw = (-p.atmosphere_attenuation_rate_per_m * r).exp();
+                if raw <= p.dropoff_intensity_limit
+                    && unit(self.seeds.intensity ^ ray_key(k, channels, ch)) >= alpha * raw + beta
+                {
+                    continue;
+                }
+                s.raw[ch] = raw;
+                s.raw_done.insert(ch);
             }
             boxes.insert(ch);
+            box_max_bucket = box_max_bucket.max(bucket);
             let (surface, refl) = match hit.surface {
                 Surface::Vehicle(j) => {
                     car_hits[j].insert(ch);
@@ -1048,71 +1291,104 @@ impl PulseCtx<'_, '_> {
                 }
                 _ => (0, sc.building_reflectivity),
             };
-            s.range[ch] = r;
-            s.raw[ch] = raw;
-            s.cos[ch] = hit.cos_incidence;
-            s.refl[ch] = refl;
-            s.surface[ch] = surface;
-            s.bucket[ch] = (r / RANGE_BUCKET_M) as usize;
-            s.hit_point[ch] = hit.point;
+            s.hits[ch] = BoxHit {
+                range_m: r,
+                cos_incidence: hit.cos_incidence,
+                reflectivity: refl,
+                surface,
+                bucket,
+                point: hit.point,
+            };
         }
-        for ch in (ground & world.ground_dim).iter() {
+        let dimmed = (ground & world.ground_dim).filter(|ch| {
             let keep_below = world.ground[ch].and_then(|g| g.keep_below);
-            if keep_below
-                .is_some_and(|x| unit(self.seeds.intensity ^ ray_key(k, channels, ch)) >= x)
-            {
-                ground.remove(ch);
-            }
-        }
+            keep_below.is_some_and(|x| unit(self.seeds.intensity ^ ray_key(k, channels, ch)) >= x)
+        });
+        ground = ground & !dimmed;
         s.boxes = boxes;
         s.noise_drawn = Chans::EMPTY;
         s.points_done = Chans::EMPTY;
-        let lazy_slot = (pulse.half && world.lazy_road).then(|| {
-            s.tick_pulses.push((pulse.cos_az, pulse.sin_az));
-            s.tick_pulses.len() - 1
-        });
+        let lazy_slot =
+            (pulse.half && world.lazy_road).then(|| s.tick.push(pulse.cos_az, pulse.sin_az));
+        PulseRays {
+            ground,
+            boxes,
+            car_hits,
+            box_max_bucket,
+            lazy_slot,
+        }
+    }
+
+    /// The fast path's cells of a pulse, given its rays.
+    #[inline(never)]
+    fn fast_cells(
+        &self,
+        pulse: &Pulse<W>,
+        rays: &PulseRays<W>,
+        cells: &mut [CellState<W>],
+        s: &mut Scratch<W>,
+    ) {
+        let world = self.world;
+        let p = &self.scenario.carla;
+        let channels = world.ground.len();
+        let k = pulse.k;
+        let PulseRays {
+            ground,
+            boxes,
+            car_hits,
+            box_max_bucket,
+            lazy_slot,
+        } = *rays;
         for (st, spec) in cells.iter_mut().zip(self.specs) {
             let level = &st.levels[st.level_of_bin[pulse.bin]];
-            let mut ret = ground & level.always;
-            for ch in (ground & level.maybe).iter() {
-                if s.noise(ch, self.seeds.noise, k, channels) < level.p_d[ch] {
-                    ret.insert(ch);
-                }
-            }
+            let mut ret = ground & level.always
+                | (ground & level.maybe)
+                    .filter(|ch| s.noise(ch, self.seeds.noise, k, channels) < level.p_d[ch]);
             let power = st.power_ratio[pulse.bin];
-            for ch in boxes.iter() {
-                let returned = match *spec.model {
-                    ReturnModel::Argus {
-                        fog_factor,
-                        threshold,
-                    } => argus_returns(power, s.raw[ch], s.range[ch], fog_factor, threshold),
-                    ReturnModel::Physical { .. } => {
-                        st.saturation.as_ref().is_some_and(|x| {
-                            x.saturated(s.surface[ch], s.bucket[ch], power, s.cos[ch])
-                        }) || physical_returns(
+            ret |= match *spec.model {
+                // Rounding is monotone: `power·floor·fog ≥ threshold` implies
+                // `power·raw·fog ≥ threshold` (non-negative factors, floor
+                // below raw): every bucket below `sure_bucket` returns.
+                ReturnModel::Argus { .. } if box_max_bucket < level.sure_bucket => boxes,
+                ReturnModel::Argus {
+                    fog_factor,
+                    threshold,
+                } => boxes.filter(|ch| {
+                    s.hits[ch].bucket < level.sure_bucket
+                        || argus_returns(
+                            power,
+                            s.raw(ch, p.atmosphere_attenuation_rate_per_m),
+                            s.hits[ch].range_m,
+                            fog_factor,
+                            threshold,
+                        )
+                }),
+                ReturnModel::Physical { .. } => boxes.filter(|ch| {
+                    let h = s.hits[ch];
+                    st.saturation
+                        .as_ref()
+                        .is_some_and(|x| x.saturated(h.surface, h.bucket, power, h.cos_incidence))
+                        || physical_returns(
                             spec.model.detection_probability(
                                 power,
-                                s.refl[ch],
-                                s.cos[ch],
-                                s.range[ch],
+                                h.reflectivity,
+                                h.cos_incidence,
+                                h.range_m,
                             ),
                             || s.noise(ch, self.seeds.noise, k, channels),
                         )
-                    }
-                };
-                ret.put(ch, returned);
-            }
+                }),
+            };
             if st.in_rof {
-                let mut kept = Chans::EMPTY;
-                for ch in ret.iter() {
-                    st.keep_acc += spec.rof_keep;
-                    if st.keep_acc < 1.0 {
-                        continue;
+                let acc = &mut st.keep_acc;
+                ret = ret.filter(|_| {
+                    *acc += spec.rof_keep;
+                    if *acc < 1.0 {
+                        return false;
                     }
-                    st.keep_acc -= 1.0;
-                    kept.insert(ch);
-                }
-                ret = kept;
+                    *acc -= 1.0;
+                    true
+                });
             }
             let n = ret.len();
             st.roi_points += u64::from(st.in_roi) * n;
@@ -1148,7 +1424,16 @@ impl PulseCtx<'_, '_> {
     }
 }
 
-impl Scratch {
+impl<const W: usize> Scratch<W> {
+    /// The raw intensity of box hit `ch` (computed once per pulse).
+    fn raw(&mut self, ch: usize, rate: f64) -> f64 {
+        if !self.raw_done.contains(ch) {
+            self.raw[ch] = (-rate * self.hits[ch].range_m).exp();
+            self.raw_done.insert(ch);
+        }
+        self.raw[ch]
+    }
+
     /// The physical model's noise draw of channel `ch` at pulse `k` (drawn once per pulse).
     fn noise(&mut self, ch: usize, seed: u64, k: u64, channels: usize) -> f64 {
         if !self.noise_drawn.contains(ch) {
@@ -1163,13 +1448,13 @@ impl Scratch {
     fn point(
         &mut self,
         ch: usize,
-        world: &World<'_>,
-        pulse: &Pulse,
+        world: &World<'_, W>,
+        pulse: &Pulse<W>,
         grid: &ArgusDetector,
     ) -> (Point3<f64>, Option<usize>) {
         if !self.points_done.contains(ch) {
             self.points[ch] = if self.boxes.contains(ch) {
-                let ps = world.sensor.to_sensor(&self.hit_point[ch]);
+                let ps = world.sensor.to_sensor(&self.hits[ch].point);
                 (ps, grid.cell_of(ps.x, ps.y))
             } else {
                 world.ground_point(ch, pulse.cos_az, pulse.sin_az, grid)
