@@ -175,7 +175,8 @@ fn slab(lo: f64, hi: f64, o: f64, d: f64) -> Option<(f64, f64)> {
     } else {
         let a = (lo - o) / d;
         let b = (hi - o) / d;
-        Some((a.min(b), a.max(b)))
+        // Neither is NaN (finite bounds, d ≠ 0): the ordered pair.
+        Some(if a <= b { (a, b) } else { (b, a) })
     }
 }
 
@@ -213,7 +214,9 @@ fn slab3_given_z(
             t_in = a;
             axis = k;
         }
-        t_out = t_out.min(b);
+        if b < t_out {
+            t_out = b;
+        }
     }
     if t_in > t_out || t_in <= 0.0 {
         return None;
@@ -530,5 +533,26 @@ mod tests {
         let h = ground_hit(&o, &d).unwrap();
         assert_relative_eq!(h.point.x, 3.0 / 10f64.to_radians().tan(), epsilon = 1e-9);
         assert!(ground_hit(&o, &Vector3::x()).is_none());
+    }
+
+    #[test]
+    fn level_direction_is_the_basis_sum() {
+        let s = Sensor::new(3.0, carla_elevations_deg(64, 10.0, -30.0), 100.0);
+        assert!(s.is_level());
+        for i in 0..3600 {
+            let (sin_az, cos_az) = (f64::from(i) * 0.1).to_radians().sin_cos();
+            for ch in 0..64 {
+                let [a, b, c] = &s.basis[ch];
+                let sum = a * cos_az + b * sin_az + c;
+                // Equal values (== treats the two zeros alike).
+                assert_eq!(s.direction(ch, cos_az, sin_az), sum);
+                assert_eq!(
+                    s.direction(ch, cos_az, sin_az).z.to_bits(),
+                    s.sin_el[ch].to_bits()
+                );
+            }
+        }
+        let p = Point3::new(1.5, -2.5, 0.0);
+        assert_eq!(s.to_sensor(&p), s.mount.inverse_transform_point(&p));
     }
 }

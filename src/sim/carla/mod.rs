@@ -21,11 +21,25 @@
 //! same azimuth at every pulse) are evaluated on the same rays: geometry and
 //! CARLA's drop-off are cast once per trial and timeline.
 //!
-//! Acceleration, bit-identical to casting every ray against everything
-//! (`brute_force`; tested): a box is tested only if the channel's ray can
-//! reach its height band inside its horizontal distance band before the
-//! trace ends or meets the ground ([`geometry::channel_may_reach`]), and
-//! only if the azimuth lies in the box's angular extent (cars: per tick).
+//! Acceleration, bit-identical to casting every ray against everything and
+//! deciding every hit in every cell (`brute_force`, the plain reference
+//! loop `PulseCtx::reference`; tested on both models, all variants, fog
+//! levels, both detectors and scenes that turn the shortcuts off): a
+//! pulse's rays are handled as channel sets (`Chans`, one word for
+//! up to 64 channels). A box is tested only if the channel's ray can reach
+//! its height band inside its horizontal distance band before the trace ends
+//! or meets the ground ([`geometry::channel_may_reach`]) and the azimuth lies
+//! in its angular extent (cars: per tick); a ray that can meet no box meets
+//! the ground at its channel's ring (a level mount: the same distance at
+//! every azimuth), whose verdict each cell has per distinct power ratio.
+//! CARLA's general drop-off is drawn once per trial and pulse rate
+//! ([`TrialRays`]); box hits take the raw intensity from a per-range-bucket
+//! floor unless the drop-off or the ARGUS model near its threshold needs it
+//! exactly, and the physical model skips `erfc` where a per-bucket amplitude
+//! bound proves `P_D = 1` (`Saturation`). ARGUS's detector is fed only
+//! while its verdict can still change, and takes the ground points' road
+//! cells lazily (`World::lazy_road`); pulses whose points nothing counts
+//! are skipped.
 
 pub mod argus;
 mod chans;
@@ -1217,6 +1231,7 @@ impl<const W: usize> PulseCtx<'_, '_, W> {
                 cand |= chans;
             }
         }
+        let cars_here = (0..2).filter(|&j| car_arc[j]);
         // A ray that can meet nothing returns nothing whatever its draws.
         let alive = pulse.survivors & (world.ground_chans | cand);
         let mut ground = alive & !cand;
@@ -1246,8 +1261,9 @@ impl<const W: usize> PulseCtx<'_, '_, W> {
                     }
                 }
             }
-            for (j, car) in self.cars.boxes.iter().enumerate() {
-                if !(car_arc[j] && self.cars.chans[j].contains(ch)) {
+            for j in cars_here.clone() {
+                let car = &self.cars.boxes[j];
+                if !self.cars.chans[j].contains(ch) {
                     continue;
                 }
                 if let Some(h) = car.ray_hit(o, &d, Surface::Vehicle(j)) {
@@ -1462,5 +1478,108 @@ impl<const W: usize> Scratch<W> {
             self.points_done.insert(ch);
         }
         self.points[ch]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::returns::{FogLevel, ModelKind};
+
+    /// Uniform draws for the sweeps.
+    fn draws(seed: u64, n: usize) -> impl Iterator<Item = f64> {
+        (0..n as u64).map(move |i| unit(seed ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15)))
+    }
+
+    #[test]
+    fn erfc_is_exactly_two_at_and_below_minus_six() {
+        // What [`Saturation`] rests on (libm's erfc: 2 − ε with ε below
+        // half an ulp of 2 from −6 down, 2 − 2^−1022 from −28 down).
+        let mut x = -6.0;
+        while x > -40.0 {
+            assert_eq!(0.5 * libm::erfc(x), 1.0, "{x}");
+            x -= 1.0 / 1024.0;
+        }
+        for x in draws(1, 100_000).map(|u| -6.0 - 50.0 * u) {
+            assert_eq!(0.5 * libm::erfc(x), 1.0, "{x}");
+        }
+        assert_eq!(0.5 * libm::erfc(f64::NEG_INFINITY), 1.0);
+        assert_eq!(0.5 * libm::erfc(-1e300), 1.0);
+    }
+
+    #[test]
+    fn saturated_box_hits_have_p_d_exactly_one() {
+        let sc = Scenario::default();
+        let refl = [sc.building_reflectivity, sc.vehicle_reflectivity];
+        let sensor = crate::model::presets::paper();
+        let mut saturated = 0;
+        for fog in [0, 25, 50] {
+            let model = ReturnModel::new(
+                ModelKind::Physical,
+                FogLevel::of(fog).unwrap(),
+                sensor.lidar.rated_range_m,
+                sensor.lidar.reference_reflectivity,
+            );
+            let sat = Saturation::new(&model, refl, sc.carla.range_m).unwrap();
+            let u: Vec<f64> = draws(fog.into(), 400_000).collect();
+            for w in u.chunks(4) {
+                let (power, cos, r) = (2.0 * w[0], w[1], sc.carla.range_m * w[2] + 1e-9);
+                let surface = usize::from(w[3] < 0.5);
+                let bucket = (r * (1.0 / RANGE_BUCKET_M)) as usize;
+                if sat.saturated(surface, bucket, power, cos) {
+                    saturated += 1;
+                    let p_d = model.detection_probability(power, refl[surface], cos, r);
+                    assert_eq!(p_d, 1.0, "fog {fog} power {power} cos {cos} r {r}");
+                }
+            }
+        }
+        assert!(saturated > 10_000, "{saturated}");
+        let argus = ReturnModel::new(ModelKind::Argus, FogLevel::of(0).unwrap(), 100.0, 0.1);
+        assert!(Saturation::new(&argus, refl, 100.0).is_none());
+    }
+
+    #[test]
+    fn raw_floor_lies_below_the_raw_intensity_of_its_bucket() {
+        let sc = Scenario::default();
+        let statics = sc.carla_static_boxes();
+        let world = World::<1>::new(&sc, &statics);
+        let rate = sc.carla.atmosphere_attenuation_rate_per_m;
+        for r in draws(7, 100_000).map(|u| u * sc.carla.range_m) {
+            let floor = world.raw_floor[(r * (1.0 / RANGE_BUCKET_M)) as usize];
+            assert!(floor < (-rate * r).exp(), "{r}");
+        }
+    }
+
+    #[test]
+    fn lazy_road_bounds_hold_on_the_default_mount() {
+        // |y| of the ground points of one azimuth never grows with the
+        // channel: the lowest and highest ground channel bound a set's y.
+        let sc = Scenario::default();
+        let statics = sc.carla_static_boxes();
+        let world = World::<1>::new(&sc, &statics);
+        let grid = ArgusDetector::new(&sc.carla);
+        assert!(world.level && world.lazy_road);
+        let rings: Vec<usize> = world.ground_chans.iter().collect();
+        assert!(rings.len() > 30);
+        for az in draws(3, 20_000).map(|u| 360.0 * u) {
+            let (sin_az, cos_az) = az.to_radians().sin_cos();
+            let y: Vec<f64> = rings
+                .iter()
+                .map(|&ch| world.ground_point(ch, cos_az, sin_az, &grid).0.y)
+                .collect();
+            assert!(y.windows(2).all(|w| w[1].abs() <= w[0].abs()), "{az}");
+            // The ring's point is the cast's ground hit.
+            for &ch in &rings {
+                let d = world.sensor.direction(ch, cos_az, sin_az);
+                let hit = geometry::ground_hit(&world.origin, &d).unwrap();
+                let ps = world.sensor.to_sensor(&hit.point);
+                assert_eq!(world.ground_point(ch, cos_az, sin_az, &grid).0, ps);
+                assert_eq!(Some(hit.range_m), world.ground_t[ch]);
+            }
+        }
+        // A mount below ARGUS's road threshold: no lazy cells.
+        let mut low = sc.clone();
+        low.carla.mount_height_m = 2.5;
+        assert!(!World::<1>::new(&low, &statics).lazy_road);
     }
 }
