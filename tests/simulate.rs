@@ -321,10 +321,20 @@ fn carla_first_return_tta_matches_the_ground_ring_closed_form() {
 fn carla_grid(detector: Detector, brute_force: bool, far_side: bool) -> GridResult {
     let mut scenario = short_carla();
     scenario.carla.far_side_buildings = far_side;
+    carla_grid_in(scenario, detector, &[0, 50], 2, brute_force)
+}
+
+fn carla_grid_in(
+    scenario: Scenario,
+    detector: Detector,
+    fog_pcts: &[u32],
+    trials: usize,
+    brute_force: bool,
+) -> GridResult {
     let config = SimConfig {
         models: vec![ModelKind::Argus, ModelKind::Physical],
-        fog_pcts: vec![0, 50],
-        trials: 2,
+        fog_pcts: fog_pcts.to_vec(),
+        trials,
         scenario,
         geometry: Geometry::Carla,
         detector,
@@ -337,12 +347,49 @@ fn carla_grid(detector: Detector, brute_force: bool, far_side: bool) -> GridResu
 
 #[test]
 fn carla_culling_and_shared_casts_are_bit_identical_to_brute_force() {
-    for (detector, far_side) in [(Detector::Argus, false), (Detector::FirstReturn, true)] {
-        let fast = carla_grid(detector, false, far_side);
-        let slow = carla_grid(detector, true, far_side);
-        assert_eq!(fast.trials, slow.trials, "{detector:?}");
-        assert_eq!(fast.rows, slow.rows);
-        assert!(fast.rows.iter().any(|x| x.detected > 0));
+    // The fast path (culled casts, analytic ground rings, per-cell ground
+    // verdicts, saturated physical returns, ARGUS's lazy road cells and its
+    // detector left alone once decided) against casting every ray at
+    // everything and deciding every hit: both models, the paper's four
+    // variants, all three fog levels, both detectors, and scenes that turn
+    // the shortcuts off or stress them.
+    let base = short_carla();
+    let mut far_side = base.clone();
+    far_side.carla.far_side_buildings = true;
+    // Ground points above ARGUS's road threshold (no lazy road cells; they
+    // are vehicle candidates instead, and nothing is road: no detection),
+    // 80 channels (two words of channels).
+    let mut low_mount = base.clone();
+    low_mount.carla.mount_height_m = 2.5;
+    low_mount.carla.channels = 80;
+    // No general drop-off, intensity drop-off on every ray, a short trace,
+    // a channel exactly level.
+    let mut dim = base.clone();
+    dim.carla.dropoff_general_rate = 0.0;
+    dim.carla.dropoff_intensity_limit = 1.0;
+    dim.carla.range_m = 70.0;
+    dim.carla.channels = 41;
+    dim.carla.upper_fov_deg = 10.0;
+    dim.carla.lower_fov_deg = -30.0;
+    let cases = [
+        (base.clone(), Detector::Argus, 3, true),
+        (far_side, Detector::FirstReturn, 2, true),
+        (base, Detector::FirstReturn, 2, true),
+        (low_mount, Detector::Argus, 2, false),
+        (dim, Detector::Argus, 2, true),
+    ];
+    for (i, (scenario, detector, trials, detects)) in cases.into_iter().enumerate() {
+        let fast = carla_grid_in(scenario.clone(), detector, &[0, 25, 50], trials, false);
+        let slow = carla_grid_in(scenario, detector, &[0, 25, 50], trials, true);
+        assert_eq!(fast.trials, slow.trials, "case {i} ({detector:?})");
+        assert_eq!(fast.rows, slow.rows, "case {i}");
+        assert_eq!(fast.rows.len(), 2 * 4 * 3);
+        assert_eq!(
+            fast.rows.iter().any(|x| x.detected > 0),
+            detects,
+            "case {i}"
+        );
+        assert!(fast.rows.iter().all(|x| x.argus_density_points > 0.0));
     }
 }
 

@@ -796,6 +796,7 @@ fn run_carla<'s>(
                 }
             }
             let mut out = Vec::new();
+            let mut rays = carla::TrialRays::default();
             for g in &groups {
                 let mut specs = Vec::new();
                 let mut keys = Vec::new();
@@ -822,7 +823,7 @@ fn run_carla<'s>(
                     brute_force: config.brute_force,
                     gaze_deg: d.gaze_deg,
                 };
-                let outcomes = carla::run_group(&setup, &d);
+                let outcomes = carla::run_group_with(&setup, &d, &mut rays);
                 for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
                     tick();
                     out.push(TrialRecord {

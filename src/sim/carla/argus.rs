@@ -167,10 +167,28 @@ impl ArgusDetector {
         self.mask.index(x, y)
     }
 
+    /// Takes the y of a road point (`z` below the road threshold) whose
+    /// cell the caller keeps: it hands such cells to [`Self::end_tick_with`]
+    /// only if the callback updates the mask (the extent decides that).
+    pub fn road_y(&mut self, y: f64) {
+        self.tick_y = Some(match self.tick_y {
+            None => (y, y),
+            Some((lo, hi)) => (lo.min(y), hi.max(y)),
+        });
+    }
+
     /// Ends a callback: updates the road mask as `GridCache` does and
     /// returns whether the right car was detected in it.
     pub fn end_tick(&mut self) -> bool {
+        self.end_tick_with(|_| {})
+    }
+
+    /// [`Self::end_tick`] where `road_cells` yields (to the function it is
+    /// given) the cells of this callback's road points taken by
+    /// [`Self::road_y`]; it is called only if the mask takes them.
+    pub fn end_tick_with(&mut self, road_cells: impl FnOnce(&mut dyn FnMut(usize))) -> bool {
         let Some((y_lo, y_hi)) = self.tick_y.take() else {
+            self.tick_road.clear();
             self.tick_candidates.clear();
             return false;
         };
@@ -199,6 +217,8 @@ impl ArgusDetector {
             for &i in &self.tick_road {
                 self.mask.insert(i);
             }
+            let mask = &mut self.mask;
+            road_cells(&mut |i| mask.insert(i));
             self.empty = false;
         }
         self.tick_road.clear();
@@ -277,5 +297,40 @@ mod tests {
         d.point(8.5, -61.5, -3.0);
         d.point(8.4, -61.6, -2.0);
         assert!(d.end_tick());
+    }
+
+    #[test]
+    fn lazy_road_cells_equal_eager_ones() {
+        // The same points, road cells either pushed with each point or taken
+        // by extent first and handed over only when the mask takes them.
+        let p = CarlaParams::default();
+        let (mut eager, mut lazy) = (ArgusDetector::new(&p), ArgusDetector::new(&p));
+        let mut state = 0x1234_5678_u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut found = 0;
+        for tick in 0..400 {
+            let mut road = Vec::new();
+            for _ in 0..50 {
+                let (x, y) = (30.0 * next(), -60.0 * next() - 0.5 * f64::from(tick % 7));
+                let z = if next() < 0.7 { -3.0 } else { -2.0 };
+                eager.point(x, y, z);
+                if z < p.argus_road_z_m {
+                    lazy.road_y(y);
+                    road.push(lazy.cell_of(x, y));
+                } else {
+                    lazy.point(x, y, z);
+                }
+            }
+            let a = eager.end_tick();
+            let b = lazy.end_tick_with(|insert| road.iter().flatten().for_each(|&i| insert(i)));
+            assert_eq!(a, b, "tick {tick}");
+            found += usize::from(a);
+        }
+        assert!(found > 0);
     }
 }

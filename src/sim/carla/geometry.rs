@@ -41,6 +41,8 @@ pub struct Sensor {
     /// Per channel, the direction's components along the azimuth's cosine,
     /// its sine and the constant part (mount rotation applied once).
     basis: Vec<[Vector3<f64>; 3]>,
+    /// [`Self::is_level`], found once.
+    level: bool,
 }
 
 impl Sensor {
@@ -66,14 +68,39 @@ impl Sensor {
                 ]
             })
             .collect();
-        Self {
+        let mut sensor = Self {
             mount,
             elevations_deg,
             cos_el,
             sin_el,
             range_m,
             basis,
-        }
+            level: false,
+        };
+        sensor.level = sensor.find_level();
+        sensor
+    }
+
+    /// Whether the mount is level and every channel's direction is exactly
+    /// `(cos·cos az, cos·sin az, sin)` of its elevation: then its vertical
+    /// component is the same at every azimuth, bit for bit, and so is the
+    /// distance to the ground plane.
+    #[must_use]
+    pub fn is_level(&self) -> bool {
+        self.level
+    }
+
+    fn find_level(&self) -> bool {
+        self.mount.rotation == UnitQuaternion::identity()
+            && self
+                .basis
+                .iter()
+                .zip(self.cos_el.iter().zip(&self.sin_el))
+                .all(|([a, b, c], (&co, &si))| {
+                    *a == Vector3::new(co, 0.0, 0.0)
+                        && *b == Vector3::new(0.0, co, 0.0)
+                        && *c == Vector3::new(0.0, 0.0, si)
+                })
     }
 
     /// The sensor's origin in the road frame.
@@ -82,17 +109,31 @@ impl Sensor {
         self.mount * Point3::origin()
     }
 
-    /// Unit direction (road frame) of channel `ch` at azimuth `(cos, sin)`.
+    /// Unit direction (road frame) of channel `ch` at azimuth `(cos, sin)`:
+    /// on a level sensor `(cos·cos az, cos·sin az, sin)` of the elevation
+    /// (the basis sum's values up to the sign of a zero component).
     #[must_use]
+    #[inline]
     pub fn direction(&self, ch: usize, cos_az: f64, sin_az: f64) -> Vector3<f64> {
-        let [a, b, c] = &self.basis[ch];
-        a * cos_az + b * sin_az + c
+        if self.level {
+            let c = self.cos_el[ch];
+            Vector3::new(c * cos_az, c * sin_az, self.sin_el[ch])
+        } else {
+            let [a, b, c] = &self.basis[ch];
+            a * cos_az + b * sin_az + c
+        }
     }
 
-    /// A point of the road frame in the sensor frame.
+    /// A point of the road frame in the sensor frame (a level mount: the
+    /// translation alone, the same values as the isometry's inverse up to
+    /// the sign of zero).
     #[must_use]
     pub fn to_sensor(&self, p: &Point3<f64>) -> Point3<f64> {
-        self.mount.inverse_transform_point(p)
+        if self.mount.rotation == UnitQuaternion::identity() {
+            p - self.mount.translation.vector
+        } else {
+            self.mount.inverse_transform_point(p)
+        }
     }
 }
 
@@ -123,6 +164,7 @@ pub struct Hit {
 
 /// Entry and exit parameters of the slab `[lo, hi]` along one axis for a ray
 /// starting at `o` with direction component `d`; `None` if parallel outside.
+#[inline]
 fn slab(lo: f64, hi: f64, o: f64, d: f64) -> Option<(f64, f64)> {
     if d == 0.0 {
         if lo <= o && o <= hi {
@@ -133,34 +175,68 @@ fn slab(lo: f64, hi: f64, o: f64, d: f64) -> Option<(f64, f64)> {
     } else {
         let a = (lo - o) / d;
         let b = (hi - o) / d;
-        Some((a.min(b), a.max(b)))
+        // Neither is NaN (finite bounds, d ≠ 0): the ordered pair.
+        Some(if a <= b { (a, b) } else { (b, a) })
     }
 }
 
 /// Slab test against `[lo, hi]` (3 axes): entry distance, the axis entered
 /// and the face value on that axis, if the ray enters at a positive distance.
+#[inline]
 fn slab3(
     lo: &Point3<f64>,
     hi: &Point3<f64>,
     o: &Point3<f64>,
     d: &Vector3<f64>,
 ) -> Option<(f64, usize, f64)> {
-    let mut t_in = f64::NEG_INFINITY;
+    let z = slab(lo.z, hi.z, o.z, d.z)?;
+    slab3_given_z(lo, hi, o, d, z)
+}
+
+/// [`slab3`] with the z slab's `(entry, exit)` given (the same for every
+/// azimuth of a channel of a level sensor).
+#[inline]
+fn slab3_given_z(
+    lo: &Point3<f64>,
+    hi: &Point3<f64>,
+    o: &Point3<f64>,
+    d: &Vector3<f64>,
+    z: (f64, f64),
+) -> Option<(f64, usize, f64)> {
+    let x = slab(lo.x, hi.x, o.x, d.x)?;
+    let y = slab(lo.y, hi.y, o.y, d.y)?;
+    // The entry is the last slab entered (the first axis on ties), the exit
+    // the first left: x, y, z in turn.
+    let (mut t_in, mut axis) = (f64::NEG_INFINITY, 0);
     let mut t_out = f64::INFINITY;
-    let mut axis = 0;
-    for k in 0..3 {
-        let (a, b) = slab(lo[k], hi[k], o[k], d[k])?;
+    for (k, (a, b)) in [(0, x), (1, y), (2, z)] {
         if a > t_in {
             t_in = a;
             axis = k;
         }
-        t_out = t_out.min(b);
+        if b < t_out {
+            t_out = b;
+        }
     }
     if t_in > t_out || t_in <= 0.0 {
         return None;
     }
-    let face = if d[axis] > 0.0 { lo[axis] } else { hi[axis] };
+    let (dk, lo_k, hi_k) = match axis {
+        0 => (d.x, lo.x, hi.x),
+        1 => (d.y, lo.y, hi.y),
+        _ => (d.z, lo.z, hi.z),
+    };
+    let face = if dk > 0.0 { lo_k } else { hi_k };
     Some((t_in, axis, face))
+}
+
+/// Where a ray enters a static box: distance, axis and face value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Entry {
+    /// Distance along the ray, m.
+    pub range_m: f64,
+    axis: usize,
+    face: f64,
 }
 
 /// An axis-aligned box of the road frame (a building).
@@ -176,15 +252,67 @@ impl StaticBox {
     /// The first hit of the ray `o + t·d` (`d` unit), if any.
     #[must_use]
     pub fn ray_hit(&self, o: &Point3<f64>, d: &Vector3<f64>) -> Option<Hit> {
-        let (t, axis, face) = slab3(&self.min, &self.max, o, d)?;
-        let mut point = o + d * t;
-        point[axis] = face;
-        Some(Hit {
+        let (range_m, axis, face) = slab3(&self.min, &self.max, o, d)?;
+        Some(Self::hit(
+            o,
+            d,
+            Entry {
+                range_m,
+                axis,
+                face,
+            },
+        ))
+    }
+
+    /// The z slab `(entry, exit)` of rays from `o` with vertical component
+    /// `d_z`; `None` if they never lie in the box's height band.
+    #[must_use]
+    pub fn z_slab(&self, o: &Point3<f64>, d_z: f64) -> Option<(f64, f64)> {
+        slab(self.min.z, self.max.z, o.z, d_z)
+    }
+
+    /// Where the ray `o + t·d` enters, given its [`Self::z_slab`]: the same
+    /// as [`Self::ray_hit`]'s range, bit for bit.
+    #[must_use]
+    pub fn entry(&self, o: &Point3<f64>, d: &Vector3<f64>, z: (f64, f64)) -> Option<Entry> {
+        let (range_m, axis, face) = slab3_given_z(&self.min, &self.max, o, d, z)?;
+        Some(Entry {
+            range_m,
+            axis,
+            face,
+        })
+    }
+
+    /// The hit of the ray `o + t·d` at its entry `e`: as [`Self::ray_hit`].
+    #[must_use]
+    pub fn hit(o: &Point3<f64>, d: &Vector3<f64>, e: Entry) -> Hit {
+        let Entry {
             range_m: t,
-            cos_incidence: d[axis].abs(),
+            axis,
+            face,
+        } = e;
+        let mut point = o + d * t;
+        // The axis by name, not by index: keeps the point in registers.
+        let cos_incidence = match axis {
+            0 => {
+                point.x = face;
+                d.x.abs()
+            }
+            1 => {
+                point.y = face;
+                d.y.abs()
+            }
+            _ => {
+                point.z = face;
+                d.z.abs()
+            }
+        };
+        Hit {
+            range_m: t,
+            cos_incidence,
             point,
             surface: Surface::Building,
-        })
+        }
     }
 
     /// The footprint as a 2D box `(x0, x1, y0, y1)`.
@@ -405,5 +533,26 @@ mod tests {
         let h = ground_hit(&o, &d).unwrap();
         assert_relative_eq!(h.point.x, 3.0 / 10f64.to_radians().tan(), epsilon = 1e-9);
         assert!(ground_hit(&o, &Vector3::x()).is_none());
+    }
+
+    #[test]
+    fn level_direction_is_the_basis_sum() {
+        let s = Sensor::new(3.0, carla_elevations_deg(64, 10.0, -30.0), 100.0);
+        assert!(s.is_level());
+        for i in 0..3600 {
+            let (sin_az, cos_az) = (f64::from(i) * 0.1).to_radians().sin_cos();
+            for ch in 0..64 {
+                let [a, b, c] = &s.basis[ch];
+                let sum = a * cos_az + b * sin_az + c;
+                // Equal values (== treats the two zeros alike).
+                assert_eq!(s.direction(ch, cos_az, sin_az), sum);
+                assert_eq!(
+                    s.direction(ch, cos_az, sin_az).z.to_bits(),
+                    s.sin_el[ch].to_bits()
+                );
+            }
+        }
+        let p = Point3::new(1.5, -2.5, 0.0);
+        assert_eq!(s.to_sensor(&p), s.mount.inverse_transform_point(&p));
     }
 }
