@@ -255,8 +255,9 @@ pub fn render_with_pipeline(
         "2. **Fog, argus model.** Taken literally, the paper's code attenuates by a *constant* factor \
          e^(−(0.004 + 5.4·fog/100)) and drops points below an intensity threshold, which caps the range at \
          {:.0} m (fog 25 %) and {:.0} m (fog 50 %) for the baseline and at {:.0} m / {:.0} m with the ×1.1 power of range \
-         control. So our baseline fog TTAs ({} s, {} s) fall below the paper's ≈ 4.5 s and 3.5–4.5 s: the code's fog \
-         is harsher than what the paper's figure shows (the fog-level mapping is undocumented). Range control gains \
+         control. So our baseline fog TTAs ({} s, {} s) fall below the paper's ≈ 4.5 s and 3.5–4.5 s. Under the proportional \
+         mapping (undocumented; see *The fog mapping* below) the paper's fog panels are not merely harsher in the \
+         code, they are out of its reach: no baseline return survives beyond those ranges. Range control gains \
          {} s and {} s, more than the paper's ≈ 1 s, for the same reason: near the threshold a 10 % intensity \
          change moves the cut-off range by ln(1.1)/0.004 ≈ 24 m.",
         argus_range(25, 1.0),
