@@ -76,18 +76,26 @@ impl Band {
     }
 }
 
+/// `t^0.75` as `√t · ⁴√t` (two correctly rounded square roots: within a few
+/// ulp of `powf`, far inside the differential test's 1e-12, and several
+/// times faster; `powf` was ~40 % of a long run's time).
+fn pow_3_4(t: f64) -> f64 {
+    let r = t.sqrt();
+    r * r.sqrt()
+}
+
 /// Row `i` of the AEL table (J at duration `t`) and the duration where it ends.
 fn row(band: Band, c4: f64, i: usize, t: f64) -> (f64, f64) {
     match (band, i) {
         (Band::Nir, 0) => (5e-6, 7.7e-8 * c4),
-        (Band::Nir, 1) => (10.0, 7e-4 * c4 * t.powf(0.75)),
+        (Band::Nir, 1) => (10.0, 7e-4 * c4 * pow_3_4(t)),
         (Band::Nir, _) => (f64::INFINITY, 3.9e-4 * c4 * t),
         (Band::Ir1400, 0) => (1e-3, 8e-4),
-        (Band::Ir1400, 1) => (0.35, 4.4e-3 * t.powf(0.25)),
+        (Band::Ir1400, 1) => (0.35, 4.4e-3 * t.sqrt().sqrt()),
         (Band::Ir1400, 2) => (10.0, 1e-2 * t),
         (Band::Ir1400, _) => (f64::INFINITY, 1e-2 * t),
         (Band::Ir1500, 0) => (0.35, 8e-3),
-        (Band::Ir1500, 1) => (10.0, 1.8e-2 * t.powf(0.75)),
+        (Band::Ir1500, 1) => (10.0, 1.8e-2 * pow_3_4(t)),
         (Band::Ir1500, _) => (f64::INFINITY, 1e-2 * t),
     }
 }
