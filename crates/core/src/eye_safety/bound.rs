@@ -49,8 +49,6 @@
 //! as the larger one and a perturbation of the inputs by 1e-12 cannot
 //! lower it ([`COUNT_MARGIN`]).
 
-use std::collections::VecDeque;
-
 use super::ael::{self, Band, Row};
 use crate::profile::kinematics::{BinMotion, Timeline};
 
@@ -101,50 +99,52 @@ fn of_total_key(k: i64) -> f64 {
 /// deduplicated: the same vector as `sort_by(total_cmp)` then `dedup`
 /// (the sorted order of a total order is unique), in linear time (merges of
 /// the rotated runs, in two buffers). Falls back to the sort if a run has
-/// two descents or a NaN.
+/// two descents or a NaN. The runs must cover `v` (`bounds` from 0 to its
+/// length).
 fn sort_runs(mut v: Vec<f64>, bounds: &[usize]) -> Vec<f64> {
-    // The rotated runs' keys, one after the other, and where each starts.
-    let mut keys: Vec<i64> = Vec::with_capacity(v.len());
-    let mut starts: Vec<usize> = Vec::with_capacity(bounds.len());
+    debug_assert!(bounds.first() == Some(&0) && bounds.last() == Some(&v.len()));
+    if v.iter().any(|x| x.is_nan()) {
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        return v;
+    }
+    let keys: Vec<i64> = v.iter().map(|&x| total_key(x)).collect();
+    // Each run rotated at its descent (if any) into `merged`.
+    let mut merged: Vec<i64> = Vec::with_capacity(keys.len());
     for w in bounds.windows(2) {
-        let run = &v[w[0]..w[1]];
-        let mut descent = None;
-        let mut ok = true;
+        let run = &keys[w[0]..w[1]];
+        let (mut descents, mut at) = (0usize, 0usize);
         for i in 1..run.len() {
-            if total_key(run[i - 1]) > total_key(run[i]) {
-                ok &= descent.is_none();
-                descent = Some(i);
+            if run[i - 1] > run[i] {
+                descents += 1;
+                at = i;
             }
         }
-        let i = descent.unwrap_or(0);
-        if !ok
-            || run.iter().any(|x| x.is_nan())
-            || (i > 0 && total_key(run[run.len() - 1]) > total_key(run[0]))
-        {
+        if descents > 1 || (descents == 1 && run[run.len() - 1] > run[0]) {
             v.sort_by(f64::total_cmp);
             v.dedup();
             return v;
         }
-        starts.push(keys.len());
-        keys.extend(run[i..].iter().chain(&run[..i]).map(|&x| total_key(x)));
+        merged.extend_from_slice(&run[at..]);
+        merged.extend_from_slice(&run[..at]);
     }
-    starts.push(keys.len());
     // Bottom-up: merge neighbouring runs pairwise until one is left.
-    let mut other = vec![0i64; keys.len()];
+    let mut other = keys;
+    let mut starts: Vec<usize> = bounds.to_vec();
     while starts.len() > 2 {
         let mut next = Vec::with_capacity(starts.len() / 2 + 2);
         for k in (0..starts.len() - 1).step_by(2) {
             let (lo, mid) = (starts[k], starts[k + 1]);
             let hi = starts.get(k + 2).copied().unwrap_or(mid);
             next.push(lo);
-            merge_keys(&keys[lo..mid], &keys[mid..hi], &mut other[lo..hi]);
+            merge_keys(&merged[lo..mid], &merged[mid..hi], &mut other[lo..hi]);
         }
-        next.push(keys.len());
+        next.push(merged.len());
         starts = next;
-        std::mem::swap(&mut keys, &mut other);
+        std::mem::swap(&mut merged, &mut other);
     }
     v.clear();
-    for &k in &keys {
+    for &k in &merged {
         let x = of_total_key(k);
         if v.last() != Some(&x) {
             v.push(x);
@@ -677,7 +677,7 @@ impl Envelope {
         // The deque holds (power, end time) of the bins in it.
         let (mut turn, mut bin) = (0usize, 0usize); // next bin to push, as k div n, k mod n
         let offset = |turn: usize| (turn as f64 - 1.0) * frame_s;
-        let mut deque: VecDeque<(f64, f64)> = VecDeque::new();
+        let mut deque: Queue<(f64, f64)> = Queue::default();
         // The bins of the period before that end by the first piece's
         // window (`c_0 − Δ`) never count: they would be pushed and popped
         // again at the first piece (they come first, and a bin only pops
@@ -814,19 +814,62 @@ impl Envelope {
     }
 }
 
+/// A double-ended queue for the monotone-deque maxima, where items are
+/// pushed only at the back: a vector and the index of its front (popping
+/// the front advances the index; nothing is moved or wrapped).
+struct Queue<T> {
+    items: Vec<T>,
+    head: usize,
+}
+
+impl<T> Default for Queue<T> {
+    fn default() -> Self {
+        Self {
+            items: Vec::new(),
+            head: 0,
+        }
+    }
+}
+
+impl<T: Copy> Queue<T> {
+    fn front(&self) -> Option<&T> {
+        self.items.get(self.head)
+    }
+
+    fn back(&self) -> Option<&T> {
+        self.items.last().filter(|_| self.items.len() > self.head)
+    }
+
+    fn pop_front(&mut self) {
+        if self.head < self.items.len() {
+            self.head += 1;
+        }
+    }
+
+    fn pop_back(&mut self) {
+        if self.items.len() > self.head {
+            self.items.pop();
+        }
+    }
+
+    fn push_back(&mut self, x: T) {
+        self.items.push(x);
+    }
+}
+
 /// Maximum of a periodic sequence over index windows `[lo, hi]` whose ends
 /// never decrease from one query to the next (monotone deque): amortised
 /// constant time per query.
 struct SlidingMax {
     /// (index, value) of the candidates, values decreasing.
-    deque: VecDeque<(i64, f64)>,
+    deque: Queue<(i64, f64)>,
     next: Option<i64>,
 }
 
 impl SlidingMax {
     fn new() -> Self {
         Self {
-            deque: VecDeque::new(),
+            deque: Queue::default(),
             next: None,
         }
     }
