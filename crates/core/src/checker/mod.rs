@@ -894,23 +894,26 @@ pub fn check_with(profile: &Profile, opts: &CheckOptions<'_>) -> Vec<Violation> 
     check_and_evaluate(profile, opts).0
 }
 
-/// [`check_with`], keeping the eye-safety evaluation it ran.
+/// [`check_with`], keeping the eye-safety evaluation it ran and the
+/// summary it computed (`None` if the bins were too broken for either).
 fn check_and_evaluate(
     profile: &Profile,
     opts: &CheckOptions<'_>,
-) -> (Vec<Violation>, Option<ExposureReport>) {
+) -> (Vec<Violation>, Option<ExposureReport>, Option<Summary>) {
     let mut v = Vec::new();
     check_header(profile, &mut v);
     if let Some(sensor) = opts.sensor {
         check_against_sensor(profile, sensor, &mut v);
     }
     let mut report = None;
+    let mut summary = None;
     if check_structure(profile, &mut v) && !v.iter().any(is_structural) {
         let s = summarize(profile);
         check_limits(profile, &s, &mut v);
         report = check_eye_safety(profile, opts, &mut v);
+        summary = Some(s);
     }
-    (v, report)
+    (v, report, summary)
 }
 
 /// Violations after which the profile cannot be evaluated further.
@@ -936,11 +939,13 @@ pub fn certify_with(
     mut profile: Profile,
     opts: &CheckOptions<'_>,
 ) -> Result<CertifiedProfile, Rejected> {
-    let (violations, eye_safety) = check_and_evaluate(&profile, opts);
+    let (violations, eye_safety, summary) = check_and_evaluate(&profile, opts);
     if !violations.is_empty() {
         return Err(Rejected { violations });
     }
-    profile.summary = Some(summarize(&profile));
+    // No violation: the bins were checked, so the summary was computed (of
+    // this very profile; `summarize` is a function of the bins).
+    profile.summary = Some(summary.unwrap_or_else(|| summarize(&profile)));
     Ok(CertifiedProfile {
         profile,
         eye_safety,

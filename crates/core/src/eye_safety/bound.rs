@@ -39,14 +39,15 @@
 //! cheap upper bound of its figures, and every window walk an upper bound of
 //! its ratio; only cells and walks whose bound can still change the result
 //! are evaluated exactly. [`Search::Exhaustive`] evaluates everything and is
-//! tested bit-identical (`specs/eye_safety.md`, "Search").
+//! tested bit-identical (`specs/eye_safety.md`, "Search"). Every shortcut
+//! of the sweeps (merges for sorts, cached per-bin constants, memoized
+//! monotone counts, cheaper `floor` and wrap) computes the same values as
+//! the plain operation, and is tested so.
 //!
 //! **Rounding.** Every count that is a floor is taken as
 //! `⌊x·(1 + 1e-9) + 1e-9⌋`, so a count that sits on an integer is taken
 //! as the larger one and a perturbation of the inputs by 1e-12 cannot
 //! lower it ([`COUNT_MARGIN`]).
-
-use std::collections::VecDeque;
 
 use super::ael::{self, Band, Row};
 use crate::profile::kinematics::{BinMotion, Timeline};
@@ -63,10 +64,140 @@ pub const RATIO_MARGIN: f64 = 1e-9;
 /// very fine profiles.
 pub const WALK_MAX_PIECES: usize = 96;
 
+/// `(idx div m, idx mod m)` (Euclidean, `m > 0`) without an integer
+/// division for the indices the sweeps use (within a period of `[0, m)`).
+fn split_index(idx: i64, m: i64) -> (i64, usize) {
+    if (0..m).contains(&idx) {
+        (0, idx as usize)
+    } else if (-m..0).contains(&idx) {
+        (-1, (idx + m) as usize)
+    } else if (m..2 * m).contains(&idx) {
+        (1, (idx - m) as usize)
+    } else {
+        (idx.div_euclid(m), idx.rem_euclid(m) as usize)
+    }
+}
+
+/// `idx mod m` in `[0, m)` (see [`split_index`]).
+fn wrap_index(idx: i64, m: i64) -> usize {
+    split_index(idx, m).1
+}
+
+/// The key `f64::total_cmp` orders by, as an integer (the same transform).
+fn total_key(x: f64) -> i64 {
+    let k = x.to_bits() as i64;
+    k ^ (((k >> 63) as u64) >> 1) as i64
+}
+
+/// The inverse of [`total_key`].
+fn of_total_key(k: i64) -> f64 {
+    f64::from_bits((k ^ (((k >> 63) as u64) >> 1) as i64) as u64)
+}
+
+/// The runs `v[bounds[k]..bounds[k + 1]]`, each nondecreasing but for at
+/// most one wrap (a single descent), sorted by `f64::total_cmp` and
+/// deduplicated: the same vector as `sort_by(total_cmp)` then `dedup`
+/// (the sorted order of a total order is unique), in linear time (merges of
+/// the rotated runs, in two buffers). Falls back to the sort if a run has
+/// two descents or a NaN. The runs must cover `v` (`bounds` from 0 to its
+/// length).
+fn sort_runs(mut v: Vec<f64>, bounds: &[usize]) -> Vec<f64> {
+    debug_assert!(bounds.first() == Some(&0) && bounds.last() == Some(&v.len()));
+    if v.iter().any(|x| x.is_nan()) {
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        return v;
+    }
+    let keys: Vec<i64> = v.iter().map(|&x| total_key(x)).collect();
+    // Each run rotated at its descent (if any) into `merged`.
+    let mut merged: Vec<i64> = Vec::with_capacity(keys.len());
+    for w in bounds.windows(2) {
+        let run = &keys[w[0]..w[1]];
+        let (mut descents, mut at) = (0usize, 0usize);
+        for i in 1..run.len() {
+            if run[i - 1] > run[i] {
+                descents += 1;
+                at = i;
+            }
+        }
+        if descents > 1 || (descents == 1 && run[run.len() - 1] > run[0]) {
+            v.sort_by(f64::total_cmp);
+            v.dedup();
+            return v;
+        }
+        merged.extend_from_slice(&run[at..]);
+        merged.extend_from_slice(&run[..at]);
+    }
+    // Bottom-up: merge neighbouring runs pairwise until one is left.
+    let mut other = keys;
+    let mut starts: Vec<usize> = bounds.to_vec();
+    while starts.len() > 2 {
+        let mut next = Vec::with_capacity(starts.len() / 2 + 2);
+        for k in (0..starts.len() - 1).step_by(2) {
+            let (lo, mid) = (starts[k], starts[k + 1]);
+            let hi = starts.get(k + 2).copied().unwrap_or(mid);
+            next.push(lo);
+            merge_keys(&merged[lo..mid], &merged[mid..hi], &mut other[lo..hi]);
+        }
+        next.push(merged.len());
+        starts = next;
+        std::mem::swap(&mut merged, &mut other);
+    }
+    v.clear();
+    for &k in &merged {
+        let x = of_total_key(k);
+        if v.last() != Some(&x) {
+            v.push(x);
+        }
+    }
+    v
+}
+
+/// The stable merge of the sorted keys `a` and `b` (no `i64::MAX` or
+/// `i64::MIN`, the keys of NaNs) into `out` (of their total length), built
+/// from both ends at once: the front takes the smaller head (`a` on ties),
+/// the back the larger tail (`b` on ties), so they fill the merged order's
+/// two halves without branches on the data and as two independent chains.
+fn merge_keys(a: &[i64], b: &[i64], out: &mut [i64]) {
+    let n = a.len() + b.len();
+    debug_assert_eq!(out.len(), n);
+    let (mut i, mut j) = (0usize, 0usize);
+    let (mut ie, mut je) = (a.len(), b.len());
+    for k in 0..n / 2 {
+        let av = if i < a.len() { a[i] } else { i64::MAX };
+        let bv = if j < b.len() { b[j] } else { i64::MAX };
+        let take_b = bv < av;
+        out[k] = if take_b { bv } else { av };
+        j += usize::from(take_b);
+        i += usize::from(!take_b);
+        let av = if ie > 0 { a[ie - 1] } else { i64::MIN };
+        let bv = if je > 0 { b[je - 1] } else { i64::MIN };
+        let take_a = av > bv;
+        out[n - 1 - k] = if take_a { av } else { bv };
+        ie -= usize::from(take_a);
+        je -= usize::from(!take_a);
+    }
+    if n % 2 == 1 {
+        let av = if i < a.len() { a[i] } else { i64::MAX };
+        let bv = if j < b.len() { b[j] } else { i64::MAX };
+        out[n / 2] = av.min(bv);
+    }
+}
+
 /// `⌊x⌋` rounded up when `x` is within [`COUNT_MARGIN`] of the next integer.
 #[must_use]
 pub fn floor_up(x: f64) -> f64 {
-    (x * (1.0 + COUNT_MARGIN) + COUNT_MARGIN).floor()
+    floor(x * (1.0 + COUNT_MARGIN) + COUNT_MARGIN)
+}
+
+/// `x.floor()`, without a library call for `0 < x < 2⁵²` (the counts):
+/// there the truncation to an integer is exact and equals the floor.
+fn floor(x: f64) -> f64 {
+    if x > 0.0 && x < 4_503_599_627_370_496.0 {
+        (x as u64) as f64
+    } else {
+        x.floor()
+    }
 }
 
 /// Greatest number of pulses of a clock of rate `f_p` in a closed interval
@@ -536,19 +667,27 @@ impl Envelope {
                 s
             }
         }));
-        // Increasing runs (the second wraps once): a merge, nearly linear.
-        cand.sort_by(f64::total_cmp);
-        cand.dedup();
+        // Increasing runs (the second wraps once): a merge, linear.
+        let mut cand = sort_runs(cand, &[0, n, 2 * n]);
         if cand[0] > 0.0 {
             cand.insert(0, 0.0);
         }
         // Sliding-window maximum over the unrolled bins (3 periods: bin
         // index k covers [cum(k mod n) + (k div n − 1)·T_f, ...)).
-        let start_of = |k: usize| tl.bin_start_time_s(k % n) + ((k / n) as f64 - 1.0) * frame_s;
-        let end_of = |k: usize| tl.bin_start_time_s(k % n + 1) + ((k / n) as f64 - 1.0) * frame_s;
-        let power = |k: usize| segs[k % n].power_w;
-        let mut deque: VecDeque<usize> = VecDeque::new();
-        let mut next_in = 0usize; // next bin to push
+        // The deque holds (power, end time) of the bins in it.
+        let (mut turn, mut bin) = (0usize, 0usize); // next bin to push, as k div n, k mod n
+        let offset = |turn: usize| (turn as f64 - 1.0) * frame_s;
+        let mut deque: Queue<(f64, f64)> = Queue::default();
+        // The bins of the period before that end by the first piece's
+        // window (`c_0 − Δ`) never count: they would be pushed and popped
+        // again at the first piece (they come first, and a bin only pops
+        // earlier ones), so they are skipped.
+        while turn == 0 && tl.bin_start_time_s(bin + 1) + offset(turn) <= cand[0] - delta_s {
+            bin += 1;
+            if bin == n {
+                (turn, bin) = (turn + 1, 0);
+            }
+        }
         let m = cand.len();
         let mut p_w = Vec::with_capacity(m);
         for j in 0..m {
@@ -557,17 +696,21 @@ impl Envelope {
             // On the open piece (c_j, c_{j+1}), P̄ is the max over bins
             // meeting [t − Δ, t]: those starting before c_{j+1} and ending
             // after c_j − Δ.
-            while next_in < 3 * n && start_of(next_in) < hi {
-                while deque.back().is_some_and(|&b| power(b) <= power(next_in)) {
+            while turn < 3 && tl.bin_start_time_s(bin) + offset(turn) < hi {
+                let p = segs[bin].power_w;
+                while deque.back().is_some_and(|&(q, _)| q <= p) {
                     deque.pop_back();
                 }
-                deque.push_back(next_in);
-                next_in += 1;
+                deque.push_back((p, tl.bin_start_time_s(bin + 1) + offset(turn)));
+                bin += 1;
+                if bin == n {
+                    (turn, bin) = (turn + 1, 0);
+                }
             }
-            while deque.front().is_some_and(|&b| end_of(b) <= lo) {
+            while deque.front().is_some_and(|&(_, end)| end <= lo) {
                 deque.pop_front();
             }
-            p_w.push(deque.front().map_or(p_max, |&b| power(b)));
+            p_w.push(deque.front().map_or(p_max, |&(p, _)| p));
         }
         let mut t_s = cand;
         t_s.push(frame_s);
@@ -605,6 +748,7 @@ impl Envelope {
     /// As [`Self::locate`], searching forward from piece `*hint` (the piece
     /// of an earlier offset in the same period): the same piece, in amortised
     /// constant time for increasing times.
+    #[inline]
     fn locate_from(&self, t: f64, hint: &mut usize) -> (f64, f64, usize) {
         let (k, r) = self.split(t);
         let m = self.pieces();
@@ -620,6 +764,7 @@ impl Envelope {
         (k, r, j)
     }
 
+    #[inline]
     fn split(&self, t: f64) -> (f64, f64) {
         if (0.0..self.frame_s).contains(&t) {
             // The common case, without a call to `floor` (same result).
@@ -636,6 +781,7 @@ impl Envelope {
             .min(self.pieces() - 1)
     }
 
+    #[inline]
     fn integral_at(&self, (k, r, j): (f64, f64, usize)) -> f64 {
         k * self.total_j() + self.cum_j[j] + self.p_w[j] * (r - self.t_s[j])
     }
@@ -653,8 +799,8 @@ impl Envelope {
     /// Unwrapped breakpoint `idx` (piece starts, periodic).
     fn bp(&self, idx: i64) -> f64 {
         let m = self.pieces() as i64;
-        let k = idx.div_euclid(m);
-        self.t_s[idx.rem_euclid(m) as usize] + k as f64 * self.frame_s
+        let (k, j) = split_index(idx, m);
+        self.t_s[j] + k as f64 * self.frame_s
     }
 
     /// Unwrapped index of the piece containing unwrapped `t`.
@@ -664,7 +810,50 @@ impl Envelope {
     }
 
     fn p_of(&self, idx: i64) -> f64 {
-        self.p_w[idx.rem_euclid(self.pieces() as i64) as usize]
+        self.p_w[wrap_index(idx, self.pieces() as i64)]
+    }
+}
+
+/// A double-ended queue for the monotone-deque maxima, where items are
+/// pushed only at the back: a vector and the index of its front (popping
+/// the front advances the index; nothing is moved or wrapped).
+struct Queue<T> {
+    items: Vec<T>,
+    head: usize,
+}
+
+impl<T> Default for Queue<T> {
+    fn default() -> Self {
+        Self {
+            items: Vec::new(),
+            head: 0,
+        }
+    }
+}
+
+impl<T: Copy> Queue<T> {
+    fn front(&self) -> Option<&T> {
+        self.items.get(self.head)
+    }
+
+    fn back(&self) -> Option<&T> {
+        self.items.last().filter(|_| self.items.len() > self.head)
+    }
+
+    fn pop_front(&mut self) {
+        if self.head < self.items.len() {
+            self.head += 1;
+        }
+    }
+
+    fn pop_back(&mut self) {
+        if self.items.len() > self.head {
+            self.items.pop();
+        }
+    }
+
+    fn push_back(&mut self, x: T) {
+        self.items.push(x);
     }
 }
 
@@ -672,14 +861,15 @@ impl Envelope {
 /// never decrease from one query to the next (monotone deque): amortised
 /// constant time per query.
 struct SlidingMax {
-    deque: VecDeque<i64>,
+    /// (index, value) of the candidates, values decreasing.
+    deque: Queue<(i64, f64)>,
     next: Option<i64>,
 }
 
 impl SlidingMax {
     fn new() -> Self {
         Self {
-            deque: VecDeque::new(),
+            deque: Queue::default(),
             next: None,
         }
     }
@@ -687,20 +877,20 @@ impl SlidingMax {
     /// `max value(k)` for `k` in `[lo, hi]` (`lo ≤ hi`; both ends at least
     /// those of the previous query).
     fn max_over(&mut self, lo: i64, hi: i64, value: impl Fn(i64) -> f64) -> f64 {
-        while self.deque.front().is_some_and(|&k| k < lo) {
+        while self.deque.front().is_some_and(|&(k, _)| k < lo) {
             self.deque.pop_front();
         }
         let mut next = self.next.map_or(lo, |n| n.max(lo));
         while next <= hi {
             let v = value(next);
-            while self.deque.back().is_some_and(|&k| value(k) <= v) {
+            while self.deque.back().is_some_and(|&(_, w)| w <= v) {
                 self.deque.pop_back();
             }
-            self.deque.push_back(next);
+            self.deque.push_back((next, v));
             next += 1;
         }
         self.next = Some(next);
-        self.deque.front().map_or(0.0, |&k| value(k))
+        self.deque.front().map_or(0.0, |&(_, v)| v)
     }
 }
 
@@ -824,7 +1014,19 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
 
 /// `a` wrapped into `[0, 360)`.
 fn wrap360(a: f64) -> f64 {
-    let w = a.rem_euclid(360.0);
+    // `rem_euclid` takes `r = a % 360` (exact), then `r + 360` if `r < 0`.
+    // Within a turn of `[0, 360)`, `a % 360` is `a` (`|a| < 360`) or
+    // `a − 360` (`360 ≤ a < 720`, a subtraction that is exact by Sterbenz's
+    // lemma): the same value without the library's `fmod`.
+    let w = if (0.0..360.0).contains(&a) {
+        a
+    } else if a > -360.0 && a < 0.0 {
+        a + 360.0
+    } else if (360.0..720.0).contains(&a) {
+        a - 360.0
+    } else {
+        a.rem_euclid(360.0)
+    };
     if w >= 360.0 {
         0.0
     } else {
@@ -870,17 +1072,25 @@ struct Cells<'a> {
     /// `τ` and `E` at each cut, `[0, len]`.
     tau_pt: Vec<f64>,
     e_pt: Vec<f64>,
-    /// Highest power of the bins touching each cell's union arc, W.
-    p_cell: Vec<f64>,
-    /// Whether a pass edge crosses a bin with angular acceleration.
-    curved: Vec<bool>,
-    /// Upper bounds of each cell's `tau_s`, `e.0` and `single` (the exact
-    /// figures for cells that are not curved).
-    tau_ub: Vec<f64>,
-    e_ub: Vec<f64>,
-    env_ub: Vec<f64>,
-    single_ub: Vec<f64>,
+    /// Each cell's figures from the sweep.
+    rows: Vec<CellRow>,
     per_j: PerJouleCache,
+}
+
+/// A cell as the sweep leaves it.
+#[derive(Debug, Clone, Copy)]
+struct CellRow {
+    /// Highest power of the bins touching the cell's union arc, W.
+    p: f64,
+    /// Whether a pass edge crosses a bin with angular acceleration.
+    curved: bool,
+    /// Upper bounds of the cell's `tau_s`, `e.0`, `e_env` and `single`
+    /// (the exact `tau_s`, `e_env` and `single` when it is not curved;
+    /// `e.0` is then still capped per bin by the exact evaluation).
+    tau_ub: f64,
+    e_ub: f64,
+    env_ub: f64,
+    single_ub: f64,
 }
 
 /// The maxima over cells: Rule 1 (ratio, azimuth), pass energy
@@ -913,10 +1123,8 @@ impl<'a> Cells<'a> {
             let t = tl.bin_start_time_s(i) + frame_s - delta;
             wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) - h)
         }));
-        // Four runs, each increasing but for one wrap: a merge, nearly linear.
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup();
-        let m = cuts.len();
+        // Four runs, each increasing but for one wrap: a merge, linear.
+        let cuts = sort_runs(cuts, &[0, n, 2 * n, 3 * n, 4 * n]);
         let mut cells = Self {
             tl,
             env,
@@ -924,14 +1132,9 @@ impl<'a> Cells<'a> {
             h,
             delta,
             cuts,
-            tau_pt: Vec::with_capacity(m + 1),
-            e_pt: Vec::with_capacity(m + 1),
-            p_cell: Vec::with_capacity(m),
-            curved: Vec::with_capacity(m),
-            tau_ub: Vec::with_capacity(m),
-            e_ub: Vec::with_capacity(m),
-            env_ub: Vec::with_capacity(m),
-            single_ub: Vec::with_capacity(m),
+            tau_pt: Vec::new(),
+            e_pt: Vec::new(),
+            rows: Vec::new(),
             per_j: PerJouleCache::default(),
         };
         cells.sweep();
@@ -958,6 +1161,10 @@ impl<'a> Cells<'a> {
     /// end values by at most the cell width times the smaller of its
     /// largest forward and backward slopes: the bounds. Rule 1 grows with
     /// the pulse and pass counts (C5 falls with the count).
+    ///
+    /// Two passes: the pass edges' times and envelope integrals at every
+    /// cut, then the cells. Without a bin with angular acceleration no cell
+    /// is curved, and the bins under the edges are not looked up.
     fn sweep(&mut self) {
         let tl = self.tl;
         let env = self.env;
@@ -969,48 +1176,61 @@ impl<'a> Cells<'a> {
         let t2 = ael::T2_S.min(ael::TIME_BASE_S);
         let e_slack = PRUNE_SLACK * env.total_j();
         let t_slack = PRUNE_SLACK * frame_s;
-        let mut window = SlidingMax::new();
-        let mut hints = [0usize; 8];
-        // Times of the pass edges at cut `c`, envelope integrals there and
-        // the envelope's power at each edge.
+        // Bins with angular acceleration (`ω²` not constant); with none, no
+        // cell is curved and the edges' bins need not be looked up.
+        let bin_curved: Vec<bool> = segs.iter().map(|s| spin_sq_line(s).1 != 0.0).collect();
+        let any_curved = bin_curved.contains(&true);
         let cuts = &self.cuts;
-        let at_cut = |c: usize, hints: &mut [usize; 8]| {
-            let [h0, h1, h2, h3, ..] = hints;
+        let m = cuts.len();
+        // At every cut: the pass edges' times, the envelope integrals there
+        // and (for the curved cells' bounds) the envelope's power at the
+        // left and the right edge.
+        let mut edge_p: Vec<(f64, f64)> = Vec::with_capacity(if any_curved { m + 1 } else { 0 });
+        let (mut h0, mut h1, mut h2, mut h3) = (0usize, 0usize, 0usize, 0usize);
+        let (mut tau_pt, mut e_pt) = (Vec::with_capacity(m + 1), Vec::with_capacity(m + 1));
+        for c in 0..=m {
             let theta = cut_of(cuts, c);
-            let t_lo = tl.time_at_unwrapped_from_s(theta - h, h0);
-            let t_hi = tl.time_at_unwrapped_from_s(theta + h, h1);
-            let at_lo = env.locate_from(t_lo, h2);
-            let at_hi = env.locate_from(t_hi + delta, h3);
-            (
-                t_lo,
-                t_hi,
-                env.integral_at(at_lo),
-                env.integral_at(at_hi),
-                env.p_w[at_lo.2],
-                env.p_w[at_hi.2],
-            )
-        };
-        let mut prev = at_cut(0, &mut hints);
-        self.tau_pt.push(prev.1 - prev.0);
-        self.e_pt.push(prev.3 - prev.2);
-        for c in 0..cuts.len() {
-            let next = at_cut(c + 1, &mut hints);
-            self.tau_pt.push(next.1 - next.0);
-            self.e_pt.push(next.3 - next.2);
+            let t_lo = tl.time_at_unwrapped_from_s(theta - h, &mut h0);
+            let t_hi = tl.time_at_unwrapped_from_s(theta + h, &mut h1);
+            let at_lo = env.locate_from(t_lo, &mut h2);
+            let at_hi = env.locate_from(t_hi + delta, &mut h3);
+            tau_pt.push(t_hi - t_lo);
+            e_pt.push(env.integral_at(at_hi) - env.integral_at(at_lo));
+            if any_curved {
+                edge_p.push((env.p_w[at_lo.2], env.p_w[at_hi.2]));
+            }
+        }
+        // Per cell. The counts are nondecreasing functions of `τ` (products
+        // by positive constants, sums and floors are monotone in floating
+        // point too), so a value between two arguments of one count has it.
+        let mut window = SlidingMax::new();
+        let (mut h4, mut h5, mut h6, mut h7) = (0usize, 0usize, 0usize, 0usize);
+        let mut per_pass_of = StepMemo::default();
+        let mut passes_of = StepMemo::default();
+        let mut rows = Vec::with_capacity(m);
+        for c in 0..m {
             let (u, v) = (cut_of(cuts, c), cut_of(cuts, c + 1));
-            let [.., h4, h5, h6, h7] = &mut hints;
-            let lo = unwrapped_bin(tl, u - h - TOUCH_SNAP_DEG, h4);
-            let hi = unwrapped_bin(tl, v + h + TOUCH_SNAP_DEG, h5);
-            let p = window.max_over(lo, hi.max(lo), |k| segs[k.rem_euclid(n) as usize].power_w);
+            let lo = unwrapped_bin(tl, u - h - TOUCH_SNAP_DEG, &mut h4);
+            let hi = unwrapped_bin(tl, v + h + TOUCH_SNAP_DEG, &mut h5);
+            let p = window.max_over(lo, hi.max(lo), |k| segs[wrap_index(k, n)].power_w);
             let mid = 0.5 * (u + v);
-            let right = tl.locate_unwrapped_from(mid + h, h6);
-            let left = tl.locate_unwrapped_from(mid - h, h7);
-            let (seg_r, seg_l) = (&segs[right.1], &segs[left.1]);
-            let curved = spin_sq_line(seg_r).1 != 0.0 || spin_sq_line(seg_l).1 != 0.0;
-            self.p_cell.push(p);
-            self.curved.push(curved);
-            let ends = ends(cuts, &self.tau_pt, &self.e_pt, c);
-            let (tau, e) = if curved {
+            let edges = any_curved
+                .then(|| {
+                    let right = tl.locate_unwrapped_from(mid + h, &mut h6);
+                    let left = tl.locate_unwrapped_from(mid - h, &mut h7);
+                    (right, left)
+                })
+                .filter(|(right, left)| bin_curved[right.1] || bin_curved[left.1]);
+            // `ends(..)`'s two values, without the azimuth.
+            let ends_tau = 0.0f64.max(tau_pt[c]).max(tau_pt[c + 1]);
+            let mut ends_e = 0.0f64;
+            for x in [e_pt[c], e_pt[c + 1]] {
+                if x > ends_e {
+                    ends_e = x;
+                }
+            }
+            let (tau, e) = if let Some((right, left)) = edges {
+                let (seg_r, seg_l) = (&segs[right.1], &segs[left.1]);
                 // ω at both ends of each edge's arc, on that edge's bin.
                 let spin = |seg: &Seg, k: f64, theta: f64| {
                     let (a, b) = spin_sq_line(seg);
@@ -1021,14 +1241,15 @@ impl<'a> Cells<'a> {
                 let (wl_u, wl_v) = (spin(seg_l, left.0, u - h), spin(seg_l, left.0, v - h));
                 let (wr_min, wr_max) = (wr_u.min(wr_v), wr_u.max(wr_v));
                 let (wl_min, wl_max) = (wl_u.min(wl_v), wl_u.max(wl_v));
-                let (pr_min, pr_max) = (prev.5.min(next.5), prev.5.max(next.5));
-                let (pl_min, pl_max) = (prev.4.min(next.4), prev.4.max(next.4));
+                let ((pl_u, pr_u), (pl_v, pr_v)) = (edge_p[c], edge_p[c + 1]);
+                let (pr_min, pr_max) = (pr_u.min(pr_v), pr_u.max(pr_v));
+                let (pl_min, pl_max) = (pl_u.min(pl_v), pl_u.max(pl_v));
                 let width_rad = (v - u).to_radians();
                 let rise = |fwd: f64, back: f64| width_rad * fwd.max(0.0).min(back.max(0.0));
-                let tau = ends.tau_s
+                let tau = ends_tau
                     + rise(1.0 / wr_min - 1.0 / wl_max, 1.0 / wl_min - 1.0 / wr_max)
                     + t_slack;
-                let e = ends.e.0
+                let e = ends_e
                     + rise(
                         pr_max / wr_min - pl_min / wl_max,
                         pl_max / wl_min - pr_min / wr_max,
@@ -1036,17 +1257,23 @@ impl<'a> Cells<'a> {
                     + e_slack;
                 (tau, e)
             } else {
-                (ends.tau_s, ends.e.0)
+                (ends_tau, ends_e)
             };
-            let per_pass = max_pulses_in(tau, f_p);
-            let passes = passes_in_window(t2, tau, frame_s);
-            self.tau_ub.push(tau);
-            self.e_ub.push(e.min(per_pass * p * delta));
-            self.env_ub.push(e);
+            let per_pass = per_pass_of.get(tau, |t| max_pulses_in(t, f_p));
+            let passes = passes_of.get(tau, |t| passes_in_window(t2, t, frame_s));
             let per_j = self.per_j.get(self.laser, per_pass, passes);
-            self.single_ub.push(p * delta * per_j);
-            prev = next;
+            rows.push(CellRow {
+                p,
+                curved: edges.is_some(),
+                tau_ub: tau,
+                e_ub: e.min(per_pass * p * delta),
+                env_ub: e,
+                single_ub: p * delta * per_j,
+            });
         }
+        self.tau_pt = tau_pt;
+        self.e_pt = e_pt;
+        self.rows = rows;
     }
 
     /// Unwrapped time of the head at unwrapped azimuth `theta`.
@@ -1073,7 +1300,7 @@ impl<'a> Cells<'a> {
             e: mut cell_e,
             ..
         } = ends(&self.cuts, &self.tau_pt, &self.e_pt, c);
-        if self.curved[c] {
+        if self.rows[c].curved {
             let mid = 0.5 * (u + v);
             let right = self.spin_sq_at(mid, self.h);
             let left = self.spin_sq_at(mid, -self.h);
@@ -1097,7 +1324,7 @@ impl<'a> Cells<'a> {
                 }
             }
         }
-        let p = self.p_cell[c];
+        let p = self.rows[c].p;
         let per_pass = max_pulses_in(cell_tau, self.laser.pulse_rate_hz);
         let passes = passes_in_window(
             ael::T2_S.min(ael::TIME_BASE_S),
@@ -1140,20 +1367,27 @@ impl<'a> Cells<'a> {
             return None;
         }
         let f_p = self.laser.pulse_rate_hz;
-        let mut bins: Vec<(f64, f64)> = (lo..=hi)
-            .map(|k| {
-                let seg = &segs[k.rem_euclid(n) as usize];
-                let start = 360.0 * k.div_euclid(n) as f64 + seg.start_deg;
-                let a = start.max(lo_deg);
-                let b = (start + seg.width_deg).min(hi_deg);
-                let t_b = (self.time_at(b) - self.time_at(a)).max(0.0);
-                (seg.power_w, max_pulses_in(t_b, f_p))
-            })
-            .collect();
+        // (power, pulse cap) of each bin, on the stack (at most
+        // `PULSE_CAP_MAX_BINS`); the times by forward searches (the same
+        // values as fresh ones).
+        let mut buf = [(0.0f64, 0.0f64); PULSE_CAP_MAX_BINS as usize];
+        let bins = &mut buf[..(hi - lo + 1) as usize];
+        let first = lo.rem_euclid(n) as usize;
+        let (mut ha, mut hb) = (first, first);
+        for (slot, k) in bins.iter_mut().zip(lo..=hi) {
+            let seg = &segs[k.rem_euclid(n) as usize];
+            let start = 360.0 * k.div_euclid(n) as f64 + seg.start_deg;
+            let a = start.max(lo_deg);
+            let b = (start + seg.width_deg).min(hi_deg);
+            let t_b = (tl.time_at_unwrapped_from_s(b, &mut hb)
+                - tl.time_at_unwrapped_from_s(a, &mut ha))
+            .max(0.0);
+            *slot = (seg.power_w, max_pulses_in(t_b, f_p));
+        }
         bins.sort_unstable_by(|x, y| y.0.total_cmp(&x.0));
         let mut left = per_pass;
         let mut e = 0.0;
-        for (p_w, cap) in bins {
+        for &(p_w, cap) in bins.iter() {
             if left <= 0.0 {
                 break;
             }
@@ -1190,12 +1424,37 @@ impl<'a> Cells<'a> {
                 best
             }
             Search::Pruned => {
-                let done = std::cell::RefCell::new(std::collections::HashMap::new());
-                let eval = |c: usize| *done.borrow_mut().entry(c).or_insert_with(|| self.exact(c));
-                let single = first_max(&self.single_ub, |c| eval(c).single);
-                let e = first_max(&self.e_ub, |c| eval(c).e.0);
-                let tau = first_max(&self.tau_ub, |c| eval(c).tau_s);
-                let e_env = first_max(&self.env_ub, |c| eval(c).e_env);
+                // Each cell is evaluated at most once: `slot[c]` indexes
+                // its figures in `done` (`u32::MAX`: not yet).
+                let memo = std::cell::RefCell::new((vec![u32::MAX; self.len()], Vec::new()));
+                let eval = |c: usize| {
+                    let mut memo = memo.borrow_mut();
+                    let (slot, done) = &mut *memo;
+                    if let Some(x) = done.get(slot[c] as usize) {
+                        return *x;
+                    }
+                    let x = self.exact(c);
+                    slot[c] = u32::try_from(done.len()).unwrap_or(u32::MAX);
+                    done.push(x);
+                    x
+                };
+                let rows = &self.rows;
+                // One scan for the figures whose bound is exact on the
+                // cells that are not curved (Rule 1, pass duration,
+                // envelope integral).
+                let mut scans = [ExactScan::default(); 3];
+                for (c, row) in rows.iter().enumerate() {
+                    scans[0].take(row, row.single_ub, c);
+                    scans[1].take(row, row.tau_ub, c);
+                    scans[2].take(row, row.env_ub, c);
+                }
+                let single = first_max_from(rows, |r| r.single_ub, scans[0], |c| eval(c).single);
+                let tau = first_max_from(rows, |r| r.tau_ub, scans[1], |c| eval(c).tau_s);
+                let e_env = first_max_from(rows, |r| r.env_ub, scans[2], |c| eval(c).e_env);
+                // The pass energy's bound is not exact on any cell (the
+                // exact evaluation caps it per bin): the plain branch and
+                // bound, over the same bounds in the same order.
+                let e = first_max_sorted(rows.len(), |c| rows[c].e_ub, |c| eval(c).e.0);
                 CellBest {
                     single: single.map_or((0.0, 0.0), |(r, c)| (r, mid_of(c))),
                     e_max: e.map_or((0.0, 0.0), |(e, c)| (e, eval(c).e.1)),
@@ -1225,6 +1484,7 @@ fn cut_of(cuts: &[f64], c: usize) -> f64 {
 
 /// `τ` and the envelope `E` (with its azimuth, the first maximum) over the
 /// two ends of cell `c`, from their values at the cuts.
+#[inline]
 fn ends(cuts: &[f64], tau_pt: &[f64], e_pt: &[f64], c: usize) -> CellExact {
     let mut tau = 0.0f64;
     let mut e = (0.0f64, cut_of(cuts, c));
@@ -1242,19 +1502,115 @@ fn ends(cuts: &[f64], tau_pt: &[f64], e_pt: &[f64], c: usize) -> CellExact {
     }
 }
 
+/// The best of the cells whose bound is exact (not curved), in index
+/// order (strictly larger values only, so the first of equal ones stays),
+/// whether any bound is NaN, and the curved cell with the largest bound.
+#[derive(Debug, Clone, Copy, Default)]
+struct ExactScan {
+    best: Option<(f64, usize)>,
+    nan: bool,
+    top_curved: Option<(f64, usize)>,
+}
+
+impl ExactScan {
+    fn take(&mut self, row: &CellRow, u: f64, c: usize) {
+        self.nan |= u.is_nan();
+        let slot = if row.curved {
+            &mut self.top_curved
+        } else {
+            &mut self.best
+        };
+        if slot.is_none_or(|b| u > b.0) {
+            *slot = Some((u, c));
+        }
+    }
+}
+
 /// Branch and bound for the largest positive `exact(c)` and the first cell
-/// attaining it, given `ub[c] ≥ exact(c)` for every cell (`None` if nothing
-/// is positive): cells are evaluated in decreasing order of their bound
-/// (ties by index) until the next bound can neither exceed the best value
-/// nor tie it at a smaller index.
-fn first_max(ub: &[f64], mut exact: impl FnMut(usize) -> f64) -> Option<(f64, usize)> {
-    let top = (0..ub.len()).max_by(|&a, &b| ub[a].total_cmp(&ub[b]).then(b.cmp(&a)))?;
+/// attaining it, given `bound(row c) ≥ exact(c)` for every cell, with
+/// equality where the cell is not curved (`None` if nothing is positive).
+/// One scan in index order takes the best of the cells whose bound is exact
+/// ([`ExactScan`]) and the curved cell with the largest bound is evaluated
+/// (so that the best value is a tight threshold also when every cell is
+/// curved); the curved cells whose bound can still beat it are then
+/// evaluated in decreasing order of their bound (ties by index) until the
+/// next bound can neither exceed the best value nor tie it at a smaller
+/// index. The result is the maximum in the order (value, then smaller
+/// index), whatever the order of evaluation; with a NaN in sight, the plain
+/// branch and bound ([`first_max_sorted`]) decides, as before.
+#[cfg(test)]
+fn first_max(
+    rows: &[CellRow],
+    bound: impl Fn(&CellRow) -> f64,
+    exact: impl FnMut(usize) -> f64,
+) -> Option<(f64, usize)> {
+    let mut scan = ExactScan::default();
+    for (c, row) in rows.iter().enumerate() {
+        scan.take(row, bound(row), c);
+    }
+    first_max_from(rows, bound, scan, exact)
+}
+
+/// [`first_max`] after its scan.
+fn first_max_from(
+    rows: &[CellRow],
+    bound: impl Fn(&CellRow) -> f64,
+    scan: ExactScan,
+    mut exact: impl FnMut(usize) -> f64,
+) -> Option<(f64, usize)> {
+    let beats = |x: f64, c: usize, best: (f64, usize)| x > best.0 || (x == best.0 && c < best.1);
+    let ub = |c: usize| bound(&rows[c]);
+    let ExactScan {
+        mut best,
+        mut nan,
+        top_curved,
+    } = scan;
+    if let (false, Some((u, c))) = (nan, top_curved) {
+        if best.is_none_or(|b| beats(u, c, b)) {
+            let x = exact(c);
+            nan |= x.is_nan();
+            if best.is_none_or(|b| beats(x, c, b)) {
+                best = Some((x, c));
+            }
+        }
+    }
+    if !nan && top_curved.is_some() {
+        let mut order: Vec<usize> = (0..rows.len())
+            .filter(|&c| rows[c].curved && best.is_none_or(|b| beats(ub(c), c, b)))
+            .collect();
+        order.sort_unstable_by(|&a, &b| ub(b).total_cmp(&ub(a)).then(a.cmp(&b)));
+        for c in order {
+            if best.is_some_and(|b| !beats(ub(c), c, b)) {
+                break;
+            }
+            let x = exact(c);
+            nan |= x.is_nan();
+            if best.is_none_or(|b| beats(x, c, b)) {
+                best = Some((x, c));
+            }
+        }
+    }
+    if nan {
+        return first_max_sorted(rows.len(), |c| bound(&rows[c]), exact);
+    }
+    best.filter(|b| b.0 > 0.0)
+}
+
+/// The plain branch and bound behind [`first_max`]: cells are evaluated in
+/// decreasing order of their bound (ties by index) until the next bound can
+/// neither exceed the best value nor tie it at a smaller index.
+fn first_max_sorted(
+    len: usize,
+    ub: impl Fn(usize) -> f64,
+    mut exact: impl FnMut(usize) -> f64,
+) -> Option<(f64, usize)> {
+    let top = (0..len).max_by(|&a, &b| ub(a).total_cmp(&ub(b)).then(b.cmp(&a)))?;
     let mut best = (exact(top), top);
     let beats = |x: f64, c: usize, best: (f64, usize)| x > best.0 || (x == best.0 && c < best.1);
-    let mut order: Vec<usize> = (0..ub.len()).filter(|&c| beats(ub[c], c, best)).collect();
-    order.sort_unstable_by(|&a, &b| ub[b].total_cmp(&ub[a]).then(a.cmp(&b)));
+    let mut order: Vec<usize> = (0..len).filter(|&c| beats(ub(c), c, best)).collect();
+    order.sort_unstable_by(|&a, &b| ub(b).total_cmp(&ub(a)).then(a.cmp(&b)));
     for c in order {
-        if !beats(ub[c], c, best) {
+        if !beats(ub(c), c, best) {
             break;
         }
         let x = exact(c);
@@ -1263,6 +1619,33 @@ fn first_max(ub: &[f64], mut exact: impl FnMut(usize) -> f64) -> Option<(f64, us
         }
     }
     (best.0 > 0.0).then_some(best)
+}
+
+/// A nondecreasing step function (a count of `τ`) memoized over the
+/// interval of arguments seen with its last value: an argument inside it
+/// has that value (monotonicity), so it is returned without a call. The
+/// same value as a fresh call.
+#[derive(Default)]
+struct StepMemo {
+    /// `[lo, hi]` and the value there (none yet if `lo > hi`).
+    range: Option<(f64, f64, f64)>,
+}
+
+impl StepMemo {
+    fn get(&mut self, x: f64, f: impl Fn(f64) -> f64) -> f64 {
+        if let Some((lo, hi, v)) = self.range {
+            if lo <= x && x <= hi {
+                return v;
+            }
+        }
+        let v = f(x);
+        self.range = match self.range {
+            Some((lo, hi, w)) if w == v && !x.is_nan() => Some((lo.min(x), hi.max(x), v)),
+            _ if x.is_nan() => None,
+            _ => Some((x, x, v)),
+        };
+        v
+    }
 }
 
 /// [`Laser::single_pulse_ratio_per_j`] for the few distinct (pulse count,
@@ -1379,28 +1762,34 @@ impl Walks<'_> {
     }
 
     /// Every walk: (start piece, direction, highest `P̄` within `l_max` of
-    /// its start in its direction).
+    /// its start in its direction). Walks start only at steps of `P̄`, so
+    /// the reach of the others is not computed (the window maxima take
+    /// queries whose ends never decrease; skipped ones change nothing).
     fn walks(&self) -> Vec<(i64, i64, f64)> {
         let env = self.env;
         let m = env.pieces() as i64;
         let mut out = Vec::new();
         let (mut fwd, mut back) = (SlidingMax::new(), SlidingMax::new());
         let (mut h_fwd, mut h_back) = (0usize, 0usize);
+        let mut p_prev = env.p_of(-1);
         for i in 0..m {
+            let p_i = env.p_w[i as usize];
+            let up = p_i > p_prev;
+            let down = p_i < p_prev;
+            p_prev = p_i;
+            if !(up || down || i == 0) {
+                continue;
+            }
             let b0 = env.bp(i);
             // Pieces i.. up to the one holding b0 + l_max; pieces ..i−1 down
             // to the one holding b0 − l_max.
-            let j_fwd = env.unwrapped_piece(b0 + self.l_max, &mut h_fwd).max(i);
-            let j_back = env.unwrapped_piece(b0 - self.l_max, &mut h_back).min(i - 1);
-            let p_fwd = fwd.max_over(i, j_fwd, |k| env.p_of(k));
-            let p_back = back.max_over(j_back, i - 1, |k| env.p_of(k));
-            let up = env.p_of(i) > env.p_of(i - 1);
-            let down = env.p_of(i) < env.p_of(i - 1);
             if up || i == 0 {
-                out.push((i, 1, p_fwd));
+                let j_fwd = env.unwrapped_piece(b0 + self.l_max, &mut h_fwd).max(i);
+                out.push((i, 1, fwd.max_over(i, j_fwd, |k| env.p_of(k))));
             }
             if down {
-                out.push((i, -1, p_back));
+                let j_back = env.unwrapped_piece(b0 - self.l_max, &mut h_back).min(i - 1);
+                out.push((i, -1, back.max_over(j_back, i - 1, |k| env.p_of(k))));
             }
         }
         out
@@ -1454,5 +1843,169 @@ impl Walks<'_> {
         let l0 = l.max(delta);
         let e0 = e + p_span * (l0 - l);
         best.take(laser.linear_capped_max(l0 - delta, t_walk, e0, p_span, e_pass));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The helpers the search is made fast with compute the same values as
+    //! the plain operations they replace, bit for bit.
+    use super::*;
+    use proptest::prelude::*;
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    fn sorted(mut v: Vec<f64>) -> Vec<f64> {
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    }
+
+    /// A run increasing but for one wrap: `xs` (sorted) rotated by `r`.
+    fn wrapped_run(mut xs: Vec<f64>, r: usize) -> Vec<f64> {
+        xs.sort_by(f64::total_cmp);
+        let r = if xs.is_empty() { 0 } else { r % xs.len() };
+        xs.rotate_left(r);
+        xs
+    }
+
+    proptest! {
+        #[test]
+        fn sort_runs_is_sort_and_dedup(
+            runs in proptest::collection::vec(
+                (proptest::collection::vec(prop_oneof![
+                    0.0f64..360.0,
+                    Just(0.0), Just(-0.0), Just(90.0), Just(359.999_999_999),
+                ], 0..40), 0usize..40),
+                1..5,
+            ),
+            extra in proptest::option::of((0usize..4, 0usize..40, prop_oneof![
+                Just(f64::NAN), Just(-1.0), Just(1e300), Just(5.0),
+            ])),
+        ) {
+            let mut v = Vec::new();
+            let mut bounds = vec![0];
+            for (k, (xs, r)) in runs.into_iter().enumerate() {
+                let mut run = wrapped_run(xs, r);
+                // Sometimes a second descent, or a NaN: the fallback.
+                if let Some((j, at, x)) = extra {
+                    if j == k && !run.is_empty() {
+                        let at = at % run.len();
+                        run[at] = x;
+                    }
+                }
+                v.extend(run);
+                bounds.push(v.len());
+            }
+            let expected = sorted(v.clone());
+            prop_assert_eq!(bits(&sort_runs(v, &bounds)), bits(&expected));
+        }
+
+        #[test]
+        fn wrap360_is_rem_euclid(a in prop_oneof![
+            -1e4f64..1e4, -720.0f64..720.0, -1e-12f64..1e-12,
+            Just(-360.0), Just(-0.0), Just(0.0), Just(360.0), Just(720.0),
+            Just(-1e-300), Just(359.999_999_999_999_94), Just(f64::NAN), Just(f64::INFINITY),
+        ]) {
+            let w = a.rem_euclid(360.0);
+            let expected = if w >= 360.0 { 0.0 } else { w };
+            prop_assert_eq!(wrap360(a).to_bits(), expected.to_bits());
+        }
+
+        #[test]
+        fn floor_is_floor(x in prop_oneof![
+            -1e20f64..1e20, 0.0f64..1e3, Just(0.0), Just(-0.0), Just(4_503_599_627_370_495.5),
+            Just(4_503_599_627_370_496.0), Just(f64::NAN), Just(f64::INFINITY),
+            Just(f64::MIN_POSITIVE), Just(0.999_999_999_999_999_9),
+        ]) {
+            prop_assert_eq!(floor(x).to_bits(), x.floor().to_bits());
+        }
+
+        #[test]
+        fn split_index_is_euclidean(idx in -10_000i64..10_000, m in 1i64..500) {
+            let (k, j) = split_index(idx, m);
+            prop_assert_eq!((k, j as i64), (idx.div_euclid(m), idx.rem_euclid(m)));
+            prop_assert_eq!(wrap_index(idx, m) as i64, idx.rem_euclid(m));
+        }
+
+        #[test]
+        fn step_memo_is_a_fresh_call(
+            taus in proptest::collection::vec(prop_oneof![
+                0.0f64..2e-3, 1e-3f64..1.0001e-3, Just(0.0), Just(-0.0), Just(f64::NAN),
+            ], 1..200),
+            f_p in 1e3f64..5e5,
+            frame_s in 0.01f64..0.2,
+        ) {
+            let (mut a, mut b) = (StepMemo::default(), StepMemo::default());
+            for tau in taus {
+                let fresh = max_pulses_in(tau, f_p);
+                prop_assert_eq!(a.get(tau, |t| max_pulses_in(t, f_p)).to_bits(), fresh.to_bits());
+                let fresh = passes_in_window(10.0, tau, frame_s);
+                let memo = b.get(tau, |t| passes_in_window(10.0, t, frame_s));
+                prop_assert_eq!(memo.to_bits(), fresh.to_bits());
+            }
+        }
+
+        /// The one-scan branch and bound against the plain one (which
+        /// evaluates in decreasing order of the bound), on bounds with many
+        /// ties: the same maximum and first cell.
+        #[test]
+        fn first_max_is_the_plain_branch_and_bound(
+            cells in proptest::collection::vec(
+                (0u8..6, any::<bool>(), 0u8..4),
+                1..60,
+            ),
+        ) {
+            // Values on a coarse grid (ties); a curved cell's exact value
+            // is at most its bound.
+            let rows: Vec<CellRow> = cells
+                .iter()
+                .map(|&(u, curved, _)| CellRow {
+                    p: 1.0,
+                    curved,
+                    tau_ub: f64::from(u) - 1.0,
+                    e_ub: f64::from(u) - 1.0,
+                    env_ub: f64::from(u) - 1.0,
+                    single_ub: f64::from(u) - 1.0,
+                })
+                .collect();
+            let exact = |c: usize| {
+                let (u, curved, d) = cells[c];
+                let ub = f64::from(u) - 1.0;
+                if curved { ub - f64::from(d) } else { ub }
+            };
+            let ub: Vec<f64> = rows.iter().map(|r| r.single_ub).collect();
+            prop_assert_eq!(
+                first_max(&rows, |r| r.single_ub, exact),
+                first_max_sorted(ub.len(), |c| ub[c], exact)
+            );
+        }
+    }
+
+    #[test]
+    fn first_max_with_a_nan_is_the_plain_branch_and_bound() {
+        let rows: Vec<CellRow> = [(1.0, false), (f64::NAN, true), (2.0, false), (2.0, true)]
+            .iter()
+            .map(|&(u, curved)| CellRow {
+                p: 1.0,
+                curved,
+                tau_ub: u,
+                e_ub: u,
+                env_ub: u,
+                single_ub: u,
+            })
+            .collect();
+        let ub: Vec<f64> = rows.iter().map(|r| r.tau_ub).collect();
+        for exact in [
+            |c: usize| [1.0, f64::NAN, 2.0, 1.5][c],
+            |c: usize| [1.0, 0.5, 2.0, 2.0][c],
+        ] {
+            assert_eq!(
+                first_max(&rows, |r| r.tau_ub, exact),
+                first_max_sorted(ub.len(), |c| ub[c], exact)
+            );
+        }
     }
 }

@@ -43,22 +43,19 @@ pub trait BinMotion {
     /// Time to advance `x_rad` into the bin from its start, s
     /// (`2x / (ω_s + ω(x))`; 0 for `x ≤ 0`).
     fn time_into_s(&self, x_rad: f64) -> f64 {
-        if x_rad <= 0.0 {
-            return 0.0;
-        }
-        let w_s = self.spin_start_rad_s();
-        let w_x = (w_s.powi(2) + 2.0 * self.accel_rad_s2() * x_rad)
-            .max(0.0)
-            .sqrt();
-        2.0 * x_rad / (w_s + w_x)
+        time_into_s(self.spin_start_rad_s(), 2.0 * self.accel_rad_s2(), x_rad)
     }
 
     /// Angle advanced `t_s` after entering the bin, rad: `x = ω_s t + a t²/2`
     /// with `t` clamped to the dwell, so the result lies in `[0, width]`.
     fn angle_into_rad(&self, t_s: f64) -> f64 {
-        let t = t_s.clamp(0.0, self.dwell_s());
-        (self.spin_start_rad_s() * t + 0.5 * self.accel_rad_s2() * t * t)
-            .clamp(0.0, self.width_deg().to_radians())
+        angle_into_rad(
+            self.spin_start_rad_s(),
+            self.accel_rad_s2(),
+            self.dwell_s(),
+            self.width_deg(),
+            t_s,
+        )
     }
 }
 
@@ -78,6 +75,77 @@ impl BinMotion for Bin {
     fn power_w(&self) -> f64 {
         self.power_w
     }
+}
+
+/// A bin's constants for [`BinMotion::time_into_s`] and
+/// [`BinMotion::angle_into_rad`], computed once per timeline with the same
+/// operations those compute per call: the spin at its start, the
+/// acceleration `a`, the dwell, and, when `a = 0`, the denominator
+/// `ω_s + √(ω_s²)` (the value the general formula computes for every `x`,
+/// since `ω_s² + 0·x = ω_s²`), which saves the square root.
+#[derive(Debug, Clone, Copy)]
+struct Motion {
+    w_s: f64,
+    accel: f64,
+    dwell_s: f64,
+    /// `ω_s + √(max(ω_s², 0))` if `2a = 0`, else NaN.
+    den_const: f64,
+}
+
+impl Motion {
+    fn of<B: BinMotion + ?Sized>(b: &B) -> Self {
+        let w_s = b.spin_start_rad_s();
+        let accel = b.accel_rad_s2();
+        let den_const = if 2.0 * accel == 0.0 {
+            w_s + w_s.powi(2).max(0.0).sqrt()
+        } else {
+            f64::NAN
+        };
+        Self {
+            w_s,
+            accel,
+            dwell_s: b.dwell_s(),
+            den_const,
+        }
+    }
+
+    /// Time to advance `x_rad` into the bin: `2x / (ω_s + ω(x))`,
+    /// `ω(x) = √(ω_s² + 2ax)`; 0 for `x ≤ 0`.
+    #[inline]
+    fn time_into_s(&self, x_rad: f64) -> f64 {
+        if x_rad <= 0.0 {
+            return 0.0;
+        }
+        let two_a = 2.0 * self.accel;
+        if two_a == 0.0 && x_rad < f64::INFINITY {
+            return 2.0 * x_rad / self.den_const;
+        }
+        time_into_s(self.w_s, two_a, x_rad)
+    }
+
+    /// Angle advanced `t_s` after entering the bin (of `width_deg`), rad:
+    /// `x = ω_s t + a t²/2` with `t` clamped to the dwell.
+    #[inline]
+    fn angle_into_rad(&self, t_s: f64, width_deg: f64) -> f64 {
+        angle_into_rad(self.w_s, self.accel, self.dwell_s, width_deg, t_s)
+    }
+}
+
+/// [`BinMotion::time_into_s`] from the spin at the start and `2a`.
+#[inline]
+fn time_into_s(w_s: f64, two_a: f64, x_rad: f64) -> f64 {
+    if x_rad <= 0.0 {
+        return 0.0;
+    }
+    let w_x = (w_s.powi(2) + two_a * x_rad).max(0.0).sqrt();
+    2.0 * x_rad / (w_s + w_x)
+}
+
+/// [`BinMotion::angle_into_rad`] from the bin's constants.
+#[inline]
+fn angle_into_rad(w_s: f64, accel: f64, dwell_s: f64, width_deg: f64, t_s: f64) -> f64 {
+    let t = t_s.clamp(0.0, dwell_s);
+    (w_s * t + 0.5 * accel * t * t).clamp(0.0, width_deg.to_radians())
 }
 
 /// Whole turns below an unwrapped azimuth and the azimuth within the turn.
@@ -111,6 +179,8 @@ pub struct Timeline<'a, B = Bin> {
     cum_time_s: Vec<f64>,
     /// Same for emitted energy, J.
     cum_energy_j: Vec<f64>,
+    /// Each bin's [`Motion`].
+    motion: Vec<Motion>,
 }
 
 impl<'a> Timeline<'a, Bin> {
@@ -130,20 +200,24 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
         let n = bins.len();
         let mut cum_time_s = Vec::with_capacity(n + 1);
         let mut cum_energy_j = Vec::with_capacity(n + 1);
+        let mut motion = Vec::with_capacity(n);
         let (mut t, mut e) = (0.0, 0.0);
         cum_time_s.push(0.0);
         cum_energy_j.push(0.0);
         for b in bins {
-            let dt = b.dwell_s();
+            let m = Motion::of(b);
+            let dt = m.dwell_s;
             t += dt;
             e += dt * b.power_w();
             cum_time_s.push(t);
             cum_energy_j.push(e);
+            motion.push(m);
         }
         Self {
             bins,
             cum_time_s,
             cum_energy_j,
+            motion,
         }
     }
 
@@ -188,7 +262,7 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
         let x = (azimuth_deg - b.start_deg())
             .clamp(0.0, b.width_deg())
             .to_radians();
-        let dt = b.time_into_s(x);
+        let dt = self.motion[i].time_into_s(x);
         (
             self.cum_time_s[i] + dt,
             self.cum_energy_j[i] + dt * b.power_w(),
@@ -207,6 +281,7 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
     /// As [`Self::locate_unwrapped`], searching forward from bin `*hint`
     /// (then set to the bin found): the same result, in amortised constant
     /// time for a nondecreasing sequence of azimuths.
+    #[inline]
     pub fn locate_unwrapped_from(&self, theta_deg: f64, hint: &mut usize) -> (f64, usize, f64) {
         let (k, a) = split_turns(theta_deg);
         let n = self.bins.len();
@@ -232,15 +307,17 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
 
     /// As [`Self::time_at_unwrapped_s`] with a forward search from `*hint`
     /// (see [`Self::locate_unwrapped_from`]): the same value.
+    #[inline]
     pub fn time_at_unwrapped_from_s(&self, theta_deg: f64, hint: &mut usize) -> f64 {
         self.time_at_located(self.locate_unwrapped_from(theta_deg, hint))
     }
 
+    #[inline]
     fn time_at_located(&self, (k, i, x_deg): (f64, usize, f64)) -> f64 {
         let b = &self.bins[i];
         k * self.period_s()
             + self.cum_time_s[i]
-            + b.time_into_s(x_deg.clamp(0.0, b.width_deg()).to_radians())
+            + self.motion[i].time_into_s(x_deg.clamp(0.0, b.width_deg()).to_radians())
     }
 
     /// Unwrapped azimuth at unwrapped time `t_s`, deg.
@@ -280,7 +357,8 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
         let b = &self.bins[i];
         FULL_TURN_DEG * k
             + b.start_deg()
-            + b.angle_into_rad(t - self.cum_time_s[i])
+            + self.motion[i]
+                .angle_into_rad(t - self.cum_time_s[i], b.width_deg())
                 .to_degrees()
                 .clamp(0.0, b.width_deg())
     }
@@ -371,7 +449,67 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
 
     fn azimuth_in_bin(&self, t_s: f64, i: usize) -> (f64, usize) {
         let b = &self.bins[i];
-        let x = b.angle_into_rad(t_s - self.cum_time_s[i]);
+        let x = self.motion[i].angle_into_rad(t_s - self.cum_time_s[i], b.width_deg());
         (wrap_deg(b.start_deg() + x.to_degrees()), i)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The per-call formulas as they were before [`Motion`] cached their
+    /// constants: the reference the cache must match bit for bit.
+    fn time_into_reference(b: &Bin, x_rad: f64) -> f64 {
+        if x_rad <= 0.0 {
+            return 0.0;
+        }
+        let w_s = b.spin_start_rad_s;
+        let w_x = (w_s.powi(2) + 2.0 * b.accel_rad_s2() * x_rad)
+            .max(0.0)
+            .sqrt();
+        2.0 * x_rad / (w_s + w_x)
+    }
+
+    fn angle_into_reference(b: &Bin, t_s: f64) -> f64 {
+        let t = t_s.clamp(0.0, b.dwell_s());
+        (b.spin_start_rad_s * t + 0.5 * b.accel_rad_s2() * t * t)
+            .clamp(0.0, b.width_deg.to_radians())
+    }
+
+    fn bin(width_deg: f64, w0: f64, w1: f64) -> Bin {
+        Bin {
+            start_deg: 0.0,
+            width_deg,
+            power_w: 1e-3,
+            spin_start_rad_s: w0,
+            spin_end_rad_s: w1,
+            region: None,
+            dwell_s: None,
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn cached_motion_is_the_per_call_formula(
+            width in prop_oneof![1e-6f64..360.0, Just(1.0)],
+            w0 in prop_oneof![1e-3f64..1e4, Just(62.83185307179586), Just(1e-160), Just(1e160)],
+            w1_same in any::<bool>(),
+            w1 in 1e-3f64..1e4,
+            x in prop_oneof![-1.0f64..7.0, Just(0.0), Just(-0.0), Just(f64::INFINITY), Just(f64::NAN)],
+            t in prop_oneof![-1.0f64..10.0, Just(0.0), Just(f64::INFINITY)],
+        ) {
+            let b = bin(width, w0, if w1_same { w0 } else { w1 });
+            let m = Motion::of(&b);
+            prop_assert_eq!(m.time_into_s(x).to_bits(), time_into_reference(&b, x).to_bits());
+            prop_assert_eq!(b.time_into_s(x).to_bits(), time_into_reference(&b, x).to_bits());
+            prop_assert_eq!(
+                m.angle_into_rad(t, b.width_deg).to_bits(),
+                angle_into_reference(&b, t).to_bits()
+            );
+            prop_assert_eq!(b.angle_into_rad(t).to_bits(), angle_into_reference(&b, t).to_bits());
+            prop_assert_eq!(m.dwell_s.to_bits(), b.dwell_s().to_bits());
+        }
     }
 }
