@@ -336,6 +336,47 @@ fn pruned_search_is_bit_identical_to_exhaustive() {
         .unwrap();
 }
 
+/// The same on the closed-form planner's profiles (the real-time path:
+/// two levels of power and spin, so long runs of cells tie to the last
+/// bit and the first one attaining the maximum decides the azimuth), for
+/// random gazes, every controller, both presets and several bin counts.
+#[test]
+fn pruned_search_is_bit_identical_on_closed_form_profiles() {
+    use gaze_lidar::model::presets;
+    use gaze_lidar::planner::closed_form::build_profile;
+    use gaze_lidar::planner::Mode;
+    let mut runner = TestRunner::new(Config {
+        cases: 120,
+        ..Config::default()
+    });
+    let strategy = (
+        -360.0f64..720.0,
+        proptest::sample::select(Mode::ALL.to_vec()),
+        any::<bool>(),
+        proptest::sample::select(vec![36usize, 90, 360, 361, 720]),
+    );
+    runner
+        .run(&strategy, |(gaze, mode, paper, bins)| {
+            let preset = if paper {
+                presets::paper()
+            } else {
+                presets::vls128()
+            };
+            let Ok(p) = build_profile(&preset, mode, Some(gaze), bins) else {
+                return Ok(());
+            };
+            let params = params_of(&p);
+            let a = evaluate_profile_with(&p, &params, Search::Pruned).unwrap();
+            let b = evaluate_profile_with(&p, &params, Search::Exhaustive).unwrap();
+            prop_assert_eq!(a.worst_ratio.to_bits(), b.worst_ratio.to_bits());
+            prop_assert_eq!(a.binding_rule, b.binding_rule);
+            prop_assert_eq!(a.worst_azimuth_deg.to_bits(), b.worst_azimuth_deg.to_bits());
+            prop_assert_eq!(a, b);
+            Ok(())
+        })
+        .unwrap();
+}
+
 /// The same on the `check` benchmark's rough workload (power ripple and
 /// in-bin acceleration on every bin), where the pruning skips almost every
 /// cell and walk.

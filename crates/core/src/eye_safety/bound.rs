@@ -1333,9 +1333,14 @@ impl<'a> Cells<'a> {
         );
         // A pass also holds at most `per_pass` pulses of at most `p·Δ`, and
         // at most the pulses each bin's share of it holds (`pulse_capped`).
+        // The per-bin sum can round one ulp above `per_pass·p·Δ` (the
+        // sweep's bound `e_ub`, same operations): take the smaller, so the
+        // exact value never exceeds its bound and the pruned search finds
+        // what the exhaustive one finds.
+        let coarse = per_pass * p * self.delta;
         let cap = self
             .pulse_capped_j(c, per_pass)
-            .unwrap_or(per_pass * p * self.delta);
+            .map_or(coarse, |e| e.min(coarse));
         CellExact {
             tau_s: cell_tau,
             e: (cell_e.0.min(cap), wrap360(cell_e.1)),
