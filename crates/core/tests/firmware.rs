@@ -419,6 +419,45 @@ fn hand_computed_four_bins() {
     assert_eq!((r.worst_ratio_ppm, r.class1), (0, true));
 }
 
+/// Two checks whose ratios round to the same ppm: the exactly larger one is
+/// reported (compared by cross-multiplication, not by rounded ppm). One 360°
+/// bin of 1000 ticks at 1 kHz, 100 Hz pulses, a 10° pass: 27.8 ticks, 3
+/// pulses. Code 10,000,001 against 10,000,000: 1.0000001 (⌈1,000,000.1⌉ =
+/// 1,000,001 ppm); bucket {1}: the same ratio (a tie: the first is kept);
+/// bucket {2, 3}: G(3) = 30,000,003 against 29,999,999 = 1.00000013…,
+/// also 1,000,001 ppm but larger, so the within-pass rule is the worst.
+#[test]
+fn ratios_equal_to_the_ppm_are_still_ordered_exactly() {
+    let t = table(1000, &[(360_000, 1000, 10_000_001)]);
+    let l = limits(
+        &t,
+        100_000,
+        10_000,
+        10_000_000,
+        &[(1, 10_000_000), (2, 29_999_999)],
+        1 << 40,
+    );
+    let r = evaluate(&t, &l).unwrap();
+    assert_eq!(
+        (r.worst_ratio_ppm, r.rule, r.azimuth_mdeg, r.class1),
+        (1_000_001, IntRule::PassTrain, 5_000, false)
+    );
+    // Bucket {2, 3} at 30,000,000: 1.0000001, a tie with rule 1, which came first.
+    let l = limits(
+        &t,
+        100_000,
+        10_000,
+        10_000_000,
+        &[(1, 10_000_000), (2, 30_000_000)],
+        1 << 40,
+    );
+    let r = evaluate(&t, &l).unwrap();
+    assert_eq!(
+        (r.worst_ratio_ppm, r.rule, r.azimuth_mdeg, r.class1),
+        (1_000_001, IntRule::SinglePulse, 5_000, false)
+    );
+}
+
 /// A pass wider than several bins: the middle bins count all their pulses.
 /// Twelve 30° bins of 100 ticks (1 kHz, 1.2 s per turn), 10 Hz pulses, a 95°
 /// pass: τ = 95/30·100 = 316.7 ticks → ⌊3.167⌋ + 1 = 4 pulses; each whole bin
