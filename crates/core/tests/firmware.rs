@@ -845,6 +845,63 @@ fn derived_limits_of_a_slow_turn_by_hand() {
     );
 }
 
+/// C4 at 905 nm (Table 9), by hand: 10^(0.002·205).
+fn c4_905() -> f64 {
+    10f64.powf(0.41)
+}
+
+/// Rule 1 with C5 < 1: ten turns a second (four 90° bins of 25 ticks at
+/// 1 kHz), 10 kHz pulses, q = 1e-7 W / 10^4 Hz = 1e-11 J. The pass lasts
+/// 8595/90000·25 = 2.3875 ticks → 3, holds ⌊23.875⌋ + 1 = 24 pulses; a T2
+/// window meets ⌊(10,000 + 3)/100⌋ + 1 = 101 passes: N = 2424 > 600, C5 =
+/// 5·2424^−¼ = 0.7126; pulses 100 µs apart, one per T_i = 5 µs. So
+/// pulse_code_max = ⌊(1 − 10⁻⁹)·C5·7.7e-8·C4/q⌋ = ⌊14,103.6⌋.
+#[test]
+fn derived_pulse_limit_with_c5_by_hand() {
+    let mut t = table(1000, &[(90_000, 25, 1); 4]);
+    t.pulse_rate_hz = 10_000.0;
+    t.power_w_per_code = 1e-7;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(l.pulse_rate_millihz_ceil, 10_000_000);
+    assert_eq!((l.pass_ticks_max, l.pulses_per_pass_max), (3, 24));
+    let c5 = 5.0 * 2424f64.powf(-0.25);
+    assert!((0.712..0.713).contains(&c5));
+    let want = ((1.0 - 1e-9) * c5 * 7.7e-8 * c4_905() / 1e-11).floor() as u64;
+    assert_eq!(want, 14_103);
+    assert_eq!(l.pulse_code_max, want);
+}
+
+/// Every integer limit loses `LIMIT_MARGIN` (10⁻⁹) before it is rounded
+/// down: a limit that is a whole number of quanta (to float precision)
+/// becomes one less. The four-bin table of `derived_limits_by_hand` with the
+/// step chosen so that q is 1/1000 of (a) the single-pulse AEL 7.7e-8·C4
+/// (C5 = 1) and (b) AEL_inf(0) = 7e-4·C4·(5 µs)^0.75 (the first bucket).
+#[test]
+fn derived_limits_lose_the_margin_on_whole_numbers() {
+    let mut t = table(
+        1000,
+        &[
+            (90_000, 250, 1),
+            (90_000, 250, 5),
+            (90_000, 250, 2),
+            (90_000, 250, 3),
+        ],
+    );
+    // q = step / 100 Hz.
+    t.power_w_per_code = 7.7e-8 * c4_905() / 1000.0 * 100.0;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(l.pulse_code_max, 999);
+    t.power_w_per_code = 7e-4 * c4_905() * 5e-6f64.powf(0.75) / 1000.0 * 100.0;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(
+        l.train[0],
+        TrainLimit {
+            pulses_from: 1,
+            energy_max_quanta: 999
+        }
+    );
+}
+
 #[test]
 fn derive_refuses_what_it_cannot_bound() {
     let mut t = table(1000, &[(360_000, 1000, 1)]);

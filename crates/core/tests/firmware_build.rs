@@ -234,7 +234,10 @@ fn tick_rate_limit_is_inclusive() {
     let p = profile(&[10.0; 36], PowerAccounting::Angle, limits(50.0, 80.0));
     let t = build(p, 10_000_000_000, None).expect("1e10 Hz is allowed");
     assert_eq!(t.frame_ticks, 1_000_000_000);
-    assert_eq!(t.bins.iter().map(|b| b.dwell_ticks).sum::<u64>(), 1_000_000_000);
+    assert_eq!(
+        t.bins.iter().map(|b| b.dwell_ticks).sum::<u64>(),
+        1_000_000_000
+    );
     assert!(t
         .bins
         .iter()
@@ -313,7 +316,11 @@ fn near_limit_codes_are_lowered_until_the_integer_check_holds() {
     assert!(r.class1, "{r:?}");
     for b in &t.bins {
         assert!(b.power_code < 3_999_999_999, "lowered: {}", b.power_code);
-        assert!(b.power_code >= 3_960_000_000, "lowered by ~0.5 %: {}", b.power_code);
+        assert!(
+            b.power_code >= 3_960_000_000,
+            "lowered by ~0.5 %: {}",
+            b.power_code
+        );
     }
 }
 
@@ -389,7 +396,9 @@ fn as_run_segments_by_hand() {
 #[test]
 fn table_exposure_by_hand() {
     let t = fw_table(1000, &[(90_000, 250, 2), (270_000, 500, 4)]);
-    let got = table_exposure(&t).expect("has parameters").expect("evaluates");
+    let got = table_exposure(&t)
+        .expect("has parameters")
+        .expect("evaluates");
     let segs = [
         Seg {
             start_deg: 0.0,
@@ -422,7 +431,10 @@ fn table_exposure_by_hand() {
                 field, reason, ..
             })) => {
                 assert_eq!(field, "bins");
-                assert_eq!(reason, "a table needs at least one bin with width and dwell");
+                assert_eq!(
+                    reason,
+                    "a table needs at least one bin with width and dwell"
+                );
             }
             other => panic!("expected the no-segment error, got {other:?}"),
         }

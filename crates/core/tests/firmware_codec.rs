@@ -40,7 +40,12 @@ fn tick_target_roundings_by_hand() {
         (tt(5, 0, 6, 9), None, None, Some(5)),
         // The ceil overflows.
         (tt(u64::MAX, 1, 0, u64::MAX), None, None, None),
-        (tt(u64::MAX, 0, 0, u64::MAX), Some(u64::MAX), Some(u64::MAX), Some(u64::MAX)),
+        (
+            tt(u64::MAX, 0, 0, u64::MAX),
+            Some(u64::MAX),
+            Some(u64::MAX),
+            Some(u64::MAX),
+        ),
     ];
     for (t, low, high, ceil) in cases {
         assert_eq!(t.low(), low, "{t:?}");
@@ -69,7 +74,11 @@ fn apportion_by_hand() {
     assert_eq!(apportion(&e, 14), Ok(vec![5, 5, 4]));
     // A bin bounded to its floor is not flexible, however large its
     // remainder; a bin bounded above its floor starts at its ceil.
-    let b = [tt(5, f(0.9), 0, 5), tt(5, f(0.1), 0, 10), tt(5, f(0.5), 6, 10)];
+    let b = [
+        tt(5, f(0.9), 0, 5),
+        tt(5, f(0.1), 0, 10),
+        tt(5, f(0.5), 6, 10),
+    ];
     assert_eq!(apportion(&b, 16), Ok(vec![5, 5, 6]));
     assert_eq!(apportion(&b, 17), Ok(vec![5, 6, 6]));
     // Reachable range: low 5 + 5 + 6 = 16, high 5 + 6 + 6 = 17.
@@ -91,7 +100,10 @@ fn apportion_by_hand() {
     );
     // The first bin without an admissible rounding is named.
     let bad = [tt(5, HALF, 0, 9), tt(5, HALF, 7, 9), tt(5, HALF, 8, 9)];
-    assert_eq!(apportion(&bad, 10), Err(QuantizeError::BinBounds { bin: 1 }));
+    assert_eq!(
+        apportion(&bad, 10),
+        Err(QuantizeError::BinBounds { bin: 1 })
+    );
     assert_eq!(apportion(&[], 0), Ok(vec![]));
 }
 
@@ -172,13 +184,22 @@ fn encoding_layout_by_hand() {
     assert_eq!(b[6], 1); // angle
     assert_eq!(b[7], 1); // parameters present
     assert_eq!(&b[8..16], &[8, 7, 6, 5, 4, 3, 2, 1]);
-    assert_eq!(&b[16..24], &[0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11]);
+    assert_eq!(
+        &b[16..24],
+        &[0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11]
+    );
     assert_eq!(&b[24..32], &0.25f64.to_bits().to_le_bytes());
     assert_eq!(&b[32..36], &[0x24, 0x23, 0x22, 0x21]);
     assert_eq!(&b[36..40], &[0x34, 0x33, 0x32, 0x31]);
-    assert_eq!(&b[40..48], &[0x48, 0x47, 0x46, 0x45, 0x44, 0x43, 0x42, 0x41]);
+    assert_eq!(
+        &b[40..48],
+        &[0x48, 0x47, 0x46, 0x45, 0x44, 0x43, 0x42, 0x41]
+    );
     assert_eq!(&b[48..52], &[0x54, 0x53, 0x52, 0x51]);
-    assert_eq!(&b[52..60], &[0x68, 0x67, 0x66, 0x65, 0x64, 0x63, 0x62, 0x61]);
+    assert_eq!(
+        &b[52..60],
+        &[0x68, 0x67, 0x66, 0x65, 0x64, 0x63, 0x62, 0x61]
+    );
     assert_eq!(&b[60..64], &[2, 0, 0, 0]);
     assert_eq!(&b[64..72], &20_000.0f64.to_bits().to_le_bytes());
     assert_eq!(&b[72..80], &905.0f64.to_bits().to_le_bytes());
@@ -248,7 +269,10 @@ fn decode_errors_at_their_edges() {
     assert_eq!(with(4, &[1, 0]), Err(DecodeError::Version(1)));
     assert_eq!(with(4, &[2, 1]), Err(DecodeError::Version(258)));
     assert_eq!(with(6, &[2]), Err(DecodeError::Accounting(2)));
-    assert_eq!(with(6, &[0]).map(|t| t.power_accounting), Ok(PowerAccounting::Time));
+    assert_eq!(
+        with(6, &[0]).map(|t| t.power_accounting),
+        Ok(PowerAccounting::Time)
+    );
     assert_eq!(with(7, &[2]), Err(DecodeError::Reserved(2)));
     // Flag clear but parameter bytes present.
     assert_eq!(with(7, &[0]), Err(DecodeError::Reserved(0)));
