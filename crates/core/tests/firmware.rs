@@ -845,6 +845,34 @@ fn derived_limits_of_a_slow_turn_by_hand() {
     );
 }
 
+/// More pulses per pass than `EXACT_PULSE_BUCKETS` (256): the slow turn of
+/// `derived_limits_of_a_slow_turn_by_hand` at 2 kHz pulses: the pass holds
+/// ⌊477.5·2⌋ + 1 = 956 pulses. Buckets start at every count up to 511
+/// (511 buckets; from 256 on the step is ⌊k/256⌋ = 1), then every second
+/// count 512…766 (128), then every third from 768 until the first start
+/// ≥ 956: 768 + 3·63 = 957 (64): 703 buckets. Bucket 957 holds windows of
+/// at least 956 pulse periods: ⌊7e-4·C4·0.478^0.75/q·(1 − 10⁻⁹)⌋, q = 1e-7 W / 2 kHz.
+#[test]
+fn derived_buckets_grow_beyond_256_pulses_by_hand() {
+    let mut t = table(1000, &[(90_000, 5000, 1); 4]);
+    t.pulse_rate_hz = 2000.0;
+    t.power_w_per_code = 1e-7;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(l.pulses_per_pass_max, 956);
+    let starts: Vec<u64> = l.train.iter().map(|b| b.pulses_from).collect();
+    assert_eq!(starts.len(), 703);
+    assert_eq!(starts[..3], [1, 2, 3]);
+    assert_eq!(starts[254..258], [255, 256, 257, 258]);
+    assert_eq!(starts[509..513], [510, 511, 512, 514]);
+    assert_eq!(starts[637..641], [764, 766, 768, 771]);
+    assert_eq!(starts[702], 957);
+    let q = 1e-7 / 2000.0;
+    let want = (7e-4 * c4_905() * 0.478f64.powf(0.75) / q * (1.0 - 1e-9)).floor() as u64;
+    assert_eq!(l.train[702].energy_max_quanta, want);
+    // 7e-4 · 2.5704 · 0.5749 / 5e-11 ≈ 2.0688e7.
+    assert_eq!(l.train[702].energy_max_quanta, 20_687_068);
+}
+
 /// C4 at 905 nm (Table 9), by hand: 10^(0.002·205).
 fn c4_905() -> f64 {
     10f64.powf(0.41)
