@@ -114,10 +114,11 @@ fn floor_code_by_hand() {
     assert_eq!(floor_code(0.0, 1.0), Some(0));
     assert_eq!(floor_code(1e-4, 2e-6), Some(50));
     // 0.35 / 0.005 rounds to 70.0, but 70 × 0.005 > 0.35 in floating point.
-    assert!(70.0 * 0.005 > 0.35);
+    assert!(std::hint::black_box(70.0f64) * 0.005 > 0.35);
     assert_eq!(floor_code(0.35, 0.005), Some(69));
     // 0.29 / 0.005 rounds to 57.99…, but 58 × 0.005 ≤ 0.29.
-    assert!(58.0 * 0.005 <= 0.29 && (0.29f64 / 0.005).floor() == 57.0);
+    let (c, v) = (std::hint::black_box(58.0f64), std::hint::black_box(0.29f64));
+    assert!(c * 0.005 <= v && (v / 0.005).floor() == 57.0);
     assert_eq!(floor_code(0.29, 0.005), Some(58));
     // The largest code, and one past it.
     let max = f64::from(u32::MAX);
