@@ -215,11 +215,14 @@ fn configuration_errors_name_their_setting() {
     assert_eq!(config_field(build(u(), 0, None)), "tick_hz");
     assert_eq!(config_field(build(u(), 10_000_000_001, None)), "tick_hz");
     for step in [0.0, -1e-6, f64::NAN, f64::INFINITY] {
-        assert_eq!(
-            config_field(build(u(), 3_600_000, Some(step))),
-            "power_w_per_code",
-            "{step}"
-        );
+        match build(u(), 3_600_000, Some(step)) {
+            Err(FirmwareError::Config { field, reason }) => {
+                assert_eq!(field, "power_w_per_code", "{step}");
+                // Refused as a step, not later as a code that does not fit.
+                assert!(reason.contains("must be finite and > 0"), "{step}: {reason}");
+            }
+            other => panic!("{step}: expected a configuration error, got {other:?}"),
+        }
     }
     // A step so small that the codes do not fit a u32.
     assert_eq!(
