@@ -219,7 +219,10 @@ fn configuration_errors_name_their_setting() {
             Err(FirmwareError::Config { field, reason }) => {
                 assert_eq!(field, "power_w_per_code", "{step}");
                 // Refused as a step, not later as a code that does not fit.
-                assert!(reason.contains("must be finite and > 0"), "{step}: {reason}");
+                assert!(
+                    reason.contains("must be finite and > 0"),
+                    "{step}: {reason}"
+                );
             }
             other => panic!("{step}: expected a configuration error, got {other:?}"),
         }
