@@ -419,6 +419,45 @@ fn hand_computed_four_bins() {
     assert_eq!((r.worst_ratio_ppm, r.class1), (0, true));
 }
 
+/// Two checks whose ratios round to the same ppm: the exactly larger one is
+/// reported (compared by cross-multiplication, not by rounded ppm). One 360°
+/// bin of 1000 ticks at 1 kHz, 100 Hz pulses, a 10° pass: 27.8 ticks, 3
+/// pulses. Code 10,000,001 against 10,000,000: 1.0000001 (⌈1,000,000.1⌉ =
+/// 1,000,001 ppm); bucket {1}: the same ratio (a tie: the first is kept);
+/// bucket {2, 3}: G(3) = 30,000,003 against 29,999,999 = 1.00000013…,
+/// also 1,000,001 ppm but larger, so the within-pass rule is the worst.
+#[test]
+fn ratios_equal_to_the_ppm_are_still_ordered_exactly() {
+    let t = table(1000, &[(360_000, 1000, 10_000_001)]);
+    let l = limits(
+        &t,
+        100_000,
+        10_000,
+        10_000_000,
+        &[(1, 10_000_000), (2, 29_999_999)],
+        1 << 40,
+    );
+    let r = evaluate(&t, &l).unwrap();
+    assert_eq!(
+        (r.worst_ratio_ppm, r.rule, r.azimuth_mdeg, r.class1),
+        (1_000_001, IntRule::PassTrain, 5_000, false)
+    );
+    // Bucket {2, 3} at 30,000,000: 1.0000001, a tie with rule 1, which came first.
+    let l = limits(
+        &t,
+        100_000,
+        10_000,
+        10_000_000,
+        &[(1, 10_000_000), (2, 30_000_000)],
+        1 << 40,
+    );
+    let r = evaluate(&t, &l).unwrap();
+    assert_eq!(
+        (r.worst_ratio_ppm, r.rule, r.azimuth_mdeg, r.class1),
+        (1_000_001, IntRule::SinglePulse, 5_000, false)
+    );
+}
+
 /// A pass wider than several bins: the middle bins count all their pulses.
 /// Twelve 30° bins of 100 ticks (1 kHz, 1.2 s per turn), 10 Hz pulses, a 95°
 /// pass: τ = 95/30·100 = 316.7 ticks → ⌊3.167⌋ + 1 = 4 pulses; each whole bin
@@ -803,6 +842,91 @@ fn derived_limits_of_a_slow_turn_by_hand() {
     assert_eq!(
         (l.pass_energy_max_quanta, l.pass_energy_rule),
         (9_784_956, IntRule::TimeBase)
+    );
+}
+
+/// More pulses per pass than `EXACT_PULSE_BUCKETS` (256): the slow turn of
+/// `derived_limits_of_a_slow_turn_by_hand` at 2 kHz pulses: the pass holds
+/// ⌊477.5·2⌋ + 1 = 956 pulses. Buckets start at every count up to 511
+/// (511 buckets; from 256 on the step is ⌊k/256⌋ = 1), then every second
+/// count 512…766 (128), then every third from 768 until the first start
+/// ≥ 956: 768 + 3·63 = 957 (64): 703 buckets. Bucket 957 holds windows of
+/// at least 956 pulse periods: ⌊7e-4·C4·0.478^0.75/q·(1 − 10⁻⁹)⌋, q = 1e-7 W / 2 kHz.
+#[test]
+fn derived_buckets_grow_beyond_256_pulses_by_hand() {
+    let mut t = table(1000, &[(90_000, 5000, 1); 4]);
+    t.pulse_rate_hz = 2000.0;
+    t.power_w_per_code = 1e-7;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(l.pulses_per_pass_max, 956);
+    let starts: Vec<u64> = l.train.iter().map(|b| b.pulses_from).collect();
+    assert_eq!(starts.len(), 703);
+    assert_eq!(starts[..3], [1, 2, 3]);
+    assert_eq!(starts[254..258], [255, 256, 257, 258]);
+    assert_eq!(starts[509..513], [510, 511, 512, 514]);
+    assert_eq!(starts[637..641], [764, 766, 768, 771]);
+    assert_eq!(starts[702], 957);
+    let q = 1e-7 / 2000.0;
+    let want = (7e-4 * c4_905() * 0.478f64.powf(0.75) / q * (1.0 - 1e-9)).floor() as u64;
+    assert_eq!(l.train[702].energy_max_quanta, want);
+    // 7e-4 · 2.5704 · 0.5749 / 5e-11 ≈ 2.0688e7.
+    assert_eq!(l.train[702].energy_max_quanta, 20_687_068);
+}
+
+/// C4 at 905 nm (Table 9), by hand: 10^(0.002·205).
+fn c4_905() -> f64 {
+    10f64.powf(0.41)
+}
+
+/// Rule 1 with C5 < 1: ten turns a second (four 90° bins of 25 ticks at
+/// 1 kHz), 10 kHz pulses, q = 1e-7 W / 10^4 Hz = 1e-11 J. The pass lasts
+/// 8595/90000·25 = 2.3875 ticks → 3, holds ⌊23.875⌋ + 1 = 24 pulses; a T2
+/// window meets ⌊(10,000 + 3)/100⌋ + 1 = 101 passes: N = 2424 > 600, C5 =
+/// 5·2424^−¼ = 0.7126; pulses 100 µs apart, one per T_i = 5 µs. So
+/// pulse_code_max = ⌊(1 − 10⁻⁹)·C5·7.7e-8·C4/q⌋ = ⌊14,103.6⌋.
+#[test]
+fn derived_pulse_limit_with_c5_by_hand() {
+    let mut t = table(1000, &[(90_000, 25, 1); 4]);
+    t.pulse_rate_hz = 10_000.0;
+    t.power_w_per_code = 1e-7;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(l.pulse_rate_millihz_ceil, 10_000_000);
+    assert_eq!((l.pass_ticks_max, l.pulses_per_pass_max), (3, 24));
+    let c5 = 5.0 * 2424f64.powf(-0.25);
+    assert!((0.712..0.713).contains(&c5));
+    let want = ((1.0 - 1e-9) * c5 * 7.7e-8 * c4_905() / 1e-11).floor() as u64;
+    assert_eq!(want, 14_103);
+    assert_eq!(l.pulse_code_max, want);
+}
+
+/// Every integer limit loses `LIMIT_MARGIN` (10⁻⁹) before it is rounded
+/// down: a limit that is a whole number of quanta (to float precision)
+/// becomes one less. The four-bin table of `derived_limits_by_hand` with the
+/// step chosen so that q is 1/1000 of (a) the single-pulse AEL 7.7e-8·C4
+/// (C5 = 1) and (b) AEL_inf(0) = 7e-4·C4·(5 µs)^0.75 (the first bucket).
+#[test]
+fn derived_limits_lose_the_margin_on_whole_numbers() {
+    let mut t = table(
+        1000,
+        &[
+            (90_000, 250, 1),
+            (90_000, 250, 5),
+            (90_000, 250, 2),
+            (90_000, 250, 3),
+        ],
+    );
+    // q = step / 100 Hz.
+    t.power_w_per_code = 7.7e-8 * c4_905() / 1000.0 * 100.0;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(l.pulse_code_max, 999);
+    t.power_w_per_code = 7e-4 * c4_905() * 5e-6f64.powf(0.75) / 1000.0 * 100.0;
+    let l = IntEyeLimits::derive(&t).unwrap();
+    assert_eq!(
+        l.train[0],
+        TrainLimit {
+            pulses_from: 1,
+            energy_max_quanta: 999
+        }
     );
 }
 
