@@ -7,10 +7,10 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::time::Instant;
 
+use gaze_lidar::checker::check;
 use gaze_lidar::gaze::{
     ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeSample, GazeStream,
 };
-use gaze_lidar::checker::check;
 use gaze_lidar::model::presets;
 use gaze_lidar::planner::closed_form::build_profile;
 use gaze_lidar::planner::Mode;
@@ -79,7 +79,9 @@ fn bench(c: &mut Criterion) {
         "gaze → certified profile, closed form (joint, 360 bins): p50 {p50:.1} µs, p99 {p99:.1} µs"
     );
     let (p50, p99) = checker_latencies(3000);
-    eprintln!("checker alone on the planned profile (joint, 360 bins): p50 {p50:.1} µs, p99 {p99:.1} µs");
+    eprintln!(
+        "checker alone on the planned profile (joint, 360 bins): p50 {p50:.1} µs, p99 {p99:.1} µs"
+    );
     #[cfg(feature = "solver")]
     {
         let path = concat!(
