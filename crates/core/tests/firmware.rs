@@ -6,54 +6,32 @@
 //! early exits) on seeded random tables; plus hand-computed cases, the error
 //! paths, and the checker's assembly of violations.
 
+mod common;
+
 use gaze_lidar_core::eye_safety::EyeSafetyParams;
 use gaze_lidar_core::firmware::eye::{
     evaluate, millihz_ceil, pass_timing, DeriveError, IntEyeError, IntEyeLimits, IntRule,
     TrainLimit,
 };
 use gaze_lidar_core::firmware::{
-    check_integer, check_table, check_table_with, FirmwareTable, FwBin, FwViolation, IntLimits,
-    FIRMWARE_FORMAT,
+    check_integer, check_table, check_table_with, FirmwareTable, FwViolation,
 };
-use gaze_lidar_core::model::PowerAccounting;
 use std::sync::OnceLock;
 
 const W: i64 = 360_000;
 
 /// A table of `(width_mdeg, dwell_ticks, code)` bins; frame = Σ dwell.
 fn table(tick_hz: u64, bins: &[(u32, u64, u32)]) -> FirmwareTable {
-    FirmwareTable {
-        format: FIRMWARE_FORMAT.to_owned(),
+    common::open_table(
         tick_hz,
-        frame_ticks: bins.iter().map(|b| b.1).sum(),
-        power_w_per_code: 1e-3,
-        power_accounting: PowerAccounting::Time,
-        pulse_rate_hz: 100.0,
-        eye_safety: Some(EyeSafetyParams {
+        100.0,
+        Some(EyeSafetyParams {
             wavelength_nm: 905.0,
             pulse_duration_s: 5e-9,
             beam_diameter_mm: 8.0,
         }),
-        limits: IntLimits {
-            power_code_min: 0,
-            power_code_max: u32::MAX,
-            energy_budget: u64::MAX,
-            window_bins: 1,
-            window_energy_max: u64::MAX,
-        },
-        bins: bins
-            .iter()
-            .map(|&(width_mdeg, dwell_ticks, power_code)| FwBin {
-                start_deg: 0.0,
-                width_mdeg,
-                dwell_ticks,
-                power_code,
-                dwell_ticks_min: 0,
-                dwell_ticks_max: u64::MAX,
-                power_code_cap: u32::MAX,
-            })
-            .collect(),
-    }
+        bins,
+    )
 }
 
 /// Limits for `t` with every figure given (the struct is non-exhaustive:

@@ -3,13 +3,15 @@
 //! `table_exposure` had no test inside the core crate). Expected tick counts,
 //! codes, bounds and budgets are worked out by hand in the comments.
 
+mod common;
+
 use gaze_lidar_core::checker::{certify, certify_with, CheckOptions};
 use gaze_lidar_core::eye_safety::bound::Seg;
 use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams};
 use gaze_lidar_core::firmware::eye::{evaluate, IntEyeLimits};
 use gaze_lidar_core::firmware::{
     as_run_segments, check_table, table_exposure, FirmwareConfig, FirmwareError, FirmwareTable,
-    FwBin, FwViolation, IntLimits, QuantizeError, FIRMWARE_FORMAT, MAX_TABLE_BINS,
+    FwViolation, QuantizeError, FIRMWARE_FORMAT, MAX_TABLE_BINS,
 };
 use gaze_lidar_core::model::lidar::{Limits, PowerAccounting};
 use gaze_lidar_core::profile::{Bin, Profile, PROFILE_FORMAT};
@@ -341,34 +343,7 @@ fn json_round_trips_with_a_newline() {
 }
 
 fn fw_table(tick_hz: u64, bins: &[(u32, u64, u32)]) -> FirmwareTable {
-    FirmwareTable {
-        format: FIRMWARE_FORMAT.to_owned(),
-        tick_hz,
-        frame_ticks: bins.iter().map(|b| b.1).sum(),
-        power_w_per_code: 1e-3,
-        power_accounting: PowerAccounting::Time,
-        pulse_rate_hz: 20_000.0,
-        eye_safety: Some(params()),
-        limits: IntLimits {
-            power_code_min: 0,
-            power_code_max: u32::MAX,
-            energy_budget: u64::MAX,
-            window_bins: 1,
-            window_energy_max: u64::MAX,
-        },
-        bins: bins
-            .iter()
-            .map(|&(width_mdeg, dwell_ticks, power_code)| FwBin {
-                start_deg: 0.0,
-                width_mdeg,
-                dwell_ticks,
-                power_code,
-                dwell_ticks_min: 0,
-                dwell_ticks_max: u64::MAX,
-                power_code_cap: u32::MAX,
-            })
-            .collect(),
-    }
+    common::open_table(tick_hz, 20_000.0, Some(params()), bins)
 }
 
 fn close(a: f64, b: f64) -> bool {

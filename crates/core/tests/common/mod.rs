@@ -1,0 +1,43 @@
+//! Helpers shared by the core's integration tests.
+
+use gaze_lidar_core::eye_safety::EyeSafetyParams;
+use gaze_lidar_core::firmware::{FirmwareTable, FwBin, IntLimits, FIRMWARE_FORMAT};
+use gaze_lidar_core::model::PowerAccounting;
+
+/// A time-accounted table of `(width_mdeg, dwell_ticks, code)` bins at
+/// 1 mW per code, with open limits and unconstrained bins; frame = Σ dwell.
+pub fn open_table(
+    tick_hz: u64,
+    pulse_rate_hz: f64,
+    eye_safety: Option<EyeSafetyParams>,
+    bins: &[(u32, u64, u32)],
+) -> FirmwareTable {
+    FirmwareTable {
+        format: FIRMWARE_FORMAT.to_owned(),
+        tick_hz,
+        frame_ticks: bins.iter().map(|b| b.1).sum(),
+        power_w_per_code: 1e-3,
+        power_accounting: PowerAccounting::Time,
+        pulse_rate_hz,
+        eye_safety,
+        limits: IntLimits {
+            power_code_min: 0,
+            power_code_max: u32::MAX,
+            energy_budget: u64::MAX,
+            window_bins: 1,
+            window_energy_max: u64::MAX,
+        },
+        bins: bins
+            .iter()
+            .map(|&(width_mdeg, dwell_ticks, power_code)| FwBin {
+                start_deg: 0.0,
+                width_mdeg,
+                dwell_ticks,
+                power_code,
+                dwell_ticks_min: 0,
+                dwell_ticks_max: u64::MAX,
+                power_code_cap: u32::MAX,
+            })
+            .collect(),
+    }
+}
