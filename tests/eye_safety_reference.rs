@@ -13,7 +13,8 @@
 //!     --test eye_safety_reference differential -- --nocapture
 //! ```
 //! `GAZE_LIDAR_REF_SEED=<u64>` picks another deterministic case stream;
-//! `GAZE_LIDAR_REF_PHASES=<n>` the number of uniformly spread clock phases.
+//! `GAZE_LIDAR_REF_PHASES=<n>` the number of uniformly spread clock phases;
+//! `GAZE_LIDAR_REF_ONLY=<i>,<j>` runs only those cases of the stream.
 
 #[path = "../benches/common/big_profile.rs"]
 mod big_profile;
@@ -46,7 +47,7 @@ use std::time::Instant;
 /// on other seeds report it: seed 606, 10,000 cases, saw 1.413 (1450 nm,
 /// 9 bins, a dark sector; the checker's within-pass bound against the
 /// reference's multi-pass window), see `specs/eye_safety.md`.
-const TIGHT_FACTOR: f64 = 1.2;
+const TIGHT_FACTOR: f64 = 1.06;
 
 /// The case stream `cargo test` runs.
 const DEFAULT_SEED: u64 = 0x6a7e_11da;
@@ -285,7 +286,8 @@ fn env_usize(name: &str, default: usize) -> usize {
 struct Stats {
     n: usize,
     below: usize,
-    above_105: usize,
+    /// Phase-locked step profiles at ≥ 20 kHz above [`TIGHT_FACTOR`].
+    untight: usize,
     min: f64,
     max: f64,
     min_case: String,
@@ -299,7 +301,7 @@ impl Stats {
         }
         self.n += 1;
         self.below += usize::from(!sound);
-        self.above_105 += usize::from(!tight);
+        self.untight += usize::from(!tight);
         if q < self.min {
             self.min = q;
             self.min_case = label.to_owned();
@@ -395,6 +397,8 @@ struct Outcome {
     class: String,
     q: f64,
     sound: bool,
+    /// A phase-locked step profile at ≥ 20 kHz (where tightness is asserted).
+    asserted: bool,
     tight: bool,
     label: String,
     json: String,
@@ -428,8 +432,8 @@ fn one_case(case: usize, spec: &Spec, phases: usize) -> Outcome {
     // Below ~20 kHz a pass holds a handful of pulses and the checker's
     // envelope (one pulse spacing of hot power per pass) is measurably
     // looser; those cases are printed, not asserted.
-    let tight = !(step && spec.locked && p.pulse_rate_hz >= 20_000.0)
-        || report.worst_ratio <= reference * TIGHT_FACTOR;
+    let asserted = step && spec.locked && p.pulse_rate_hz >= 20_000.0;
+    let tight = !asserted || report.worst_ratio <= reference * TIGHT_FACTOR;
     let class = format!(
         "{:>4} nm {} {} {:?}",
         LAMBDAS[spec.band],
@@ -452,6 +456,7 @@ fn one_case(case: usize, spec: &Spec, phases: usize) -> Outcome {
         class,
         q,
         sound,
+        asserted,
         tight,
         json: if sound && tight {
             String::new()
@@ -482,17 +487,25 @@ fn differential_checker_never_below_reference() {
     let mut all = Stats::default();
     let mut failures: Vec<(f64, String, String)> = Vec::new();
     let mut untight: Vec<(f64, String, String)> = Vec::new();
+    // Phase-locked step profiles at ≥ 20 kHz: how many, within 1.05, loosest.
+    let mut locked_steps = (0usize, 0usize, 0.0f64);
     // Specs are drawn in order from the seeded runner; the cases are then
     // evaluated in parallel (rayon) and folded in case order, so the output
     // does not depend on the thread count.
     let specs: Vec<Spec> = (0..cases)
         .map(|_| strategy.new_tree(&mut runner).expect("case").current())
         .collect();
+    // `GAZE_LIDAR_REF_ONLY=2084,17`: only those cases of the stream (to
+    // re-examine what a long run printed).
+    let only: Option<Vec<usize>> = std::env::var("GAZE_LIDAR_REF_ONLY")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect());
     let outcomes: Vec<Outcome> = {
         use rayon::prelude::*;
         specs
             .par_iter()
             .enumerate()
+            .filter(|(case, _)| only.as_ref().is_none_or(|o| o.contains(case)))
             .map(|(case, spec)| one_case(case, spec, phases))
             .collect()
     };
@@ -504,6 +517,11 @@ fn differential_checker_never_below_reference() {
         all.add(o.q, o.sound, o.tight, &o.label);
         if !o.sound {
             failures.push((o.q, o.label.clone(), o.json.clone()));
+        }
+        if o.asserted {
+            locked_steps.0 += 1;
+            locked_steps.1 += usize::from(o.q <= 1.05);
+            locked_steps.2 = locked_steps.2.max(o.q);
         }
         if !o.tight {
             untight.push((o.q, o.label, o.json));
@@ -517,13 +535,17 @@ fn differential_checker_never_below_reference() {
     );
     println!("  smallest at {}", all.min_case);
     println!(
+        "phase-locked step profiles at ≥ 20 kHz: {}, {} within 1.05, loosest {:.4}",
+        locked_steps.0, locked_steps.1, locked_steps.2
+    );
+    println!(
         "{:<36} {:>6} {:>7} {:>9} {:>12} {:>10}",
-        "class (reference's binding rule)", "cases", "below", ">1.05step", "min q", "max q"
+        "class (reference's binding rule)", "cases", "below", "untight", "min q", "max q"
     );
     for (c, s) in &by_class {
         println!(
             "{c:<36} {:>6} {:>7} {:>9} {:>12.6} {:>10.4}",
-            s.n, s.below, s.above_105, s.min, s.max
+            s.n, s.below, s.untight, s.min, s.max
         );
     }
     failures.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -256,6 +256,20 @@ impl Laser {
             .filter(move |&t| t > lo && t < hi)
     }
 
+    /// `sup τ/AEL(τ)` over `0 < τ ≤ tau_hi_s`: on every row of Table 3 the
+    /// AEL is `c·τ^p` with `0 ≤ p ≤ 1`, so `τ/AEL(τ)` is nondecreasing
+    /// within a row (and below the clamp at the pulse duration, where the
+    /// AEL is constant), and the supremum is at `tau_hi_s` or at a row edge
+    /// below it (where [`Self::ael_j`] takes the smaller row). Bounds
+    /// `E/AEL(τ) ≤ (E/τ)·K` for every `τ ≤ tau_hi_s`.
+    fn mean_power_factor(&self, tau_hi_s: f64) -> f64 {
+        let mut k = tau_hi_s / self.ael_j(tau_hi_s);
+        for t in self.edges_within(0.0, tau_hi_s) {
+            k = k.max(t / self.ael_j(t));
+        }
+        k
+    }
+
     /// Pulses grouped into one effective pulse (summed within `T_i`, 700–1050 nm):
     /// the most pulses a closed `T_i` window holds, at most `per_pass`.
     #[must_use]
@@ -954,14 +968,19 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
     let cells = Cells::new(&tl, &env, half_deg.min(180.0), laser);
     let best = cells.search(search);
 
-    // Rule 2 within one revolution: window walks over envelope breakpoints.
+    // Rule 2 within one revolution: the whole-pass windows, then window
+    // walks over envelope breakpoints within one pass.
+    let l_max = (best.tau_max + delta).min(frame_s);
+    let full = cells.full_pass_max(search, best.e_max.0, best.tau_max);
     let walks = Walks {
         env: &env,
+        tl: &tl,
         laser,
+        two_h_deg: 2.0 * half_deg.min(180.0),
         e_pass: best.e_max.0,
-        l_max: (best.tau_max + delta).min(frame_s),
+        l_max,
     };
-    let (pass_ratio, pass_window) = walks.search(search);
+    let (pass_ratio, pass_window) = walks.search(search, full);
     // Rule 2 over several passes, up to the time base.
     let pass = PassFigures {
         envelope_j: best.e_env_max,
@@ -1047,6 +1066,8 @@ const TOUCH_SNAP_DEG: f64 = 1e-9;
 struct CellExact {
     /// Largest pass duration over the cell, s.
     tau_s: f64,
+    /// Smallest pass duration over the cell, s.
+    tau_min_s: f64,
     /// Largest pass energy (envelope and pulse-count bounds), J, and the
     /// azimuth (wrapped) where the envelope bound peaks.
     e: (f64, f64),
@@ -1091,6 +1112,9 @@ struct CellRow {
     e_ub: f64,
     env_ub: f64,
     single_ub: f64,
+    /// A lower bound of the cell's smallest pass duration (exact when the
+    /// cell is not curved), s.
+    tau_lb: f64,
 }
 
 /// The maxima over cells: Rule 1 (ratio, azimuth), pass energy
@@ -1223,13 +1247,14 @@ impl<'a> Cells<'a> {
                 .filter(|(right, left)| bin_curved[right.1] || bin_curved[left.1]);
             // `ends(..)`'s two values, without the azimuth.
             let ends_tau = 0.0f64.max(tau_pt[c]).max(tau_pt[c + 1]);
+            let ends_tau_min = tau_pt[c].min(tau_pt[c + 1]);
             let mut ends_e = 0.0f64;
             for x in [e_pt[c], e_pt[c + 1]] {
                 if x > ends_e {
                     ends_e = x;
                 }
             }
-            let (tau, e) = if let Some((right, left)) = edges {
+            let (tau, e, tau_lb) = if let Some((right, left)) = edges {
                 let (seg_r, seg_l) = (&segs[right.1], &segs[left.1]);
                 // ω at both ends of each edge's arc, on that edge's bin.
                 let spin = |seg: &Seg, k: f64, theta: f64| {
@@ -1246,18 +1271,20 @@ impl<'a> Cells<'a> {
                 let (pl_min, pl_max) = (pl_u.min(pl_v), pl_u.max(pl_v));
                 let width_rad = (v - u).to_radians();
                 let rise = |fwd: f64, back: f64| width_rad * fwd.max(0.0).min(back.max(0.0));
-                let tau = ends_tau
-                    + rise(1.0 / wr_min - 1.0 / wl_max, 1.0 / wl_min - 1.0 / wr_max)
-                    + t_slack;
+                // τ falls below its smaller end value by at most the same
+                // (the smaller of its largest descent either way).
+                let tau_rise = rise(1.0 / wr_min - 1.0 / wl_max, 1.0 / wl_min - 1.0 / wr_max);
+                let tau = ends_tau + tau_rise + t_slack;
+                let tau_lb = ends_tau_min - tau_rise - t_slack;
                 let e = ends_e
                     + rise(
                         pr_max / wr_min - pl_min / wl_max,
                         pl_max / wl_min - pr_min / wr_max,
                     )
                     + e_slack;
-                (tau, e)
+                (tau, e, tau_lb)
             } else {
-                (ends_tau, ends_e)
+                (ends_tau, ends_e, ends_tau_min)
             };
             let per_pass = per_pass_of.get(tau, |t| max_pulses_in(t, f_p));
             let passes = passes_of.get(tau, |t| passes_in_window(t2, t, frame_s));
@@ -1269,6 +1296,7 @@ impl<'a> Cells<'a> {
                 e_ub: e.min(per_pass * p * delta),
                 env_ub: e,
                 single_ub: p * delta * per_j,
+                tau_lb,
             });
         }
         self.tau_pt = tau_pt;
@@ -1297,6 +1325,7 @@ impl<'a> Cells<'a> {
         let (u, v) = (self.cut(c), self.cut(c + 1));
         let CellExact {
             tau_s: mut cell_tau,
+            tau_min_s: mut cell_tau_min,
             e: mut cell_e,
             ..
         } = ends(&self.cuts, &self.tau_pt, &self.e_pt, c);
@@ -1315,6 +1344,7 @@ impl<'a> Cells<'a> {
                         let t_lo = self.time_at(phi - self.h);
                         let t_hi = self.time_at(phi + self.h);
                         cell_tau = cell_tau.max(t_hi - t_lo);
+                        cell_tau_min = cell_tau_min.min(t_hi - t_lo);
                         let e =
                             self.env.integral_to(t_hi + self.delta) - self.env.integral_to(t_lo);
                         if e > cell_e.0 {
@@ -1343,6 +1373,7 @@ impl<'a> Cells<'a> {
             .map_or(coarse, |e| e.min(coarse));
         CellExact {
             tau_s: cell_tau,
+            tau_min_s: cell_tau_min,
             e: (cell_e.0.min(cap), wrap360(cell_e.1)),
             e_env: cell_e.0,
             single: p * self.delta * self.per_j.peek(self.laser, per_pass, passes),
@@ -1401,6 +1432,87 @@ impl<'a> Cells<'a> {
             left -= k;
         }
         Some(e)
+    }
+
+    /// Rule 2 over the windows that hold one whole pass (the boundary of
+    /// the walks' reach, see [`Walks::search`]): an upper bound of
+    /// `min(E(φ), E⁺)/AEL(τ(φ))` over the azimuths `φ` of cell `c`, with the
+    /// `τ` where it is taken. Off the curved cells `E` and `τ` are affine in
+    /// `φ` (both pass edges in bins of constant spin, the envelope pieces
+    /// fixed), so on each row of Table 3 `E/AEL(τ) = (e₀ + e₁x)/(c·(τ₀ +
+    /// t₁x)^p)` has a derivative whose sign is that of
+    /// `e₁τ − p·t₁·E`, affine in `x` with slope `(1 − p)·e₁·t₁`: positive
+    /// throughout when `e₁·t₁ < 0` (or its mirror), and crossing zero at
+    /// most once upwards otherwise, so the ratio is largest at the cell ends
+    /// or where `τ` meets a row edge; capped at `E⁺`, also where `E`
+    /// reaches `E⁺` (on each side of it the capped ratio is one of the two
+    /// forms above). On a curved cell: the largest `E` (capped) over the
+    /// smallest `τ` (both exact, see [`Self::exact`]).
+    fn full_pass(&self, c: usize, e_cap: f64) -> (f64, f64) {
+        let laser = self.laser;
+        if self.rows[c].curved {
+            let x = self.exact(c);
+            let r = x.e_env.min(e_cap) / laser.ael_j(x.tau_min_s);
+            return (r, x.tau_min_s);
+        }
+        let (tu, tv) = (self.tau_pt[c], self.tau_pt[c + 1]);
+        let (eu, ev) = (self.e_pt[c], self.e_pt[c + 1]);
+        let mut best = Best(0.0, 0.0);
+        let mut take = |e: f64, t: f64| best.take((e.min(e_cap) / laser.ael_j(t), t));
+        take(eu, tu);
+        take(ev, tv);
+        // Along the cell `E` is affine in `τ`. Interpolations are widened by
+        // the error of the values at the cuts (`PRUNE_SLACK` of a turn's
+        // time and envelope energy) amplified by the division.
+        let t_err = 2.0 * PRUNE_SLACK * self.tl.period_s();
+        let e_err = 2.0 * PRUNE_SLACK * self.env.total_j();
+        let (lo, hi) = (tu.min(tv), tu.max(tv));
+        let (de, dt) = (ev - eu, tv - tu);
+        for t in laser.edges_within(lo, hi) {
+            let w = ((t - tu) / dt).clamp(0.0, 1.0);
+            let spread = (t_err / (hi - lo)).min(1.0);
+            take(eu + de * w + de.abs() * spread + e_err, t);
+        }
+        // Where `E` reaches `E⁺` (the cap's kink): `E⁺` over the `τ` there.
+        if eu.min(ev) < e_cap && e_cap < eu.max(ev) {
+            let w = ((e_cap - eu) / de).clamp(0.0, 1.0);
+            let spread = (e_err / de.abs()).min(1.0);
+            let t = (tu + dt * w - dt.abs() * spread - t_err).max(0.0);
+            take(e_cap, t);
+        }
+        (best.0, best.1)
+    }
+
+    /// The largest [`Self::full_pass`] over the cells. Pruned: a cell is
+    /// evaluated only if `min(E_ub, E⁺)/τ_lb · K` ([`Laser::mean_power_factor`]
+    /// up to the longest pass), then `min(E_ub, E⁺)/AEL(τ_lb)`, both upper
+    /// bounds of its value, can reach the best so far.
+    fn full_pass_max(&self, search: Search, e_cap: f64, tau_max: f64) -> Best {
+        let mut best = Best(0.0, 0.0);
+        match search {
+            Search::Exhaustive => {
+                for c in 0..self.len() {
+                    best.take(self.full_pass(c, e_cap));
+                }
+            }
+            Search::Pruned => {
+                let laser = self.laser;
+                let k = laser.mean_power_factor(tau_max) * (1.0 + PRUNE_SLACK);
+                for (c, row) in self.rows.iter().enumerate() {
+                    // (A NaN bound never prunes; a bound `τ_lb ≤ 0` only
+                    // through the AEL, which clamps it.)
+                    let e = row.env_ub.min(e_cap);
+                    if row.tau_lb > 0.0 && e / row.tau_lb * k < best.0 {
+                        continue;
+                    }
+                    if e / laser.ael_j(row.tau_lb) * (1.0 + PRUNE_SLACK) < best.0 {
+                        continue;
+                    }
+                    best.take(self.full_pass(c, e_cap));
+                }
+            }
+        }
+        best
     }
 
     /// The three maxima, each with the first cell (in azimuth order)
@@ -1492,15 +1604,18 @@ fn cut_of(cuts: &[f64], c: usize) -> f64 {
 #[inline]
 fn ends(cuts: &[f64], tau_pt: &[f64], e_pt: &[f64], c: usize) -> CellExact {
     let mut tau = 0.0f64;
+    let mut tau_min = f64::INFINITY;
     let mut e = (0.0f64, cut_of(cuts, c));
     for k in [c, c + 1] {
         tau = tau.max(tau_pt[k]);
+        tau_min = tau_min.min(tau_pt[k]);
         if e_pt[k] > e.0 {
             e = (e_pt[k], cut_of(cuts, k));
         }
     }
     CellExact {
         tau_s: tau,
+        tau_min_s: tau_min,
         e,
         e_env: e.0,
         single: 0.0,
@@ -1698,10 +1813,17 @@ impl Best {
     }
 }
 
+/// Relative slack (of a turn's time) by which a walk's reach is widened, so
+/// the float inversions of the head's motion stay above the exact reach.
+const REACH_SLACK: f64 = 1e-9;
+
 /// Rule 2 for windows shorter than one revolution (see [`Walks::search`]).
 struct Walks<'a> {
     env: &'a Envelope,
+    tl: &'a Timeline<'a, Seg>,
     laser: &'a Laser,
+    /// The pass angle `2h`, deg.
+    two_h_deg: f64,
     /// The largest pass energy `E⁺`, J.
     e_pass: f64,
     /// Longest window a walk follows: a pass plus one pulse spacing, s.
@@ -1709,116 +1831,155 @@ struct Walks<'a> {
 }
 
 impl Walks<'_> {
-    /// The supremum of `min(E⁺, ∫ P̄ over L)/AEL(T)`, `T = L − Δ`, over
-    /// windows shorter than a turn: window starts at envelope up-steps and
-    /// window ends at down-steps (where the best placement of a
-    /// fixed-length window lies; one walk from the first breakpoint covers a
-    /// constant envelope), walking breakpoint to breakpoint up to `l_max`.
-    /// Windows of `l_max` or more hold at most `E⁺`.
+    /// The supremum of `min(E⁺, ∫ P̄ over J)/AEL(T)` over the windows that
+    /// fit in one pass, after `best` (the whole-pass windows,
+    /// [`Cells::full_pass`]).
+    ///
+    /// A window `W` of duration `T` meets the pass `I_φ = [a, a + τ(φ)]` of
+    /// aperture `φ` in pulses whose envelope cells lie in
+    /// `J = (W ⊕ [0, Δ]) ∩ (I_φ ⊕ [0, Δ]) = [u, u + ℓ]`, `ℓ ≤ T + Δ`; the
+    /// head is at `θ(u) ≥ φ − h` at `u`, so the pass ends by
+    /// `t(θ(u) + 2h)` and `ℓ ≤ R(u) = t(θ(u) + 2h) + Δ − u`. The ratio is at
+    /// most `g(u, ℓ) = min(E⁺, ∫_J P̄)/AEL(ℓ − Δ)` over `0 < ℓ ≤ R(u)`. For a
+    /// fixed `ℓ`, `∫_J P̄` is piecewise linear in `u` and its maxima over
+    /// each interval of feasible `u` lie where `u` is an up-step of `P̄` or
+    /// `u + ℓ` a down-step (the walks: forward from up-steps up to `R(u)`,
+    /// backward from down-steps `b` up to `b − t(θ(b − Δ) − 2h)`, the same
+    /// condition), or at the interval's ends, where `ℓ = R(u)`: `J` is then
+    /// the whole pass of `θ(u) + h` (the `best` given).
     ///
     /// Pruned: a walk's windows hold at most `min(E⁺, p·L)` with `p` the
-    /// highest `P̄` it can reach within `l_max`, so its ratio is at most
-    /// `G(p) = sup_T min(E⁺, p·(T + Δ))/AEL(T)`, nondecreasing in `p`; walks
-    /// are followed in decreasing `p` until `G(p)` falls below the best.
-    fn search(&self, search: Search) -> (f64, f64) {
-        let env = self.env;
+    /// highest `P̄` it can reach, so its ratio is at most
+    /// `G(p) = sup_T min(E⁺, p·(T + Δ))/AEL(T)` (over `T` up to `l_max`),
+    /// nondecreasing in `p`; walks are followed in decreasing `p` until
+    /// `G(p)` falls below the best.
+    fn search(&self, search: Search, mut best: Best) -> (f64, f64) {
         let laser = self.laser;
         let delta = 1.0 / laser.pulse_rate_hz;
-        let t_end = (env.frame_s - delta).max(0.0);
         let t_walk = self.l_max - delta;
-        let mut best = Best(0.0, 0.0);
-        // Windows of at least `l_max` (and shorter than a turn).
-        let t0 = t_walk.max(0.0);
-        best.take(laser.linear_capped_max(t0, t_end.max(t0), self.e_pass, 0.0, self.e_pass));
         if t_walk <= 0.0 {
             return (best.0, best.1);
         }
         let walks = self.walks();
         match search {
             Search::Exhaustive => {
-                for &(i, dir, p_span) in &walks {
-                    self.walk(i, dir, p_span, &mut best);
+                for &w in &walks {
+                    self.walk(w, &mut best);
                 }
             }
             Search::Pruned => {
                 let mut order: Vec<usize> = (0..walks.len()).collect();
-                order.sort_unstable_by(|&a, &b| walks[b].2.total_cmp(&walks[a].2).then(a.cmp(&b)));
+                order.sort_unstable_by(|&a, &b| {
+                    walks[b].p_span.total_cmp(&walks[a].p_span).then(a.cmp(&b))
+                });
                 let mut g = (f64::NAN, 0.0);
                 for k in order {
-                    let (i, dir, p_span) = walks[k];
-                    if g.0 != p_span {
+                    let w = walks[k];
+                    if g.0 != w.p_span {
                         let (r, _) = laser.linear_capped_max(
                             0.0,
                             t_walk,
-                            p_span * delta,
-                            p_span,
+                            w.p_span * delta,
+                            w.p_span,
                             self.e_pass,
                         );
-                        g = (p_span, r * (1.0 + PRUNE_SLACK));
+                        g = (w.p_span, r * (1.0 + PRUNE_SLACK));
                     }
                     if g.1 < best.0 {
                         break;
                     }
-                    self.walk(i, dir, p_span, &mut best);
+                    self.walk(w, &mut best);
                 }
             }
         }
         (best.0, best.1)
     }
 
-    /// Every walk: (start piece, direction, highest `P̄` within `l_max` of
-    /// its start in its direction). Walks start only at steps of `P̄`, so
-    /// the reach of the others is not computed (the window maxima take
-    /// queries whose ends never decrease; skipped ones change nothing).
-    fn walks(&self) -> Vec<(i64, i64, f64)> {
+    /// Every walk: its start piece, direction, reach (the longest `ℓ` it
+    /// follows, widened by [`REACH_SLACK`]) and the highest `P̄` within it.
+    /// Walks start only at steps of `P̄` (and at the first piece, so a
+    /// constant envelope has one). The reaches' far ends are made monotone
+    /// in the walk order (widened: a running maximum forward, a running
+    /// minimum from the end backward) for the sliding maxima.
+    fn walks(&self) -> Vec<WalkSpec> {
         let env = self.env;
+        let tl = self.tl;
+        let delta = 1.0 / self.laser.pulse_rate_hz;
+        let slack = REACH_SLACK * env.frame_s;
         let m = env.pieces() as i64;
-        let mut out = Vec::new();
-        let (mut fwd, mut back) = (SlidingMax::new(), SlidingMax::new());
-        let (mut h_fwd, mut h_back) = (0usize, 0usize);
+        // (start piece, far end of the reach) of each forward and backward walk.
+        let mut fwd_ends: Vec<(i64, f64)> = Vec::new();
+        let mut back_starts: Vec<(i64, f64)> = Vec::new();
+        let (mut ha, mut hb, mut hc, mut hd) = (0usize, 0usize, 0usize, 0usize);
         let mut p_prev = env.p_of(-1);
         for i in 0..m {
             let p_i = env.p_w[i as usize];
             let up = p_i > p_prev;
             let down = p_i < p_prev;
             p_prev = p_i;
-            if !(up || down || i == 0) {
-                continue;
-            }
             let b0 = env.bp(i);
-            // Pieces i.. up to the one holding b0 + l_max; pieces ..i−1 down
-            // to the one holding b0 − l_max.
             if up || i == 0 {
-                let j_fwd = env.unwrapped_piece(b0 + self.l_max, &mut h_fwd).max(i);
-                out.push((i, 1, fwd.max_over(i, j_fwd, |k| env.p_of(k))));
+                let theta = tl.azimuth_at_unwrapped_from_deg(b0, &mut ha);
+                let end =
+                    tl.time_at_unwrapped_from_s(theta + self.two_h_deg, &mut hb) + delta + slack;
+                let end = end.min(b0 + self.l_max);
+                let end = fwd_ends.last().map_or(end, |&(_, e)| end.max(e));
+                fwd_ends.push((i, end));
             }
             if down {
-                let j_back = env.unwrapped_piece(b0 - self.l_max, &mut h_back).min(i - 1);
-                out.push((i, -1, back.max_over(j_back, i - 1, |k| env.p_of(k))));
+                let theta = tl.azimuth_at_unwrapped_from_deg(b0 - delta, &mut hc);
+                let start = tl.time_at_unwrapped_from_s(theta - self.two_h_deg, &mut hd) - slack;
+                back_starts.push((i, start.max(b0 - self.l_max)));
             }
+        }
+        for k in (0..back_starts.len().saturating_sub(1)).rev() {
+            back_starts[k].1 = back_starts[k].1.min(back_starts[k + 1].1);
+        }
+        let mut out = Vec::with_capacity(fwd_ends.len() + back_starts.len());
+        let (mut fwd, mut back) = (SlidingMax::new(), SlidingMax::new());
+        let (mut h_fwd, mut h_back) = (0usize, 0usize);
+        for &(i, end) in &fwd_ends {
+            let b0 = env.bp(i);
+            let j = env.unwrapped_piece(end, &mut h_fwd).max(i);
+            out.push(WalkSpec {
+                start: i,
+                dir: 1,
+                reach_s: end - b0,
+                p_span: fwd.max_over(i, j, |k| env.p_of(k)),
+            });
+        }
+        for &(i, start) in &back_starts {
+            let b0 = env.bp(i);
+            let j = env.unwrapped_piece(start, &mut h_back).min(i - 1);
+            out.push(WalkSpec {
+                start: i,
+                dir: -1,
+                reach_s: b0 - start,
+                p_span: back.max_over(j, i - 1, |k| env.p_of(k)),
+            });
         }
         out
     }
 
-    /// One walk from breakpoint `i` in direction `dir`: the window energy is
-    /// linear in `L` between breakpoints; after `WALK_MAX_PIECES` pieces it
-    /// is bounded by the slope `p_span` (the highest `P̄` the walk can reach).
-    fn walk(&self, i: i64, dir: i64, p_span: f64, best: &mut Best) {
+    /// One walk: the window energy is linear in `L` between breakpoints, up
+    /// to the walk's reach; after `WALK_MAX_PIECES` pieces it is bounded by
+    /// the slope `p_span` (the highest `P̄` within the reach).
+    fn walk(&self, w: WalkSpec, best: &mut Best) {
         let env = self.env;
         let laser = self.laser;
         let delta = 1.0 / laser.pulse_rate_hz;
         let e_pass = self.e_pass;
-        let l_max = self.l_max;
-        let t_walk = l_max - delta;
-        let b0 = env.bp(i);
-        let (mut e, mut l, mut idx) = (0.0f64, 0.0f64, i);
+        let reach = w.reach_s;
+        let t_reach = reach - delta;
+        let b0 = env.bp(w.start);
+        let (mut e, mut l, mut idx) = (0.0f64, 0.0f64, w.start);
         for _ in 0..WALK_MAX_PIECES {
-            let (next_idx, piece_p) = if dir > 0 {
+            let (next_idx, piece_p) = if w.dir > 0 {
                 (idx + 1, env.p_of(idx))
             } else {
                 (idx - 1, env.p_of(idx - 1))
             };
-            let seg_end = (env.bp(next_idx) - b0).abs().min(l_max);
+            let seg_end = (env.bp(next_idx) - b0).abs().min(reach);
             if seg_end > delta {
                 let l0 = l.max(delta);
                 let e0 = e + piece_p * (l0 - l);
@@ -1832,23 +1993,40 @@ impl Walks<'_> {
             }
             e += piece_p * (seg_end - l);
             l = seg_end;
-            if e >= e_pass || l >= l_max {
-                // From here on the window holds at most E⁺.
-                let t_c = if e >= e_pass && piece_p > 0.0 {
+            if e >= e_pass {
+                // From here on the window holds at most E⁺: the ratio is
+                // largest where it gets there.
+                let t_c = if piece_p > 0.0 {
                     (l - (e - e_pass) / piece_p - delta).max(0.0)
                 } else {
                     (l - delta).max(0.0)
                 };
-                best.take(laser.linear_capped_max(t_c, t_walk.max(t_c), e_pass, 0.0, e_pass));
+                best.take(laser.linear_capped_max(t_c, t_reach.max(t_c), e_pass, 0.0, e_pass));
+                return;
+            }
+            if l >= reach {
                 return;
             }
             idx = next_idx;
         }
         // Truncated: longer windows gain at most `p_span` per second.
         let l0 = l.max(delta);
-        let e0 = e + p_span * (l0 - l);
-        best.take(laser.linear_capped_max(l0 - delta, t_walk, e0, p_span, e_pass));
+        let e0 = e + w.p_span * (l0 - l);
+        best.take(laser.linear_capped_max(l0 - delta, t_reach, e0, w.p_span, e_pass));
     }
+}
+
+/// One window walk of [`Walks`].
+#[derive(Debug, Clone, Copy)]
+struct WalkSpec {
+    /// Envelope breakpoint it starts at (unwrapped piece index).
+    start: i64,
+    /// +1 forward (window starts there), −1 backward (window ends there).
+    dir: i64,
+    /// The longest window span `L` it follows, s.
+    reach_s: f64,
+    /// Highest `P̄` within the reach, W.
+    p_span: f64,
 }
 
 #[cfg(test)]
@@ -1974,6 +2152,7 @@ mod tests {
                     e_ub: f64::from(u) - 1.0,
                     env_ub: f64::from(u) - 1.0,
                     single_ub: f64::from(u) - 1.0,
+                    tau_lb: 0.0,
                 })
                 .collect();
             let exact = |c: usize| {
@@ -2000,6 +2179,7 @@ mod tests {
                 e_ub: u,
                 env_ub: u,
                 single_ub: u,
+                tau_lb: 0.0,
             })
             .collect();
         let ub: Vec<f64> = rows.iter().map(|r| r.tau_ub).collect();
