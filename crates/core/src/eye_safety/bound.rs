@@ -256,6 +256,18 @@ impl Laser {
             .filter(move |&t| t > lo && t < hi)
     }
 
+    /// The smallest AEL over `[lo_s, hi_s]`: the AEL grows within each row
+    /// of Table 3 but may fall at a row edge (905 nm at 5 µs, where
+    /// [`Self::ael_j`] takes the smaller row), so the ends and the edges
+    /// between are every candidate.
+    fn min_ael_over(&self, lo_s: f64, hi_s: f64) -> f64 {
+        let mut a = self.ael_j(lo_s).min(self.ael_j(hi_s));
+        for t in self.edges_within(lo_s, hi_s) {
+            a = a.min(self.ael_j(t));
+        }
+        a
+    }
+
     /// `sup τ/AEL(τ)` over `0 < τ ≤ tau_hi_s`: on every row of Table 3 the
     /// AEL is `c·τ^p` with `0 ≤ p ≤ 1`, so `τ/AEL(τ)` is nondecreasing
     /// within a row (and below the clamp at the pulse duration, where the
@@ -971,7 +983,6 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
     // Rule 2 within one revolution: the whole-pass windows, then window
     // walks over envelope breakpoints within one pass.
     let l_max = (best.tau_max + delta).min(frame_s);
-    let full = cells.full_pass_max(search, best.e_max.0, best.tau_max);
     let walks = Walks {
         env: &env,
         tl: &tl,
@@ -980,7 +991,13 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
         e_pass: best.e_max.0,
         l_max,
     };
-    let (pass_ratio, pass_window) = walks.search(search, full);
+    // Windows of a whole pass or more hold at most `E⁺` (not above the
+    // whole-pass bound below, a cheap first threshold for the pruning).
+    let t0 = best.tau_max;
+    let first = Best(best.e_max.0 / laser.ael_j(t0), t0);
+    let within = walks.search(search, first);
+    let Best(pass_ratio, pass_window) =
+        cells.full_pass_max(search, best.e_max.0, best.tau_max, within);
     // Rule 2 over several passes, up to the time base.
     let pass = PassFigures {
         envelope_j: best.e_env_max,
@@ -1444,15 +1461,17 @@ impl<'a> Cells<'a> {
     /// `e₁τ − p·t₁·E`, affine in `x` with slope `(1 − p)·e₁·t₁`: positive
     /// throughout when `e₁·t₁ < 0` (or its mirror), and crossing zero at
     /// most once upwards otherwise, so the ratio is largest at the cell ends
-    /// or where `τ` meets a row edge; capped at `E⁺`, also where `E`
-    /// reaches `E⁺` (on each side of it the capped ratio is one of the two
-    /// forms above). On a curved cell: the largest `E` (capped) over the
-    /// smallest `τ` (both exact, see [`Self::exact`]).
+    /// or where `τ` meets a row edge (with the smaller row there); capped at
+    /// `E⁺`, also where `E` reaches `E⁺` (on each side of it the capped
+    /// ratio is one of the two forms above). On a curved cell: the largest
+    /// `E` (capped) over the smallest AEL between its smallest and largest
+    /// `τ` (all exact, see [`Self::exact`]; the AEL may fall at a row
+    /// edge).
     fn full_pass(&self, c: usize, e_cap: f64) -> (f64, f64) {
         let laser = self.laser;
         if self.rows[c].curved {
             let x = self.exact(c);
-            let r = x.e_env.min(e_cap) / laser.ael_j(x.tau_min_s);
+            let r = x.e_env.min(e_cap) / laser.min_ael_over(x.tau_min_s, x.tau_s);
             return (r, x.tau_min_s);
         }
         let (tu, tv) = (self.tau_pt[c], self.tau_pt[c + 1]);
@@ -1471,24 +1490,27 @@ impl<'a> Cells<'a> {
         for t in laser.edges_within(lo, hi) {
             let w = ((t - tu) / dt).clamp(0.0, 1.0);
             let spread = (t_err / (hi - lo)).min(1.0);
-            take(eu + de * w + de.abs() * spread + e_err, t);
+            let e = eu + de * w + de.abs() * spread + e_err;
+            // (Affine: never above the larger end.)
+            take(e.min(eu.max(ev)), t);
         }
         // Where `E` reaches `E⁺` (the cap's kink): `E⁺` over the `τ` there.
         if eu.min(ev) < e_cap && e_cap < eu.max(ev) {
             let w = ((e_cap - eu) / de).clamp(0.0, 1.0);
             let spread = (e_err / de.abs()).min(1.0);
-            let t = (tu + dt * w - dt.abs() * spread - t_err).max(0.0);
-            take(e_cap, t);
+            let t = tu + dt * w - dt.abs() * spread - t_err;
+            // (Affine: never below the smaller end.)
+            take(e_cap, t.max(lo));
         }
         (best.0, best.1)
     }
 
-    /// The largest [`Self::full_pass`] over the cells. Pruned: a cell is
+    /// The largest [`Self::full_pass`] over the cells and `best`. Pruned: a cell is
     /// evaluated only if `min(E_ub, E⁺)/τ_lb · K` ([`Laser::mean_power_factor`]
-    /// up to the longest pass), then `min(E_ub, E⁺)/AEL(τ_lb)`, both upper
-    /// bounds of its value, can reach the best so far.
-    fn full_pass_max(&self, search: Search, e_cap: f64, tau_max: f64) -> Best {
-        let mut best = Best(0.0, 0.0);
+    /// up to the longest pass), then `min(E_ub, E⁺)` over the smallest AEL
+    /// between `τ_lb` and `τ_ub`, both upper bounds of its value, can reach
+    /// the best so far.
+    fn full_pass_max(&self, search: Search, e_cap: f64, tau_max: f64, mut best: Best) -> Best {
         match search {
             Search::Exhaustive => {
                 for c in 0..self.len() {
@@ -1505,7 +1527,8 @@ impl<'a> Cells<'a> {
                     if row.tau_lb > 0.0 && e / row.tau_lb * k < best.0 {
                         continue;
                     }
-                    if e / laser.ael_j(row.tau_lb) * (1.0 + PRUNE_SLACK) < best.0 {
+                    let ael = laser.min_ael_over(row.tau_lb, row.tau_ub);
+                    if e / ael * (1.0 + PRUNE_SLACK) < best.0 {
                         continue;
                     }
                     best.take(self.full_pass(c, e_cap));
@@ -1853,12 +1876,12 @@ impl Walks<'_> {
     /// `G(p) = sup_T min(E⁺, p·(T + Δ))/AEL(T)` (over `T` up to `l_max`),
     /// nondecreasing in `p`; walks are followed in decreasing `p` until
     /// `G(p)` falls below the best.
-    fn search(&self, search: Search, mut best: Best) -> (f64, f64) {
+    fn search(&self, search: Search, mut best: Best) -> Best {
         let laser = self.laser;
         let delta = 1.0 / laser.pulse_rate_hz;
         let t_walk = self.l_max - delta;
         if t_walk <= 0.0 {
-            return (best.0, best.1);
+            return best;
         }
         let walks = self.walks();
         match search {
@@ -1892,7 +1915,7 @@ impl Walks<'_> {
                 }
             }
         }
-        (best.0, best.1)
+        best
     }
 
     /// Every walk: its start piece, direction, reach (the longest `ℓ` it
