@@ -35,19 +35,18 @@ use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 use std::time::Instant;
 
-/// The reference's view of a profile (read through the public fields only).
 /// How far above the reference the checker may be on phase-locked step
-/// profiles at ≥ 20 kHz. The goal is 1.05, not met. Measured: default seed,
-/// 1000 cases: 239 of 250 such profiles within 1.03, the loosest 1.112;
-/// seeds 101 and 202, 10,000 cases: the loosest 1.154. The loose ones are a
-/// single slow pass, where the within-pass window walks take the hottest
-/// window of the emitted envelope up to the longest pass of any aperture
-/// (a slow dark sector makes that long). It was 1.31 before passes were
-/// capped per bin (`pulse_capped_j`). Tighten this as the bound tightens.
-/// Asserted on the default case stream only (a regression guard); long runs
-/// on other seeds report it: seed 606, 10,000 cases, saw 1.413 (1450 nm,
-/// 9 bins, a dark sector; the checker's within-pass bound against the
-/// reference's multi-pass window), see `specs/eye_safety.md`.
+/// profiles at ≥ 20 kHz (the goal is "a few per cent"). Measured on the
+/// default stream (500 cases): 74 such profiles, 72 within 1.05, the
+/// loosest 1.058; long runs (5,000 cases per seed) report theirs, e.g.
+/// seed 606: 649 profiles, 646 within 1.05, the loosest 1.067. The loose
+/// ones now bind on the multi-pass rules (T2Train), which combine the
+/// largest pass energy and the longest pass of different apertures.
+/// History: 1.31 before passes were capped per bin (`pulse_capped_j`); then
+/// 1.112 on the default stream and 1.413 on seed 606 (case 2084, now
+/// `hot_fast_bin_before_a_slow_dark_sector_is_tight`) before the
+/// within-pass walks were limited to one pass. Asserted on the default case
+/// stream only (a regression guard); see `specs/eye_safety.md`.
 const TIGHT_FACTOR: f64 = 1.06;
 
 /// The case stream `cargo test` runs.
