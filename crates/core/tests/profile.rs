@@ -253,6 +253,11 @@ fn timeline_unwrapped_time_and_azimuth_by_hand() {
         assert_near!(tl.azimuth_at_unwrapped_deg(t), az);
         assert_near!(tl.azimuth_at_unwrapped_from_deg(t, &mut hint_t), az);
     }
+    // Just before 0°: the turn is −1 and the time within it rounds to the
+    // period itself (−1e-20 + 5 = 5 in f64), which must stay in the last bin.
+    assert_near!(tl.azimuth_at_unwrapped_deg(-1e-20), 0.0);
+    assert_near!(tl.azimuth_at_unwrapped_from_deg(-1e-20, &mut 0), 0.0);
+    assert_near!(tl.time_at_unwrapped_s(-1e-20), 0.0);
     // Hints left on the last bin still find earlier bins.
     let (mut h, mut ht) = (3, 3);
     assert_near!(tl.time_at_unwrapped_from_s(45.0, &mut h), 0.5);
