@@ -220,3 +220,59 @@ fn pass_energy_is_capped_per_bin() {
         two_pulses
     );
 }
+
+/// `EyeSafetyParams::validate` (found by `cargo mutants` on `eye_safety/mod.rs`):
+/// the band of each wavelength, and the beam diameter's open range `(0, 1000)` mm
+/// at both edges, negative, NaN and infinite.
+#[test]
+fn eye_safety_params_are_validated_at_their_edges() {
+    use gaze_lidar_core::eye_safety::ael::Band;
+    use gaze_lidar_core::eye_safety::EyeSafetyError;
+    let with = |wavelength_nm: f64, beam_diameter_mm: f64| EyeSafetyParams {
+        wavelength_nm,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm,
+    };
+    // Bands by Table 3's wavelength ranges.
+    assert_eq!(with(905.0, 8.0).validate(), Ok(Band::RetinalNir));
+    assert_eq!(with(1450.0, 8.0).validate(), Ok(Band::Ir1400));
+    assert_eq!(with(1550.0, 8.0).validate(), Ok(Band::Ir1500));
+    assert!(matches!(
+        with(1200.0, 8.0).validate(),
+        Err(EyeSafetyError::Ael(_))
+    ));
+    // Beam diameter: inside the open range is accepted, right up to its edges.
+    for ok in [1e-9, 0.5, 999.999] {
+        assert_eq!(with(905.0, ok).validate(), Ok(Band::RetinalNir), "{ok}");
+    }
+    for bad in [
+        0.0,
+        -0.0,
+        -1.0,
+        -1e6,
+        1000.0,
+        1e6,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ] {
+        match with(905.0, bad).validate() {
+            Err(EyeSafetyError::Param { field, value, .. }) => {
+                assert_eq!(field, "beam_diameter_mm", "{bad}");
+                assert!(value.to_bits() == bad.to_bits(), "{bad}");
+            }
+            other => panic!("beam_diameter_mm = {bad}: {other:?}"),
+        }
+    }
+    // A pulse duration outside Table 3 is named as such.
+    for bad in [0.0, -5e-9, f64::NAN, 3.1e4] {
+        let p = EyeSafetyParams {
+            pulse_duration_s: bad,
+            ..with(905.0, 8.0)
+        };
+        match p.validate() {
+            Err(EyeSafetyError::Param { field, .. }) => assert_eq!(field, "pulse_duration_s"),
+            other => panic!("pulse_duration_s = {bad}: {other:?}"),
+        }
+    }
+}
