@@ -78,6 +78,9 @@ struct Spec {
     beam_mm: f64,
     pulse_log: f64,
     scale: f64,
+    /// Bins come in runs of this many with one power and one spin (runs of
+    /// constant spin for `accel`), which the bound merges: 1 for none.
+    run: usize,
 }
 
 fn spec_strategy() -> impl Strategy<Value = Spec> {
@@ -104,13 +107,14 @@ fn spec_strategy() -> impl Strategy<Value = Spec> {
             1.0f64..10.0,
             (1e-9f64).ln()..(1e-7f64).ln(),
             0.5f64..1.5,
+            prop_oneof![2 => Just(1usize), 1 => 2usize..16],
         ),
     )
         .prop_map(
             |(
                 (band, accel, n_bins, frame_hz, fp_log, locked, uniform_widths),
                 (hot, dark, v_dips),
-                (u_w, u_p, u_s, beam_mm, pulse_log, scale),
+                (u_w, u_p, u_s, beam_mm, pulse_log, scale, run),
             )| Spec {
                 band,
                 accel,
@@ -128,6 +132,7 @@ fn spec_strategy() -> impl Strategy<Value = Spec> {
                 beam_mm,
                 pulse_log,
                 scale,
+                run,
             },
         )
 }
@@ -206,6 +211,8 @@ fn build(spec: &Spec) -> Profile {
             }
         })
         .collect();
+    // The first bin of `i`'s run (the runs share their draws).
+    let head = |i: usize| i / spec.run.max(1) * spec.run.max(1);
     let in_dark = |i: usize| {
         spec.dark
             .is_some_and(|(d0, len, _, _)| (i + n - d0 % n) % n < len.min(n / 2))
@@ -213,7 +220,9 @@ fn build(spec: &Spec) -> Profile {
     // Spin.
     let base = TAU * spec.frame_hz;
     let mut spins: Vec<(f64, f64)> = if spec.accel {
-        let mut edge: Vec<f64> = (0..n).map(|i| base * (0.6 + 0.8 * spec.u_s[i])).collect();
+        let mut edge: Vec<f64> = (0..n)
+            .map(|i| base * (0.6 + 0.8 * spec.u_s[head(i)]))
+            .collect();
         for i in 0..n {
             if in_dark(i) {
                 edge[i] *= spec.dark.unwrap().2;
@@ -226,7 +235,7 @@ fn build(spec: &Spec) -> Profile {
     } else {
         (0..n)
             .map(|i| {
-                let mut x = base * (0.5 + spec.u_s[i]);
+                let mut x = base * (0.5 + spec.u_s[head(i)]);
                 if in_dark(i) {
                     x *= spec.dark.unwrap().2;
                 }
@@ -246,7 +255,7 @@ fn build(spec: &Spec) -> Profile {
     // Power (scaled later so that the reference ratio is `spec.scale`).
     let powers: Vec<f64> = (0..n)
         .map(|i| {
-            let mut p = 1e-3 * (0.3 + 0.7 * spec.u_p[i]);
+            let mut p = 1e-3 * (0.3 + 0.7 * spec.u_p[head(i)]);
             if in_dark(i) {
                 p *= spec.dark.unwrap().3.max(1e-3);
             }
@@ -442,8 +451,9 @@ fn one_case(case: usize, spec: &Spec, phases: usize, keep_json: bool) -> Outcome
         r_raw.rule
     );
     let label = format!(
-        "case {case}: {class}, {} bins, f={:.2} Hz, fp={:.0} Hz, hot={:?}, dark={}, checker {:.6} ({:?}) vs reference {}",
+        "case {case}: {class}, {} bins (runs of {}), f={:.2} Hz, fp={:.0} Hz, hot={:?}, dark={}, checker {:.6} ({:?}) vs reference {}",
         p.bins.len(),
+        spec.run,
         spec.frame_hz,
         p.pulse_rate_hz,
         spec.hot.map(|h| h.2),

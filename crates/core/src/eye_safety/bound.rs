@@ -648,6 +648,40 @@ impl BinMotion for Seg {
     }
 }
 
+/// Whether `b` continues `a` as the same emission: equal power and one
+/// constant spin across both (no acceleration in either).
+fn same_run(a: &Seg, b: &Seg) -> bool {
+    a.power_w == b.power_w
+        && a.spin_start_rad_s == a.spin_end_rad_s
+        && b.spin_start_rad_s == b.spin_end_rad_s
+        && a.spin_start_rad_s == b.spin_start_rad_s
+}
+
+/// `segs` with every run of consecutive bins of one power and one constant
+/// spin merged into one bin (not across 0°). The head's motion and the
+/// emitted power are the same functions of time, so every quantity the
+/// bound bounds (pass durations, pulse counts, envelope integrals) is the
+/// same; only edges where nothing changes are dropped, and with them the
+/// cells, walks and per-bin pulse caps they would cost (a pulse cap over a
+/// merged bin is at most the sum of its parts' caps). The merged width is
+/// the sum of the parts' (the times differ from the parts' sum by float
+/// rounding only, far inside [`RATIO_MARGIN`]). Borrowed when nothing
+/// merges. Piecewise-constant profiles (the closed forms: three runs in
+/// 360 bins) cost their runs, not their bins.
+fn coalesce(segs: &[Seg]) -> std::borrow::Cow<'_, [Seg]> {
+    if !segs.windows(2).any(|w| same_run(&w[0], &w[1])) {
+        return std::borrow::Cow::Borrowed(segs);
+    }
+    let mut out: Vec<Seg> = Vec::with_capacity(segs.len());
+    for s in segs {
+        match out.last_mut() {
+            Some(last) if same_run(last, s) => last.width_deg += s.width_deg,
+            _ => out.push(*s),
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
 /// `ω²` at `x_deg` into `seg` as `a + b·x_deg` (linear: constant acceleration).
 fn spin_sq_line(seg: &Seg) -> (f64, f64) {
     (
@@ -983,6 +1017,8 @@ pub fn evaluate(segs: &[Seg], half_deg: f64, laser: &Laser) -> Bound {
 #[doc(hidden)]
 #[must_use]
 pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search) -> Bound {
+    let runs = coalesce(segs);
+    let segs: &[Seg] = &runs;
     let tl = Timeline::from_bins(segs);
     let delta = 1.0 / laser.pulse_rate_hz;
     let frame_s = tl.period_s();
@@ -1084,6 +1120,9 @@ fn wrap360(a: f64) -> f64 {
 /// Most bins a cell's union arc may touch for the per-bin pulse cap of a
 /// pass to be evaluated (beyond, the cap `K·P_max·Δ` is used).
 pub const PULSE_CAP_MAX_BINS: i64 = 64;
+
+/// Sub-cells per cell for the per-bin pulse caps (`Cells::pulse_capped_split`).
+const PULSE_CAP_SPLIT: usize = 8;
 
 /// Snap (deg) by which the arc a cell's pulses can come from is widened, so
 /// bins touched at an edge count.
@@ -1397,7 +1436,7 @@ impl<'a> Cells<'a> {
         // what the exhaustive one finds.
         let coarse = per_pass * p * self.delta;
         let cap = self
-            .pulse_capped_j(c, per_pass)
+            .pulse_capped_split(c, u, v, per_pass)
             .map_or(coarse, |e| e.min(coarse));
         CellExact {
             tau_s: cell_tau,
@@ -1418,11 +1457,10 @@ impl<'a> Cells<'a> {
     /// `per_pass · P_max · Δ` where a narrow hot bin holds fewer pulses than
     /// the pass. `None` when the arc touches more than
     /// [`PULSE_CAP_MAX_BINS`] bins (the caller keeps the coarser cap).
-    fn pulse_capped_j(&self, c: usize, per_pass: f64) -> Option<f64> {
+    fn pulse_capped_j(&self, u: f64, v: f64, per_pass: f64) -> Option<f64> {
         let tl = self.tl;
         let segs = tl.bins();
         let n = segs.len() as i64;
-        let (u, v) = (self.cut(c), self.cut(c + 1));
         let (lo_deg, hi_deg) = (u - self.h - TOUCH_SNAP_DEG, v + self.h + TOUCH_SNAP_DEG);
         let mut hint = 0;
         let lo = unwrapped_bin(tl, lo_deg, &mut hint);
@@ -1460,6 +1498,41 @@ impl<'a> Cells<'a> {
             left -= k;
         }
         Some(e)
+    }
+
+    /// [`Self::pulse_capped_j`] over cell `c` = `[u, v]` taken as the
+    /// largest over [`PULSE_CAP_SPLIT`] equal sub-cells, each with its own
+    /// union arc and pulse count (the counts of a sub-cell are at most the
+    /// cell's `per_pass`). Every azimuth of the cell lies in a sub-cell, so
+    /// the largest is an upper bound over the cell; it is tighter because
+    /// one union arc lets the pulses of one end of the cell sit in the
+    /// bins of the other (a hot bin's neighbours: one slow, one fast). Off
+    /// the curved cells `τ` is affine, so a sub-cell's count is the larger
+    /// of its ends'; on a curved cell every sub-cell keeps `per_pass`.
+    fn pulse_capped_split(&self, c: usize, u: f64, v: f64, per_pass: f64) -> Option<f64> {
+        let f_p = self.laser.pulse_rate_hz;
+        let curved = self.rows[c].curved;
+        let tau_at = |phi: f64| self.time_at(phi + self.h) - self.time_at(phi - self.h);
+        let k = PULSE_CAP_SPLIT as f64;
+        let mut best: Option<f64> = None;
+        let (mut a, mut tau_a) = (u, self.tau_pt[c]);
+        for i in 1..=PULSE_CAP_SPLIT {
+            let (b, tau_b) = if i == PULSE_CAP_SPLIT {
+                (v, self.tau_pt[c + 1])
+            } else {
+                let b = u + (v - u) * (i as f64 / k);
+                (b, tau_at(b))
+            };
+            let n = if curved {
+                per_pass
+            } else {
+                max_pulses_in(tau_a.max(tau_b), f_p).min(per_pass)
+            };
+            let e = self.pulse_capped_j(a, b, n)?;
+            best = Some(best.map_or(e, |x: f64| x.max(e)));
+            (a, tau_a) = (b, tau_b);
+        }
+        best
     }
 
     /// Rule 2 over the windows that hold one whole pass (the boundary of
