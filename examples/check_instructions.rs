@@ -7,6 +7,7 @@
 //! valgrind --tool=callgrind target/release/examples/check_instructions 3
 //! valgrind --tool=callgrind target/release/examples/check_instructions 33
 //! # instructions per check = (second total − first total) / 30
+//! # the same with `3 distinct` and `33 distinct`: no two bins alike
 //! ```
 use gaze_lidar::checker::check;
 use gaze_lidar::model::presets;
@@ -14,9 +15,21 @@ use gaze_lidar::planner::closed_form::build_profile;
 use gaze_lidar::planner::Mode;
 fn main() {
     let preset = presets::paper();
+    // `distinct` (second argument): every bin's power lowered by a
+    // different tiny fraction, so that no two neighbours are alike and
+    // nothing merges (as `benches/gaze.rs`).
+    let distinct = std::env::args().nth(2).is_some_and(|s| s == "distinct");
     let ps: Vec<_> = [90.0, 130.0, 170.0]
         .iter()
-        .map(|&g| build_profile(&preset, Mode::Joint, Some(g), 360).unwrap())
+        .map(|&g| {
+            let mut p = build_profile(&preset, Mode::Joint, Some(g), 360).unwrap();
+            if distinct {
+                for (i, b) in p.bins.iter_mut().enumerate() {
+                    b.power_w *= 1.0 - 1e-6 * (i + 1) as f64;
+                }
+            }
+            p
+        })
         .collect();
     let n: usize = std::env::args().nth(1).map_or(300, |s| s.parse().unwrap());
     let mut k = 0;

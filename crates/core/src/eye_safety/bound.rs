@@ -1436,7 +1436,7 @@ impl<'a> Cells<'a> {
         // what the exhaustive one finds.
         let coarse = per_pass * p * self.delta;
         let cap = self
-            .pulse_capped_split(c, u, v, per_pass)
+            .pulse_capped_j(u, v, per_pass)
             .map_or(coarse, |e| e.min(coarse));
         CellExact {
             tau_s: cell_tau,
@@ -1533,6 +1533,16 @@ impl<'a> Cells<'a> {
             (a, tau_a) = (b, tau_b);
         }
         best
+    }
+
+    /// Cell `c`'s pass energy `x.e.0` (of [`Self::exact`]) capped further by
+    /// [`Self::pulse_capped_split`]: never above `x.e.0`, so `x.e.0` bounds
+    /// it in the branch and bound.
+    fn e_refined(&self, c: usize, x: &CellExact) -> f64 {
+        let per_pass = max_pulses_in(x.tau_s, self.laser.pulse_rate_hz);
+        let (u, v) = (self.cut(c), self.cut(c + 1));
+        self.pulse_capped_split(c, u, v, per_pass)
+            .map_or(x.e.0, |e| e.min(x.e.0))
     }
 
     /// Rule 2 over the windows that hold one whole pass (the boundary of
@@ -1638,8 +1648,9 @@ impl<'a> Cells<'a> {
                     let x = self.exact(c);
                     best.tau_max = best.tau_max.max(x.tau_s);
                     best.e_env_max = best.e_env_max.max(x.e_env);
-                    if x.e.0 > best.e_max.0 {
-                        best.e_max = x.e;
+                    let e = self.e_refined(c, &x);
+                    if e > best.e_max.0 {
+                        best.e_max = (e, x.e.1);
                     }
                     if x.single > best.single.0 {
                         best.single = (x.single, mid_of(c));
@@ -1678,7 +1689,15 @@ impl<'a> Cells<'a> {
                 // The pass energy's bound is not exact on any cell (the
                 // exact evaluation caps it per bin): the plain branch and
                 // bound, over the same bounds in the same order.
-                let e = first_max_sorted(rows.len(), |c| rows[c].e_ub, |c| eval(c).e.0);
+                // Two levels: the sweep's bound orders the cells, the
+                // single-arc cap of `exact` skips a cell before the split
+                // caps are computed.
+                let e = first_max_sorted(
+                    rows.len(),
+                    |c| rows[c].e_ub,
+                    |c| eval(c).e.0,
+                    |c| self.e_refined(c, &eval(c)),
+                );
                 CellBest {
                     single: single.map_or((0.0, 0.0), |(r, c)| (r, mid_of(c))),
                     e_max: e.map_or((0.0, 0.0), |(e, c)| (e, eval(c).e.1)),
@@ -1818,17 +1837,20 @@ fn first_max_from(
         }
     }
     if nan {
-        return first_max_sorted(rows.len(), |c| bound(&rows[c]), exact);
+        return first_max_sorted(rows.len(), |c| bound(&rows[c]), |c| bound(&rows[c]), exact);
     }
     best.filter(|b| b.0 > 0.0)
 }
 
 /// The plain branch and bound behind [`first_max`]: cells are evaluated in
 /// decreasing order of their bound (ties by index) until the next bound can
-/// neither exceed the best value nor tie it at a smaller index.
+/// neither exceed the best value nor tie it at a smaller index. `mid`, a
+/// bound between the two (`exact ≤ mid ≤ ub`), skips a cell before its
+/// exact value is computed.
 fn first_max_sorted(
     len: usize,
     ub: impl Fn(usize) -> f64,
+    mut mid: impl FnMut(usize) -> f64,
     mut exact: impl FnMut(usize) -> f64,
 ) -> Option<(f64, usize)> {
     let top = (0..len).max_by(|&a, &b| ub(a).total_cmp(&ub(b)).then(b.cmp(&a)))?;
@@ -1839,6 +1861,9 @@ fn first_max_sorted(
     for c in order {
         if !beats(ub(c), c, best) {
             break;
+        }
+        if !beats(mid(c), c, best) {
+            continue;
         }
         let x = exact(c);
         if beats(x, c, best) {
@@ -2259,6 +2284,26 @@ mod tests {
             }
         }
 
+        /// The plain branch and bound with a middle bound (`exact ≤ mid ≤
+        /// ub`, on a coarse grid: many ties) finds the first largest exact
+        /// value, as a scan of every cell does.
+        #[test]
+        fn first_max_sorted_with_a_middle_bound_is_a_full_scan(
+            cells in proptest::collection::vec((0u8..5, 0u8..3, 0u8..3), 1..60),
+        ) {
+            let exact = |c: usize| f64::from(cells[c].0);
+            let mid = |c: usize| exact(c) + f64::from(cells[c].1);
+            let ub = |c: usize| mid(c) + f64::from(cells[c].2);
+            let mut scan: Option<(f64, usize)> = None;
+            for c in 0..cells.len() {
+                if scan.is_none_or(|b| exact(c) > b.0) {
+                    scan = Some((exact(c), c));
+                }
+            }
+            let scan = scan.filter(|b| b.0 > 0.0);
+            prop_assert_eq!(first_max_sorted(cells.len(), ub, mid, exact), scan);
+        }
+
         /// The one-scan branch and bound against the plain one (which
         /// evaluates in decreasing order of the bound), on bounds with many
         /// ties: the same maximum and first cell.
@@ -2291,7 +2336,7 @@ mod tests {
             let ub: Vec<f64> = rows.iter().map(|r| r.single_ub).collect();
             prop_assert_eq!(
                 first_max(&rows, |r| r.single_ub, exact),
-                first_max_sorted(ub.len(), |c| ub[c], exact)
+                first_max_sorted(ub.len(), |c| ub[c], |c| ub[c], exact)
             );
         }
     }
@@ -2334,7 +2379,7 @@ mod tests {
         ] {
             assert_eq!(
                 first_max(&rows, |r| r.tau_ub, exact),
-                first_max_sorted(ub.len(), |c| ub[c], exact)
+                first_max_sorted(ub.len(), |c| ub[c], |c| ub[c], exact)
             );
         }
     }
