@@ -1033,3 +1033,31 @@ fn hot_fast_bin_before_a_slow_dark_sector_is_tight() {
     assert!(q >= 1.0 - 1e-12, "checker below the reference: {q}");
     assert!(q <= 1.05, "checker {q:.4}× the reference (was 1.413×)");
 }
+
+/// The loosest phase-locked step profile of the default stream once its
+/// profiles came in runs (case 362: checker 0.7054 against the reference's
+/// 0.6633, 1.0635×, on the time-base rule): a 0.69° bin at 2.68 W between a
+/// slow neighbour (58 rad/s) and a fast one (89 rad/s), 1550 nm. One union
+/// arc per cell gave the cell the pulse count of its slow end and the fast
+/// neighbour's cap of its other end; the pass energy was 6.11e-4 J where
+/// no pass holds more than ≈ 5.8e-4 J. The caps are now taken over eight
+/// sub-cells: within 2 % of the reference, never below it.
+#[test]
+fn hot_bin_between_a_slow_and_a_fast_neighbour_is_tight() {
+    let p = load("regression_hot_bin_between_slow_and_fast_1550.json");
+    let es = p.limits.eye_safety.clone().unwrap();
+    let checker = evaluate_profile(&p, &es).unwrap();
+    let effort = Effort {
+        phases: 4,
+        locked: true,
+        ..Effort::default()
+    };
+    let reference = Reference::new(&Scan::of_profile(&p)).worst(&effort);
+    let q = checker.worst_ratio / reference.ratio;
+    println!(
+        "checker {:.6} ({:?}), reference {}: {q:.4}×",
+        checker.worst_ratio, checker.binding_rule, reference
+    );
+    assert!(q >= 1.0 - 1e-12, "checker below the reference: {q}");
+    assert!(q <= 1.02, "checker {q:.4}× the reference (was 1.0635×)");
+}
