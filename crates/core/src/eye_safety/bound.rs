@@ -1291,6 +1291,32 @@ impl<'a> Cells<'a> {
                 edge_p.push((env.p_w[at_lo.2], env.p_w[at_hi.2]));
             }
         }
+        // Rule 1 near a cut (`touch`): the azimuths within `2s` of cut `c`
+        // (`s` = TOUCH_SNAP_DEG) send passes into the arc
+        // `[θ_c − h − 3s, θ_c + h + 3s]` (one `s` for the rounding of the
+        // cut), and their duration exceeds `τ(θ_c)` by at most `2s` times
+        // the largest rate `|dτ/dφ| ≤ 2/ω_min` (`tau_touch`, doubled, plus
+        // the rounding slack); the inside of a cell, `[u + 2s, v − 2s]`,
+        // sends them into `(u − h + s, v + h − s)`. Off the curved cells
+        // this lets Rule 1 pair each end's hottest touched bin with that
+        // end's own counts instead of the cell's largest ones.
+        let spin_min = segs
+            .iter()
+            .map(|s| s.spin_start_rad_s.min(s.spin_end_rad_s))
+            .fold(f64::INFINITY, f64::min);
+        let tau_touch = 8.0 * TOUCH_SNAP_DEG.to_radians() / spin_min + t_slack;
+        // The hottest bin near each cut, on demand (forward queries).
+        let mut near = SlidingMax::new();
+        let (mut ha, mut hb) = (0usize, 0usize);
+        let mut p_near = |c: usize| {
+            let theta = cut_of(cuts, c);
+            let lo = unwrapped_bin(tl, theta - h - 3.0 * TOUCH_SNAP_DEG, &mut ha);
+            let hi = unwrapped_bin(tl, theta + h + 3.0 * TOUCH_SNAP_DEG, &mut hb);
+            near.max_over(lo, hi.max(lo), |k| segs[wrap_index(k, n)].power_w)
+        };
+        // Unwrapped bin `k`'s start, deg.
+        let start_of = |k: i64| 360.0 * k.div_euclid(n) as f64 + segs[wrap_index(k, n)].start_deg;
+        let mut inside = SlidingMax::new();
         // Per cell. The counts are nondecreasing functions of `τ` (products
         // by positive constants, sums and floors are monotone in floating
         // point too), so a value between two arguments of one count has it.
@@ -1356,13 +1382,51 @@ impl<'a> Cells<'a> {
             let per_pass = per_pass_of.get(tau, |t| max_pulses_in(t, f_p));
             let passes = passes_of.get(tau, |t| passes_in_window(t2, t, frame_s));
             let per_j = self.per_j.get(self.laser, per_pass, passes);
+            let mut single = p * delta * per_j;
+            if edges.is_none() {
+                // Rule 1 off the curved cells, tighter: the cell's largest
+                // counts with the bins the passes of its inside meet, and
+                // each end's counts with the bins its passes touch (see
+                // `touch`).
+                // The union arc's bins `[lo, hi]` but a first one that
+                // ends, or a last one that starts, within `s` of the inside
+                // (a superset of the inside's bins).
+                let lo_in = if start_of(lo + 1) <= u - h + TOUCH_SNAP_DEG {
+                    lo + 1
+                } else {
+                    lo
+                };
+                let hi_in = if start_of(hi) >= v + h - TOUCH_SNAP_DEG && hi > lo_in {
+                    hi - 1
+                } else {
+                    hi
+                };
+                // With the hottest bin inside, the first figure below is
+                // `single` itself: nothing to gain.
+                let p_in = if (lo_in, hi_in) == (lo, hi) {
+                    p
+                } else {
+                    inside.max_over(lo_in, hi_in.max(lo_in), |k| segs[wrap_index(k, n)].power_w)
+                };
+                if p_in < p {
+                    let mut at = |p_w: f64, tau_s: f64| {
+                        let k = max_pulses_in(tau_s, f_p);
+                        let q = passes_in_window(t2, tau_s, frame_s);
+                        p_w * delta * self.per_j.get(self.laser, k, q)
+                    };
+                    single = at(p_in, tau)
+                        .max(at(p_near(c), tau_pt[c] + tau_touch))
+                        .max(at(p_near(c + 1), tau_pt[c + 1] + tau_touch))
+                        .min(single);
+                }
+            }
             rows.push(CellRow {
                 p,
                 curved: edges.is_some(),
                 tau_ub: tau,
                 e_ub: e.min(per_pass * p * delta),
                 env_ub: e,
-                single_ub: p * delta * per_j,
+                single_ub: single,
                 tau_lb,
             });
         }
@@ -1443,7 +1507,12 @@ impl<'a> Cells<'a> {
             tau_min_s: cell_tau_min,
             e: (cell_e.0.min(cap), wrap360(cell_e.1)),
             e_env: cell_e.0,
-            single: p * self.delta * self.per_j.peek(self.laser, per_pass, passes),
+            // Off the curved cells the sweep's Rule 1 figure is exact.
+            single: if self.rows[c].curved {
+                p * self.delta * self.per_j.peek(self.laser, per_pass, passes)
+            } else {
+                self.rows[c].single_ub
+            },
         }
     }
 
