@@ -2476,6 +2476,195 @@ mod tests {
         assert!(q.items.len() <= 2 * QUEUE_COMPACT_MIN, "{}", q.items.len());
     }
 
+    /// A bin of `width` degrees from `start` at `power`, spinning from
+    /// `w0` to `w1` rad/s.
+    fn seg(start: f64, width: f64, power: f64, w0: f64, w1: f64) -> Seg {
+        Seg {
+            start_deg: start,
+            width_deg: width,
+            power_w: power,
+            spin_start_rad_s: w0,
+            spin_end_rad_s: w1,
+        }
+    }
+
+    fn fields(s: &Seg) -> [f64; 5] {
+        [
+            s.start_deg,
+            s.width_deg,
+            s.power_w,
+            s.spin_start_rad_s,
+            s.spin_end_rad_s,
+        ]
+    }
+
+    /// Runs of one power and one constant spin merge (widths summed, the
+    /// first bin's start kept); a change of power, an acceleration in
+    /// either bin or a change of spin ends a run. Expected lists by hand.
+    #[test]
+    fn coalesce_merges_runs_of_one_power_and_constant_spin() {
+        let segs = [
+            seg(0.0, 90.0, 1.0, 10.0, 10.0),
+            seg(90.0, 45.0, 1.0, 10.0, 10.0),
+            seg(135.0, 45.0, 1.0, 10.0, 10.0), // three of a run: 0..180
+            seg(180.0, 45.0, 2.0, 10.0, 10.0), // power changes
+            seg(225.0, 45.0, 2.0, 10.0, 10.0), // run: 180..270
+            seg(270.0, 30.0, 2.0, 10.0, 12.0), // accelerates
+            seg(300.0, 30.0, 2.0, 12.0, 12.0), // follows an accelerating bin
+            seg(330.0, 30.0, 2.0, 11.0, 11.0), // another spin
+        ];
+        let expected = [
+            seg(0.0, 180.0, 1.0, 10.0, 10.0),
+            seg(180.0, 90.0, 2.0, 10.0, 10.0),
+            segs[5],
+            segs[6],
+            segs[7],
+        ];
+        let out = coalesce(&segs);
+        assert!(matches!(out, std::borrow::Cow::Owned(_)));
+        assert_eq!(out.len(), expected.len());
+        for (got, want) in out.iter().zip(&expected) {
+            assert_eq!(fields(got), fields(want));
+        }
+        // Nothing to merge (each pair differs in one respect only): the
+        // same slice, borrowed.
+        let apart = [
+            seg(0.0, 90.0, 1.0, 10.0, 10.0),
+            seg(90.0, 90.0, 2.0, 10.0, 10.0),  // power
+            seg(180.0, 90.0, 2.0, 10.0, 11.0), // accelerates
+            seg(270.0, 90.0, 2.0, 11.0, 11.0), // after an acceleration
+        ];
+        let out = coalesce(&apart);
+        assert!(matches!(out, std::borrow::Cow::Borrowed(s) if std::ptr::eq(s, &apart[..])));
+        // Same power and spin but one of two accelerating: no merge.
+        assert!(!same_run(&apart[2], &apart[3]));
+        assert!(!same_run(
+            &seg(0.0, 1.0, 1.0, 11.0, 11.0),
+            &seg(1.0, 1.0, 1.0, 11.0, 12.0)
+        ));
+        assert!(!same_run(
+            &seg(0.0, 1.0, 1.0, 11.0, 11.0),
+            &seg(1.0, 1.0, 1.0, 12.0, 12.0)
+        ));
+        assert!(same_run(
+            &seg(0.0, 1.0, 1.0, 11.0, 11.0),
+            &seg(1.0, 1.0, 1.0, 11.0, 11.0)
+        ));
+    }
+
+    /// The cells of `segs` (bins used as they are, not coalesced) for half
+    /// pass angle `h`, a laser of `f_p` Hz, handed to `f`.
+    fn with_cells<R>(segs: &[Seg], h: f64, f_p: f64, f: impl FnOnce(&Cells<'_>) -> R) -> R {
+        let laser = Laser {
+            band: Band::RetinalNir,
+            c4: 1.0,
+            pulse_duration_s: 5e-9,
+            pulse_rate_hz: f_p,
+        };
+        let tl = Timeline::from_bins(segs);
+        let env = Envelope::new(&tl, 1.0 / f_p);
+        let cells = Cells::new(&tl, &env, h, &laser);
+        f(&cells)
+    }
+
+    /// `10` rev/s: 3600 °/s.
+    const SPIN_10_HZ: f64 = 20.0 * std::f64::consts::PI;
+
+    /// The per-bin pulse cap counts a bin that only touches the union arc
+    /// `[u − h, v + h]` at an edge (one pulse at most: no time inside),
+    /// on either side. At 100 kHz and 3600 °/s a degree holds 27.8
+    /// pulses, so the one cool bin inside holds all the rest.
+    #[test]
+    fn pulse_caps_count_bins_touched_at_the_arc_edges() {
+        let w = SPIN_10_HZ;
+        let segs = [
+            seg(0.0, 10.0, 10.0, w, w), // hot, ends at 10
+            seg(10.0, 10.0, 1.0, w, w),
+            seg(20.0, 10.0, 5.0, w, w), // warm, starts at 20
+            seg(30.0, 330.0, 2.0, w, w),
+        ];
+        let f_p = 1e5;
+        let delta = 1.0 / f_p;
+        with_cells(&segs, 1.0, f_p, |cells| {
+            let close = |got: Option<f64>, want: f64| {
+                let got = got.expect("a cap");
+                assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
+            };
+            // Arc [10, 16]: one pulse of the hot bin, four of bin 1.
+            close(cells.pulse_capped_j(11.0, 15.0, 5.0), (10.0 + 4.0) * delta);
+            // Arc [11, 20]: one pulse of the warm bin, four of bin 1.
+            close(cells.pulse_capped_j(12.0, 19.0, 5.0), (5.0 + 4.0) * delta);
+            // Arc [11, 19.5]: bin 1 only.
+            close(cells.pulse_capped_j(12.0, 18.5, 5.0), 5.0 * delta);
+        });
+    }
+
+    /// The per-bin pulse cap is taken over at most `PULSE_CAP_MAX_BINS`
+    /// bins: an arc over exactly 64 one-degree bins has it (the hottest
+    /// bin, half a degree of it inside: 13.9 pulses at 100 kHz and
+    /// 3600 °/s, holds all 3), one over 65 has none.
+    #[test]
+    fn pulse_caps_stop_beyond_64_bins() {
+        assert_eq!(PULSE_CAP_MAX_BINS, 64);
+        let w = SPIN_10_HZ;
+        let segs: Vec<Seg> = (0..360)
+            .map(|i| {
+                let p = if i == 68 {
+                    50.0
+                } else {
+                    1.0 + f64::from(i % 5)
+                };
+                seg(f64::from(i), 1.0, p, w, w)
+            })
+            .collect();
+        let f_p = 1e5;
+        with_cells(&segs, 31.5, f_p, |cells| {
+            // [68.5, 131.5]: bins 68..=131.
+            let got = cells
+                .pulse_capped_j(100.0, 100.0, 3.0)
+                .expect("64 bins: a cap");
+            let want = 3.0 * 50.0 / f_p;
+            assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
+            // [68.5, 132.5]: bins 68..=132.
+            assert_eq!(cells.pulse_capped_j(100.0, 101.0, 3.0), None);
+        });
+    }
+
+    /// The split cap takes each sub-cell's own pulse count. Bins: A
+    /// `[0, 100)` at 1800 °/s, M `[100, 115)` and the hot B `[115, 360)` at
+    /// 3600 °/s; half pass angle 10°. Cell `[105, 110]` (cuts B − h and
+    /// M + h): a pass at φ covers `(110 − φ)/1800 + 15/3600 + (φ − 105)/3600
+    /// = (130 − φ)/3600` s, falling with φ, and B's share grows with φ.
+    /// At 7560 Hz (2.1 pulses per 1/3600 s): 53 pulses over the cell, 44 at
+    /// most in the last sub-cell `[109.375, 110]` (20.625·2.1 = 43.3), whose
+    /// union arc `[99.375, 120]` holds at most 11 pulses of B (5°: 10.5),
+    /// 32 of M (15°: 31.5) and 3 of A (0.625° at half speed: 2.6). That
+    /// sub-cell is the largest (B's share is largest there and B is 100
+    /// times hotter): `11·100 + 33` pulse-watts. With the cell's 53 pulses
+    /// it would be `11·100 + 35` (M and A full).
+    #[test]
+    fn pulse_caps_split_take_each_sub_cell_s_pulse_count() {
+        let (slow, fast) = (SPIN_10_HZ / 2.0, SPIN_10_HZ);
+        let segs = [
+            seg(0.0, 100.0, 1.0, slow, slow),
+            seg(100.0, 15.0, 1.0, fast, fast),
+            seg(115.0, 245.0, 100.0, fast, fast),
+        ];
+        let f_p = 7560.0;
+        with_cells(&segs, 10.0, f_p, |cells| {
+            let c = (0..cells.len())
+                .find(|&c| cells.cut(c) == 105.0)
+                .expect("cut at 105");
+            assert_eq!(cells.cut(c + 1), 110.0);
+            assert!(!cells.rows[c].curved);
+            let got = cells
+                .pulse_capped_split(c, 105.0, 110.0, 53.0)
+                .expect("a cap");
+            let want = (11.0 * 100.0 + 33.0) / f_p;
+            assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
+        });
+    }
+
     #[test]
     fn first_max_with_a_nan_is_the_plain_branch_and_bound() {
         let rows: Vec<CellRow> = [(1.0, false), (f64::NAN, true), (2.0, false), (2.0, true)]
