@@ -29,7 +29,7 @@ use gaze_lidar::profile::Profile;
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
-use reference::{ael_j, Band, Clock, Effort, Reference, RuleKind, Scan, Worst};
+use reference::{ael_j, c5, Band, Clock, Effort, Reference, RuleKind, Scan, Worst};
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -1078,4 +1078,56 @@ fn assert_tight_against_reference(file: &str, max_q: f64, was: &str) {
     );
     assert!(q >= 1.0 - 1e-12, "checker below the reference: {q}");
     assert!(q <= max_q, "checker {q:.4}× the reference (was {was}×)");
+}
+
+/// Rule 1 where a pass ends on a hot bin's first instant, by hand, on the
+/// profile of `rule_one_pairs_a_touched_hot_bin_with_its_own_pulse_count`:
+/// the aperture whose pass `[a − 2h, a]` ends at the 4.0 mW bin's start `a`
+/// holds `⌊τ f_p⌋ + 1` pulses per pass for the clock phase that puts the
+/// last one on `a` (it carries the 4.0 mW bin's power: bins are `[start,
+/// end)`), the clock locked, so every pass of the `⌊(T2 + τ)/T_f⌋ + 1` a
+/// 10 s window meets does the same. The checker's Rule 1 figure must be at
+/// least that pulse's ratio (a bound that drops the touched bin, or pairs
+/// it with too few pulses, is not).
+#[test]
+fn rule_one_counts_a_pulse_on_a_hot_bin_s_first_instant() {
+    let p = load("regression_rule1_hot_bin_touched_at_a_cell_end_905.json");
+    let es = p.limits.eye_safety.clone().unwrap();
+    let checker = evaluate_profile(&p, &es).unwrap();
+    // The 4.0 mW bin after the 3.2 mW one that follows the slow dark bin.
+    let k = p
+        .bins
+        .iter()
+        .position(|b| (b.start_deg - 277.381).abs() < 1e-3)
+        .unwrap();
+    assert!(p.bins[k - 2].spin_start_rad_s < 45.0 && p.bins[k].power_w > 3.9e-3);
+    let a = p.bins[k].start_deg;
+    let two_h = checker.pass_angle_deg;
+    // The pass's duration: constant-spin bins, overlap over spin.
+    let tau: f64 = p
+        .bins
+        .iter()
+        .map(|b| {
+            assert_eq!(b.spin_start_rad_s, b.spin_end_rad_s, "a step profile");
+            let lo = b.start_deg.max(a - two_h);
+            let hi = (b.start_deg + b.width_deg).min(a);
+            (hi - lo).max(0.0).to_radians() / b.spin_start_rad_s
+        })
+        .sum();
+    let frame_s = 1.0 / p.frame_rate_hz;
+    let per_pass = (tau * p.pulse_rate_hz).floor() + 1.0;
+    let passes = ((10.0 + tau) / frame_s).floor() + 1.0;
+    let band = Band::of(es.wavelength_nm);
+    let c4 = 10f64.powf(0.002 * (es.wavelength_nm - 700.0));
+    let e = p.bins[k].power_w / p.pulse_rate_hz;
+    let by_hand = e / (c5(band, per_pass * passes) * ael_j(band, c4, es.pulse_duration_s));
+    println!(
+        "Rule 1: checker {:.6}, by hand {by_hand:.6} ({per_pass} pulses × {passes} passes)",
+        checker.rule_ratios[0]
+    );
+    assert!(
+        checker.rule_ratios[0] >= by_hand * (1.0 - 1e-12),
+        "checker {} below {by_hand}",
+        checker.rule_ratios[0]
+    );
 }
