@@ -3,6 +3,9 @@
 //! 200 Hz (one frame in ten samples plans a profile), closed form and the
 //! optimizer's fast path. Run: `cargo bench --bench gaze`.
 
+#[path = "common/planned.rs"]
+mod planned;
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::time::Instant;
@@ -12,8 +15,8 @@ use gaze_lidar::gaze::{
     ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeSample, GazeStream,
 };
 use gaze_lidar::model::presets;
-use gaze_lidar::planner::closed_form::build_profile;
 use gaze_lidar::planner::Mode;
+use planned::planned_profiles;
 
 fn samples() -> Vec<GazeSample> {
     (0..4000)
@@ -50,25 +53,9 @@ fn frame_latencies<P: FramePlanner>(planner: P) -> (f64, f64) {
 /// on the closed-form planner's 360-bin profile for each gaze of the
 /// trace's three fixations: p50/p99 over `reps` calls, µs. Separates the
 /// checker's time from the stream's and from scheduling noise.
-///
-/// With `distinct`, every bin's power is lowered by a different tiny
-/// fraction, so no two neighbours are alike and the bound cannot merge the
-/// closed form's runs of equal bins: the cost of a profile whose 360 bins
-/// all differ (a smooth optimizer profile, say).
+/// With `distinct`, no two bins alike (see `common/planned.rs`).
 fn checker_latencies(reps: usize, distinct: bool) -> (f64, f64) {
-    let preset = presets::paper();
-    let profiles: Vec<_> = [90.0, 130.0, 170.0]
-        .iter()
-        .map(|&g| {
-            let mut p = build_profile(&preset, Mode::Joint, Some(g), 360).unwrap();
-            if distinct {
-                for (i, b) in p.bins.iter_mut().enumerate() {
-                    b.power_w *= 1.0 - 1e-6 * (i + 1) as f64;
-                }
-            }
-            p
-        })
-        .collect();
+    let profiles = planned_profiles(distinct);
     let mut us = Vec::with_capacity(reps);
     for k in 0..reps {
         let p = &profiles[k % profiles.len()];

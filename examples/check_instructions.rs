@@ -10,27 +10,14 @@
 //! # the same with `3 distinct` and `33 distinct`: no two bins alike
 //! ```
 use gaze_lidar::checker::check;
-use gaze_lidar::model::presets;
-use gaze_lidar::planner::closed_form::build_profile;
-use gaze_lidar::planner::Mode;
+#[path = "../benches/common/planned.rs"]
+mod planned;
+
+use planned::planned_profiles;
 fn main() {
-    let preset = presets::paper();
-    // `distinct` (second argument): every bin's power lowered by a
-    // different tiny fraction, so that no two neighbours are alike and
-    // nothing merges (as `benches/gaze.rs`).
+    // `distinct` (second argument): no two bins alike, nothing merges.
     let distinct = std::env::args().nth(2).is_some_and(|s| s == "distinct");
-    let ps: Vec<_> = [90.0, 130.0, 170.0]
-        .iter()
-        .map(|&g| {
-            let mut p = build_profile(&preset, Mode::Joint, Some(g), 360).unwrap();
-            if distinct {
-                for (i, b) in p.bins.iter_mut().enumerate() {
-                    b.power_w *= 1.0 - 1e-6 * (i + 1) as f64;
-                }
-            }
-            p
-        })
-        .collect();
+    let ps = planned_profiles(distinct);
     let n: usize = std::env::args().nth(1).map_or(300, |s| s.parse().unwrap());
     let mut k = 0;
     for i in 0..n {
