@@ -1,4 +1,4 @@
-//! `gaze-lidar check`: verify a profile@1 file.
+//! `gaze-lidar check`: verify a profile@1 file or a firmware table.
 
 use clap::ValueEnum;
 use std::path::PathBuf;
@@ -7,7 +7,7 @@ use gaze_lidar::checker::{certify_with, summarize, CheckOptions};
 use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::profile::Profile;
 
-use super::io::{read_text, warn, Stdout, MAX_PROFILE_BYTES};
+use super::io::{read_bytes, warn, Stdout, MAX_PROFILE_BYTES};
 use super::CliError;
 
 /// Report format.
@@ -21,7 +21,7 @@ pub enum Format {
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Profile JSON file (`-` for stdin).
+    /// Profile JSON, firmware@1 JSON or binary firmware table (`-` for stdin).
     file: PathBuf,
     /// Report format.
     #[arg(long, value_enum, default_value_t = Format::Text)]
@@ -30,10 +30,11 @@ pub struct Args {
     /// than the sensor's is rejected, naming the key.
     #[arg(long, conflicts_with = "sensor")]
     preset: Option<String>,
-    /// Also certify against a sensor described in TOML (the fields of a
-    /// preset's `lidar`: name, frame_rate_hz, pulse_rate_hz, channels,
+    /// Also certify against a sensor described in TOML: exactly the fields
+    /// of a preset's `lidar` (name, frame_rate_hz, pulse_rate_hz, channels,
     /// average_power_w, rated_range_m, reference_reflectivity,
-    /// power_accounting, [limits]).
+    /// power_accounting, [limits] with "unlimited" for no limit,
+    /// [limits.eye_safety]); `gaze-lidar sensor --preset P` writes one.
     #[arg(long, value_name = "FILE.toml")]
     sensor: Option<PathBuf>,
     /// Accept a file without eye-safety parameters (`limits.eye_safety:
@@ -49,28 +50,27 @@ fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
         return Ok(Some(p.lidar));
     }
     if let Some(path) = &a.sensor {
-        let text = read_text(path, super::io::MAX_CONFIG_BYTES)?;
-        let spec: LidarSpec = toml::from_str(&text).map_err(|e| {
-            CliError::input(format!(
-                "--sensor {}: {}",
-                path.display(),
-                e.to_string().lines().collect::<Vec<_>>().join(" ")
-            ))
-        })?;
-        return Ok(Some(spec));
+        return super::sensor::read(path).map(Some);
     }
     Ok(None)
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
-    let text = read_text(&a.file, MAX_PROFILE_BYTES)?;
+    let bytes = read_bytes(&a.file, MAX_PROFILE_BYTES)?;
+    let origin = a.file.display().to_string();
+    let text = match super::table::classify(bytes, &a.file, &origin)? {
+        super::table::Input::Table(t) => {
+            let sensor = sensor_of(a)?;
+            return super::table::check(&t, &origin, sensor.as_ref(), a.format, a.no_eye_safety);
+        }
+        super::table::Input::Text(text) => text,
+    };
     let profile = if a.file.as_os_str() == "-" {
         Profile::from_json(&text, "<stdin>")?
     } else {
-        Profile::from_json(&text, &a.file.display().to_string())?
+        Profile::from_json(&text, &origin)?
     };
     drop(text);
-    let origin = a.file.display().to_string();
     let sensor = sensor_of(a)?;
     let mut opts = CheckOptions::declared().allow_missing_eye_safety(a.no_eye_safety);
     if let Some(s) = &sensor {

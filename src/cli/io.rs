@@ -15,17 +15,38 @@ pub const MAX_PROFILE_BYTES: u64 = 512 << 20;
 /// Largest TOML configuration accepted (scenario, optimizer).
 pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
 
-/// Reads `path` (`-` for stdin) as UTF-8 text of at most `limit` bytes.
+/// Reads `path` (`-` for stdin) as UTF-8 text of at most `limit` bytes
+/// (see [`read_bytes`]).
+pub fn read_text(path: &Path, limit: u64) -> Result<String, CliError> {
+    utf8(read_bytes(path, limit)?, path)
+}
+
+fn input_name(path: &Path) -> String {
+    if path.as_os_str() == "-" {
+        "<stdin>".to_owned()
+    } else {
+        path.display().to_string()
+    }
+}
+
+/// The bytes read from `path` as UTF-8 text (an error names the offset).
+pub fn utf8(bytes: Vec<u8>, path: &Path) -> Result<String, CliError> {
+    String::from_utf8(bytes).map_err(|e| {
+        CliError::input(format!(
+            "{}: not UTF-8 text (invalid byte at offset {})",
+            input_name(path),
+            e.utf8_error().valid_up_to()
+        ))
+    })
+}
+
+/// Reads `path` (`-` for stdin): at most `limit` bytes.
 ///
 /// A regular file larger than the limit is refused before it is read; any
 /// other input (stdin, a FIFO, a character device such as `/dev/zero`) is
 /// read up to the limit and refused past it, so an endless input ends.
-pub fn read_text(path: &Path, limit: u64) -> Result<String, CliError> {
-    let name = if path.as_os_str() == "-" {
-        "<stdin>".to_owned()
-    } else {
-        path.display().to_string()
-    };
+pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, CliError> {
+    let name = input_name(path);
     let fail = |e: io::Error| CliError::input(format!("{name}: {e}"));
     let too_big = || {
         CliError::input(format!(
@@ -53,12 +74,7 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, CliError> {
     if bytes.len() as u64 > limit {
         return Err(too_big());
     }
-    String::from_utf8(bytes).map_err(|e| {
-        CliError::input(format!(
-            "{name}: not UTF-8 text (invalid byte at offset {})",
-            e.utf8_error().valid_up_to()
-        ))
-    })
+    Ok(bytes)
 }
 
 /// Standard output for a command's data: locked, quiet once the reader has

@@ -11,8 +11,10 @@ mod ael;
 mod check;
 pub mod io;
 mod profile;
+mod sensor;
 mod simulate;
 mod stream;
+mod table;
 
 use clap::{Parser, Subcommand};
 use std::path::Path;
@@ -79,7 +81,8 @@ struct Cli {
 enum Command {
     /// Build a certified power/spin profile for a gaze direction.
     Profile(profile::Args),
-    /// Verify a profile@1 JSON file against its declared limits.
+    /// Verify a profile@1 JSON file or a firmware table (firmware@1 JSON or
+    /// binary) against its declared limits.
     Check(check::Args),
     /// Class 1 eye-safety limits (IEC 60825-1:2014) for a laser.
     Ael(ael::Args),
@@ -87,6 +90,8 @@ enum Command {
     Simulate(simulate::Args),
     /// Gaze samples on stdin → one certified profile per LiDAR frame (JSON lines).
     Stream(stream::Args),
+    /// Write a preset's sensor as a sensor file (TOML) for `check --sensor`.
+    Sensor(sensor::Args),
 }
 
 /// Writes `text` to `out` (see [`io::write_output`]), or to stdout.
@@ -160,6 +165,7 @@ pub fn main() -> ExitCode {
         Command::Ael(a) => ael::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Stream(a) => stream::run(&a),
+        Command::Sensor(a) => sensor::run(&a),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -6,6 +6,7 @@
 pub mod acuity;
 pub use gaze_lidar_core::model::{angle, lidar};
 pub mod presets;
+pub mod sensor;
 
 pub use acuity::{AcuityModel, FocusModel, Regions};
 pub use angle::{Arc, Binning, CircularSet};

@@ -20,6 +20,7 @@ use thiserror::Error;
 use crate::eye_safety::{self, ExposureReport};
 use crate::model::angle::{next_index, FULL_TURN_DEG};
 use crate::model::lidar::{LidarSpec, PowerAccounting};
+use crate::model::valid;
 use crate::profile::{Profile, Region, Summary, PROFILE_FORMAT};
 
 /// Relative tolerance on power, spin, time and acceleration comparisons.
@@ -491,26 +492,30 @@ fn check_header(p: &Profile, v: &mut Vec<Violation>) {
             found: p.format.clone(),
         });
     }
-    let pos = |field, value: f64, v: &mut Vec<Violation>| {
-        if !(value.is_finite() && value > 0.0) {
+    // The one numeric boundary (`model::valid`): rates finite and of
+    // physical size (a subnormal rate's period overflows to infinity), every
+    // other number finite, zero or normal; each rule fails on NaN.
+    for (field, value) in [
+        ("frame_rate_hz", p.frame_rate_hz),
+        ("pulse_rate_hz", p.pulse_rate_hz),
+    ] {
+        if let Err(reason) = valid::rate_hz(value) {
             v.push(Violation::Header {
                 field,
                 value,
-                reason: "must be finite and > 0",
+                reason,
             });
         }
-    };
-    pos("frame_rate_hz", p.frame_rate_hz, v);
-    pos("pulse_rate_hz", p.pulse_rate_hz, v);
-    if !(p.average_power_w.is_finite() && p.average_power_w >= 0.0) {
+    }
+    if let Err(reason) = valid::magnitude(p.average_power_w) {
         v.push(Violation::Header {
             field: "average_power_w",
             value: p.average_power_w,
-            reason: "must be finite and >= 0",
+            reason,
         });
     }
     if let Some(g) = p.gaze_deg {
-        if !g.is_finite() {
+        if valid::finite(g).is_err() {
             v.push(Violation::Header {
                 field: "gaze_deg",
                 value: g,
@@ -520,11 +525,11 @@ fn check_header(p: &Profile, v: &mut Vec<Violation>) {
     }
     let l = &p.limits;
     let mut nonneg = |field, value: f64| {
-        if !(value.is_finite() && value >= 0.0) {
+        if let Err(reason) = valid::magnitude(value) {
             v.push(Violation::BadLimit {
                 field,
                 value,
-                reason: "must be finite and >= 0",
+                reason,
             });
         }
     };
@@ -538,14 +543,21 @@ fn check_header(p: &Profile, v: &mut Vec<Violation>) {
     if let Some(s) = l.power_slew_w_per_deg_max {
         nonneg("power_slew_w_per_deg_max", s);
     }
-    if l.power_w_min > l.power_w_max {
+    // Inverted limits (a NaN is already reported above; not twice).
+    if !valid::ordered(l.power_w_min, l.power_w_max)
+        && !l.power_w_min.is_nan()
+        && !l.power_w_max.is_nan()
+    {
         v.push(Violation::BadLimit {
             field: "power_w_min",
             value: l.power_w_min,
             reason: "is above power_w_max",
         });
     }
-    if l.spin_rad_s_min > l.spin_rad_s_max {
+    if !valid::ordered(l.spin_rad_s_min, l.spin_rad_s_max)
+        && !l.spin_rad_s_min.is_nan()
+        && !l.spin_rad_s_max.is_nan()
+    {
         v.push(Violation::BadLimit {
             field: "spin_rad_s_min",
             value: l.spin_rad_s_min,
@@ -573,12 +585,12 @@ fn check_structure(p: &Profile, v: &mut Vec<Violation>) -> bool {
             ("spin_end_rad_s", b.spin_end_rad_s),
         ];
         for (field, value) in fields {
-            if !value.is_finite() {
+            if let Err(reason) = valid::finite(value) {
                 v.push(Violation::BinField {
                     bin: i,
                     field,
                     value,
-                    reason: "must be finite",
+                    reason,
                 });
             }
         }
@@ -682,7 +694,7 @@ fn check_limits(p: &Profile, s: &Summary, v: &mut Vec<Violation>) {
                 });
             }
             let jump = (b.spin_end_rad_s - next.spin_start_rad_s).abs();
-            if jump > REL_TOL * b.spin_end_rad_s.abs().max(1.0) {
+            if !(jump <= REL_TOL * b.spin_end_rad_s.abs().max(1.0)) {
                 v.push(Violation::SpinStep {
                     bin: i,
                     end_rad_s: b.spin_end_rad_s,
@@ -782,12 +794,16 @@ impl<'a> CheckOptions<'a> {
 
 fn check_against_sensor(p: &Profile, sensor: &LidarSpec, v: &mut Vec<Violation>) {
     let (d, s) = (&p.limits, &sensor.limits);
+    // Written so that a NaN on either side is looser (the sensor's limits
+    // are validated where they are read, but this comparison must not rest
+    // on that): "no looser" is `declared <= sensor` for an upper limit,
+    // `declared >= sensor` for a lower one, both false on NaN.
     let mut looser =
         |field: &'static str, declared: Option<f64>, sensor: Option<f64>, upper: bool| {
             let bad = match (declared, sensor) {
                 (_, None) => false,
                 (None, Some(_)) => true,
-                (Some(x), Some(y)) => x.is_nan() || if upper { x > y } else { x < y },
+                (Some(x), Some(y)) => !(if upper { x <= y } else { x >= y }),
             };
             if bad {
                 v.push(Violation::LooserThanSensor {
@@ -833,13 +849,12 @@ fn check_against_sensor(p: &Profile, sensor: &LidarSpec, v: &mut Vec<Violation>)
         s.power_slew_w_per_deg_max,
         true,
     );
-    if p.average_power_w.is_nan() || p.average_power_w > sensor.average_power_w {
-        v.push(Violation::LooserThanSensor {
-            field: "average_power_w",
-            declared: Some(p.average_power_w),
-            sensor: Some(sensor.average_power_w),
-        });
-    }
+    looser(
+        "average_power_w",
+        Some(p.average_power_w),
+        Some(sensor.average_power_w),
+        true,
+    );
     let mut mismatch = |field: &'static str, detail: String| {
         v.push(Violation::SensorMismatch { field, detail });
     };

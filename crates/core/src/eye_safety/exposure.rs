@@ -54,11 +54,12 @@ pub struct ExposureReport {
 /// The laser constants of `params` at `pulse_rate_hz`, validated.
 pub fn laser(params: &EyeSafetyParams, pulse_rate_hz: f64) -> Result<Laser, EyeSafetyError> {
     let band = params.validate()?;
-    if !(pulse_rate_hz.is_finite() && pulse_rate_hz > 0.0) {
+    // The one numeric boundary: a rate of physical size (not subnormal).
+    if let Err(reason) = crate::model::valid::rate_hz(pulse_rate_hz) {
         return Err(EyeSafetyError::Param {
             field: "pulse_rate_hz",
             value: pulse_rate_hz,
-            reason: "must be finite and > 0",
+            reason,
         });
     }
     if pulse_rate_hz * params.pulse_duration_s >= 1.0 {

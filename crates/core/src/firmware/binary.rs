@@ -36,7 +36,8 @@ use crate::model::accounting::PowerAccounting;
 pub const HEADER_LEN: usize = 96;
 /// Record size, bytes.
 pub const RECORD_LEN: usize = 36;
-const MAGIC: &[u8; 4] = b"GLFW";
+/// The first four bytes of every encoded table.
+pub const MAGIC: &[u8; 4] = b"GLFW";
 const VERSION: u16 = 2;
 
 /// Why bytes are not a table.

@@ -38,6 +38,47 @@ fn u64_of(x: f64, field: &'static str) -> Result<u64, FirmwareError> {
     }
 }
 
+/// Ticks per revolution at `frame_rate_hz`: `round(tick_hz / frame_rate_hz)`.
+pub fn frame_ticks_for(tick_hz: u64, frame_rate_hz: f64) -> Result<u64, FirmwareError> {
+    u64_of((tick_hz as f64 / frame_rate_hz).round(), "frame_ticks")
+}
+
+/// A table's energy budget for an average power of `average_power_w`, in
+/// code units per tick (time accounting) or per millidegree (angle), over
+/// `weight_total` ticks or millidegrees: `floor(P̄/step)` per unit exactly
+/// (as the codes are rounded), plus the remainder's share rounded down, so a
+/// uniform profile at P̄ always fits and no more than P̄ does.
+pub fn energy_budget(
+    average_power_w: f64,
+    step: f64,
+    weight_total: u64,
+) -> Result<u64, FirmwareError> {
+    let q = floor_code(average_power_w, step).ok_or_else(|| FirmwareError::Config {
+        field: "power_w_per_code",
+        reason: format!(
+            "average_power_w {average_power_w} W / step {step} W does not fit a u32 code"
+        ),
+    })?;
+    let rem = ((average_power_w - f64::from(q) * step) / step).clamp(0.0, 1.0);
+    u64::from(q)
+        .checked_mul(weight_total)
+        .and_then(|b| b.checked_add((rem * weight_total as f64).floor() as u64))
+        .ok_or_else(|| FirmwareError::Config {
+            field: "energy_budget",
+            reason: "overflows u64: use a coarser power_w_per_code or a slower tick".into(),
+        })
+}
+
+/// The energy budget's weight total: `frame_ticks` (time accounting) or a
+/// full turn in millidegrees (angle).
+#[must_use]
+pub fn budget_weight_total(accounting: PowerAccounting, frame_ticks: u64) -> u64 {
+    match accounting {
+        PowerAccounting::Time => frame_ticks,
+        PowerAccounting::Angle => u64::from(FULL_TURN_MDEG),
+    }
+}
+
 impl FirmwareTable {
     /// Quantizes a certified profile.
     pub fn from_certified(
@@ -62,7 +103,7 @@ impl FirmwareTable {
                 ),
             });
         }
-        let frame_ticks = u64_of((f / p.frame_rate_hz).round(), "frame_ticks")?;
+        let frame_ticks = frame_ticks_for(cfg.tick_hz, p.frame_rate_hz)?;
         if p.bins.len() > MAX_TABLE_BINS {
             return Err(FirmwareError::Config {
                 field: "bins",
@@ -127,25 +168,8 @@ impl FirmwareTable {
         // Budget in code units per tick (time) or per millidegree (angle):
         // floor(P̄/step) exactly (as the codes are rounded), plus the
         // remainder's share, so a uniform profile at P̄ always fits.
-        let weight_total = match p.power_accounting {
-            PowerAccounting::Time => frame_ticks,
-            PowerAccounting::Angle => u64::from(FULL_TURN_MDEG),
-        };
-        let q = floor_code(p.average_power_w, step).ok_or_else(|| FirmwareError::Config {
-            field: "power_w_per_code",
-            reason: format!(
-                "average_power_w {} W / step {step} W does not fit a u32 code",
-                p.average_power_w
-            ),
-        })?;
-        let rem = ((p.average_power_w - f64::from(q) * step) / step).clamp(0.0, 1.0);
-        let energy_budget = u64::from(q)
-            .checked_mul(weight_total)
-            .and_then(|b| b.checked_add((rem * weight_total as f64).floor() as u64))
-            .ok_or_else(|| FirmwareError::Config {
-                field: "energy_budget",
-                reason: "overflows u64: use a coarser power_w_per_code or a slower tick".into(),
-            })?;
+        let weight_total = budget_weight_total(p.power_accounting, frame_ticks);
+        let energy_budget = energy_budget(p.average_power_w, step, weight_total)?;
         let n = p.bins.len();
         let bins = (0..n)
             .map(|i| {
@@ -192,6 +216,31 @@ impl FirmwareTable {
         } else {
             Err(FirmwareError::Rejected(v))
         }
+    }
+
+    /// Parses firmware@1 JSON; `origin` names the source in errors (line
+    /// and column, the field serde names).
+    #[cfg(feature = "json")]
+    pub fn from_json(text: &str, origin: &str) -> Result<Self, crate::profile::IoError> {
+        use crate::profile::IoError;
+        let t: Self = serde_json::from_str(text).map_err(|e| IoError::Json {
+            path: origin.to_owned(),
+            line: e.line(),
+            column: e.column(),
+            message: crate::profile::strip_position(&e.to_string()),
+        })?;
+        if t.format != FIRMWARE_FORMAT {
+            return Err(IoError::Json {
+                path: origin.to_owned(),
+                line: 1,
+                column: 1,
+                message: format!(
+                    "field 'format' is '{}', expected '{FIRMWARE_FORMAT}'",
+                    t.format
+                ),
+            });
+        }
+        Ok(t)
     }
 
     /// Pretty JSON with a trailing newline.

@@ -75,6 +75,24 @@ pub enum FwViolation {
         /// Why.
         reason: String,
     },
+    /// A declared integer limit is looser than the sensor's own (quantized
+    /// the way the table's own limits are).
+    LooserThanSensor {
+        /// The key (`limits.…` of the table).
+        field: &'static str,
+        /// The table's value.
+        declared: u64,
+        /// The sensor's value.
+        sensor: u64,
+    },
+    /// The table does not run the sensor it is checked for (pulse rate,
+    /// frame, accounting, eye-safety parameters, spin as run).
+    SensorMismatch {
+        /// The key.
+        field: &'static str,
+        /// What differs.
+        detail: String,
+    },
     /// Energy in a window of consecutive bins above the eye-safety bound.
     Window {
         /// First bin of the window.
@@ -114,10 +132,33 @@ impl fmt::Display for FwViolation {
                 "eye_safety: the table has no eye-safety parameters (not Class 1 evidence)"
             ),
             Self::EyeSafetyParams { reason } => write!(f, "eye_safety: {reason}"),
+            Self::LooserThanSensor { field, declared, sensor } => {
+                write!(f, "{field} = {declared} is looser than the sensor's {sensor}")
+            }
+            Self::SensorMismatch { field, detail } => write!(f, "{field}: {detail}"),
             Self::Window { bin, energy, limit } => write!(
                 f,
                 "eye safety: energy {energy} in the window starting at bins[{bin}] exceeds limits.window_energy_max {limit}"
             ),
+        }
+    }
+}
+
+impl FwViolation {
+    /// The table key or limit this violation is about.
+    #[must_use]
+    pub fn limit_key(&self) -> &'static str {
+        match self {
+            Self::BinCount { .. } | Self::Coverage { .. } => "bins",
+            Self::FrameTicks { .. } => "frame_ticks",
+            Self::Dwell { .. } => "dwell_ticks",
+            Self::PowerCode { .. } => "power_code",
+            Self::Budget { .. } => "energy_budget",
+            Self::EyeSafety { .. } | Self::EyeSafetyMissing | Self::EyeSafetyParams { .. } => {
+                "eye_safety"
+            }
+            Self::LooserThanSensor { field, .. } | Self::SensorMismatch { field, .. } => field,
+            Self::Window { .. } => "window_energy_max",
         }
     }
 }
@@ -132,27 +173,43 @@ impl fmt::Display for FwViolation {
 #[cfg(feature = "std")]
 #[must_use]
 pub fn check_table(table: &FirmwareTable) -> Vec<FwViolation> {
-    let v = check_integer(table);
+    check_table_evaluated(table).0
+}
+
+/// [`check_table`], keeping the integer eye-safety evaluation it ran
+/// (`None` when the table could not be evaluated: no parameters, a timing
+/// outside the integer bounds, no bins).
+#[cfg(feature = "std")]
+#[must_use]
+pub fn check_table_evaluated(
+    table: &FirmwareTable,
+) -> (Vec<FwViolation>, Option<eye::IntEyeReport>) {
+    let mut v = check_integer(table);
     if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
-        return v;
+        return (v, None);
     }
     match IntEyeLimits::derive(table) {
-        Ok(limits) => {
-            let mut v = v;
-            v.extend(eye_violation(table, &limits));
-            v
-        }
+        Ok(limits) => match eye::evaluate(table, &limits) {
+            Ok(r) => {
+                v.extend(report_violation(&r));
+                (v, Some(r))
+            }
+            Err(e) => {
+                v.push(FwViolation::EyeSafetyParams {
+                    reason: e.to_string(),
+                });
+                (v, None)
+            }
+        },
         Err(eye::DeriveError::Missing) => {
-            let mut v = v;
             v.push(FwViolation::EyeSafetyMissing);
-            v
+            (v, None)
         }
         Err(e) => {
-            let mut v = v;
             v.push(FwViolation::EyeSafetyParams {
                 reason: e.to_string(),
             });
-            v
+            (v, None)
         }
     }
 }
@@ -172,16 +229,20 @@ pub fn check_table_with(table: &FirmwareTable, limits: &IntEyeLimits) -> Vec<FwV
 
 fn eye_violation(table: &FirmwareTable, limits: &IntEyeLimits) -> Option<FwViolation> {
     match eye::evaluate(table, limits) {
-        Ok(r) if r.class1 => None,
-        Ok(r) => Some(FwViolation::EyeSafety {
-            ratio_ppm: r.worst_ratio_ppm,
-            azimuth_mdeg: r.azimuth_mdeg,
-            rule: r.rule.to_string(),
-        }),
+        Ok(r) => report_violation(&r),
         Err(e) => Some(FwViolation::EyeSafetyParams {
             reason: e.to_string(),
         }),
     }
+}
+
+/// The violation an integer eye-safety report implies, if any.
+fn report_violation(r: &eye::IntEyeReport) -> Option<FwViolation> {
+    (!r.class1).then(|| FwViolation::EyeSafety {
+        ratio_ppm: r.worst_ratio_ppm,
+        azimuth_mdeg: r.azimuth_mdeg,
+        rule: r.rule.to_string(),
+    })
 }
 
 /// Every integer violation of `table` (frame, coverage, dwell bounds, codes,

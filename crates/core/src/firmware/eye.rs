@@ -812,10 +812,10 @@ mod derive {
             let arc_mdeg = arc as u32;
             let timing = pass_timing(table, millihz, arc_mdeg)?;
             let step = table.power_w_per_code;
-            if !(step.is_finite() && step > 0.0) {
+            if let Err(reason) = crate::model::valid::positive(step) {
                 return Err(DeriveError::Range {
                     field: "power_w_per_code",
-                    reason: "must be finite and > 0",
+                    reason,
                 });
             }
             let quantum_j = step / f_p;

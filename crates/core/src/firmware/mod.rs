@@ -29,6 +29,8 @@ mod build;
 pub mod check;
 pub mod eye;
 pub mod quantize;
+#[cfg(feature = "std")]
+pub mod sensor;
 
 use alloc::string::String;
 use alloc::vec::Vec;
@@ -38,13 +40,18 @@ use serde::{Deserialize, Serialize};
 use crate::model::accounting::PowerAccounting;
 
 #[cfg(feature = "std")]
-pub use build::{as_run_segments, table_exposure, FirmwareError};
-#[cfg(feature = "std")]
-pub use check::check_table;
+pub use build::{
+    as_run_segments, budget_weight_total, energy_budget, frame_ticks_for, table_exposure,
+    FirmwareError,
+};
 pub use check::{check_integer, check_table_with, FwViolation};
+#[cfg(feature = "std")]
+pub use check::{check_table, check_table_evaluated};
 #[cfg(feature = "std")]
 pub use quantize::floor_code;
 pub use quantize::{apportion, QuantizeError, TickTarget};
+#[cfg(feature = "std")]
+pub use sensor::check_table_for_sensor;
 
 /// The value of the `format` field.
 pub const FIRMWARE_FORMAT: &str = "gaze-lidar/firmware@1";

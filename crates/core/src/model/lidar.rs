@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
 use crate::eye_safety::EyeSafetyParams;
+use crate::model::valid;
 
 pub use super::accounting::PowerAccounting;
 
@@ -86,5 +87,99 @@ impl LidarSpec {
     #[must_use]
     pub fn points_per_turn(&self) -> f64 {
         self.pulse_rate_hz / self.frame_rate_hz
+    }
+}
+
+/// A sensor description that cannot be a sensor: the key (as written in a
+/// sensor file, e.g. `limits.power_w_max`), its value and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field} = {value}: {reason}")]
+pub struct SpecError {
+    /// The key, dotted from the top of the sensor description.
+    pub field: String,
+    /// The value found (NaN when the key is not a number).
+    pub value: f64,
+    /// Why it is refused.
+    pub reason: String,
+}
+
+impl LidarSpec {
+    /// Checks every number of the sensor at the one numeric boundary
+    /// ([`valid`]): rates of physical size, magnitudes finite and not
+    /// subnormal, budgets and maxima `> 0`, no inverted pair, eye-safety
+    /// parameters present and valid. Every rule fails on NaN. The first
+    /// offending key is named.
+    pub fn validate(&self) -> Result<(), SpecError> {
+        let err = |field: &str, value: f64, reason: &str| SpecError {
+            field: field.to_owned(),
+            value,
+            reason: reason.to_owned(),
+        };
+        let check = |field: &str, value: f64, rule: fn(f64) -> Result<f64, valid::Reason>| {
+            rule(value).map(drop).map_err(|r| err(field, value, r))
+        };
+        check("frame_rate_hz", self.frame_rate_hz, valid::rate_hz)?;
+        check("pulse_rate_hz", self.pulse_rate_hz, valid::rate_hz)?;
+        if self.channels == 0 {
+            return Err(err("channels", 0.0, "must be >= 1"));
+        }
+        check("average_power_w", self.average_power_w, valid::positive)?;
+        check("rated_range_m", self.rated_range_m, valid::positive)?;
+        check(
+            "reference_reflectivity",
+            self.reference_reflectivity,
+            valid::positive,
+        )?;
+        if !(self.reference_reflectivity <= 1.0) {
+            return Err(err(
+                "reference_reflectivity",
+                self.reference_reflectivity,
+                "must be <= 1 (a Lambertian reflectivity)",
+            ));
+        }
+        let l = &self.limits;
+        check("limits.power_w_min", l.power_w_min, valid::magnitude)?;
+        check("limits.power_w_max", l.power_w_max, valid::positive)?;
+        check("limits.spin_rad_s_min", l.spin_rad_s_min, valid::magnitude)?;
+        check("limits.spin_rad_s_max", l.spin_rad_s_max, valid::positive)?;
+        if let Some(a) = l.spin_accel_rad_s2_max {
+            check("limits.spin_accel_rad_s2_max", a, valid::magnitude)?;
+        }
+        if let Some(s) = l.power_slew_w_per_deg_max {
+            check("limits.power_slew_w_per_deg_max", s, valid::magnitude)?;
+        }
+        if !valid::ordered(l.power_w_min, l.power_w_max) {
+            return Err(err(
+                "limits.power_w_min",
+                l.power_w_min,
+                "is above limits.power_w_max",
+            ));
+        }
+        if !valid::ordered(l.spin_rad_s_min, l.spin_rad_s_max) {
+            return Err(err(
+                "limits.spin_rad_s_min",
+                l.spin_rad_s_min,
+                "is above limits.spin_rad_s_max",
+            ));
+        }
+        match &l.eye_safety {
+            None => Err(err(
+                "limits.eye_safety",
+                f64::NAN,
+                "missing: a sensor's laser and optics parameters are needed for Class 1",
+            )),
+            Some(params) => params.validate().map(drop).map_err(|e| match e {
+                crate::eye_safety::EyeSafetyError::Param {
+                    field,
+                    value,
+                    reason,
+                } => err(&format!("limits.eye_safety.{field}"), value, reason),
+                crate::eye_safety::EyeSafetyError::Ael(_) => err(
+                    "limits.eye_safety.wavelength_nm",
+                    params.wavelength_nm,
+                    "outside the supported bands (700–1050 nm, 1400–1800 nm)",
+                ),
+            }),
+        }
     }
 }

@@ -7,6 +7,7 @@ pub mod angle;
 pub mod index;
 #[cfg(feature = "std")]
 pub mod lidar;
+pub mod valid;
 
 pub use accounting::PowerAccounting;
 #[cfg(feature = "std")]

@@ -169,7 +169,7 @@ pub enum IoError {
 
 #[cfg(feature = "json")]
 /// serde_json appends " at line L column C"; the error prints them already.
-fn strip_position(msg: &str) -> String {
+pub(crate) fn strip_position(msg: &str) -> String {
     match msg.rfind(" at line ") {
         Some(i) => msg[..i].to_owned(),
         None => msg.to_owned(),
