@@ -657,3 +657,194 @@ fn the_sensor_requires_eye_safety_even_with_the_opt_out() {
     let opts = CheckOptions::for_sensor(&s).allow_missing_eye_safety(true);
     assert_eq!(check_with(&p, &opts), vec![]);
 }
+
+/// Issue 21, item 2, at the library: a NaN in the sensor's limits must not
+/// let a profile through `certify_for_sensor` (the comparison used to be
+/// `x > y`, false against NaN). Every comparison with a NaN sensor limit is
+/// "looser", for upper and lower limits alike. (The CLI refuses such a
+/// sensor file before this point; this is the checker not resting on it.)
+#[test]
+fn nan_sensor_limits_never_pass() {
+    type Change = Box<dyn Fn(&mut LidarSpec)>;
+    let cases: Vec<(&str, Change)> = vec![
+        ("power_w_max", Box::new(|s| s.limits.power_w_max = f64::NAN)),
+        ("power_w_min", Box::new(|s| s.limits.power_w_min = f64::NAN)),
+        (
+            "spin_rad_s_max",
+            Box::new(|s| s.limits.spin_rad_s_max = f64::NAN),
+        ),
+        (
+            "spin_rad_s_min",
+            Box::new(|s| s.limits.spin_rad_s_min = f64::NAN),
+        ),
+        (
+            "spin_accel_rad_s2_max",
+            Box::new(|s| s.limits.spin_accel_rad_s2_max = Some(f64::NAN)),
+        ),
+        (
+            "power_slew_w_per_deg_max",
+            Box::new(|s| s.limits.power_slew_w_per_deg_max = Some(f64::NAN)),
+        ),
+        (
+            "average_power_w",
+            Box::new(|s| s.average_power_w = f64::NAN),
+        ),
+        ("pulse_rate_hz", Box::new(|s| s.pulse_rate_hz = f64::NAN)),
+        ("frame_rate_hz", Box::new(|s| s.frame_rate_hz = f64::NAN)),
+    ];
+    for (key, change) in cases {
+        let mut s = sensor();
+        change(&mut s);
+        let err = certify_for_sensor(uniform(), &s).unwrap_err();
+        assert!(keys(&err.violations).contains(&key), "{key}: {err}");
+        assert!(s.validate().is_err(), "{key}");
+    }
+}
+
+/// Issue 21, item 3: subnormal rates were certified (`frame_rate_hz:
+/// 5e-324` gave an infinite expected period, which matched any dwell sum
+/// within a relative tolerance). Every rate outside 1e-9..=1e12 Hz and every
+/// subnormal number of the header, limits and bins is a violation naming
+/// its key; 1e-9 and 1e12 themselves are only judged by the other rules.
+#[test]
+fn subnormal_and_unphysical_numbers_are_rejected_naming_the_key() {
+    for bad in [5e-324, 4e-309, 1e-300, 9.9e-10, 1.1e12] {
+        let mut p = uniform();
+        p.frame_rate_hz = bad;
+        let v = check(&p);
+        assert!(
+            v.iter().any(|x| matches!(
+                x,
+                Violation::Header {
+                    field: "frame_rate_hz",
+                    ..
+                }
+            )),
+            "{bad}: {v:?}"
+        );
+        let mut p = uniform();
+        p.pulse_rate_hz = bad;
+        assert!(keys(&check(&p)).contains(&"pulse_rate_hz"), "{bad}");
+    }
+    let sub = f64::from_bits(1);
+    let mut p = uniform();
+    p.average_power_w = sub;
+    assert!(keys(&check(&p)).contains(&"average_power_w"));
+    let mut p = uniform();
+    p.limits.power_w_max = sub;
+    assert!(check(&p).iter().any(|x| matches!(
+        x,
+        Violation::BadLimit {
+            field: "power_w_max",
+            ..
+        }
+    )));
+    let mut p = uniform();
+    p.limits.spin_accel_rad_s2_max = Some(sub);
+    assert!(keys(&check(&p)).contains(&"spin_accel_rad_s2_max"));
+    for field in 0..3 {
+        let mut p = uniform();
+        match field {
+            0 => p.bins[4].power_w = sub,
+            1 => p.bins[4].width_deg = sub,
+            _ => p.bins[4].spin_end_rad_s = sub,
+        }
+        assert!(
+            check(&p)
+                .iter()
+                .any(|x| matches!(x, Violation::BinField { bin: 4, .. })),
+            "{field}"
+        );
+    }
+    // Inverted limits are named once each (not also as NaN).
+    let mut p = uniform();
+    p.limits.power_w_min = 3e-4;
+    p.limits.spin_rad_s_min = 90.0;
+    let bad: Vec<_> = check(&p)
+        .into_iter()
+        .filter(|x| matches!(x, Violation::BadLimit { .. }))
+        .collect();
+    assert_eq!(bad.len(), 2, "{bad:?}");
+}
+
+/// `LidarSpec::validate`: each key refused for NaN, infinity, a negative or
+/// subnormal value, or an inverted pair, and named in the error; a valid
+/// sensor passes.
+#[test]
+fn sensor_validation_names_the_key() {
+    assert_eq!(sensor().validate(), Ok(()));
+    type Change = Box<dyn Fn(&mut LidarSpec, f64)>;
+    let keys: Vec<(&str, Change)> = vec![
+        ("frame_rate_hz", Box::new(|s, x| s.frame_rate_hz = x)),
+        ("pulse_rate_hz", Box::new(|s, x| s.pulse_rate_hz = x)),
+        ("average_power_w", Box::new(|s, x| s.average_power_w = x)),
+        ("rated_range_m", Box::new(|s, x| s.rated_range_m = x)),
+        (
+            "reference_reflectivity",
+            Box::new(|s, x| s.reference_reflectivity = x),
+        ),
+        (
+            "limits.power_w_min",
+            Box::new(|s, x| s.limits.power_w_min = x),
+        ),
+        (
+            "limits.power_w_max",
+            Box::new(|s, x| s.limits.power_w_max = x),
+        ),
+        (
+            "limits.spin_rad_s_min",
+            Box::new(|s, x| s.limits.spin_rad_s_min = x),
+        ),
+        (
+            "limits.spin_rad_s_max",
+            Box::new(|s, x| s.limits.spin_rad_s_max = x),
+        ),
+        (
+            "limits.spin_accel_rad_s2_max",
+            Box::new(|s, x| s.limits.spin_accel_rad_s2_max = Some(x)),
+        ),
+        (
+            "limits.power_slew_w_per_deg_max",
+            Box::new(|s, x| s.limits.power_slew_w_per_deg_max = Some(x)),
+        ),
+        (
+            "limits.eye_safety.beam_diameter_mm",
+            Box::new(|s, x| {
+                s.limits.eye_safety.as_mut().unwrap().beam_diameter_mm = x;
+            }),
+        ),
+        (
+            "limits.eye_safety.wavelength_nm",
+            Box::new(|s, x| s.limits.eye_safety.as_mut().unwrap().wavelength_nm = x),
+        ),
+    ];
+    for (key, change) in &keys {
+        for bad in [f64::NAN, f64::INFINITY, -1.0, f64::from_bits(1)] {
+            let mut s = sensor();
+            change(&mut s, bad);
+            let e = s.validate().expect_err(key);
+            assert_eq!(e.field, *key, "{bad}: {e}");
+            assert!(e.to_string().starts_with(key), "{e}");
+        }
+    }
+    let mut s = sensor();
+    s.limits.power_w_min = 3e-4;
+    assert_eq!(s.validate().unwrap_err().field, "limits.power_w_min");
+    let mut s = sensor();
+    s.limits.spin_rad_s_min = 90.0;
+    assert_eq!(s.validate().unwrap_err().field, "limits.spin_rad_s_min");
+    let mut s = sensor();
+    s.reference_reflectivity = 1.5;
+    assert_eq!(s.validate().unwrap_err().field, "reference_reflectivity");
+    let mut s = sensor();
+    s.channels = 0;
+    assert_eq!(s.validate().unwrap_err().field, "channels");
+    let mut s = sensor();
+    s.limits.eye_safety = None;
+    assert_eq!(s.validate().unwrap_err().field, "limits.eye_safety");
+    // Unlimited (None) optional limits are valid.
+    let mut s = sensor();
+    s.limits.spin_accel_rad_s2_max = None;
+    s.limits.power_slew_w_per_deg_max = None;
+    assert_eq!(s.validate(), Ok(()));
+}

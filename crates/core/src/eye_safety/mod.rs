@@ -75,14 +75,13 @@ impl EyeSafetyParams {
                 reason: "must be finite, > 0 and within Table 3's durations for the band",
             }
         })?;
-        if !(self.beam_diameter_mm.is_finite()
-            && self.beam_diameter_mm > 0.0
+        if !(crate::model::valid::positive(self.beam_diameter_mm).is_ok()
             && self.beam_diameter_mm < 1000.0)
         {
             return Err(EyeSafetyError::Param {
                 field: "beam_diameter_mm",
                 value: self.beam_diameter_mm,
-                reason: "must be finite, > 0 and < 1000",
+                reason: "must be finite, > 0 (not subnormal) and < 1000",
             });
         }
         Ok(band)
