@@ -106,6 +106,48 @@ fn subnormal_rates_are_never_certified() {
     }
 }
 
+/// Flags pass the same boundary: a subnormal DAC step, pulse rate or beam
+/// diameter is bad input (exit 2) naming the flag.
+#[test]
+fn subnormal_flags_are_bad_input() {
+    let o = run(
+        &[
+            "profile",
+            "--preset",
+            "paper",
+            "--mode",
+            "range",
+            "--gaze-deg",
+            "90",
+            "--format",
+            "firmware",
+            "--power-w-per-code",
+            "5e-324",
+        ],
+        None,
+    );
+    assert_bad_input(&o, "power_w_per_code");
+    for (flag, value) in [
+        ("--pulse-rate-hz", "5e-324"),
+        ("--pulse-rate-hz", "4e-309"),
+        ("--beam-diameter-mm", "5e-324"),
+    ] {
+        let o = run(
+            &[
+                "ael",
+                "--wavelength-nm",
+                "905",
+                "--pulse-duration-s",
+                "5e-9",
+                flag,
+                value,
+            ],
+            None,
+        );
+        assert_bad_input(&o, flag);
+    }
+}
+
 /// Issue 21, item 2: `power_w_max = nan` in a sensor file certified a
 /// profile declaring 2 mW (the paper sensor allows 1.25 mW); a negative
 /// budget or `power_w_min > power_w_max` was blamed on the profile (exit 1).
@@ -435,4 +477,53 @@ fn tables_against_the_wrong_sensor_and_broken_tables() {
     assert_eq!(code, Some(1));
     let v: Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["certified"], false);
+}
+
+/// The `firmware_check` fuzz target's oracle, on its committed seeds and on
+/// real and tampered tables: the integer rules accept exactly the tables
+/// the integer restatement accepts, `check_table` keeps every integer
+/// violation and certifies only tables within their integer limits.
+#[test]
+fn check_table_agrees_with_the_integer_restatement() {
+    use gaze_lidar::firmware::check::within_integer_limits;
+    use gaze_lidar::firmware::{check_integer, check_table};
+    let dir = tempfile::tempdir().unwrap();
+    let mut tables = Vec::new();
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/firmware_check");
+    for e in std::fs::read_dir(seeds).unwrap() {
+        if let Ok(t) = binary::decode(&std::fs::read(e.unwrap().path()).unwrap()) {
+            tables.push(t);
+        }
+    }
+    for preset in ["paper", "vls128"] {
+        let (json, _) = table_files(dir.path(), preset);
+        let t = FirmwareTable::from_json(&std::fs::read_to_string(&json).unwrap(), "t").unwrap();
+        for k in 0..6 {
+            let mut u = t.clone();
+            match k {
+                0 => {}
+                1 => u.bins[3].power_code += 1_000,
+                2 => u.bins[3].width_mdeg += 1,
+                3 => u.bins[3].dwell_ticks += 1,
+                4 => u.limits.energy_budget /= 2,
+                _ => u.eye_safety = None,
+            }
+            tables.push(u);
+        }
+    }
+    let (mut accepted, mut rejected) = (0, 0);
+    for t in &tables {
+        let within = within_integer_limits(t);
+        let integer = check_integer(t);
+        assert_eq!(integer.is_empty(), within, "{integer:?}");
+        let full = check_table(t);
+        assert!(integer.iter().all(|v| full.contains(v)));
+        if full.is_empty() {
+            assert!(within && t.eye_safety.is_some());
+            accepted += 1;
+        } else {
+            rejected += 1;
+        }
+    }
+    assert!(accepted >= 2 && rejected >= 8, "{accepted} {rejected}");
 }

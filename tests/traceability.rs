@@ -594,3 +594,163 @@ fn cover_check_finds_unasserted_covers() {
     let missing: Vec<_> = covered.difference(&asserted).cloned().collect();
     assert_eq!(missing, vec!["zero".to_owned()]);
 }
+
+// ---------------------------------------------------------------------------
+// Every requirement ID cited anywhere exists, and a harness cites the
+// requirements that list it.
+
+/// `REQ-LETTERS-DIGITS` IDs in `text`, in order.
+fn cited_req_ids(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = text;
+    while let Some(i) = rest.find("REQ-") {
+        let after = &rest[i + 4..];
+        let letters = after
+            .find(|c: char| !c.is_ascii_uppercase())
+            .unwrap_or(after.len());
+        let tail = &after[letters..];
+        if letters > 0 && tail.starts_with('-') {
+            let digits = tail[1..]
+                .find(|c: char| !c.is_ascii_digit())
+                .unwrap_or(tail.len() - 1);
+            if digits > 0 {
+                out.push(format!(
+                    "REQ-{}-{}",
+                    &after[..letters],
+                    &tail[1..1 + digits]
+                ));
+            }
+        }
+        rest = &rest[i + 4..];
+    }
+    out
+}
+
+/// Source, script and documentation files of the repository (no build
+/// output, no fuzz corpora, not the table itself).
+fn cited_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if p.is_dir() {
+            if !(name.starts_with('.')
+                || [
+                    "target",
+                    "corpus",
+                    "artifacts",
+                    "node_modules",
+                    "__pycache__",
+                ]
+                .contains(&name.as_str()))
+            {
+                cited_files(&p, out);
+            }
+        } else if p.extension().is_some_and(|x| {
+            ["rs", "py", "pyi", "md", "sh", "toml", "tex"]
+                .iter()
+                .any(|e| x == *e)
+        }) && p != root().join("specs/traceability.toml")
+            && name != "Cargo.lock"
+        {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn every_cited_requirement_exists() {
+    let text = std::fs::read_to_string(root().join("specs/traceability.toml")).unwrap();
+    let spec: Spec = toml::from_str(&text).unwrap();
+    let ids: BTreeSet<&str> = spec.requirement.iter().map(|r| r.id.as_str()).collect();
+    let mut files = Vec::new();
+    cited_files(&root(), &mut files);
+    let mut cited = 0;
+    let mut missing = Vec::new();
+    for f in &files {
+        let Ok(text) = std::fs::read_to_string(f) else {
+            continue;
+        };
+        for (n, line) in text.lines().enumerate() {
+            for id in cited_req_ids(line) {
+                cited += 1;
+                if !ids.contains(id.as_str()) {
+                    let rel = f.strip_prefix(root()).unwrap().display().to_string();
+                    missing.push(format!("{rel}:{}: {id}", n + 1));
+                }
+            }
+        }
+    }
+    assert!(
+        cited >= 20,
+        "only {cited} citations found: the scan is broken"
+    );
+    assert!(
+        missing.is_empty(),
+        "cited but not in specs/traceability.toml:\n{}",
+        missing.join("\n")
+    );
+}
+
+/// A proof harness's doc comment cites requirements; each of them must list
+/// the harness in its `kani` entry (so the comment and the table agree).
+#[test]
+fn harness_doc_comments_cite_the_requirements_that_list_them() {
+    let text = std::fs::read_to_string(root().join("specs/traceability.toml")).unwrap();
+    let spec: Spec = toml::from_str(&text).unwrap();
+    let mut files = Vec::new();
+    rust_files(&root().join("src"), &mut files);
+    rust_files(&root().join("crates/core/src"), &mut files);
+    let mut problems = Vec::new();
+    let mut checked = 0;
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        for (i, l) in lines.iter().enumerate() {
+            if !(l.contains("kani::proof") && l.trim_start().starts_with("#[")) {
+                continue;
+            }
+            let name = lines[i..]
+                .iter()
+                .find_map(|l| {
+                    l.trim_start()
+                        .strip_prefix("fn ")
+                        .map(|r| r.split('(').next().unwrap_or("").to_owned())
+                })
+                .unwrap();
+            // The doc comment: the `///` lines right above the attributes.
+            let doc: String = lines[..i]
+                .iter()
+                .rev()
+                .take_while(|l| l.trim_start().starts_with("///"))
+                .copied()
+                .collect::<Vec<_>>()
+                .join("\n");
+            let cited = cited_req_ids(&doc);
+            if cited.is_empty() {
+                problems.push(format!("{name}: doc comment cites no requirement"));
+            }
+            for id in cited {
+                checked += 1;
+                match spec.requirement.iter().find(|r| r.id == id) {
+                    Some(r) if r.kani.contains(&name) => {}
+                    Some(_) => problems.push(format!("{name}: cites {id}, which does not list it")),
+                    None => problems.push(format!("{name}: cites {id}, which does not exist")),
+                }
+            }
+        }
+    }
+    assert!(checked >= 10, "{checked}");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The ID scanner can fail: it finds IDs in prose and code, and an ID that
+/// is not in the table is reported (built here so that this file cites none).
+#[test]
+fn req_id_scanner_finds_ids() {
+    let bogus = format!("REQ-{}-{}", "ZZ", 9);
+    let text = format!("/// {bogus}: text; see REQ-FW-3, (REQ-IN-1) and REQ-x-1, REQ-AB-, REQ-");
+    assert_eq!(
+        cited_req_ids(&text),
+        vec![bogus, "REQ-FW-3".into(), "REQ-IN-1".into()]
+    );
+}

@@ -49,10 +49,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         )));
     }
     if let Some(r) = a.pulse_rate_hz {
-        if !(r.is_finite() && r > 0.0) {
-            return Err(CliError::input(format!(
-                "--pulse-rate-hz: {r} must be finite and > 0"
-            )));
+        if let Err(reason) = gaze_lidar::model::valid::rate_hz(r) {
+            return Err(CliError::input(format!("--pulse-rate-hz: {r}: {reason}")));
         }
         // Pulses of this duration at this rate would overlap: not a pulse train.
         if r * a.pulse_duration_s >= 1.0 {
@@ -64,10 +62,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
     }
     let pass_angle_deg = match a.beam_diameter_mm {
-        Some(d) if d.is_finite() && d > 0.0 => Some(d),
+        Some(d) if gaze_lidar::model::valid::positive(d).is_ok() => Some(d),
         Some(d) => {
             return Err(CliError::input(format!(
-                "--beam-diameter-mm: {d} must be finite and > 0"
+                "--beam-diameter-mm: {d} must be finite and > 0 (not subnormal)"
             )))
         }
         None => None,

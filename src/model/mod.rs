@@ -4,7 +4,7 @@
 //! ([`gaze_lidar_core::model`]) and are re-exported here.
 
 pub mod acuity;
-pub use gaze_lidar_core::model::{angle, lidar};
+pub use gaze_lidar_core::model::{angle, lidar, valid};
 pub mod presets;
 pub mod sensor;
 

@@ -219,7 +219,7 @@ mod verification {
     use super::*;
     use crate::verification::{cover, for_all};
 
-    /// REQ-IN-3: decoding any byte string never panics; whatever decodes
+    /// REQ-FW-4, REQ-IN-1: decoding any byte string never panics; whatever decodes
     /// has a consistent length.
     #[cfg_attr(kani, kani::proof, kani::unwind(4))]
     #[cfg_attr(not(kani), test)]
@@ -252,7 +252,7 @@ mod verification {
         crate::verification::assert_covered(&["a record decodes", "garbage is rejected"]);
     }
 
-    /// REQ-FW-5: encode then decode is the identity on the integer content.
+    /// REQ-FW-4: encode then decode is the identity on the integer content.
     #[cfg_attr(kani, kani::proof, kani::unwind(4))]
     #[cfg_attr(not(kani), test)]
     fn encode_decode_round_trip() {

@@ -95,11 +95,11 @@ impl FirmwareTable {
         }
         let f = cfg.tick_hz as f64;
         let step = cfg.power_w_per_code.unwrap_or(l.power_w_max / 4095.0);
-        if !(step.is_finite() && step > 0.0) {
+        if crate::model::valid::positive(step).is_err() {
             return Err(FirmwareError::Config {
                 field: "power_w_per_code",
                 reason: format!(
-                    "{step} must be finite and > 0 (power_w_max must be > 0 for the default)"
+                    "{step} must be finite, > 0 and not subnormal (power_w_max must be > 0 for the default)"
                 ),
             });
         }

@@ -921,8 +921,19 @@ mod verification {
     use crate::verification::cover;
     use alloc::borrow::ToOwned;
 
+    /// Most bins a harness table has.
+    const HARNESS_BINS: usize = 3;
+    /// The unwind bound of the harnesses below. The longest loops of
+    /// `for_each_cell` and `evaluate` run once per entry of the bins unrolled
+    /// over three turns (`3 · n` ≤ 9: the interval list, its prefix sums, the
+    /// `lo`/`hi`/`mid` sweeps and the greedy walk over the touched entries);
+    /// the cell loop runs over at most `2 · n` ≤ 6 breakpoints, the train
+    /// buckets are 2. Kani needs one more unwinding than the most iterations
+    /// (`harness_unwind_covers_the_loops` checks the attributes against it).
+    const HARNESS_UNWIND: usize = 3 * HARNESS_BINS + 1;
+
     /// Up to three raw bins: (width, dwell, code).
-    type RawBins = [(u32, u64, u32); 3];
+    type RawBins = [(u32, u64, u32); HARNESS_BINS];
 
     /// A table within the format's and the evaluation's bounds: widths sum to
     /// 360,000 mdeg, dwells (each ≥ 1) to `frame_ticks ≤ MAX_FRAME_TICKS`.
@@ -1011,7 +1022,7 @@ mod verification {
     /// Evaluates one table at the bounds; returns (extreme three-bin table, class 1).
     fn no_overflow(input: OverflowInput) -> (bool, bool) {
         let (raw, n, tick, frame, millihz, arc, extreme, l) = input;
-        let n = 1 + usize::from(n % 3);
+        let n = 1 + usize::from(n) % HARNESS_BINS;
         // Bounds of the evaluation (`check_bounds`): every value within them.
         let mut tick_hz = 1 + tick % MAX_TICK_HZ;
         let mut frame_ticks = n as u64 + frame % (MAX_FRAME_TICKS - n as u64 + 1);
@@ -1054,7 +1065,7 @@ mod verification {
     /// is per cell, so three bins exercise every product), any `u32` code,
     /// `frame_ticks ≤ 2^44`, `tick_hz ≤ 2^34`, pulse rate ≤ 2^40 mHz and
     /// fewer than 2^40 pulses per turn.
-    #[cfg_attr(kani, kani::proof, kani::unwind(8))]
+    #[cfg_attr(kani, kani::proof, kani::unwind(10))]
     #[cfg_attr(not(kani), test)]
     fn eye_sums_never_overflow_within_format_bounds() {
         crate::for_all!(OverflowInput, |x| {
@@ -1078,7 +1089,7 @@ mod verification {
     /// Returns (non-zero shift, three bins, class 1).
     fn rotation_keeps_verdict(input: RotationInput) -> (bool, bool, bool) {
         let (raw, n, shift, millihz, arc, (code_max, e1, split, e_pass)) = input;
-        let n = 1 + usize::from(n % 3);
+        let n = 1 + usize::from(n) % HARNESS_BINS;
         let raw3: RawBins = [0, 1, 2].map(|i| {
             (
                 u32::from(raw[i].0) * 8,
@@ -1107,7 +1118,7 @@ mod verification {
     /// REQ-FW-5: a cyclic rotation of a table (where the turn starts) keeps
     /// the integer eye-safety verdict and its worst ratio: the aperture cells
     /// are the same arcs, shifted.
-    #[cfg_attr(kani, kani::proof, kani::unwind(8))]
+    #[cfg_attr(kani, kani::proof, kani::unwind(10))]
     #[cfg_attr(not(kani), test)]
     fn rotation_keeps_integer_verdict() {
         crate::for_all!(RotationInput, |x| {
@@ -1124,5 +1135,39 @@ mod verification {
                 "an accepted three-bin table rotated",
             ]);
         }
+    }
+
+    /// The harnesses' unwind bounds cover their loops: each is at least
+    /// `HARNESS_UNWIND` (one more than the `3 · HARNESS_BINS` iterations of
+    /// the longest loop), and the tables they build never have more bins.
+    #[test]
+    fn harness_unwind_covers_the_loops() {
+        let src = include_str!("eye.rs");
+        for name in [
+            "eye_sums_never_overflow_within_format_bounds",
+            "rotation_keeps_integer_verdict",
+        ] {
+            let at = src.find(&alloc::format!("fn {name}()")).expect(name);
+            let attr = src[..at].rfind("kani::unwind(").expect(name) + "kani::unwind(".len();
+            let bound: usize = src[attr..]
+                .split(')')
+                .next()
+                .and_then(|x| x.parse().ok())
+                .expect(name);
+            assert!(
+                bound >= HARNESS_UNWIND,
+                "{name}: unwind({bound}) < {HARNESS_UNWIND}"
+            );
+        }
+        // The unrolled loop really is 3·n long for the largest harness table.
+        let t = table(&[(1, 1, 1); HARNESS_BINS], HARNESS_BINS, 1000, 3 * 100);
+        assert_eq!(t.bins.len(), HARNESS_BINS);
+        let mut cells = 0usize;
+        for_each_cell(&t, clock_of(&t, 1000), 10, |_| {
+            cells += 1;
+            Ok(())
+        })
+        .unwrap();
+        assert!(cells <= 2 * HARNESS_BINS && 3 * HARNESS_BINS < HARNESS_UNWIND);
     }
 }

@@ -149,7 +149,7 @@ mod verification {
     use super::*;
     use crate::verification::{cover, for_all};
 
-    /// REQ-FW-6: whatever the quantizer returns passes the integer checker's
+    /// REQ-FW-1: whatever the quantizer returns passes the integer checker's
     /// frame and dwell rules (quantizer and checker agree).
     #[cfg_attr(kani, kani::proof, kani::unwind(6))]
     #[cfg_attr(not(kani), test)]

@@ -804,7 +804,7 @@ mod verification {
         crate::verification::assert_covered(&["last bin wraps to the first"]);
     }
 
-    /// REQ-IDX-2: rotating an index never overflows, stays in bounds and
+    /// REQ-IDX-1: rotating an index never overflows, stays in bounds and
     /// equals modular addition, for any shift (a gaze index of any size).
     #[cfg_attr(kani, kani::proof)]
     #[cfg_attr(not(kani), test)]
@@ -822,7 +822,7 @@ mod verification {
         crate::verification::assert_covered(&["shift near usize::MAX"]);
     }
 
-    /// REQ-IDX-3: rotating by `s` then by `n − s mod n` is the identity (the
+    /// REQ-IDX-1: rotating by `s` then by `n − s mod n` is the identity (the
     /// fast path's rotated profile maps back onto the original bins).
     #[cfg_attr(kani, kani::proof)]
     #[cfg_attr(not(kani), test)]
