@@ -99,7 +99,7 @@ impl FirmwareTable {
             return Err(FirmwareError::Config {
                 field: "power_w_per_code",
                 reason: format!(
-                    "{step} must be finite, > 0 and not subnormal (power_w_max must be > 0 for the default)"
+                    "{step} must be finite and > 0, not subnormal (power_w_max must be > 0 for the default)"
                 ),
             });
         }
