@@ -4,6 +4,9 @@
 //! ([`super::FirmwareTable::from_certified`]), and the table runs the
 //! sensor's laser, pulse clock and frame (floating point: `std` only).
 
+// Negated comparisons (`!(x <= limit)`) are deliberate: a NaN must fail.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use alloc::format;
 use alloc::vec::Vec;
 

@@ -130,7 +130,7 @@ impl LidarSpec {
             self.reference_reflectivity,
             valid::positive,
         )?;
-        if !(self.reference_reflectivity <= 1.0) {
+        if !valid::ordered(self.reference_reflectivity, 1.0) {
             return Err(err(
                 "reference_reflectivity",
                 self.reference_reflectivity,

@@ -27,7 +27,8 @@ pub type Reason = &'static str;
 
 /// A rate in Hz (see the module docs).
 pub fn rate_hz(x: f64) -> Result<f64, Reason> {
-    if x.is_finite() && x >= RATE_HZ_MIN && x <= RATE_HZ_MAX {
+    // `contains` is false on NaN (both of its comparisons are).
+    if (RATE_HZ_MIN..=RATE_HZ_MAX).contains(&x) {
         Ok(x)
     } else {
         Err("must be a finite rate within 1e-9..=1e12 Hz")
