@@ -49,8 +49,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         )));
     }
     if let Some(r) = a.pulse_rate_hz {
-        if let Err(reason) = gaze_lidar::model::valid::rate_hz(r) {
-            return Err(CliError::input(format!("--pulse-rate-hz: {r}: {reason}")));
+        if !(r.is_finite() && r > 0.0) {
+            return Err(CliError::input(format!(
+                "--pulse-rate-hz: {r} must be finite and > 0"
+            )));
         }
         // Pulses of this duration at this rate would overlap: not a pulse train.
         if r * a.pulse_duration_s >= 1.0 {
@@ -59,6 +61,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 a.pulse_duration_s,
                 r * a.pulse_duration_s
             )));
+        }
+        // The one numeric boundary: a rate of physical size (not subnormal).
+        if let Err(reason) = gaze_lidar::model::valid::rate_hz(r) {
+            return Err(CliError::input(format!("--pulse-rate-hz: {r:e}: {reason}")));
         }
     }
     let pass_angle_deg = match a.beam_diameter_mm {
