@@ -65,10 +65,26 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
         super::table::Input::Text(text) => text,
     };
-    let profile = if a.file.as_os_str() == "-" {
-        Profile::from_json(&text, "<stdin>")?
+    let name = if a.file.as_os_str() == "-" {
+        "<stdin>"
     } else {
-        Profile::from_json(&text, &origin)?
+        origin.as_str()
+    };
+    let profile = match Profile::from_json(&text, name) {
+        Ok(p) => p,
+        Err(e) => {
+            let Some(table) = super::table::table_json(&text, name) else {
+                return Err(e.into());
+            };
+            let sensor = sensor_of(a)?;
+            return super::table::check(
+                &table?,
+                &origin,
+                sensor.as_ref(),
+                a.format,
+                a.no_eye_safety,
+            );
+        }
     };
     drop(text);
     let sensor = sensor_of(a)?;

@@ -25,27 +25,29 @@ pub enum Input {
     Table(FirmwareTable),
 }
 
-/// Sorts the bytes of `check`'s input: the binary encoding by its magic, a
-/// firmware@1 JSON by its `format`, anything else is text for the profile
-/// reader.
+/// Sorts the bytes of `check`'s input: the binary encoding by its magic;
+/// anything else is text for the profile reader (a firmware@1 JSON is
+/// recognised by [`table_json`] when the profile reader refuses it, so a
+/// profile costs no second pass).
 pub fn classify(bytes: Vec<u8>, path: &Path, origin: &str) -> Result<Input, CliError> {
     if bytes.starts_with(binary::MAGIC) {
         return binary::decode(&bytes)
             .map(Input::Table)
             .map_err(|e| CliError::input(format!("{origin}: firmware-bin: {e}")));
     }
-    let text = utf8(bytes, path)?;
+    Ok(Input::Text(utf8(bytes, path)?))
+}
+
+/// A text the profile reader refused, read as a firmware@1 table if its
+/// `format` says so (`None`: not a table; the profile's error stands).
+pub fn table_json(text: &str, origin: &str) -> Option<Result<FirmwareTable, CliError>> {
     #[derive(serde::Deserialize)]
     struct Head {
         format: String,
     }
-    // Only a text that names the table format is parsed twice.
-    if text.contains(FIRMWARE_FORMAT)
-        && serde_json::from_str::<Head>(&text).is_ok_and(|h| h.format == FIRMWARE_FORMAT)
-    {
-        return Ok(Input::Table(FirmwareTable::from_json(&text, origin)?));
-    }
-    Ok(Input::Text(text))
+    let is_table = text.contains(FIRMWARE_FORMAT)
+        && serde_json::from_str::<Head>(text).is_ok_and(|h| h.format == FIRMWARE_FORMAT);
+    is_table.then(|| FirmwareTable::from_json(text, origin).map_err(CliError::from))
 }
 
 fn summary(t: &FirmwareTable) -> serde_json::Value {
