@@ -1044,9 +1044,13 @@ mod verification {
                 - 1)
                 / u128::from(frame_ticks);
         // ≥ 62 mHz even at 1 Hz ticks and the longest frame.
+        let drawn = millihz;
         millihz = millihz
             .min(u64::try_from(allowed).unwrap_or(u64::MAX))
             .max(1);
+        // The assumption "fewer than 2^40 pulses per turn" is active (the
+        // clamp lowered the drawn rate), so the corner it bounds is reached.
+        cover!(millihz < drawn, "pulse rate clamped to the per-turn bound");
         let arc_mdeg = 1 + arc % (FULL_TURN_MDEG / 2 - 1);
         let t = table(&raw, n, tick_hz, frame_ticks);
         let lim = limits(&t, millihz, arc_mdeg, l);
@@ -1077,6 +1081,7 @@ mod verification {
         #[cfg(not(kani))]
         {
             crate::verification::assert_covered(&[
+                "pulse rate clamped to the per-turn bound",
                 "extreme three-bin table evaluated",
                 "a table over its limits evaluated",
                 "a table within its limits evaluated",
