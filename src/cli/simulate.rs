@@ -6,7 +6,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use gaze_lidar::sim::{
-    self, Arrival, Detector, Geometry, KOfN, ModelKind, Scenario, SimConfig, Variant,
+    self, Arrival, Detector, Geometry, KOfN, ModelKind, Sampling, Scenario, SimConfig, Variant,
     FOG_LEVELS_PCT,
 };
 
@@ -59,6 +59,13 @@ pub struct Args {
     /// `argus-centre` (the centre does, as the paper's code).
     #[arg(long, value_enum, default_value_t = Arrival::Front)]
     arrival: Arrival,
+    /// How the LiDAR fires (`--geometry carla` only; default `carla`):
+    /// `carla` (CARLA's fixed tick: round(rate·tick) points per laser per
+    /// tick over the tick's rotation), `carla-async` (the same with each
+    /// tick's length jittered by `[carla] async_tick_jitter_frac`, assumed)
+    /// or `drift` (pulses at k / pulse rate, the planar geometry's clock).
+    #[arg(long, value_enum)]
+    sampling: Option<Sampling>,
     /// Detection rule k-of-n frames, e.g. `2/3` (paper: first return, `1/1`).
     #[arg(long, default_value = "1/1")]
     detect: String,
@@ -234,6 +241,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         geometry: a.geometry,
         detector: a.detector,
         arrival: a.arrival,
+        sampling: a.sampling,
         #[cfg(feature = "solver")]
         optimizer,
         ..SimConfig::default()
@@ -299,14 +307,25 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 ..config.clone()
             };
             let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
-            Some((r, pc))
+            // Clear air under the other sampling, for the comparison.
+            let oc = SimConfig {
+                fog_pcts: vec![0],
+                sampling: Some(match pc.sampling() {
+                    Sampling::Drift => Sampling::Carla,
+                    _ => Sampling::Drift,
+                }),
+                ..pc.clone()
+            };
+            let o = sim::run(&oc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
+            Some(((r, pc), (o, oc)))
         } else {
             None
         };
-        let md = sim::report::render_with_pipeline(
+        let md = sim::report::render_with_pipelines(
             &result,
             &config,
-            pipeline.as_ref().map(|(r, c)| (r, c)),
+            pipeline.as_ref().map(|((r, c), _)| (r, c)),
+            pipeline.as_ref().map(|(_, (o, oc))| (o, oc)),
         );
         outputs.add(path, md);
     }

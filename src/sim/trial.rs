@@ -383,3 +383,244 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
         channels_simulated: 1,
     }
 }
+
+/// One cell of a planar group: what differs between cells that share a
+/// trial, a timeline and the driver's regions.
+#[derive(Debug, Clone, Copy)]
+pub struct GroupCell<'a> {
+    /// The certified profile the LiDAR runs (its timeline is the group's).
+    pub profile: &'a Profile,
+    /// Fraction of RoF points kept.
+    pub rof_keep: f64,
+    /// Return model at this fog level.
+    pub model: &'a ReturnModel,
+    /// Driver's visual range in this fog (MOR), m.
+    pub driver_range_m: f64,
+}
+
+/// Per-cell state of [`run_group`].
+struct GroupState {
+    power_ratio: Vec<f64>,
+    detected_at: [Option<f64>; 2],
+    driver_at: [Option<f64>; 2],
+    hit_frames: [Vec<u64>; 2],
+    roi_points: u64,
+    argus_roi_points: u64,
+    keep_acc: f64,
+}
+
+/// [`run_trial`] for several cells at once, bit-identical to running each
+/// alone: `setup`'s profile, regions, scene and rules are the group's
+/// (every cell's profile must put every pulse at the same azimuth —
+/// [`super::carla::same_timeline`] — and share the regions), and
+/// `setup.model`, `rof_keep`, `driver_range_m` are ignored in favour of the
+/// cells'. A pulse's azimuth, region tests and ray cast are computed once;
+/// each cell then decides its own return (its power and model), in the
+/// order [`run_trial`] does. Outcomes in the cells' order.
+#[must_use]
+pub fn run_group(setup: &TrialSetup<'_>, cells: &[GroupCell<'_>], draw: &TrialDraw) -> Vec<TrialOutcome> {
+    let sc = setup.scenario;
+    let tl = Timeline::new(setup.profile);
+    let period = tl.period_s();
+    let pulse_rate = setup.profile.pulse_rate_hz;
+    let v = sc.speed_m_s();
+    let lane_x = sc.lane_x_m();
+    let half_w = 0.5 * sc.vehicle_width_m;
+    let len = sc.vehicle_length_m;
+    let ch = sc.conflict_half_width_m;
+    let Crossing {
+        front0_m: front0,
+        dir,
+        t_arrive_s: t_conflict,
+    } = draw.crossing(
+        sc.bend_distance_m,
+        ch,
+        setup.arrival.extra_distance_m(len),
+        v,
+    );
+    let t_end = t_conflict[0].max(t_conflict[1]);
+    let car_box = |j: usize, t: f64| -> Aabb {
+        let front = front0[j] + dir[j] * v * t;
+        let back = front - dir[j] * len;
+        Aabb::new(lane_x[j] - half_w, lane_x[j] + half_w, front, back)
+    };
+    let static_arcs: Vec<Arc> = setup
+        .statics
+        .iter()
+        .map(|b| cull_arc(std::slice::from_ref(b)))
+        .collect();
+    let phase = draw.phase_frac * period;
+    let mut states: Vec<GroupState> = cells
+        .iter()
+        .map(|c| GroupState {
+            power_ratio: c
+                .profile
+                .bins
+                .iter()
+                .map(|b| b.power_w / c.profile.average_power_w)
+                .collect(),
+            detected_at: [None, None],
+            driver_at: [None, None],
+            hit_frames: [Vec::new(), Vec::new()],
+            roi_points: 0,
+            argus_roi_points: 0,
+            keep_acc: 0.0,
+        })
+        .collect();
+    let any_decimates = cells.iter().any(|c| c.rof_keep < 1.0);
+    let mut roi_pulses = 0u64;
+    let mut current_frame = u64::MAX;
+    let mut car_arcs = [static_arcs[0]; 2];
+    let n_pulses = (t_end * pulse_rate).floor() as u64;
+    let mut frames = 0u64;
+    let mut bin_hint = 0usize;
+
+    let cast = |c: f64,
+                s: f64,
+                az: f64,
+                t: f64,
+                car_arcs: &[Arc; 2]|
+     -> Option<(f64, f64, f64, Option<usize>)> {
+        let mut best: Option<(f64, f64, f64, Option<usize>)> = None;
+        for (b, arc) in setup.statics.iter().zip(&static_arcs) {
+            if setup.brute_force || arc.contains(az) {
+                if let Some(h) = b.ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.building_reflectivity, None));
+                    }
+                }
+            }
+        }
+        for (j, arc) in car_arcs.iter().enumerate() {
+            if setup.brute_force || arc.contains(az) {
+                if let Some(h) = car_box(j, t).ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.vehicle_reflectivity, Some(j)));
+                    }
+                }
+            }
+        }
+        best
+    };
+    let full = Arc {
+        start_deg: 0.0,
+        width_deg: 360.0,
+    };
+
+    for k in 0..n_pulses {
+        let t = k as f64 / pulse_rate;
+        let tau_total = t + phase;
+        let frame = (tau_total / period).floor() as u64;
+        let tau = (tau_total - frame as f64 * period).clamp(0.0, period);
+        if frame != current_frame {
+            current_frame = frame;
+            frames += 1;
+            bin_hint = 0;
+            let t0 = (frame as f64 * period - phase).max(0.0);
+            let t1 = (frame + 1) as f64 * period - phase;
+            for (j, arc) in car_arcs.iter_mut().enumerate() {
+                *arc = cull_arc(&[car_box(j, t0), car_box(j, t1)]);
+            }
+            // The driver: looks at each car's front centre at the frame start.
+            for j in 0..2 {
+                if t0 > t_conflict[j] {
+                    continue;
+                }
+                let (x, y) = (lane_x[j], front0[j] + dir[j] * v * t0);
+                let az = y.atan2(x).to_degrees();
+                let dist = x.hypot(y);
+                if !setup.regions.rof.contains(az) {
+                    continue;
+                }
+                let mut sees: Option<bool> = None;
+                for (st, cell) in states.iter_mut().zip(cells) {
+                    if st.driver_at[j].is_some() || dist > cell.driver_range_m {
+                        continue;
+                    }
+                    let seen = *sees.get_or_insert_with(|| {
+                        let (c, s) = (x / dist, y / dist);
+                        matches!(cast(c, s, wrap_deg(az), t0, &[full, full]), Some((_, _, _, Some(hit))) if hit == j)
+                    });
+                    if seen {
+                        st.driver_at[j] = Some(t0);
+                    }
+                }
+            }
+        }
+        let (az, bin) = tl.azimuth_at_from(tau, bin_hint);
+        bin_hint = bin;
+        let in_roi = setup.regions.roi.contains(az);
+        roi_pulses += u64::from(in_roi);
+        let rad = az.to_radians();
+        let (s, c) = rad.sin_cos();
+        let Some((range, cos_i, refl, car)) = cast(c, s, az, t, &car_arcs) else {
+            continue;
+        };
+        let mut noise: Option<f64> = None;
+        let in_rof = any_decimates && setup.regions.rof.contains(az);
+        let dens = super::carla::argus::in_density_region(az, setup.gaze_deg, setup.ego_yaw_deg);
+        for (st, cell) in states.iter_mut().zip(cells) {
+            let p_d = cell
+                .model
+                .detection_probability(st.power_ratio[bin], refl, cos_i, range);
+            let returned = p_d >= 1.0
+                || (p_d > 0.0
+                    && *noise.get_or_insert_with(|| {
+                        unit(draw.noise_seed ^ k.wrapping_mul(0xD1B5_4A32_D192_ED03))
+                    }) < p_d);
+            if !returned {
+                continue;
+            }
+            if cell.rof_keep < 1.0 && in_rof {
+                st.keep_acc += cell.rof_keep;
+                if st.keep_acc < 1.0 {
+                    continue;
+                }
+                st.keep_acc -= 1.0;
+            }
+            st.roi_points += u64::from(in_roi);
+            st.argus_roi_points += u64::from(dens);
+            if let Some(j) = car {
+                if st.detected_at[j].is_none() && t <= t_conflict[j] {
+                    let frames_hit = &mut st.hit_frames[j];
+                    if frames_hit.last() != Some(&frame) {
+                        frames_hit.push(frame);
+                    }
+                    let window_start = frame.saturating_sub(u64::from(setup.detection.n) - 1);
+                    let recent = frames_hit
+                        .iter()
+                        .rev()
+                        .take_while(|&&f| f >= window_start)
+                        .count();
+                    if recent as u32 >= setup.detection.k {
+                        st.detected_at[j] = Some(t);
+                    }
+                }
+            }
+        }
+    }
+
+    let tta = |j: usize, t: Option<f64>| t.map(|t| t_conflict[j] - t).filter(|x| *x >= 0.0);
+    states
+        .iter()
+        .map(|st| {
+            let tta_s = [tta(0, st.detected_at[0]), tta(1, st.detected_at[1])];
+            let driver_tta = [tta(0, st.driver_at[0]), tta(1, st.driver_at[1])];
+            let hybrid = |j: usize| match (tta_s[j], driver_tta[j]) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                (a, b) => a.or(b),
+            };
+            TrialOutcome {
+                tta_s,
+                hybrid_tta_s: [hybrid(0), hybrid(1)],
+                roi_points: st.roi_points,
+                roi_pulses,
+                roi_width_deg: setup.regions.roi.measure_deg(),
+                duration_s: n_pulses as f64 / pulse_rate,
+                frames,
+                argus_roi_points: st.argus_roi_points,
+                channels_simulated: 1,
+            }
+        })
+        .collect()
+}
