@@ -596,8 +596,7 @@ fn share_above(p: &GridResult, cut_s: f64) -> Option<f64> {
         .cell(ModelKind::Argus, "baseline", 0)
         .filter_map(|t| t.outcome.tta_s[1])
         .collect();
-    (!tta.is_empty())
-        .then(|| tta.iter().filter(|&&x| x > cut_s).count() as f64 / tta.len() as f64)
+    (!tta.is_empty()).then(|| tta.iter().filter(|&&x| x > cut_s).count() as f64 / tta.len() as f64)
 }
 
 /// The sampling paragraph: CARLA's per-tick rule at this tick and the
@@ -637,14 +636,11 @@ fn sampling_paragraph(
         )
     };
     let compare = other.map_or_else(
-        || "(run with `--paper-pipeline-trials` for the comparison with the other sampling)".to_owned(),
-        |(o, oc)| {
-            format!(
-                "against {} ({} trials)",
-                describe(o, oc),
-                oc.trials
-            )
+        || {
+            "(run with `--paper-pipeline-trials` for the comparison with the other sampling)"
+                .to_owned()
         },
+        |(o, oc)| format!("against {} ({} trials)", describe(o, oc), oc.trials),
     );
     let _ = writeln!(
         s,

@@ -418,7 +418,11 @@ struct GroupState {
 /// each cell then decides its own return (its power and model), in the
 /// order [`run_trial`] does. Outcomes in the cells' order.
 #[must_use]
-pub fn run_group(setup: &TrialSetup<'_>, cells: &[GroupCell<'_>], draw: &TrialDraw) -> Vec<TrialOutcome> {
+pub fn run_group(
+    setup: &TrialSetup<'_>,
+    cells: &[GroupCell<'_>],
+    draw: &TrialDraw,
+) -> Vec<TrialOutcome> {
     let sc = setup.scenario;
     let tl = Timeline::new(setup.profile);
     let period = tl.period_s();
@@ -468,6 +472,25 @@ pub fn run_group(setup: &TrialSetup<'_>, cells: &[GroupCell<'_>], draw: &TrialDr
         })
         .collect();
     let any_decimates = cells.iter().any(|c| c.rof_keep < 1.0);
+    // Cells sharing a model's range factor share its value per pulse.
+    let mut factor_keys: Vec<[u64; 4]> = Vec::new();
+    let factor_slot: Vec<usize> = cells
+        .iter()
+        .map(|c| {
+            let key = c.model.range_factor_key();
+            factor_keys
+                .iter()
+                .position(|k| *k == key)
+                .unwrap_or_else(|| {
+                    factor_keys.push(key);
+                    factor_keys.len() - 1
+                })
+        })
+        .collect();
+    let mut factors: Vec<Option<f64>> = vec![None; factor_keys.len()];
+    // Culling masks: bit i for static i (all statics if more than 62),
+    // bits 62 and 63 for the cars.
+    let statics_masked = setup.statics.len() <= 62;
     let mut roi_pulses = 0u64;
     let mut current_frame = u64::MAX;
     let mut car_arcs = [static_arcs[0]; 2];
@@ -505,6 +528,29 @@ pub fn run_group(setup: &TrialSetup<'_>, cells: &[GroupCell<'_>], draw: &TrialDr
     let full = Arc {
         start_deg: 0.0,
         width_deg: 360.0,
+    };
+    // [`cast`] over the objects of `mask` (in the same order).
+    let cast_masked = |c: f64, s: f64, t: f64, mask: u64| {
+        let mut best: Option<(f64, f64, f64, Option<usize>)> = None;
+        for (i, b) in setup.statics.iter().enumerate() {
+            if mask >> i.min(61) & 1 == 1 {
+                if let Some(h) = b.ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.building_reflectivity, None));
+                    }
+                }
+            }
+        }
+        for j in 0..2 {
+            if mask >> (62 + j) & 1 == 1 {
+                if let Some(h) = car_box(j, t).ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.vehicle_reflectivity, Some(j)));
+                    }
+                }
+            }
+        }
+        best
     };
 
     for k in 0..n_pulses {
@@ -551,18 +597,39 @@ pub fn run_group(setup: &TrialSetup<'_>, cells: &[GroupCell<'_>], draw: &TrialDr
         bin_hint = bin;
         let in_roi = setup.regions.roi.contains(az);
         roi_pulses += u64::from(in_roi);
+        // The objects whose extent contains the azimuth ([`run_trial`]'s
+        // culling); none: no hit, no cast.
+        let mut mask = 0u64;
+        if setup.brute_force || !statics_masked {
+            mask = (1u64 << 62) - 1;
+        } else {
+            for (i, arc) in static_arcs.iter().enumerate() {
+                mask |= u64::from(arc.contains(az)) << i;
+            }
+        }
+        for (j, arc) in car_arcs.iter().enumerate() {
+            mask |= u64::from(setup.brute_force || arc.contains(az)) << (62 + j);
+        }
+        if mask == 0 {
+            continue;
+        }
         let rad = az.to_radians();
         let (s, c) = rad.sin_cos();
-        let Some((range, cos_i, refl, car)) = cast(c, s, az, t, &car_arcs) else {
+        let Some((range, cos_i, refl, car)) = cast_masked(c, s, t, mask) else {
             continue;
         };
+        factors.iter_mut().for_each(|f| *f = None);
         let mut noise: Option<f64> = None;
         let in_rof = any_decimates && setup.regions.rof.contains(az);
         let dens = super::carla::argus::in_density_region(az, setup.gaze_deg, setup.ego_yaw_deg);
-        for (st, cell) in states.iter_mut().zip(cells) {
-            let p_d = cell
-                .model
-                .detection_probability(st.power_ratio[bin], refl, cos_i, range);
+        for ((st, cell), &slot) in states.iter_mut().zip(cells).zip(&factor_slot) {
+            let p_d = cell.model.detection_probability_with(
+                st.power_ratio[bin],
+                refl,
+                cos_i,
+                range,
+                || *factors[slot].get_or_insert_with(|| cell.model.range_factor(range)),
+            );
             let returned = p_d >= 1.0
                 || (p_d > 0.0
                     && *noise.get_or_insert_with(|| {

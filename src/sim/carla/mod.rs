@@ -991,8 +991,7 @@ fn run<const W: usize>(
                         continue;
                     }
                     let front = front0[j] + dir[j] * v * t_state;
-                    let target =
-                        Point3::new(lane_x[j], front, clearance + 0.5 * size.z);
+                    let target = Point3::new(lane_x[j], front, clearance + 0.5 * size.z);
                     let az = target.y.atan2(target.x).to_degrees();
                     let dist = (target - origin).norm();
                     if spec.regions.rof.contains(az) && dist <= spec.driver_range_m {

@@ -288,7 +288,10 @@ mod tests {
                 // CARLA: HorizAngle = fmod(0 + (360/391)·i, 360) from the start;
                 // here as a fraction of the 0.05 s turn.
                 let carla_deg = (360.0 / 391.0) * i as f64;
-                assert!((p.tau_s / 0.05 * 360.0 - carla_deg).abs() < 1e-9, "{tick} {i}");
+                assert!(
+                    (p.tau_s / 0.05 * 360.0 - carla_deg).abs() < 1e-9,
+                    "{tick} {i}"
+                );
                 // Bit for bit the same as the first tick's.
                 assert_eq!(p.tau_s, pulses[i].tau_s);
                 assert_eq!(p.frame, tick);
@@ -333,20 +336,21 @@ mod tests {
             });
             assert_eq!(a, schedule(&paper(Sampling::Carla)));
         }
-        // 27.5 Hz: the start is one of the eight multiples of 135°.
+        // 27.5 Hz: the start is one of the eight multiples of 135° (mod 360°).
         let mut starts = Vec::new();
         for i in 0..64 {
             let spec = ScheduleSpec {
                 pulse_rate_hz: 687_500.0 / 64.0,
                 frame_rate_hz: 27.5,
                 period_s: 1.0 / 27.5,
-                phase_frac: f64::from(i) / 64.0 + 0.003,
+                phase_frac: (f64::from(i) + 0.5) / 65_536.0,
                 ..paper(Sampling::Carla)
             };
+            // m · 135° (mod 360°): the multiples of 45°.
             let deg = schedule(&spec).0[0].tau_s * 27.5 * 360.0;
-            let k = (deg / 135.0).round();
-            assert!((deg - 135.0 * k).abs() < 1e-6, "{deg}");
-            starts.push(k as i64);
+            let k = (deg / 45.0).round();
+            assert!((deg - 45.0 * k).abs() < 1e-6, "{deg}");
+            starts.push(k as i64 % 8);
         }
         starts.sort_unstable();
         starts.dedup();
