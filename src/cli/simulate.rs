@@ -307,25 +307,55 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 ..config.clone()
             };
             let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
-            // Clear air under the other sampling, for the comparison.
-            let oc = SimConfig {
-                fog_pcts: vec![0],
-                sampling: Some(match pc.sampling() {
-                    Sampling::Drift => Sampling::Carla,
-                    _ => Sampling::Drift,
-                }),
+            // Clear air under the other samplings, and the fog-25 % baseline
+            // with cars above ARGUS's road threshold, for the comparisons.
+            let mut extras = Vec::new();
+            for other in [Sampling::Carla, Sampling::Drift, Sampling::CarlaAsync] {
+                if other != pc.sampling() {
+                    extras.push(SimConfig {
+                        fog_pcts: vec![0],
+                        variants: vec![Variant::Baseline],
+                        sampling: Some(other),
+                        ..pc.clone()
+                    });
+                }
+            }
+            let mut lifted = SimConfig {
+                fog_pcts: vec![25],
+                variants: vec![Variant::Baseline],
                 ..pc.clone()
             };
-            let o = sim::run(&oc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
-            Some(((r, pc), (o, oc)))
+            let c = &mut lifted.scenario.carla;
+            c.vehicle_ground_clearance_m =
+                (c.mount_height_m + c.argus_road_z_m + 0.05).clamp(0.0, 0.49 * c.vehicle_height_m);
+            extras.push(lifted);
+            let runs = extras
+                .into_iter()
+                .map(|c| sim::run(&c, &|| {}).map(|r| (r, c)))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| CliError::input(e.to_string()))?;
+            Some(((r, pc), runs))
         } else {
             None
         };
+        let runs: &[(sim::GridResult, SimConfig)] = pipeline.as_ref().map_or(&[], |(_, r)| r);
+        let others: Vec<(&sim::GridResult, &SimConfig)> = runs
+            .iter()
+            .filter(|(_, c)| c.fog_pcts == [0])
+            .map(|(r, c)| (r, c))
+            .collect();
+        let lifted = runs
+            .iter()
+            .find(|(_, c)| c.fog_pcts == [25])
+            .map(|(r, c)| (r, c));
         let md = sim::report::render_with_pipelines(
             &result,
             &config,
             pipeline.as_ref().map(|((r, c), _)| (r, c)),
-            pipeline.as_ref().map(|(_, (o, oc))| (o, oc)),
+            &sim::report::PipelineExtras {
+                other_samplings: &others,
+                lifted,
+            },
         );
         outputs.add(path, md);
     }

@@ -70,18 +70,26 @@ pub fn render_with_pipeline(
     config: &SimConfig,
     pipeline: Option<(&GridResult, &SimConfig)>,
 ) -> String {
-    render_with_pipelines(r, config, pipeline, None)
+    render_with_pipelines(r, config, pipeline, &PipelineExtras::default())
 }
 
-/// [`render_with_pipeline`] with, if given, the paper's pipeline run again
-/// under another sampling (`--sampling drift`; clear air is enough) for
-/// the sampling comparison.
+/// Further runs of the paper's pipeline the report compares with.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct PipelineExtras<'a> {
+    /// Clear air under the other samplings (`drift`, `carla-async`).
+    pub other_samplings: &'a [(&'a GridResult, &'a SimConfig)],
+    /// The fog-25 % baseline with cars lifted above ARGUS's road threshold
+    /// (no car-underside mode).
+    pub lifted: Option<(&'a GridResult, &'a SimConfig)>,
+}
+
+/// [`render_with_pipeline`] with the comparisons of `extras`.
 #[must_use]
 pub fn render_with_pipelines(
     r: &GridResult,
     config: &SimConfig,
     pipeline: Option<(&GridResult, &SimConfig)>,
-    other_sampling: Option<(&GridResult, &SimConfig)>,
+    extras: &PipelineExtras<'_>,
 ) -> String {
     let mut s = String::new();
     let pr = pipeline.map(|p| p.0);
@@ -389,7 +397,7 @@ pub fn render_with_pipelines(
             .map_or(f64::NAN, |e| e.worst_ratio * 100.0)
     );
     if let Some((p, pc)) = pipeline {
-        pipeline_section(&mut s, p, pc, other_sampling);
+        pipeline_section(&mut s, p, pc, extras);
     }
     let _ = writeln!(s, "\n## Figures\n");
     let _ = writeln!(s, "Written by `--plots DIR`: `tta_argus.svg`, `tta_physical.svg` (as the paper's figure 3), `density_argus.svg`, `density_physical.svg` (figure 4), `profiles_polar.svg`.");
@@ -398,12 +406,7 @@ pub fn render_with_pipelines(
 
 /// The paper's-pipeline section: its clear-air result explained, the fog
 /// mapping finding, and what is literal and what is assumed.
-fn pipeline_section(
-    s: &mut String,
-    p: &GridResult,
-    pc: &SimConfig,
-    other: Option<(&GridResult, &SimConfig)>,
-) {
+fn pipeline_section(s: &mut String, p: &GridResult, pc: &SimConfig, extras: &PipelineExtras<'_>) {
     let sc = &pc.scenario;
     let c = &sc.carla;
     let el =
@@ -475,28 +478,29 @@ fn pipeline_section(
          rings are {}. Between two rings there is no road cell, so the car is detected when its points first fall in a \
          cell of the farthest ring (≈ the first TTA) or, when the mask missed that ring's cells there — CARLA drops {:.0} % \
          of rays, and ARGUS adds a callback's road cells only while the road's y-extent grows — at the next ring. The \
-         two rings make the two modes of the distribution: the quantization alone gives the paper's range and median \
-         to within {:.1} s. The mount height is assumed ({:.1} m, see below); each ring moves with it.\n",
+         two rings make the two modes of the distribution, and how the sensor is sampled decides which of them \
+         dominates (next paragraph): the median lies {:.2} s from the paper's ≈ 5.8 s. The mount height is assumed \
+         ({:.1} m, see below); each ring moves with it.\n",
         f2(b0.and_then(|x| x.tta_median_s)),
         f2(b0.and_then(|x| x.tta_q1_s)),
         f2(b0.and_then(|x| x.tta_q3_s)),
         c.range_m,
         ring_txt.join(", "),
         c.dropoff_general_rate * 100.0,
-        b0.and_then(|x| x.tta_median_s).map_or(f64::NAN, |m| (m - 5.8).abs()).max(0.05),
+        b0.and_then(|x| x.tta_median_s).map_or(f64::NAN, |m| (m - 5.8).abs()),
         h,
     );
-    sampling_paragraph(s, p, pc, other, &rings, &ring_tta);
+    sampling_paragraph(s, p, pc, extras.other_samplings, &rings, &ring_tta);
     let road_band_m = h + c.argus_road_z_m;
     let _ = writeln!(
         s,
         "**The car-underside mode.** ARGUS's road rule is a height threshold: a point below z = {:.1} m in the sensor \
          frame counts as road, i.e. anything lower than {:.2} m above the road at the {:.1} m mount — a car's lowest \
          face included. With cars as boxes standing on the road, the bottom {:.2} m of a car's face became road cells \
-         under the car itself, and a point on the car above them detected it wherever it was: an undocumented \
-         detection mode (the upper mode of the 25 % baseline; with the threshold at −2.99 m it collapses to the next \
-         ring). Cars now stand on a ground clearance of {:.2} m (`[carla] vehicle_ground_clearance_m`, assumed: a \
-         typical passenger car's; wheels are not modelled), and rays pass beneath them to the road. {}\n",
+         under the car itself, and a point on the car above them detected it wherever it was, between the rings: an \
+         undocumented detection mode. Cars now stand on a ground clearance of {:.2} m (`[carla] \
+         vehicle_ground_clearance_m`, assumed: a typical passenger car's; wheels are not modelled), and rays pass \
+         beneath them to the road. {}{}\n",
         c.argus_road_z_m,
         road_band_m,
         h,
@@ -509,7 +513,18 @@ fn pipeline_section(
                 "The band from {:.2} m to {:.2} m of a car's face still counts as road; a clearance of {:.2} m or more removes the mode.",
                 c.vehicle_ground_clearance_m, road_band_m, road_band_m
             )
-        }
+        },
+        extras.lifted.map_or_else(String::new, |(l, lc)| {
+            let cell = |r: &GridResult| tta_cell(r.row(ModelKind::Argus, "baseline", 25));
+            format!(
+                " At fog 25 % the baseline gives {} with this clearance and {} with {:.2} m, where no part of a \
+                 car counts as road ({} trials): the difference is the car-underside mode.",
+                cell(p),
+                cell(l),
+                lc.scenario.carla.vehicle_ground_clearance_m,
+                lc.trials
+            )
+        })
     );
     let _ = writeln!(
         s,
@@ -605,7 +620,7 @@ fn sampling_paragraph(
     s: &mut String,
     p: &GridResult,
     pc: &SimConfig,
-    other: Option<(&GridResult, &SimConfig)>,
+    others: &[(&GridResult, &SimConfig)],
     rings: &[(usize, f64, f64)],
     ring_tta: &dyn Fn(f64) -> f64,
 ) {
@@ -635,13 +650,16 @@ fn sampling_paragraph(
             cfg.sampling().name()
         )
     };
-    let compare = other.map_or_else(
-        || {
-            "(run with `--paper-pipeline-trials` for the comparison with the other sampling)"
-                .to_owned()
-        },
-        |(o, oc)| format!("against {} ({} trials)", describe(o, oc), oc.trials),
-    );
+    let compare = if others.is_empty() {
+        "(run with `--paper-pipeline-trials` for the comparison with the other samplings)"
+            .to_owned()
+    } else {
+        let list: Vec<String> = others
+            .iter()
+            .map(|(o, oc)| format!("{} ({} trials)", describe(o, oc), oc.trials))
+            .collect();
+        format!("against {}", list.join(" and "))
+    };
     let _ = writeln!(
         s,
         "**Sampling.** CARLA casts a LiDAR's rays once per simulation tick: round(points/s · dt / channels) points per \
@@ -649,9 +667,13 @@ fn sampling_paragraph(
          (`RayCastSemanticLidar.cpp`, `SimulateLidar`; `src/sim/carla/sampling.rs`). At {:.0} points/s, {} channels, \
          {:.0} Hz and a {} s tick that is {} points per laser per tick over exactly {:.0}°: every tick repeats the same \
          azimuths, {:.4}° apart. The project's earlier pulse clock (`--sampling drift`, pulses at k / {:.1} s) fires \
-         {:.3} pulses per tick, so its azimuths drift by {:.3} of a step per tick and sweep every gap between CARLA's. \
-         The clear-air baseline median is {} {}. The paper's clear-air agreement therefore rests on how the sensor is \
-         sampled: the azimuth grid decides which road cells of the farthest ring the mask ever holds. An adaptive spin \
+         {:.3} pulses per tick and turn, so its pulse grid does not close on itself: it shifts by {:.3} of a step \
+         every turn and sweeps the gaps between CARLA's azimuths. The clear-air baseline median is {} {}. The paper's \
+         clear-air agreement therefore rests on how the sensor is sampled: the azimuth grid decides which road cells of \
+         the farthest ring the mask ever holds. ARGUS's resolution variant (27.5 Hz, {} points per laser per tick over \
+         {:.0}°) starts each tick {:.0}° further on and so covers the gaps of one tick in the next: under CARLA's \
+         sampling its clear-air median ({} s) parts from the baseline's. Asynchronous ticks (`carla-async`) vary the \
+         points per tick and the advance, and sweep the gaps too. An adaptive spin \
          has no counterpart in stock CARLA (one rotation frequency); under `--sampling carla` a profile's points are \
          spread evenly in time over the tick and placed by its timeline — CARLA's rule for a uniform spin, which all of \
          the paper code's variants are.\n",
@@ -664,8 +686,16 @@ fn sampling_paragraph(
         tick_deg / f64::from(per_laser.max(1)),
         sensor.pulse_rate_hz,
         sensor.pulse_rate_hz * c.tick_s,
-        (f64::from(per_laser) - sensor.pulse_rate_hz * c.tick_s).abs(),
+        (sensor.pulse_rate_hz * c.tick_s).fract(),
         describe(p, pc),
         compare,
+        super::carla::sampling::points_per_laser(
+            super::ARGUS_RESOLUTION_POINTS_PER_S.round() as u32,
+            c.tick_s,
+            c.channels
+        ),
+        super::ARGUS_RESOLUTION_FRAME_HZ * 360.0 * c.tick_s,
+        (super::ARGUS_RESOLUTION_FRAME_HZ * 360.0 * c.tick_s) % 360.0,
+        f2(p.row(ModelKind::Argus, "resolution", 0).and_then(|x| x.tta_median_s)),
     );
 }
