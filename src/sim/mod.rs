@@ -683,6 +683,9 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
     })
 }
 
+/// Range of the planar saturation tables, m (hits beyond take the model).
+const PLANAR_SATURATION_RANGE_M: f64 = 400.0;
+
 /// The planar geometry: per trial, every cell planned, cells sharing a
 /// timeline and the driver's regions cast together ([`trial::run_group`]);
 /// records in the order of [`run_planar_per_cell`], bit-identical to it.
@@ -697,6 +700,36 @@ fn run_planar<'s>(
         return run_planar_per_cell(config, fogs, table, sensor_of, tick);
     }
     let statics = config.scenario.static_boxes();
+    // The physical model's saturation bounds, once per distinct model
+    // (building and vehicle hits, to the farthest a planar ray can reach).
+    let reflectivity = [
+        config.scenario.building_reflectivity,
+        config.scenario.vehicle_reflectivity,
+    ];
+    let mut saturations: Vec<(ReturnModel, Option<returns::Saturation>)> = Vec::new();
+    for &model in &config.models {
+        for &variant in &config.variants {
+            let sensor = sensor_of(variant);
+            for &fog in fogs {
+                let m = ReturnModel::new(
+                    model,
+                    fog,
+                    sensor.lidar.rated_range_m,
+                    sensor.lidar.reference_reflectivity,
+                );
+                if !saturations.iter().any(|(x, _)| *x == m) {
+                    let sat = returns::Saturation::new(&m, reflectivity, PLANAR_SATURATION_RANGE_M);
+                    saturations.push((m, sat));
+                }
+            }
+        }
+    }
+    let saturation_of = |m: &ReturnModel| {
+        saturations
+            .iter()
+            .find(|(x, _)| x == m)
+            .and_then(|(_, s)| s.as_ref())
+    };
     let per_trial: Result<Vec<Vec<TrialRecord>>, SimError> = (0..config.trials)
         .into_par_iter()
         .map(|trial| {
@@ -770,6 +803,7 @@ fn run_planar<'s>(
                             rof_keep: plan.rof_keep,
                             model,
                             driver_range_m: fog.mor_m,
+                            saturation: saturation_of(model),
                         });
                         keys.push((plan.model, plan.variant, fog.fog_pct));
                     }

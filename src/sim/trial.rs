@@ -13,11 +13,11 @@
 //! checked by tests).
 
 use crate::model::acuity::Regions;
-use crate::model::angle::{diff_deg, wrap_deg, Arc};
+use crate::model::angle::{diff_deg, wrap_deg, Arc, CircularSet};
 use crate::profile::kinematics::Timeline;
 use crate::profile::Profile;
 
-use super::returns::ReturnModel;
+use super::returns::{ReturnModel, Saturation, RANGE_BUCKET_M};
 use super::scene::{Aabb, Scenario};
 
 /// Padding of the culling arcs, degrees (far above `f64` rounding of atan2).
@@ -384,6 +384,86 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
     }
 }
 
+/// Margin of [`BinFacts`], degrees: far above the rounding of a bin's
+/// azimuth `wrap(start + x)` (`x` within the bin's width) and of an arc's end.
+const BIN_FACT_PAD_DEG: f64 = 1e-6;
+
+/// What holds for every azimuth a profile bin can produce: the RoI and
+/// RoF membership if it is the same over the whole bin (`None`: test the
+/// azimuth), and the statics whose culling arc may contain it (a superset:
+/// testing a box whose arc does not contain the azimuth finds no hit, as
+/// the brute-force path shows).
+#[derive(Debug, Clone, Copy)]
+struct BinFacts {
+    roi: Option<bool>,
+    rof: Option<bool>,
+    statics: u64,
+}
+
+/// The bin `[lo, lo + width]` widened by the margin, or `None` if it
+/// reaches 0° or 360° (the wrap: no shortcut there).
+fn padded_bin(start_deg: f64, width_deg: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = (
+        start_deg - BIN_FACT_PAD_DEG,
+        start_deg + width_deg + BIN_FACT_PAD_DEG,
+    );
+    (lo >= 0.0 && hi < 360.0).then_some((lo, hi))
+}
+
+/// Membership of `set` over `[lo, hi]` (inside `(0, 360)`) if no edge of its
+/// arcs falls in it (then it is constant there).
+fn constant_membership(set: &CircularSet, arcs: &[Arc], lo: f64, hi: f64) -> Option<bool> {
+    for a in arcs {
+        if a.width_deg >= 360.0 {
+            return Some(set.contains(lo));
+        }
+        for edge in [a.start_deg, wrap_deg(a.start_deg + a.width_deg)] {
+            if lo - BIN_FACT_PAD_DEG <= edge && edge <= hi + BIN_FACT_PAD_DEG {
+                return None;
+            }
+        }
+    }
+    Some(set.contains(0.5 * (lo + hi)))
+}
+
+/// The facts of every bin of `profile`.
+fn bin_facts(profile: &Profile, regions: &Regions, static_arcs: &[Arc]) -> Vec<BinFacts> {
+    let roi_arcs = regions.roi.arcs();
+    let rof_arcs = regions.rof.arcs();
+    let all = if static_arcs.len() >= 62 {
+        (1u64 << 62) - 1
+    } else {
+        (1u64 << static_arcs.len()) - 1
+    };
+    profile
+        .bins
+        .iter()
+        .map(|b| match padded_bin(b.start_deg, b.width_deg) {
+            None => BinFacts {
+                roi: None,
+                rof: None,
+                statics: all,
+            },
+            Some((lo, hi)) => BinFacts {
+                roi: constant_membership(&regions.roi, &roi_arcs, lo, hi),
+                rof: constant_membership(&regions.rof, &rof_arcs, lo, hi),
+                statics: if static_arcs.len() >= 62 {
+                    all
+                } else {
+                    static_arcs.iter().enumerate().fold(0, |m, (i, a)| {
+                        // The arc meets [lo, hi] iff it contains lo or
+                        // starts inside it.
+                        let meets = a.contains(lo)
+                            || (lo <= a.start_deg && a.start_deg <= hi)
+                            || a.width_deg >= 360.0;
+                        m | (u64::from(meets) << i)
+                    })
+                },
+            },
+        })
+        .collect()
+}
+
 /// One cell of a planar group: what differs between cells that share a
 /// trial, a timeline and the driver's regions.
 #[derive(Debug, Clone, Copy)]
@@ -396,6 +476,10 @@ pub struct GroupCell<'a> {
     pub model: &'a ReturnModel,
     /// Driver's visual range in this fog (MOR), m.
     pub driver_range_m: f64,
+    /// The physical model's saturation bound of this model (building,
+    /// vehicle reflectivity of the scene): hits it proves have `P_D = 1`
+    /// skip the model.
+    pub(crate) saturation: Option<&'a Saturation>,
 }
 
 /// Per-cell state of [`run_group`].
@@ -491,6 +575,7 @@ pub fn run_group(
     // Culling masks: bit i for static i (all statics if more than 62),
     // bits 62 and 63 for the cars.
     let statics_masked = setup.statics.len() <= 62;
+    let facts = bin_facts(setup.profile, setup.regions, &static_arcs);
     let mut roi_pulses = 0u64;
     let mut current_frame = u64::MAX;
     let mut car_arcs = [static_arcs[0]; 2];
@@ -595,18 +680,16 @@ pub fn run_group(
         }
         let (az, bin) = tl.azimuth_at_from(tau, bin_hint);
         bin_hint = bin;
-        let in_roi = setup.regions.roi.contains(az);
+        let fact = facts[bin];
+        let in_roi = fact.roi.unwrap_or_else(|| setup.regions.roi.contains(az));
         roi_pulses += u64::from(in_roi);
-        // The objects whose extent contains the azimuth ([`run_trial`]'s
+        // The objects whose extent may contain the azimuth ([`run_trial`]'s
         // culling); none: no hit, no cast.
-        let mut mask = 0u64;
-        if setup.brute_force || !statics_masked {
-            mask = (1u64 << 62) - 1;
+        let mut mask = if setup.brute_force || !statics_masked {
+            (1u64 << 62) - 1
         } else {
-            for (i, arc) in static_arcs.iter().enumerate() {
-                mask |= u64::from(arc.contains(az)) << i;
-            }
-        }
+            fact.statics
+        };
         for (j, arc) in car_arcs.iter().enumerate() {
             mask |= u64::from(setup.brute_force || arc.contains(az)) << (62 + j);
         }
@@ -619,17 +702,24 @@ pub fn run_group(
             continue;
         };
         factors.iter_mut().for_each(|f| *f = None);
+        let surface = usize::from(car.is_some());
+        let bucket = (range * (1.0 / RANGE_BUCKET_M)) as usize;
         let mut noise: Option<f64> = None;
-        let in_rof = any_decimates && setup.regions.rof.contains(az);
+        let in_rof = any_decimates && fact.rof.unwrap_or_else(|| setup.regions.rof.contains(az));
         let dens = super::carla::argus::in_density_region(az, setup.gaze_deg, setup.ego_yaw_deg);
         for ((st, cell), &slot) in states.iter_mut().zip(cells).zip(&factor_slot) {
-            let p_d = cell.model.detection_probability_with(
-                st.power_ratio[bin],
-                refl,
-                cos_i,
-                range,
-                || *factors[slot].get_or_insert_with(|| cell.model.range_factor(range)),
-            );
+            let power = st.power_ratio[bin];
+            let p_d = if cell
+                .saturation
+                .is_some_and(|x| x.saturated(surface, bucket, power, cos_i))
+            {
+                1.0
+            } else {
+                cell.model
+                    .detection_probability_with(power, refl, cos_i, range, || {
+                        *factors[slot].get_or_insert_with(|| cell.model.range_factor(range))
+                    })
+            };
             let returned = p_d >= 1.0
                 || (p_d > 0.0
                     && *noise.get_or_insert_with(|| {
@@ -690,4 +780,51 @@ pub fn run_group(
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+    use crate::planner::{closed_form, Mode};
+
+    #[test]
+    fn bin_facts_hold_for_every_azimuth_of_their_bin() {
+        // Every bin of the paper's profiles at several gazes and bin counts
+        // (RoI edges inside bins and on their edges): azimuths across each
+        // bin, its edges included, agree with the facts.
+        let preset = presets::paper();
+        let sc = Scenario::default();
+        let statics = sc.static_boxes();
+        let static_arcs: Vec<Arc> = statics
+            .iter()
+            .map(|b| cull_arc(std::slice::from_ref(b)))
+            .collect();
+        let mut decided = 0;
+        for gaze in [0.0, 37.25, 90.0, 90.5, 181.0, 300.3] {
+            for (mode, bins) in [(Mode::Joint, 360), (Mode::Resolution, 97), (Mode::Range, 7)] {
+                let c = closed_form(&preset, mode, Some(gaze), bins).unwrap();
+                let regions = preset.focus.regions(gaze);
+                let facts = bin_facts(c.profile(), &regions, &static_arcs);
+                for (b, f) in c.profile().bins.iter().zip(&facts) {
+                    for i in 0..=64 {
+                        let az = wrap_deg(b.start_deg + b.width_deg * f64::from(i) / 64.0);
+                        if let Some(x) = f.roi {
+                            assert_eq!(x, regions.roi.contains(az), "{gaze} {az}");
+                            decided += 1;
+                        }
+                        if let Some(x) = f.rof {
+                            assert_eq!(x, regions.rof.contains(az), "{gaze} {az}");
+                        }
+                        for (j, a) in static_arcs.iter().enumerate() {
+                            if a.contains(az) {
+                                assert_eq!(f.statics >> j & 1, 1, "{gaze} {az} {j}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(decided > 10_000, "{decided}");
+    }
 }

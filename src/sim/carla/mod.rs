@@ -54,7 +54,7 @@ use crate::model::angle::Arc;
 use crate::profile::kinematics::Timeline;
 use crate::profile::Profile;
 
-use super::returns::{ReturnModel, ARGUS_RANGE_M};
+use super::returns::{ReturnModel, Saturation, ARGUS_RANGE_M, RANGE_BUCKET_M};
 use super::scene::{Aabb, Scenario};
 use super::trial::{cull_arc, mix64, KOfN, TrialDraw, TrialOutcome};
 use super::{Arrival, Detector};
@@ -417,76 +417,6 @@ struct GroundLevel<const W: usize> {
     /// ARGUS model: box hits in range buckets below this surely return
     /// (`power·floor·fog ≥ threshold` over the bucket, within 100 m).
     sure_bucket: usize,
-}
-
-/// Width of the range buckets of [`Saturation`], m (a power of two: the
-/// bucket index `⌊r / w⌋` is exact).
-const RANGE_BUCKET_M: f64 = 0.25;
-
-/// The physical model's saturation on box hits: `P_D = ½·erfc((T − A)/√2)`
-/// is exactly 1 once `(T − A)/√2 ≤ −6` (libm's `erfc` returns `2 − ε`
-/// with `ε < erfc(6) ≈ 2e-17`, below half an ulp of 2, or `2 − 2^−1022`;
-/// tested), i.e. `A ≥ T + 6√2`. The amplitude
-/// `A = T·P·(ρ/ρ0)·cos·(r0/R)²·e^(−2αR + 2α0·r0)` falls with `R` (α ≥ 0),
-/// so each range bucket has a lower bound of `A / (P·cos)`; a hit whose
-/// bound clears the limit (padded far above rounding) returns without
-/// evaluating `erfc`.
-#[derive(Debug, Clone)]
-struct Saturation {
-    /// Per surface (0 building, 1 vehicle), per bucket: the lower bound.
-    rows: [Vec<f64>; 2],
-    /// `(T + 6√2)·(1 + 1e-9)`.
-    limit: f64,
-}
-
-impl Saturation {
-    fn new(model: &ReturnModel, reflectivity: [f64; 2], range_m: f64) -> Option<Self> {
-        let ReturnModel::Physical {
-            params,
-            extinction_per_m,
-        } = *model
-        else {
-            return None;
-        };
-        let ok = |x: f64| x.is_finite() && x > 0.0;
-        if !(extinction_per_m >= 0.0
-            && ok(params.rated_range_m)
-            && ok(params.reference_reflectivity)
-            && params.clear_extinction_per_m.is_finite()
-            && extinction_per_m.is_finite()
-            && range_m.is_finite())
-        {
-            return None;
-        }
-        let buckets = (range_m / RANGE_BUCKET_M).ceil() as usize + 1;
-        let r0 = params.rated_range_m;
-        let rows = reflectivity.map(|rho| {
-            (0..buckets)
-                .map(|i| {
-                    let r_hi = (i + 1) as f64 * RANGE_BUCKET_M;
-                    let bound = params.threshold_sigma
-                        * (rho / params.reference_reflectivity)
-                        * (r0 / r_hi).powi(2)
-                        * (-2.0 * extinction_per_m * r_hi
-                            + 2.0 * params.clear_extinction_per_m * r0)
-                            .exp();
-                    bound * (1.0 - 1e-12)
-                })
-                .collect()
-        });
-        Some(Self {
-            rows,
-            limit: (params.threshold_sigma + 6.0 * std::f64::consts::SQRT_2) * (1.0 + 1e-9),
-        })
-    }
-
-    /// Whether a hit on `surface` (0 building, 1 vehicle) in range bucket
-    /// `bucket` at power ratio `power` and incidence `cos` surely has `P_D = 1`.
-    fn saturated(&self, surface: usize, bucket: usize, power: f64, cos: f64) -> bool {
-        self.rows[surface]
-            .get(bucket)
-            .is_some_and(|&l| power * cos * l >= self.limit)
-    }
 }
 
 /// Per-cell state of a trial.
