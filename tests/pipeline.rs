@@ -15,8 +15,10 @@ use nalgebra::{Point3, Vector3};
 fn planar_shared_casts_equal_every_cell_cast_alone() {
     // Both models, the paper's four variants, all fog levels, a k-of-n
     // rule and gaze jitter: the grouped run is the per-cell run, bit for bit.
-    let mut scenario = Scenario::default();
-    scenario.gaze_jitter_deg = 5.0;
+    let scenario = Scenario {
+        gaze_jitter_deg: 5.0,
+        ..Scenario::default()
+    };
     for detection in [KOfN::default(), KOfN { k: 2, n: 3 }] {
         let config = |per_cell| SimConfig {
             trials: 3,
