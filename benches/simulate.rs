@@ -78,15 +78,20 @@ fn bench(c: &mut Criterion) {
             .min()
             .unwrap_or_default()
     };
-    let (shared, alone) = (best_of_3(&planar(false)), best_of_3(&planar(true)));
-    eprintln!(
-        "planar_grid 2x4x3x100 ({} threads): shared casts {:.2} s, per cell {:.2} s, \
-         per-cell/shared {:.2}x",
-        rayon::current_num_threads(),
-        shared.as_secs_f64(),
-        alone.as_secs_f64(),
-        alone.as_secs_f64() / shared.as_secs_f64(),
-    );
+    // Timed only under `cargo bench` (criterion's test mode runs each
+    // benchmark once and skips this).
+    let benching = std::env::args().any(|a| a == "--bench");
+    if benching {
+        let (shared, alone) = (best_of_3(&planar(false)), best_of_3(&planar(true)));
+        eprintln!(
+            "planar_grid 2x4x3x100 ({} threads): shared casts {:.2} s, per cell {:.2} s, \
+             per-cell/shared {:.2}x",
+            rayon::current_num_threads(),
+            shared.as_secs_f64(),
+            alone.as_secs_f64(),
+            alone.as_secs_f64() / shared.as_secs_f64(),
+        );
+    }
 
     // The carla geometry: one trial of the paper's pipeline, rays = pulses × channels.
     let carla = |brute_force| SimConfig {
