@@ -9,6 +9,9 @@
 //! are independent draws of the same distribution run in parallel, so the
 //! full grid takes about 50 × as long; the run prints that extrapolation and
 //! the brute-force ratio (best of three timings each, outside criterion).
+//! The planar grid of `simulate --trials 100` (2 × 4 × 3 × 100 trials) is
+//! timed with its shared casts against every cell cast alone (the code
+//! before them), best of three each, ratio printed.
 //! Run: `cargo bench --bench simulate`.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
@@ -48,6 +51,47 @@ fn bench(c: &mut Criterion) {
         b.iter(|| sim::run(black_box(&grid), &|| {}).unwrap())
     });
     g.finish();
+
+    // The planar grid of `simulate --trials 100` (2,400 trials): cells that
+    // share a timeline cast together, against every cell cast alone (the
+    // code before the shared casts, kept as the reference path).
+    let planar = |per_cell| SimConfig {
+        per_cell,
+        ..SimConfig::default()
+    };
+    let mut g = c.benchmark_group("planar_grid");
+    g.sample_size(10);
+    g.bench_function("2x4x3x100_shared", |b| {
+        b.iter(|| sim::run(black_box(&planar(false)), &|| {}).unwrap())
+    });
+    g.bench_function("2x4x3x100_per_cell", |b| {
+        b.iter(|| sim::run(black_box(&planar(true)), &|| {}).unwrap())
+    });
+    g.finish();
+    let best_of_3 = |config: &SimConfig| -> Duration {
+        (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                black_box(sim::run(config, &|| {}).unwrap());
+                t.elapsed()
+            })
+            .min()
+            .unwrap_or_default()
+    };
+    // Timed only under `cargo bench` (criterion's test mode runs each
+    // benchmark once and skips this).
+    let benching = std::env::args().any(|a| a == "--bench");
+    if benching {
+        let (shared, alone) = (best_of_3(&planar(false)), best_of_3(&planar(true)));
+        eprintln!(
+            "planar_grid 2x4x3x100 ({} threads): shared casts {:.2} s, per cell {:.2} s, \
+             per-cell/shared {:.2}x",
+            rayon::current_num_threads(),
+            shared.as_secs_f64(),
+            alone.as_secs_f64(),
+            alone.as_secs_f64() / shared.as_secs_f64(),
+        );
+    }
 
     // The carla geometry: one trial of the paper's pipeline, rays = pulses × channels.
     let carla = |brute_force| SimConfig {
@@ -91,16 +135,6 @@ fn bench(c: &mut Criterion) {
         b.iter(|| sim::run(black_box(&grid(true)), &|| {}).unwrap())
     });
     g.finish();
-    let best_of_3 = |config: &SimConfig| -> Duration {
-        (0..3)
-            .map(|_| {
-                let t = Instant::now();
-                black_box(sim::run(config, &|| {}).unwrap());
-                t.elapsed()
-            })
-            .min()
-            .unwrap_or_default()
-    };
     let (fast, slow) = (best_of_3(&grid(false)), best_of_3(&grid(true)));
     let threads = rayon::current_num_threads();
     eprintln!(

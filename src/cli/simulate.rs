@@ -6,7 +6,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use gaze_lidar::sim::{
-    self, Arrival, Detector, Geometry, KOfN, ModelKind, Scenario, SimConfig, Variant,
+    self, Arrival, Detector, Geometry, KOfN, ModelKind, Sampling, Scenario, SimConfig, Variant,
     FOG_LEVELS_PCT,
 };
 
@@ -59,6 +59,13 @@ pub struct Args {
     /// `argus-centre` (the centre does, as the paper's code).
     #[arg(long, value_enum, default_value_t = Arrival::Front)]
     arrival: Arrival,
+    /// How the LiDAR fires (`--geometry carla` only; default `carla`):
+    /// `carla` (CARLA's fixed tick: round(rate·tick) points per laser per
+    /// tick over the tick's rotation), `carla-async` (the same with each
+    /// tick's length jittered by `[carla] async_tick_jitter_frac`, assumed)
+    /// or `drift` (pulses at k / pulse rate, the planar geometry's clock).
+    #[arg(long, value_enum)]
+    sampling: Option<Sampling>,
     /// Detection rule k-of-n frames, e.g. `2/3` (paper: first return, `1/1`).
     #[arg(long, default_value = "1/1")]
     detect: String,
@@ -234,6 +241,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         geometry: a.geometry,
         detector: a.detector,
         arrival: a.arrival,
+        sampling: a.sampling,
         #[cfg(feature = "solver")]
         optimizer,
         ..SimConfig::default()
@@ -299,14 +307,55 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 ..config.clone()
             };
             let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
-            Some((r, pc))
+            // Clear air under the other samplings, and the fog-25 % baseline
+            // with cars above ARGUS's road threshold, for the comparisons.
+            let mut extras = Vec::new();
+            for other in [Sampling::Carla, Sampling::Drift, Sampling::CarlaAsync] {
+                if other != pc.sampling() {
+                    extras.push(SimConfig {
+                        fog_pcts: vec![0],
+                        variants: vec![Variant::Baseline],
+                        sampling: Some(other),
+                        ..pc.clone()
+                    });
+                }
+            }
+            let mut lifted = SimConfig {
+                fog_pcts: vec![25],
+                variants: vec![Variant::Baseline],
+                ..pc.clone()
+            };
+            let c = &mut lifted.scenario.carla;
+            c.vehicle_ground_clearance_m =
+                (c.mount_height_m + c.argus_road_z_m + 0.05).clamp(0.0, 0.49 * c.vehicle_height_m);
+            extras.push(lifted);
+            let runs = extras
+                .into_iter()
+                .map(|c| sim::run(&c, &|| {}).map(|r| (r, c)))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| CliError::input(e.to_string()))?;
+            Some(((r, pc), runs))
         } else {
             None
         };
-        let md = sim::report::render_with_pipeline(
+        let runs: &[(sim::GridResult, SimConfig)] = pipeline.as_ref().map_or(&[], |(_, r)| r);
+        let others: Vec<(&sim::GridResult, &SimConfig)> = runs
+            .iter()
+            .filter(|(_, c)| c.fog_pcts == [0])
+            .map(|(r, c)| (r, c))
+            .collect();
+        let lifted = runs
+            .iter()
+            .find(|(_, c)| c.fog_pcts == [25])
+            .map(|(r, c)| (r, c));
+        let md = sim::report::render_with_pipelines(
             &result,
             &config,
-            pipeline.as_ref().map(|(r, c)| (r, c)),
+            pipeline.as_ref().map(|((r, c), _)| (r, c)),
+            &sim::report::PipelineExtras {
+                other_samplings: &others,
+                lifted,
+            },
         );
         outputs.add(path, md);
     }

@@ -31,6 +31,7 @@ use crate::checker::CertifiedProfile;
 use crate::model::presets::{self, Preset};
 use crate::planner::{closed_form, Mode, PlanError};
 
+pub use carla::Sampling;
 pub use returns::{FogLevel, ModelKind, ReturnModel, FOG_LEVELS_PCT};
 pub use scene::Scenario;
 pub use trial::{KOfN, TrialDraw, TrialOutcome};
@@ -224,6 +225,17 @@ pub fn is_paper_pipeline(geometry: Geometry, detector: Detector, arrival: Arriva
     geometry == Geometry::Carla && detector == Detector::Argus && arrival == Arrival::ArgusCentre
 }
 
+impl SimConfig {
+    /// The sampling this run uses.
+    #[must_use]
+    pub fn sampling(&self) -> Sampling {
+        self.sampling.unwrap_or(match self.geometry {
+            Geometry::Carla => Sampling::Carla,
+            Geometry::Planar => Sampling::Drift,
+        })
+    }
+}
+
 /// What to run.
 #[derive(Debug, Clone)]
 pub struct SimConfig {
@@ -246,12 +258,18 @@ pub struct SimConfig {
     pub detection: KOfN,
     /// Disable culling (reference path).
     pub brute_force: bool,
+    /// Planar geometry: cast every cell alone (the reference of the shared
+    /// casts; the same results, slower).
+    pub per_cell: bool,
     /// Sensor geometry.
     pub geometry: Geometry,
     /// Detector of the car from the right.
     pub detector: Detector,
     /// Arrival rule.
     pub arrival: Arrival,
+    /// How the LiDAR is sampled (`None`: the geometry's own — `carla` for
+    /// the `carla` geometry, `drift` for `planar`, which has only that).
+    pub sampling: Option<Sampling>,
     /// Bins of the closed-form profiles.
     pub bins: usize,
     /// The sensor and driver model of the closed-form variants (regions,
@@ -273,9 +291,11 @@ impl Default for SimConfig {
             scenario: Scenario::default(),
             detection: KOfN::default(),
             brute_force: false,
+            per_cell: false,
             geometry: Geometry::Planar,
             detector: Detector::FirstReturn,
             arrival: Arrival::Front,
+            sampling: None,
             bins: 360,
             sensor: presets::paper(),
         }
@@ -418,6 +438,9 @@ pub struct Row {
     pub detector: Detector,
     /// Arrival rule.
     pub arrival: Arrival,
+    /// Sampling (`carla` geometry only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Sampling>,
     /// Trials.
     pub trials: usize,
     /// Trials where the right car was detected before arrival.
@@ -625,6 +648,11 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
     }
     if config.geometry == Geometry::Carla {
         config.scenario.validate_carla()?;
+    } else if config.sampling() != Sampling::Drift {
+        return Err(SimError::Argument(format!(
+            "--sampling {} needs --geometry carla (the planar geometry has only the drift pulse clock)",
+            config.sampling().name()
+        )));
     }
     let fogs: Vec<FogLevel> = config
         .fog_pcts
@@ -655,8 +683,175 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
     })
 }
 
-/// The planar geometry: one job per (model, variant, fog, trial).
+/// Range of the planar saturation tables, m (hits beyond take the model).
+const PLANAR_SATURATION_RANGE_M: f64 = 400.0;
+
+/// The planar geometry: per trial, every cell planned, cells sharing a
+/// timeline and the driver's regions cast together ([`trial::run_group`]);
+/// records in the order of [`run_planar_per_cell`], bit-identical to it.
 fn run_planar<'s>(
+    config: &SimConfig,
+    fogs: &[FogLevel],
+    table: Option<&OptTable>,
+    sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
+    tick: &(dyn Fn() + Sync),
+) -> Result<Vec<TrialRecord>, SimError> {
+    if config.per_cell {
+        return run_planar_per_cell(config, fogs, table, sensor_of, tick);
+    }
+    let statics = config.scenario.static_boxes();
+    // The physical model's saturation bounds, once per distinct model
+    // (building and vehicle hits, to the farthest a planar ray can reach).
+    let reflectivity = [
+        config.scenario.building_reflectivity,
+        config.scenario.vehicle_reflectivity,
+    ];
+    let mut saturations: Vec<(ReturnModel, Option<returns::Saturation>)> = Vec::new();
+    for &model in &config.models {
+        for &variant in &config.variants {
+            let sensor = sensor_of(variant);
+            for &fog in fogs {
+                let m = ReturnModel::new(
+                    model,
+                    fog,
+                    sensor.lidar.rated_range_m,
+                    sensor.lidar.reference_reflectivity,
+                );
+                if !saturations.iter().any(|(x, _)| *x == m) {
+                    let sat = returns::Saturation::new(&m, reflectivity, PLANAR_SATURATION_RANGE_M);
+                    saturations.push((m, sat));
+                }
+            }
+        }
+    }
+    let saturation_of = |m: &ReturnModel| {
+        saturations
+            .iter()
+            .find(|(x, _)| x == m)
+            .and_then(|(_, s)| s.as_ref())
+    };
+    let per_trial: Result<Vec<Vec<TrialRecord>>, SimError> = (0..config.trials)
+        .into_par_iter()
+        .map(|trial| {
+            let d = draw(config.seed, trial, &config.scenario);
+            struct Plan {
+                model: ModelKind,
+                variant: Variant,
+                profile: CertifiedProfile,
+                rof_keep: f64,
+                regions: crate::model::acuity::Regions,
+                models: Vec<(FogLevel, ReturnModel)>,
+            }
+            let mut plans = Vec::new();
+            for &model in &config.models {
+                for &variant in &config.variants {
+                    let sensor = sensor_of(variant);
+                    let (profile, rof_keep) = plan_variant(
+                        &config.sensor,
+                        model,
+                        variant,
+                        d.gaze_deg,
+                        config.bins,
+                        table,
+                    )?;
+                    let models = fogs
+                        .iter()
+                        .map(|&fog| {
+                            (
+                                fog,
+                                ReturnModel::new(
+                                    model,
+                                    fog,
+                                    sensor.lidar.rated_range_m,
+                                    sensor.lidar.reference_reflectivity,
+                                ),
+                            )
+                        })
+                        .collect();
+                    plans.push(Plan {
+                        model,
+                        variant,
+                        profile,
+                        rof_keep,
+                        regions: sensor.focus.regions(d.gaze_deg),
+                        models,
+                    });
+                }
+            }
+            // Group the plans by timeline and regions (first-seen order).
+            let mut groups: Vec<Vec<usize>> = Vec::new();
+            for (i, plan) in plans.iter().enumerate() {
+                let same = groups.iter_mut().find(|g| {
+                    let first = &plans[g[0]];
+                    carla::same_timeline(first.profile.profile(), plan.profile.profile())
+                        && first.regions == plan.regions
+                });
+                match same {
+                    Some(g) => g.push(i),
+                    None => groups.push(vec![i]),
+                }
+            }
+            let mut out = Vec::new();
+            for g in &groups {
+                let mut cells = Vec::new();
+                let mut keys = Vec::new();
+                for &i in g {
+                    let plan = &plans[i];
+                    for (fog, model) in &plan.models {
+                        cells.push(trial::GroupCell {
+                            profile: plan.profile.profile(),
+                            rof_keep: plan.rof_keep,
+                            model,
+                            driver_range_m: fog.mor_m,
+                            saturation: saturation_of(model),
+                        });
+                        keys.push((plan.model, plan.variant, fog.fog_pct));
+                    }
+                }
+                let first = &plans[g[0]];
+                let setup = trial::TrialSetup {
+                    scenario: &config.scenario,
+                    statics: &statics,
+                    profile: first.profile.profile(),
+                    rof_keep: first.rof_keep,
+                    regions: &first.regions,
+                    model: cells[0].model,
+                    driver_range_m: cells[0].driver_range_m,
+                    detection: config.detection,
+                    brute_force: config.brute_force,
+                    arrival: config.arrival,
+                    ego_yaw_deg: config.scenario.carla.ego_yaw_deg,
+                    gaze_deg: d.gaze_deg,
+                };
+                let outcomes = trial::run_group(&setup, &cells, &d);
+                for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
+                    tick();
+                    out.push(TrialRecord {
+                        model,
+                        variant: variant.name(),
+                        fog_pct,
+                        trial,
+                        outcome,
+                    });
+                }
+            }
+            Ok(out)
+        })
+        .collect();
+    let rank = |r: &TrialRecord| {
+        let m = config.models.iter().position(|&x| x == r.model);
+        let v = config.variants.iter().position(|x| x.name() == r.variant);
+        let f = config.fog_pcts.iter().position(|&x| x == r.fog_pct);
+        (m, v, f, r.trial)
+    };
+    let mut records: Vec<TrialRecord> = per_trial?.into_iter().flatten().collect();
+    records.sort_by_key(rank);
+    Ok(records)
+}
+
+/// The planar geometry one job per (model, variant, fog, trial), each cast
+/// alone ([`trial::run_trial`]): the reference of [`run_planar`].
+fn run_planar_per_cell<'s>(
     config: &SimConfig,
     fogs: &[FogLevel],
     table: Option<&OptTable>,
@@ -822,6 +1017,7 @@ fn run_carla<'s>(
                     detection: config.detection,
                     brute_force: config.brute_force,
                     gaze_deg: d.gaze_deg,
+                    sampling: config.sampling(),
                 };
                 let outcomes = carla::run_group_with(&setup, &d, &mut rays);
                 for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
@@ -899,6 +1095,7 @@ fn rows_of<'s>(
             geometry: config.geometry,
             detector: config.detector,
             arrival: config.arrival,
+            sampling: (config.geometry == Geometry::Carla).then(|| config.sampling()),
             trials: chunk.len(),
             detected: right.len(),
             tta_median_s: q.map(|q| q[1]),

@@ -175,16 +175,84 @@ impl ReturnModel {
         cos_incidence: f64,
         range_m: f64,
     ) -> f64 {
+        self.detection_probability_with(power_ratio, reflectivity, cos_incidence, range_m, || {
+            self.range_factor(range_m)
+        })
+    }
+
+    /// [`Self::detection_probability`] with the range factor supplied
+    /// (`factor()` returns `range_factor(range_m)`, e.g. shared by cells;
+    /// not called beyond the `argus` model's 100 m).
+    #[must_use]
+    pub fn detection_probability_with(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        cos_incidence: f64,
+        range_m: f64,
+        factor: impl FnOnce() -> f64,
+    ) -> f64 {
+        if let Self::Argus { .. } = self {
+            if range_m > ARGUS_RANGE_M {
+                return 0.0;
+            }
+        }
+        self.detection_probability_from(power_ratio, reflectivity, cos_incidence, range_m, factor())
+    }
+
+    /// The factor of [`Self::detection_probability`] that depends on the
+    /// range alone: `argus` CARLA's `e^(−0.004·r)` (the same in every fog),
+    /// `physical` the extinction `e^(−2αR + 2α₀R₀)` (the same for every
+    /// power): cells that share [`Self::range_factor_key`] share it.
+    #[must_use]
+    pub fn range_factor(&self, range_m: f64) -> f64 {
+        match *self {
+            Self::Argus { .. } => (-CARLA_ATTENUATION_PER_M * range_m).exp(),
+            Self::Physical {
+                params,
+                extinction_per_m,
+            } => (-2.0 * extinction_per_m * range_m
+                + 2.0 * params.clear_extinction_per_m * params.rated_range_m)
+                .exp(),
+        }
+    }
+
+    /// Models with equal keys have the same [`Self::range_factor`].
+    #[must_use]
+    pub fn range_factor_key(&self) -> [u64; 4] {
+        match *self {
+            Self::Argus { .. } => [0; 4],
+            Self::Physical {
+                params,
+                extinction_per_m,
+            } => [
+                1,
+                extinction_per_m.to_bits(),
+                params.clear_extinction_per_m.to_bits(),
+                params.rated_range_m.to_bits(),
+            ],
+        }
+    }
+
+    /// [`Self::detection_probability`] given `factor = range_factor(range_m)`
+    /// and, for `argus`, `range_m` within its 100 m.
+    /// `P_D = ½·erfc(x)` is exactly 1 for `x ≤ −6` (libm's `erfc` is within
+    /// half an ulp of 2 there; tested in `sim::carla`), so `erfc` is skipped.
+    #[must_use]
+    fn detection_probability_from(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        cos_incidence: f64,
+        range_m: f64,
+        factor: f64,
+    ) -> f64 {
         match *self {
             Self::Argus {
                 fog_factor,
                 threshold,
             } => {
-                if range_m > ARGUS_RANGE_M {
-                    return 0.0;
-                }
-                let intensity =
-                    power_ratio * (-CARLA_ATTENUATION_PER_M * range_m).exp() * fog_factor;
+                let intensity = power_ratio * factor * fog_factor;
                 if intensity >= threshold {
                     1.0
                 } else {
@@ -192,8 +260,19 @@ impl ReturnModel {
                 }
             }
             Self::Physical { params, .. } => {
-                let a = self.amplitude_sigma(power_ratio, reflectivity, cos_incidence, range_m);
-                0.5 * libm::erfc((params.threshold_sigma - a) / std::f64::consts::SQRT_2)
+                let a = self.amplitude_sigma_from(
+                    power_ratio,
+                    reflectivity,
+                    cos_incidence,
+                    range_m,
+                    factor,
+                );
+                let x = (params.threshold_sigma - a) / std::f64::consts::SQRT_2;
+                if x <= -6.0 {
+                    1.0
+                } else {
+                    0.5 * libm::erfc(x)
+                }
             }
         }
     }
@@ -207,17 +286,29 @@ impl ReturnModel {
         cos_incidence: f64,
         range_m: f64,
     ) -> f64 {
+        self.amplitude_sigma_from(
+            power_ratio,
+            reflectivity,
+            cos_incidence,
+            range_m,
+            self.range_factor(range_m),
+        )
+    }
+
+    /// [`Self::amplitude_sigma`] given `extinction = range_factor(range_m)`.
+    fn amplitude_sigma_from(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        cos_incidence: f64,
+        range_m: f64,
+        extinction: f64,
+    ) -> f64 {
         match *self {
             Self::Argus { .. } => 0.0,
-            Self::Physical {
-                params,
-                extinction_per_m,
-            } => {
+            Self::Physical { params, .. } => {
                 let r0 = params.rated_range_m;
                 let geometric = (r0 / range_m).powi(2);
-                let extinction = (-2.0 * extinction_per_m * range_m
-                    + 2.0 * params.clear_extinction_per_m * r0)
-                    .exp();
                 params.threshold_sigma
                     * power_ratio
                     * (reflectivity / params.reference_reflectivity)
@@ -246,6 +337,76 @@ impl ReturnModel {
             }
         }
         lo
+    }
+}
+
+/// Width of the range buckets of [`Saturation`], m (a power of two: the
+/// bucket index `⌊r / w⌋` is exact).
+pub(crate) const RANGE_BUCKET_M: f64 = 0.25;
+
+/// The physical model's saturation on box hits (both geometries): `P_D = ½·erfc((T − A)/√2)`
+/// is exactly 1 once `(T − A)/√2 ≤ −6` (libm's `erfc` returns `2 − ε`
+/// with `ε < erfc(6) ≈ 2e-17`, below half an ulp of 2, or `2 − 2^−1022`;
+/// tested), i.e. `A ≥ T + 6√2`. The amplitude
+/// `A = T·P·(ρ/ρ0)·cos·(r0/R)²·e^(−2αR + 2α0·r0)` falls with `R` (α ≥ 0),
+/// so each range bucket has a lower bound of `A / (P·cos)`; a hit whose
+/// bound clears the limit (padded far above rounding) returns without
+/// evaluating `erfc`.
+#[derive(Debug, Clone)]
+pub(crate) struct Saturation {
+    /// Per surface (0 building, 1 vehicle), per bucket: the lower bound.
+    rows: [Vec<f64>; 2],
+    /// `(T + 6√2)·(1 + 1e-9)`.
+    limit: f64,
+}
+
+impl Saturation {
+    pub(crate) fn new(model: &ReturnModel, reflectivity: [f64; 2], range_m: f64) -> Option<Self> {
+        let ReturnModel::Physical {
+            params,
+            extinction_per_m,
+        } = *model
+        else {
+            return None;
+        };
+        let ok = |x: f64| x.is_finite() && x > 0.0;
+        if !(extinction_per_m >= 0.0
+            && ok(params.rated_range_m)
+            && ok(params.reference_reflectivity)
+            && params.clear_extinction_per_m.is_finite()
+            && extinction_per_m.is_finite()
+            && range_m.is_finite())
+        {
+            return None;
+        }
+        let buckets = (range_m / RANGE_BUCKET_M).ceil() as usize + 1;
+        let r0 = params.rated_range_m;
+        let rows = reflectivity.map(|rho| {
+            (0..buckets)
+                .map(|i| {
+                    let r_hi = (i + 1) as f64 * RANGE_BUCKET_M;
+                    let bound = params.threshold_sigma
+                        * (rho / params.reference_reflectivity)
+                        * (r0 / r_hi).powi(2)
+                        * (-2.0 * extinction_per_m * r_hi
+                            + 2.0 * params.clear_extinction_per_m * r0)
+                            .exp();
+                    bound * (1.0 - 1e-12)
+                })
+                .collect()
+        });
+        Some(Self {
+            rows,
+            limit: (params.threshold_sigma + 6.0 * std::f64::consts::SQRT_2) * (1.0 + 1e-9),
+        })
+    }
+
+    /// Whether a hit on `surface` (0 building, 1 vehicle) in range bucket
+    /// `bucket` at power ratio `power` and incidence `cos` surely has `P_D = 1`.
+    pub(crate) fn saturated(&self, surface: usize, bucket: usize, power: f64, cos: f64) -> bool {
+        self.rows[surface]
+            .get(bucket)
+            .is_some_and(|&l| power * cos * l >= self.limit)
     }
 }
 

@@ -13,11 +13,11 @@
 //! checked by tests).
 
 use crate::model::acuity::Regions;
-use crate::model::angle::{diff_deg, wrap_deg, Arc};
+use crate::model::angle::{diff_deg, wrap_deg, Arc, CircularSet};
 use crate::profile::kinematics::Timeline;
 use crate::profile::Profile;
 
-use super::returns::ReturnModel;
+use super::returns::{ReturnModel, Saturation, RANGE_BUCKET_M};
 use super::scene::{Aabb, Scenario};
 
 /// Padding of the culling arcs, degrees (far above `f64` rounding of atan2).
@@ -381,5 +381,450 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
         frames,
         argus_roi_points,
         channels_simulated: 1,
+    }
+}
+
+/// Margin of [`BinFacts`], degrees: far above the rounding of a bin's
+/// azimuth `wrap(start + x)` (`x` within the bin's width) and of an arc's end.
+const BIN_FACT_PAD_DEG: f64 = 1e-6;
+
+/// What holds for every azimuth a profile bin can produce: the RoI and
+/// RoF membership if it is the same over the whole bin (`None`: test the
+/// azimuth), and the statics whose culling arc may contain it (a superset:
+/// testing a box whose arc does not contain the azimuth finds no hit, as
+/// the brute-force path shows).
+#[derive(Debug, Clone, Copy)]
+struct BinFacts {
+    roi: Option<bool>,
+    rof: Option<bool>,
+    statics: u64,
+}
+
+/// The bin `[lo, lo + width]` widened by the margin, or `None` if it
+/// reaches 0° or 360° (the wrap: no shortcut there).
+fn padded_bin(start_deg: f64, width_deg: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = (
+        start_deg - BIN_FACT_PAD_DEG,
+        start_deg + width_deg + BIN_FACT_PAD_DEG,
+    );
+    (lo >= 0.0 && hi < 360.0).then_some((lo, hi))
+}
+
+/// Membership of `set` over `[lo, hi]` (inside `(0, 360)`) if no edge of its
+/// arcs falls in it (then it is constant there).
+fn constant_membership(set: &CircularSet, arcs: &[Arc], lo: f64, hi: f64) -> Option<bool> {
+    for a in arcs {
+        if a.width_deg >= 360.0 {
+            return Some(set.contains(lo));
+        }
+        for edge in [a.start_deg, wrap_deg(a.start_deg + a.width_deg)] {
+            if lo - BIN_FACT_PAD_DEG <= edge && edge <= hi + BIN_FACT_PAD_DEG {
+                return None;
+            }
+        }
+    }
+    Some(set.contains(0.5 * (lo + hi)))
+}
+
+/// The facts of every bin of `profile`.
+fn bin_facts(profile: &Profile, regions: &Regions, static_arcs: &[Arc]) -> Vec<BinFacts> {
+    let roi_arcs = regions.roi.arcs();
+    let rof_arcs = regions.rof.arcs();
+    let all = if static_arcs.len() >= 62 {
+        (1u64 << 62) - 1
+    } else {
+        (1u64 << static_arcs.len()) - 1
+    };
+    profile
+        .bins
+        .iter()
+        .map(|b| match padded_bin(b.start_deg, b.width_deg) {
+            None => BinFacts {
+                roi: None,
+                rof: None,
+                statics: all,
+            },
+            Some((lo, hi)) => BinFacts {
+                roi: constant_membership(&regions.roi, &roi_arcs, lo, hi),
+                rof: constant_membership(&regions.rof, &rof_arcs, lo, hi),
+                statics: if static_arcs.len() >= 62 {
+                    all
+                } else {
+                    static_arcs.iter().enumerate().fold(0, |m, (i, a)| {
+                        // The arc meets [lo, hi] iff it contains lo or
+                        // starts inside it.
+                        let meets = a.contains(lo)
+                            || (lo <= a.start_deg && a.start_deg <= hi)
+                            || a.width_deg >= 360.0;
+                        m | (u64::from(meets) << i)
+                    })
+                },
+            },
+        })
+        .collect()
+}
+
+/// One cell of a planar group: what differs between cells that share a
+/// trial, a timeline and the driver's regions.
+#[derive(Debug, Clone, Copy)]
+pub struct GroupCell<'a> {
+    /// The certified profile the LiDAR runs (its timeline is the group's).
+    pub profile: &'a Profile,
+    /// Fraction of RoF points kept.
+    pub rof_keep: f64,
+    /// Return model at this fog level.
+    pub model: &'a ReturnModel,
+    /// Driver's visual range in this fog (MOR), m.
+    pub driver_range_m: f64,
+    /// The physical model's saturation bound of this model (building,
+    /// vehicle reflectivity of the scene): hits it proves have `P_D = 1`
+    /// skip the model.
+    pub(crate) saturation: Option<&'a Saturation>,
+}
+
+/// Per-cell state of [`run_group`].
+struct GroupState {
+    power_ratio: Vec<f64>,
+    detected_at: [Option<f64>; 2],
+    driver_at: [Option<f64>; 2],
+    hit_frames: [Vec<u64>; 2],
+    roi_points: u64,
+    argus_roi_points: u64,
+    keep_acc: f64,
+}
+
+/// [`run_trial`] for several cells at once, bit-identical to running each
+/// alone: `setup`'s profile, regions, scene and rules are the group's
+/// (every cell's profile must put every pulse at the same azimuth —
+/// [`super::carla::same_timeline`] — and share the regions), and
+/// `setup.model`, `rof_keep`, `driver_range_m` are ignored in favour of the
+/// cells'. A pulse's azimuth, region tests and ray cast are computed once;
+/// each cell then decides its own return (its power and model), in the
+/// order [`run_trial`] does. Outcomes in the cells' order.
+#[must_use]
+pub fn run_group(
+    setup: &TrialSetup<'_>,
+    cells: &[GroupCell<'_>],
+    draw: &TrialDraw,
+) -> Vec<TrialOutcome> {
+    let sc = setup.scenario;
+    let tl = Timeline::new(setup.profile);
+    let period = tl.period_s();
+    let pulse_rate = setup.profile.pulse_rate_hz;
+    let v = sc.speed_m_s();
+    let lane_x = sc.lane_x_m();
+    let half_w = 0.5 * sc.vehicle_width_m;
+    let len = sc.vehicle_length_m;
+    let ch = sc.conflict_half_width_m;
+    let Crossing {
+        front0_m: front0,
+        dir,
+        t_arrive_s: t_conflict,
+    } = draw.crossing(
+        sc.bend_distance_m,
+        ch,
+        setup.arrival.extra_distance_m(len),
+        v,
+    );
+    let t_end = t_conflict[0].max(t_conflict[1]);
+    let car_box = |j: usize, t: f64| -> Aabb {
+        let front = front0[j] + dir[j] * v * t;
+        let back = front - dir[j] * len;
+        Aabb::new(lane_x[j] - half_w, lane_x[j] + half_w, front, back)
+    };
+    let static_arcs: Vec<Arc> = setup
+        .statics
+        .iter()
+        .map(|b| cull_arc(std::slice::from_ref(b)))
+        .collect();
+    let phase = draw.phase_frac * period;
+    let mut states: Vec<GroupState> = cells
+        .iter()
+        .map(|c| GroupState {
+            power_ratio: c
+                .profile
+                .bins
+                .iter()
+                .map(|b| b.power_w / c.profile.average_power_w)
+                .collect(),
+            detected_at: [None, None],
+            driver_at: [None, None],
+            hit_frames: [Vec::new(), Vec::new()],
+            roi_points: 0,
+            argus_roi_points: 0,
+            keep_acc: 0.0,
+        })
+        .collect();
+    let any_decimates = cells.iter().any(|c| c.rof_keep < 1.0);
+    // Cells sharing a model's range factor share its value per pulse.
+    let mut factor_keys: Vec<[u64; 4]> = Vec::new();
+    let factor_slot: Vec<usize> = cells
+        .iter()
+        .map(|c| {
+            let key = c.model.range_factor_key();
+            factor_keys
+                .iter()
+                .position(|k| *k == key)
+                .unwrap_or_else(|| {
+                    factor_keys.push(key);
+                    factor_keys.len() - 1
+                })
+        })
+        .collect();
+    let mut factors: Vec<Option<f64>> = vec![None; factor_keys.len()];
+    // Culling masks: bit i for static i (all statics if more than 62),
+    // bits 62 and 63 for the cars.
+    let statics_masked = setup.statics.len() <= 62;
+    let facts = bin_facts(setup.profile, setup.regions, &static_arcs);
+    let mut roi_pulses = 0u64;
+    let mut current_frame = u64::MAX;
+    let mut car_arcs = [static_arcs[0]; 2];
+    let n_pulses = (t_end * pulse_rate).floor() as u64;
+    let mut frames = 0u64;
+    let mut bin_hint = 0usize;
+
+    let cast = |c: f64,
+                s: f64,
+                az: f64,
+                t: f64,
+                car_arcs: &[Arc; 2]|
+     -> Option<(f64, f64, f64, Option<usize>)> {
+        let mut best: Option<(f64, f64, f64, Option<usize>)> = None;
+        for (b, arc) in setup.statics.iter().zip(&static_arcs) {
+            if setup.brute_force || arc.contains(az) {
+                if let Some(h) = b.ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.building_reflectivity, None));
+                    }
+                }
+            }
+        }
+        for (j, arc) in car_arcs.iter().enumerate() {
+            if setup.brute_force || arc.contains(az) {
+                if let Some(h) = car_box(j, t).ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.vehicle_reflectivity, Some(j)));
+                    }
+                }
+            }
+        }
+        best
+    };
+    let full = Arc {
+        start_deg: 0.0,
+        width_deg: 360.0,
+    };
+    // [`cast`] over the objects of `mask` (in the same order).
+    let cast_masked = |c: f64, s: f64, t: f64, mask: u64| {
+        let mut best: Option<(f64, f64, f64, Option<usize>)> = None;
+        for (i, b) in setup.statics.iter().enumerate() {
+            if mask >> i.min(61) & 1 == 1 {
+                if let Some(h) = b.ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.building_reflectivity, None));
+                    }
+                }
+            }
+        }
+        for j in 0..2 {
+            if mask >> (62 + j) & 1 == 1 {
+                if let Some(h) = car_box(j, t).ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence, sc.vehicle_reflectivity, Some(j)));
+                    }
+                }
+            }
+        }
+        best
+    };
+
+    for k in 0..n_pulses {
+        let t = k as f64 / pulse_rate;
+        let tau_total = t + phase;
+        let frame = (tau_total / period).floor() as u64;
+        let tau = (tau_total - frame as f64 * period).clamp(0.0, period);
+        if frame != current_frame {
+            current_frame = frame;
+            frames += 1;
+            bin_hint = 0;
+            let t0 = (frame as f64 * period - phase).max(0.0);
+            let t1 = (frame + 1) as f64 * period - phase;
+            for (j, arc) in car_arcs.iter_mut().enumerate() {
+                *arc = cull_arc(&[car_box(j, t0), car_box(j, t1)]);
+            }
+            // The driver: looks at each car's front centre at the frame start.
+            for j in 0..2 {
+                if t0 > t_conflict[j] {
+                    continue;
+                }
+                let (x, y) = (lane_x[j], front0[j] + dir[j] * v * t0);
+                let az = y.atan2(x).to_degrees();
+                let dist = x.hypot(y);
+                if !setup.regions.rof.contains(az) {
+                    continue;
+                }
+                let mut sees: Option<bool> = None;
+                for (st, cell) in states.iter_mut().zip(cells) {
+                    if st.driver_at[j].is_some() || dist > cell.driver_range_m {
+                        continue;
+                    }
+                    let seen = *sees.get_or_insert_with(|| {
+                        let (c, s) = (x / dist, y / dist);
+                        matches!(cast(c, s, wrap_deg(az), t0, &[full, full]), Some((_, _, _, Some(hit))) if hit == j)
+                    });
+                    if seen {
+                        st.driver_at[j] = Some(t0);
+                    }
+                }
+            }
+        }
+        let (az, bin) = tl.azimuth_at_from(tau, bin_hint);
+        bin_hint = bin;
+        let fact = facts[bin];
+        let in_roi = fact.roi.unwrap_or_else(|| setup.regions.roi.contains(az));
+        roi_pulses += u64::from(in_roi);
+        // The objects whose extent may contain the azimuth ([`run_trial`]'s
+        // culling); none: no hit, no cast.
+        let mut mask = if setup.brute_force || !statics_masked {
+            (1u64 << 62) - 1
+        } else {
+            fact.statics
+        };
+        for (j, arc) in car_arcs.iter().enumerate() {
+            mask |= u64::from(setup.brute_force || arc.contains(az)) << (62 + j);
+        }
+        if mask == 0 {
+            continue;
+        }
+        let rad = az.to_radians();
+        let (s, c) = rad.sin_cos();
+        let Some((range, cos_i, refl, car)) = cast_masked(c, s, t, mask) else {
+            continue;
+        };
+        factors.iter_mut().for_each(|f| *f = None);
+        let surface = usize::from(car.is_some());
+        let bucket = (range * (1.0 / RANGE_BUCKET_M)) as usize;
+        let mut noise: Option<f64> = None;
+        let in_rof = any_decimates && fact.rof.unwrap_or_else(|| setup.regions.rof.contains(az));
+        let dens = super::carla::argus::in_density_region(az, setup.gaze_deg, setup.ego_yaw_deg);
+        for ((st, cell), &slot) in states.iter_mut().zip(cells).zip(&factor_slot) {
+            let power = st.power_ratio[bin];
+            let p_d = if cell
+                .saturation
+                .is_some_and(|x| x.saturated(surface, bucket, power, cos_i))
+            {
+                1.0
+            } else {
+                cell.model
+                    .detection_probability_with(power, refl, cos_i, range, || {
+                        *factors[slot].get_or_insert_with(|| cell.model.range_factor(range))
+                    })
+            };
+            let returned = p_d >= 1.0
+                || (p_d > 0.0
+                    && *noise.get_or_insert_with(|| {
+                        unit(draw.noise_seed ^ k.wrapping_mul(0xD1B5_4A32_D192_ED03))
+                    }) < p_d);
+            if !returned {
+                continue;
+            }
+            if cell.rof_keep < 1.0 && in_rof {
+                st.keep_acc += cell.rof_keep;
+                if st.keep_acc < 1.0 {
+                    continue;
+                }
+                st.keep_acc -= 1.0;
+            }
+            st.roi_points += u64::from(in_roi);
+            st.argus_roi_points += u64::from(dens);
+            if let Some(j) = car {
+                if st.detected_at[j].is_none() && t <= t_conflict[j] {
+                    let frames_hit = &mut st.hit_frames[j];
+                    if frames_hit.last() != Some(&frame) {
+                        frames_hit.push(frame);
+                    }
+                    let window_start = frame.saturating_sub(u64::from(setup.detection.n) - 1);
+                    let recent = frames_hit
+                        .iter()
+                        .rev()
+                        .take_while(|&&f| f >= window_start)
+                        .count();
+                    if recent as u32 >= setup.detection.k {
+                        st.detected_at[j] = Some(t);
+                    }
+                }
+            }
+        }
+    }
+
+    let tta = |j: usize, t: Option<f64>| t.map(|t| t_conflict[j] - t).filter(|x| *x >= 0.0);
+    states
+        .iter()
+        .map(|st| {
+            let tta_s = [tta(0, st.detected_at[0]), tta(1, st.detected_at[1])];
+            let driver_tta = [tta(0, st.driver_at[0]), tta(1, st.driver_at[1])];
+            let hybrid = |j: usize| match (tta_s[j], driver_tta[j]) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                (a, b) => a.or(b),
+            };
+            TrialOutcome {
+                tta_s,
+                hybrid_tta_s: [hybrid(0), hybrid(1)],
+                roi_points: st.roi_points,
+                roi_pulses,
+                roi_width_deg: setup.regions.roi.measure_deg(),
+                duration_s: n_pulses as f64 / pulse_rate,
+                frames,
+                argus_roi_points: st.argus_roi_points,
+                channels_simulated: 1,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+    use crate::planner::{closed_form, Mode};
+
+    #[test]
+    fn bin_facts_hold_for_every_azimuth_of_their_bin() {
+        // Every bin of the paper's profiles at several gazes and bin counts
+        // (RoI edges inside bins and on their edges): azimuths across each
+        // bin, its edges included, agree with the facts.
+        let preset = presets::paper();
+        let sc = Scenario::default();
+        let statics = sc.static_boxes();
+        let static_arcs: Vec<Arc> = statics
+            .iter()
+            .map(|b| cull_arc(std::slice::from_ref(b)))
+            .collect();
+        let mut decided = 0;
+        for gaze in [0.0, 37.25, 90.0, 90.5, 181.0, 300.3] {
+            for (mode, bins) in [(Mode::Joint, 360), (Mode::Resolution, 97), (Mode::Range, 7)] {
+                let c = closed_form(&preset, mode, Some(gaze), bins).unwrap();
+                let regions = preset.focus.regions(gaze);
+                let facts = bin_facts(c.profile(), &regions, &static_arcs);
+                for (b, f) in c.profile().bins.iter().zip(&facts) {
+                    for i in 0..=64 {
+                        let az = wrap_deg(b.start_deg + b.width_deg * f64::from(i) / 64.0);
+                        if let Some(x) = f.roi {
+                            assert_eq!(x, regions.roi.contains(az), "{gaze} {az}");
+                            decided += 1;
+                        }
+                        if let Some(x) = f.rof {
+                            assert_eq!(x, regions.rof.contains(az), "{gaze} {az}");
+                        }
+                        for (j, a) in static_arcs.iter().enumerate() {
+                            if a.contains(az) {
+                                assert_eq!(f.statics >> j & 1, 1, "{gaze} {az} {j}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(decided > 10_000, "{decided}");
     }
 }

@@ -55,6 +55,19 @@ fn floor_i64(x: f64) -> i64 {
     }
 }
 
+/// Largest grid stored densely (one byte per cell, 16 MiB): larger grids
+/// (a fine `argus_cell_m` over a long `range_m`: 0.05 m cells over 1 km
+/// are 1.6 × 10⁹ cells) store only the cells the road touches.
+pub const DENSE_MASK_MAX_CELLS: u64 = 1 << 24;
+
+/// The cells of a road mask: dense for a small grid, else only the marked
+/// ones (a callback marks at most its road points, a few thousand).
+#[derive(Debug, Clone)]
+enum Cells {
+    Dense(Vec<bool>),
+    Sparse(std::collections::HashSet<usize>),
+}
+
 /// The road mask grid: cells of `cell_m` over `[-extent, extent)²`.
 #[derive(Debug, Clone)]
 pub struct RoadMask {
@@ -63,21 +76,40 @@ pub struct RoadMask {
     side: i64,
     /// Index offset: cell `i` is stored at `i + offset`.
     offset: i64,
-    cells: Vec<bool>,
+    cells: Cells,
 }
 
 impl RoadMask {
-    /// An empty mask covering `|x|, |y| ≤ extent_m`.
+    /// An empty mask covering `|x|, |y| ≤ extent_m`: dense up to
+    /// [`DENSE_MASK_MAX_CELLS`] cells, sparse beyond.
     #[must_use]
     pub fn new(cell_m: f64, extent_m: f64) -> Self {
+        Self::with_dense_limit(cell_m, extent_m, DENSE_MASK_MAX_CELLS)
+    }
+
+    /// [`Self::new`] with the dense storage limited to `dense_max_cells`.
+    #[must_use]
+    pub fn with_dense_limit(cell_m: f64, extent_m: f64, dense_max_cells: u64) -> Self {
         let offset = (extent_m / cell_m).ceil() as i64 + 2;
         let side = 2 * offset;
+        let n = (side as u64).saturating_mul(side as u64);
+        let cells = if n <= dense_max_cells {
+            Cells::Dense(vec![false; n as usize])
+        } else {
+            Cells::Sparse(std::collections::HashSet::new())
+        };
         Self {
             cell_m,
             side,
             offset,
-            cells: vec![false; (side * side) as usize],
+            cells,
         }
+    }
+
+    /// Whether the cells are stored sparsely.
+    #[must_use]
+    pub fn is_sparse(&self) -> bool {
+        matches!(self.cells, Cells::Sparse(_))
     }
 
     /// The cell of `(x, y)` (Python's `int(x // cell)`), as a storage index,
@@ -92,13 +124,21 @@ impl RoadMask {
 
     /// Marks a cell.
     pub fn insert(&mut self, index: usize) {
-        self.cells[index] = true;
+        match &mut self.cells {
+            Cells::Dense(v) => v[index] = true,
+            Cells::Sparse(s) => {
+                s.insert(index);
+            }
+        }
     }
 
     /// Whether a cell is marked.
     #[must_use]
     pub fn contains(&self, index: usize) -> bool {
-        self.cells[index]
+        match &self.cells {
+            Cells::Dense(v) => v[index],
+            Cells::Sparse(s) => s.contains(&index),
+        }
     }
 }
 
@@ -297,6 +337,52 @@ mod tests {
         d.point(8.5, -61.5, -3.0);
         d.point(8.4, -61.6, -2.0);
         assert!(d.end_tick());
+    }
+
+    #[test]
+    fn sparse_mask_equals_dense_mask() {
+        // The same marks through both storages give the same answers.
+        let (cell, extent) = (0.37, 60.0);
+        let mut dense = RoadMask::with_dense_limit(cell, extent, u64::MAX);
+        let mut sparse = RoadMask::with_dense_limit(cell, extent, 0);
+        assert!(!dense.is_sparse() && sparse.is_sparse());
+        let mut state = 0x9e37_79b9_u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20_000 {
+            let (x, y) = (130.0 * next() - 65.0, 130.0 * next() - 65.0);
+            assert_eq!(dense.index(x, y), sparse.index(x, y));
+            if let Some(i) = dense.index(x, y) {
+                if next() < 0.3 {
+                    dense.insert(i);
+                    sparse.insert(i);
+                }
+                assert_eq!(dense.contains(i), sparse.contains(i));
+            }
+        }
+        // Every cell of the grid agrees.
+        let side = dense.side as usize;
+        assert!((0..side * side).all(|i| dense.contains(i) == sparse.contains(i)));
+    }
+
+    #[test]
+    fn fine_long_range_mask_is_sparse_and_small() {
+        // Issue 22 item 14: 0.05 m cells over a 1 km trace were a dense
+        // 1.6 GB mask per detector.
+        let p = CarlaParams {
+            argus_cell_m: 0.05,
+            range_m: 1000.0,
+            ..CarlaParams::default()
+        };
+        let d = ArgusDetector::new(&p);
+        assert!(d.mask.is_sparse());
+        assert!(d.mask.side * d.mask.side > 1_600_000_000);
+        // The default scene stays dense.
+        assert!(!ArgusDetector::new(&CarlaParams::default()).mask.is_sparse());
     }
 
     #[test]

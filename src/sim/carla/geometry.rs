@@ -343,9 +343,16 @@ impl PosedBox {
     /// `(x, y)` and heading `yaw_rad` (from +x towards +y).
     #[must_use]
     pub fn on_road(x: f64, y: f64, yaw_rad: f64, size: Vector3<f64>) -> Self {
+        Self::above_road(x, y, 0.0, yaw_rad, size)
+    }
+
+    /// A box of `size` whose bottom face lies `clearance_m` above the road
+    /// (a car's body over its ground clearance), centred at `(x, y)`.
+    #[must_use]
+    pub fn above_road(x: f64, y: f64, clearance_m: f64, yaw_rad: f64, size: Vector3<f64>) -> Self {
         Self {
             pose: Isometry3::from_parts(
-                Translation3::new(x, y, 0.5 * size.z),
+                Translation3::new(x, y, clearance_m + 0.5 * size.z),
                 UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw_rad),
             ),
             half: size * 0.5,

@@ -45,6 +45,7 @@ pub mod argus;
 mod chans;
 pub mod geometry;
 pub mod params;
+pub mod sampling;
 
 use nalgebra::{Point3, Vector3};
 
@@ -53,12 +54,14 @@ use crate::model::angle::Arc;
 use crate::profile::kinematics::Timeline;
 use crate::profile::Profile;
 
-use super::returns::{ReturnModel, ARGUS_RANGE_M};
+use super::returns::{ReturnModel, Saturation, ARGUS_RANGE_M, RANGE_BUCKET_M};
 use super::scene::{Aabb, Scenario};
 use super::trial::{cull_arc, mix64, KOfN, TrialDraw, TrialOutcome};
 use super::{Arrival, Detector};
 use argus::ArgusDetector;
 use chans::Chans;
+pub use sampling::Sampling;
+
 use geometry::{channel_may_reach, footprint_distances, Hit, PosedBox, Sensor, StaticBox, Surface};
 
 /// Padding of the culling bounds, m (far above `f64` rounding at 1 km).
@@ -98,6 +101,8 @@ pub struct GroupSetup<'a> {
     pub brute_force: bool,
     /// This trial's gaze, degrees.
     pub gaze_deg: f64,
+    /// When the LiDAR fires and where it points.
+    pub sampling: Sampling,
 }
 
 /// Whether two profiles put every pulse at the same azimuth (same pulse
@@ -105,6 +110,7 @@ pub struct GroupSetup<'a> {
 #[must_use]
 pub fn same_timeline(a: &Profile, b: &Profile) -> bool {
     a.pulse_rate_hz.to_bits() == b.pulse_rate_hz.to_bits()
+        && a.frame_rate_hz.to_bits() == b.frame_rate_hz.to_bits()
         && a.bins.len() == b.bins.len()
         && a.bins.iter().zip(&b.bins).all(|(x, y)| {
             x.start_deg.to_bits() == y.start_deg.to_bits()
@@ -411,76 +417,6 @@ struct GroundLevel<const W: usize> {
     /// ARGUS model: box hits in range buckets below this surely return
     /// (`power·floor·fog ≥ threshold` over the bucket, within 100 m).
     sure_bucket: usize,
-}
-
-/// Width of the range buckets of [`Saturation`], m (a power of two: the
-/// bucket index `⌊r / w⌋` is exact).
-const RANGE_BUCKET_M: f64 = 0.25;
-
-/// The physical model's saturation on box hits: `P_D = ½·erfc((T − A)/√2)`
-/// is exactly 1 once `(T − A)/√2 ≤ −6` (libm's `erfc` returns `2 − ε`
-/// with `ε < erfc(6) ≈ 2e-17`, below half an ulp of 2, or `2 − 2^−1022`;
-/// tested), i.e. `A ≥ T + 6√2`. The amplitude
-/// `A = T·P·(ρ/ρ0)·cos·(r0/R)²·e^(−2αR + 2α0·r0)` falls with `R` (α ≥ 0),
-/// so each range bucket has a lower bound of `A / (P·cos)`; a hit whose
-/// bound clears the limit (padded far above rounding) returns without
-/// evaluating `erfc`.
-#[derive(Debug, Clone)]
-struct Saturation {
-    /// Per surface (0 building, 1 vehicle), per bucket: the lower bound.
-    rows: [Vec<f64>; 2],
-    /// `(T + 6√2)·(1 + 1e-9)`.
-    limit: f64,
-}
-
-impl Saturation {
-    fn new(model: &ReturnModel, reflectivity: [f64; 2], range_m: f64) -> Option<Self> {
-        let ReturnModel::Physical {
-            params,
-            extinction_per_m,
-        } = *model
-        else {
-            return None;
-        };
-        let ok = |x: f64| x.is_finite() && x > 0.0;
-        if !(extinction_per_m >= 0.0
-            && ok(params.rated_range_m)
-            && ok(params.reference_reflectivity)
-            && params.clear_extinction_per_m.is_finite()
-            && extinction_per_m.is_finite()
-            && range_m.is_finite())
-        {
-            return None;
-        }
-        let buckets = (range_m / RANGE_BUCKET_M).ceil() as usize + 1;
-        let r0 = params.rated_range_m;
-        let rows = reflectivity.map(|rho| {
-            (0..buckets)
-                .map(|i| {
-                    let r_hi = (i + 1) as f64 * RANGE_BUCKET_M;
-                    let bound = params.threshold_sigma
-                        * (rho / params.reference_reflectivity)
-                        * (r0 / r_hi).powi(2)
-                        * (-2.0 * extinction_per_m * r_hi
-                            + 2.0 * params.clear_extinction_per_m * r0)
-                            .exp();
-                    bound * (1.0 - 1e-12)
-                })
-                .collect()
-        });
-        Some(Self {
-            rows,
-            limit: (params.threshold_sigma + 6.0 * std::f64::consts::SQRT_2) * (1.0 + 1e-9),
-        })
-    }
-
-    /// Whether a hit on `surface` (0 building, 1 vehicle) in range bucket
-    /// `bucket` at power ratio `power` and incidence `cos` surely has `P_D = 1`.
-    fn saturated(&self, surface: usize, bucket: usize, power: f64, cos: f64) -> bool {
-        self.rows[surface]
-            .get(bucket)
-            .is_some_and(|&l| power * cos * l >= self.limit)
-    }
 }
 
 /// Per-cell state of a trial.
@@ -822,7 +758,8 @@ fn run<const W: usize>(
     let v = sc.speed_m_s();
     let lane_x = sc.lane_x_m();
     let len = sc.vehicle_length_m;
-    let size = Vector3::new(len, sc.vehicle_width_m, p.vehicle_height_m);
+    let clearance = p.vehicle_ground_clearance_m;
+    let size = Vector3::new(len, sc.vehicle_width_m, p.vehicle_height_m - clearance);
     let ch_half = sc.conflict_half_width_m;
     let super::trial::Crossing {
         front0_m: front0,
@@ -838,17 +775,28 @@ fn run<const W: usize>(
     let pose = |t: f64| -> [PosedBox; 2] {
         std::array::from_fn(|j| {
             let centre = front0[j] + dir[j] * (v * t - 0.5 * len);
-            PosedBox::on_road(
+            PosedBox::above_road(
                 lane_x[j],
                 centre,
+                clearance,
                 dir[j] * std::f64::consts::FRAC_PI_2,
                 size,
             )
         })
     };
-    let phase = draw.phase_frac * period;
-    let n_pulses = (t_end * pulse_rate).floor() as u64;
-    let tick_s = p.tick_s;
+    let (schedule, duration_s) = sampling::schedule(&sampling::ScheduleSpec {
+        sampling: setup.sampling,
+        pulse_rate_hz: pulse_rate,
+        frame_rate_hz: first.profile.frame_rate_hz,
+        period_s: period,
+        channels: p.channels,
+        tick_s: p.tick_s,
+        jitter_frac: p.async_tick_jitter_frac,
+        phase_frac: draw.phase_frac,
+        seed: mix64(draw.noise_seed ^ 0x6361_726c_6174_6963),
+        t_end_s: t_end,
+    });
+    let n_pulses = schedule.len() as u64;
     let ego_yaw = p.ego_yaw_deg;
     let seeds = Seeds {
         general: mix64(draw.noise_seed ^ 0x6361_726c_6167_656e),
@@ -957,15 +905,14 @@ fn run<const W: usize>(
     let mut bin_hint = 0usize;
     let gaze = setup.gaze_deg;
     let origin = world.origin;
-    for k in 0..n_pulses {
-        let t = k as f64 / pulse_rate;
-        let tick = (t / tick_s).floor() as u64;
+    for (k, sched) in (0u64..).zip(&schedule) {
+        let tick = sched.tick;
         if tick != current_tick {
             if current_tick != u64::MAX {
                 end_tick(&mut cells, &mut scratch.tick, current_tick, t_state);
             }
             current_tick = tick;
-            t_state = (tick + 1) as f64 * tick_s;
+            t_state = sched.tick_end_s;
             cars = world.cars(pose(t_state));
             // The driver: looks at each car's front centre at the tick.
             for (st, spec) in cells.iter_mut().zip(setup.cells) {
@@ -974,7 +921,7 @@ fn run<const W: usize>(
                         continue;
                     }
                     let front = front0[j] + dir[j] * v * t_state;
-                    let target = Point3::new(lane_x[j], front, 0.5 * p.vehicle_height_m);
+                    let target = Point3::new(lane_x[j], front, clearance + 0.5 * size.z);
                     let az = target.y.atan2(target.x).to_degrees();
                     let dist = (target - origin).norm();
                     if spec.regions.rof.contains(az) && dist <= spec.driver_range_m {
@@ -987,9 +934,7 @@ fn run<const W: usize>(
                 }
             }
         }
-        let tau_total = t + phase;
-        let frame = (tau_total / period).floor() as u64;
-        let tau = (tau_total - frame as f64 * period).clamp(0.0, period);
+        let (frame, tau) = (sched.frame, sched.tau_s);
         if frame != current_frame {
             current_frame = frame;
             frames += 1;
@@ -1043,7 +988,6 @@ fn run<const W: usize>(
         end_tick(&mut cells, &mut scratch.tick, current_tick, t_state);
     }
 
-    let duration_s = n_pulses as f64 / pulse_rate;
     cells
         .iter()
         .zip(setup.cells)

@@ -46,6 +46,17 @@ pub struct CarlaParams {
     pub tick_s: f64,
     /// Vehicle height, m (CARLA's Audi A2, the paper's car: ≈ 1.55).
     pub vehicle_height_m: f64,
+    /// Height of a car's body above the road, m: the box spans
+    /// `[clearance, vehicle_height_m]` and rays pass beneath it (wheels are
+    /// not modelled). Assumed 0.15 m, a typical passenger car's ground
+    /// clearance; neither ARGUS nor CARLA's code states the A2 mesh's. At
+    /// 0 the lowest 0.2 m of a car's face lies below ARGUS's road threshold
+    /// (z < −2.8 m at the 3.0 m mount) and counts as road.
+    pub vehicle_ground_clearance_m: f64,
+    /// CARLA's asynchronous mode (`--sampling carla-async`): each tick's
+    /// length is drawn uniformly from `tick_s · [1 − j, 1 + j]`. Assumed
+    /// 0.2: the spread of the server's frame times is not known.
+    pub async_tick_jitter_frac: f64,
     /// Building height, m.
     pub building_height_m: f64,
     /// Reflectivity of the road (physical model).
@@ -90,6 +101,8 @@ impl Default for CarlaParams {
             dropoff_zero_intensity: 0.4,
             tick_s: 0.05,
             vehicle_height_m: 1.55,
+            vehicle_ground_clearance_m: 0.15,
+            async_tick_jitter_frac: 0.2,
             building_height_m: 10.0,
             ground_reflectivity: 0.15,
             spawn_distance_m: 100.0,
@@ -118,7 +131,7 @@ impl CarlaParams {
                 "must lie in 1..=256",
             ));
         }
-        let finite: [(&'static str, f64, f64, f64); 20] = [
+        let finite: [(&'static str, f64, f64, f64); 22] = [
             ("carla.upper_fov_deg", self.upper_fov_deg, -89.0, 89.0),
             ("carla.lower_fov_deg", self.lower_fov_deg, -89.0, 89.0),
             ("carla.range_m", self.range_m, 1.0, 1000.0),
@@ -149,6 +162,18 @@ impl CarlaParams {
             ),
             ("carla.tick_s", self.tick_s, 1e-3, 1.0),
             ("carla.vehicle_height_m", self.vehicle_height_m, 0.1, 10.0),
+            (
+                "carla.vehicle_ground_clearance_m",
+                self.vehicle_ground_clearance_m,
+                0.0,
+                1.0,
+            ),
+            (
+                "carla.async_tick_jitter_frac",
+                self.async_tick_jitter_frac,
+                0.0,
+                0.9,
+            ),
             (
                 "carla.building_height_m",
                 self.building_height_m,
@@ -184,6 +209,13 @@ impl CarlaParams {
             if !(v.is_finite() && lo <= v && v <= hi) {
                 return Err((field, v, "out of range (see the [carla] table's docs)"));
             }
+        }
+        if self.vehicle_ground_clearance_m >= 0.5 * self.vehicle_height_m {
+            return Err((
+                "carla.vehicle_ground_clearance_m",
+                self.vehicle_ground_clearance_m,
+                "must be below half of vehicle_height_m",
+            ));
         }
         if self.lower_fov_deg > self.upper_fov_deg {
             return Err((
