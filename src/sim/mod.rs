@@ -13,6 +13,7 @@
 //! results are bit-identical whatever the number of threads.
 
 pub mod carla;
+#[cfg(feature = "cli")]
 pub mod plots;
 pub mod report;
 pub mod returns;
@@ -89,7 +90,8 @@ impl From<crate::optimizer::OptError> for SimError {
 }
 
 /// A LiDAR variant of the experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Variant {
     /// Uniform (the non-adaptive LiDAR).
@@ -138,7 +140,8 @@ impl Variant {
 }
 
 /// The sensor geometry of the simulation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Geometry {
     /// One horizontal channel in a top view, scaled by the channel count
@@ -151,7 +154,8 @@ pub enum Geometry {
 }
 
 /// When the car from the right counts as detected.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Detector {
     /// Any returned point on the car (k-of-n frames; `carla`: ticks).
@@ -163,7 +167,8 @@ pub enum Detector {
 }
 
 /// When a car arrives (TTA is measured to this moment).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Arrival {
     /// Its front reaches |y| = `conflict_half_width_m`.
