@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import queue
 import threading
+import time
 
 import numpy as np
 
@@ -87,3 +88,39 @@ def test_two_threads_share_one_stream_like_a_callback_and_a_tracker() -> None:
 def test_internal_error_is_an_ordinary_exception() -> None:
     assert issubclass(gl.InternalError, RuntimeError)
     assert issubclass(gl.InternalError, Exception)
+
+
+def progress_during(call: object, repeat: int = 3) -> int:
+    """How many times the main thread wakes up (0.5 ms naps) while a worker
+    thread is inside `call()`: about zero if `call` holds the GIL."""
+    inside = threading.Event()
+    finished = threading.Event()
+
+    def worker() -> None:
+        for _ in range(repeat):
+            inside.set()
+            call()  # type: ignore[operator]
+            inside.clear()
+        finished.set()
+
+    t = threading.Thread(target=worker)
+    t.start()
+    wakeups = 0
+    while not finished.is_set():
+        time.sleep(0.0005)
+        if inside.is_set():
+            wakeups += 1
+    t.join()
+    return wakeups
+
+
+def test_the_gil_is_released_while_points_are_processed() -> None:
+    p = gl.profile(mode="resolution", gaze_deg=90.0)
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(-100, 100, (2_000_000, 4)).astype(np.float32)  # no conversion: all native
+    apply = progress_during(lambda: gl.apply_profile(p, pts, rated_range_m=100.0))
+    azimuth = progress_during(lambda: gl.azimuth_deg(pts))
+    # The probe can fail: a C loop that keeps the GIL (longer than
+    # apply_profile here) lets the main thread wake only around the calls.
+    held = progress_during(lambda: sum(range(20_000_000)))
+    assert min(apply, azimuth) >= 50 and min(apply, azimuth) > 10 * held, (apply, azimuth, held)
