@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The Python package: build `pip install ./python` into a fresh venv (as a
-# user would), then run its pytest suite and print the apply_profile
-# benchmark. The wheel's Rust build shares the workspace's target/ (the
-# python crate uses the root's release profile), so HiGHS is not rebuilt.
-# Also keeps the binding crate fmt- and clippy-clean (it is its own
-# workspace, outside `cargo … --workspace`).
+# user would), then run its pytest suite (hypothesis property tests
+# included), `mypy.stubtest` on the installed package, `mypy --strict` on
+# the tests and examples, and print the apply_profile benchmark. The wheel's
+# Rust build shares the workspace's target/ (python/.cargo/config.toml; the
+# python crate uses the root's release profile), so HiGHS is not rebuilt
+# and nothing lands in python/target/. Also keeps the binding crate fmt-
+# and clippy-clean (it is its own workspace, outside `cargo … --workspace`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -20,11 +22,16 @@ trap 'rm -rf "$venv"' EXIT
 echo "== python: pip install ./python into a fresh venv ($venv)"
 "$PY" -m venv "$venv"
 "$venv/bin/pip" install -q ./python   # exactly what a user runs
-"$venv/bin/python" -m pip install -q pytest
+"$venv/bin/python" -m pip install -q pytest hypothesis mypy
 
 echo "== python: pytest"
 # From outside the source tree, so the installed package is what is tested.
 (cd "$venv" && "$venv/bin/python" -m pytest -q -p no:cacheprovider "$OLDPWD/python/tests" "$@")
+
+echo "== python: mypy.stubtest (runtime vs stubs) and mypy --strict (tests, examples)"
+(cd "$venv" && "$venv/bin/python" -m mypy.stubtest gaze_lidar)
+"$venv/bin/python" -m mypy --strict --no-incremental --python-executable "$venv/bin/python" \
+  python/tests examples/python
 
 echo "== python: benchmark (apply_profile, 100k points)"
 "$venv/bin/python" python/benchmarks/apply_profile.py --repeat 100

@@ -27,7 +27,8 @@
 //!   profile's slowest spin to see that gain.
 //!
 //! Nothing here is physics of its own: the return model is
-//! [`ReturnModel`], ω(β) is profile@1's constant-acceleration law.
+//! [`ReturnModel`], ω(β) is profile@1's constant-acceleration law
+//! ([`BinMotion::spin_into_rad_s`], the core's kinematics).
 
 use std::f64::consts::TAU;
 
@@ -37,6 +38,7 @@ use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
 use crate::model::angle::wrap_deg;
+use crate::profile::kinematics::BinMotion;
 use crate::sim::returns::{FogLevel, ModelKind, ReturnModel, FOG_LEVELS_PCT};
 
 /// The coordinate frame of a cloud's x, y, z.
@@ -146,14 +148,6 @@ pub fn return_model(opts: &CloudOptions) -> Result<ReturnModel, CloudError> {
     };
     // Every point is a target of the reference reflectivity: pass 1 for both.
     Ok(ReturnModel::new(opts.model, fog, opts.rated_range_m, 1.0))
-}
-
-/// Spin at `x_rad` into a bin (ω² linear in angle), rad/s.
-fn spin_at(start_rad_s: f64, end_rad_s: f64, x_rad: f64, width_rad: f64) -> f64 {
-    let f = (x_rad / width_rad).clamp(0.0, 1.0);
-    (start_rad_s * start_rad_s + (end_rad_s * end_rad_s - start_rad_s * start_rad_s) * f)
-        .max(0.0)
-        .sqrt()
 }
 
 /// Bin lookup on a sorted key in `[0, span)`: a table of 4096 equal cells,
@@ -299,12 +293,7 @@ where
             b.spin_start_rad_s
         } else {
             let az = opts.frame.azimuth_deg(x, y);
-            spin_at(
-                b.spin_start_rad_s,
-                b.spin_end_rad_s,
-                (az - b.start_deg).clamp(0.0, b.width_deg).to_radians(),
-                b.width_deg.to_radians(),
-            )
+            b.spin_into_rad_s((az - b.start_deg).to_radians())
         };
         mask.push(in_range && u * spin < cloud_spin);
     }

@@ -32,12 +32,16 @@ tracker loses the eyes.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 
 import gaze_lidar as gl
 
 
-def points_from_raw(raw_data) -> np.ndarray:
+def points_from_raw(raw_data: bytes | memoryview) -> npt.NDArray[np.float32]:
     """CARLA's LidarMeasurement.raw_data → N x 4 float32 (x, y, z, intensity), no copy."""
     return np.frombuffer(raw_data, dtype=np.float32).reshape(-1, 4)
 
@@ -50,15 +54,23 @@ class AdaptiveLidar:
     clock (or an empty list when the tracker is silent).
     """
 
-    def __init__(self, gaze_source, *, mode="range", rated_range_m=100.0, fog_mor_m=None, seed=0):
+    def __init__(
+        self,
+        gaze_source: Callable[[], Sequence[tuple[float, float, bool]]],
+        *,
+        mode: Any = "range",
+        rated_range_m: float = 100.0,
+        fog_mor_m: float | None = None,
+        seed: int = 0,
+    ) -> None:
         self.gaze_source = gaze_source
         self.stream = gl.GazeStream(preset="paper", mode=mode, timeout_ms=100)
         self.rated_range_m = rated_range_m
         self.fog_mor_m = fog_mor_m
         self.seed = seed
-        self.frame = None  # the gaze_lidar.Frame in force
+        self.frame: gl.Frame | None = None  # the gaze_lidar.Frame in force
 
-    def on_measurement(self, timestamp_s: float, raw_data) -> np.ndarray:
+    def on_measurement(self, timestamp_s: float, raw_data: bytes | memoryview) -> npt.NDArray[np.float32]:
         """The listen callback: returns the kept points (N' x 4 float32)."""
         for t_s, gaze_deg, valid in self.gaze_source():
             for frame in self.stream.push(t_s, gaze_deg, valid):
@@ -92,16 +104,16 @@ def synthetic_sweep(rng: np.random.Generator, n: int = 100_000) -> bytes:
     return pts.tobytes()
 
 
-def demo(sweeps: int = 12, seed: int = 0) -> list[dict]:
+def demo(sweeps: int = 12, seed: int = 0) -> list[dict[str, Any]]:
     """Runs the callback on synthetic sweeps at 20 Hz: the driver looks left
     (90°) for 0.3 s, then the tracker loses the eyes. One summary per sweep."""
     rng = np.random.default_rng(seed)
     clock = {"t": 0.0}
 
-    def tracker():
+    def tracker() -> list[tuple[float, float, bool]]:
         # 200 Hz samples over the last 50 ms; valid while t < 0.3 s.
         t1 = clock["t"]
-        return [(t, 90.0, t < 0.3) for t in np.arange(max(t1 - 0.05, 0.0), t1, 0.005)]
+        return [(float(t), 90.0, bool(t < 0.3)) for t in np.arange(max(t1 - 0.05, 0.0), t1, 0.005)]
 
     lidar = AdaptiveLidar(tracker)
     rows = []

@@ -9,14 +9,39 @@ that cannot be met, Rejected for a profile that fails the checker.
 
 from typing import Any, Literal, Sequence
 
+from typing_extensions import Self, final
+
 import numpy as np
 import numpy.typing as npt
+
+__all__ = [
+    "Frame",
+    "GazeStream",
+    "Infeasible",
+    "InternalError",
+    "PRESETS",
+    "Profile",
+    "Rejected",
+    "Verdict",
+    "__version__",
+    "apply_profile",
+    "azimuth_deg",
+    "check",
+    "optimize",
+    "profile",
+    "simulate",
+]
+__version__: str
+"""The package version (the Rust crate's)."""
 
 PRESETS: list[str]
 """Preset names accepted by `preset=` ("paper", "vls128")."""
 
 class Infeasible(Exception):
     """The request is well-formed but cannot be met; the message names the limit."""
+
+class InternalError(RuntimeError):
+    """A bug in gaze-lidar: a Rust panic caught at the binding's edge."""
 
 class Rejected(Exception):
     """A profile failed the checker.
@@ -26,14 +51,28 @@ class Rejected(Exception):
 
     violations: list[str]
 
+@final
 class Profile:
     """A certified scan profile (`gaze-lidar/profile@1`).
 
     Every Profile has passed the checker against its declared limits
     (power budget, frame period, power and spin bounds, motor acceleration,
-    power slew, Class 1 eye safety). Arrays are fresh float64 copies, one
-    entry per bin, bins in azimuth order tiling [0, 360).
+    power slew, Class 1 eye safety). Arrays are read-only float64, one
+    entry per bin, bins in azimuth order tiling [0, 360). Immutable:
+    compares and hashes by value (its profile@1 JSON), pickles and
+    deep-copies through that JSON. Profile(text) is Profile.from_json(text).
     """
+
+    def __new__(cls, text: str) -> Profile: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __hash__(self) -> int: ...
+    def __reduce__(self) -> tuple[type[Profile], tuple[str]]: ...
+    def __copy__(self) -> Self: ...
+    def __deepcopy__(self, _memo: Any) -> Profile: ...
+    def power_w_at(self, azimuth_deg: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Laser power at each azimuth (degrees, any shape, wrapped into [0, 360)), W."""
+    def spin_rad_s_at(self, azimuth_deg: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Head spin at each azimuth (degrees, any shape, wrapped into [0, 360)), rad/s."""
 
     @property
     def start_deg(self) -> npt.NDArray[np.float64]:
@@ -124,12 +163,13 @@ def profile(
     acceleration limit).
     """
 
-def optimize(config_toml: str, gaze_deg: float) -> Profile:
+def optimize(config_text: str, gaze_deg: float, json: bool = False) -> Profile:
     """The optimizer's certified profile (good_lp + HiGHS) for a TOML
     configuration as `gaze-lidar profile --config` reads it (see
     examples/configs/). Releases the GIL while solving.
     Raises ValueError for a bad key (named), Infeasible naming the limit."""
 
+@final
 class Verdict:
     """The checker's verdict on a profile@1 file. Truthy when certified."""
 
@@ -152,6 +192,7 @@ def check(profile_json: str, preset: str | None = None, *, no_eye_safety: bool =
     violation). A file without eye-safety parameters is rejected unless
     no_eye_safety=True. Raises ValueError when the JSON does not parse."""
 
+@final
 class Frame:
     """One LiDAR frame of a GazeStream."""
 
@@ -165,6 +206,7 @@ class Frame:
     def gaze_deg(self) -> float | None:
         """The gaze the profile was built for; None in fail-safe."""
 
+@final
 class GazeStream:
     """Gaze samples in, one certified profile per LiDAR frame out.
 
@@ -180,8 +222,8 @@ class GazeStream:
     (mode overrides the objective); otherwise by the preset's closed form.
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         preset: str = "paper",
         mode: Literal["range", "resolution", "joint", "baseline"] = "range",
         timeout_ms: float = 100.0,
@@ -191,11 +233,19 @@ class GazeStream:
         saccade_deg_s: float = 30.0,
         max_gap_frames: int = 200,
         config_toml: str | None = None,
-    ) -> None: ...
+    ) -> GazeStream: ...
     def push(self, t_s: float, gaze_deg: float, valid: bool = True) -> list[Frame]:
         """Feeds one tracker sample (gaze clock t_s); returns the frames that
         start at or before it, each decided from the samples before it.
         valid=False (or a non-finite gaze) means the tracker lost the eyes."""
+    def push_many(
+        self,
+        t_s: npt.ArrayLike,
+        gaze_deg: npt.ArrayLike,
+        valid: npt.ArrayLike | None = None,
+    ) -> list[Frame]:
+        """Feeds a recorded gaze track (1-D arrays of one length) in order, as
+        many push calls would; returns all the frames they emit."""
     def tick(self, now_s: float) -> list[Frame]:
         """Runs the frame clock to now_s without a sample: the frames due by
         then, fail-safe once the last fixation is older than the timeout.

@@ -7,11 +7,14 @@
 //! `ValueError` for bad input, `Infeasible` for a request that cannot be met,
 //! `Rejected` for a profile that fails the checker.
 
-use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
+
+use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::exceptions::{PyException, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{IntoPyDict, PyDict, PyList};
 
 use gaze_lidar::checker::{certify_with, CertifiedProfile, CheckOptions, Violation};
 use gaze_lidar::eye_safety::evaluate_profile;
@@ -20,10 +23,12 @@ use gaze_lidar::gaze::{
     ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeError, GazeSample, Notice,
     State, StreamConfig,
 };
+use gaze_lidar::model::angle::wrap_deg;
 use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::model::presets::{self, Preset};
 use gaze_lidar::planner::{closed_form, validate_gaze, Mode, PlanError};
 use gaze_lidar::pointcloud::{keep_mask, CloudFrame, CloudOptions};
+use gaze_lidar::profile::kinematics::{BinMotion, Timeline};
 use gaze_lidar::profile::{Profile as CoreProfile, Region};
 use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, Variant, FOG_LEVELS_PCT};
 
@@ -39,6 +44,46 @@ create_exception!(
     PyException,
     "A profile failed the checker; `violations` lists every violated limit (one line each)."
 );
+
+create_exception!(
+    gaze_lidar,
+    InternalError,
+    PyRuntimeError,
+    "A bug in gaze-lidar (a Rust panic caught at the binding's edge); please report it with the message."
+);
+
+fn panic_error(payload: Box<dyn std::any::Any + Send>) -> PyErr {
+    let what = payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_owned());
+    InternalError::new_err(format!("internal error: {what}"))
+}
+
+/// Runs `f`, turning a Rust panic into [`InternalError`] (a `RuntimeError`)
+/// instead of pyo3's `PanicException`, a `BaseException` that `except
+/// Exception` misses. Every public entry point runs its body through this.
+fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(panic_error(p)))
+}
+
+/// As [`guard`], for a computation run with the GIL released.
+fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    py.detach(|| catch_unwind(AssertUnwindSafe(f)))
+        .map_err(panic_error)
+}
+
+/// A read-only numpy array (the values of an immutable object: a write
+/// would be silently lost, so numpy refuses it).
+fn frozen_array<'py, T: numpy::Element>(
+    py: Python<'py>,
+    v: Vec<T>,
+) -> PyResult<Bound<'py, PyArray1<T>>> {
+    let a = PyArray1::from_vec(py, v);
+    a.call_method("setflags", (), Some(&[("write", false)].into_py_dict(py)?))?;
+    Ok(a)
+}
 
 fn value_error(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
@@ -128,8 +173,55 @@ impl PyProfile {
         &self,
         py: Python<'py>,
         f: impl Fn(&gaze_lidar::profile::Bin) -> f64,
-    ) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_vec(py, self.inner.profile().bins.iter().map(f).collect())
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        frozen_array(py, self.inner.profile().bins.iter().map(f).collect())
+    }
+
+    /// `f(bin, azimuth)` at each azimuth (degrees, any real: wrapped by the
+    /// crate's `wrap_deg`), in the input's shape; the bin is the core
+    /// timeline's (`Timeline::bin_index`, the last bin starting at or before).
+    fn at_azimuths<'py>(
+        &self,
+        py: Python<'py>,
+        azimuth_deg: &Bound<'py, PyAny>,
+        f: impl Fn(&gaze_lidar::profile::Bin, f64) -> f64 + Sync,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let np = py.import("numpy")?;
+        let a = np.call_method1("asarray", (azimuth_deg, "float64"))?;
+        let shape = a.getattr("shape")?;
+        let flat = np.call_method1("ascontiguousarray", (a.call_method0("ravel")?,))?;
+        let flat: PyReadonlyArray1<'py, f64> = flat.extract()?;
+        let xs = flat.as_slice()?;
+        let p = self.inner.profile();
+        let out = detached(py, || {
+            let timeline = Timeline::new(p);
+            xs.iter()
+                .map(|&az| {
+                    if !az.is_finite() {
+                        return Err(az);
+                    }
+                    let a = wrap_deg(az);
+                    let b = &p.bins[timeline.bin_index(a)];
+                    Ok(f(b, a))
+                })
+                .collect::<Result<Vec<f64>, f64>>()
+        })?
+        .map_err(|az| value_error(format!("azimuth_deg: {az} is not a finite angle")))?;
+        frozen_array(py, out)?.call_method1("reshape", (shape,))
+    }
+
+    fn json(&self) -> PyResult<String> {
+        self.inner
+            .profile()
+            .to_json()
+            .map_err(|e| value_error(e.to_string()))
+    }
+
+    fn parse(py: Python<'_>, text: &str) -> PyResult<Self> {
+        let p = CoreProfile::from_json(text, "<json>").map_err(|e| value_error(e.to_string()))?;
+        certify_with(p, &CheckOptions::declared())
+            .map(|inner| Self { inner })
+            .map_err(|r| rejected(py, r.to_string(), &r.violations))
     }
 
     fn firmware_table(
@@ -154,38 +246,38 @@ impl PyProfile {
 impl PyProfile {
     /// Bin start azimuths, degrees (ISO 8855, counter-clockwise from ahead).
     #[getter]
-    fn start_deg<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn start_deg<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.column(py, |b| b.start_deg)
     }
     /// Bin widths, degrees.
     #[getter]
-    fn width_deg<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn width_deg<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.column(py, |b| b.width_deg)
     }
     /// Laser power per bin, W.
     #[getter]
-    fn power_w<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn power_w<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.column(py, |b| b.power_w)
     }
     /// Spin at each bin's start, rad/s.
     #[getter]
-    fn spin_start_rad_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn spin_start_rad_s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.column(py, |b| b.spin_start_rad_s)
     }
     /// Spin at each bin's end, rad/s.
     #[getter]
-    fn spin_end_rad_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn spin_end_rad_s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.column(py, |b| b.spin_end_rad_s)
     }
     /// Dwell time per bin, s.
     #[getter]
-    fn dwell_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn dwell_s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.column(py, gaze_lidar::profile::Bin::dwell_time_s)
     }
     /// Whether each bin lies in the driver's region of focus.
     #[getter]
-    fn in_rof<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        PyArray1::from_vec(
+    fn in_rof<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        frozen_array(
             py,
             self.inner
                 .profile()
@@ -228,27 +320,82 @@ impl PyProfile {
     /// The declared limits (profile@1 `limits`), as a dict.
     #[getter]
     fn limits<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_py_json(py, &self.inner.profile().limits)
+        guard(|| to_py_json(py, &self.inner.profile().limits))
     }
     /// The checker's figures (average powers, frame period, ranges …), as a dict.
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_py_json(py, self.inner.summary())
+        guard(|| to_py_json(py, self.inner.summary()))
     }
     /// The profile as `gaze-lidar/profile@1` JSON.
     fn to_json(&self) -> PyResult<String> {
-        self.inner
-            .profile()
-            .to_json()
-            .map_err(|e| value_error(e.to_string()))
+        guard(|| {
+            self.inner
+                .profile()
+                .to_json()
+                .map_err(|e| value_error(e.to_string()))
+        })
     }
     /// Parses profile@1 JSON and certifies it against its declared limits.
+    ///
+    /// Raises ValueError for malformed JSON (line:column and field named)
+    /// and Rejected when a limit is violated.
     #[staticmethod]
     fn from_json(py: Python<'_>, text: &str) -> PyResult<Self> {
-        let p = CoreProfile::from_json(text, "<json>").map_err(|e| value_error(e.to_string()))?;
-        certify_with(p, &CheckOptions::declared())
-            .map(|inner| Self { inner })
-            .map_err(|r| rejected(py, r.to_string(), &r.violations))
+        guard(|| Self::parse(py, text))
+    }
+    #[new]
+    fn new(py: Python<'_>, text: &str) -> PyResult<Self> {
+        guard(|| Self::parse(py, text))
+    }
+    /// Laser power at each azimuth (degrees, any shape; wrapped into
+    /// [0, 360)), W: the power of the bin holding it, as the checker and the
+    /// simulator see it. Returns a read-only float64 array of the same shape.
+    fn power_w_at<'py>(
+        &self,
+        py: Python<'py>,
+        azimuth_deg: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| self.at_azimuths(py, azimuth_deg, |b, _| b.power_w))
+    }
+    /// Head spin at each azimuth (degrees, any shape; wrapped into [0, 360)),
+    /// rad/s: profile@1's constant angular acceleration within a bin,
+    /// `ω(x) = √(ω_start² + 2ax)` (the core kinematics' `spin_into_rad_s`).
+    /// Returns a read-only float64 array of the same shape.
+    fn spin_rad_s_at<'py>(
+        &self,
+        py: Python<'py>,
+        azimuth_deg: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            self.at_azimuths(py, azimuth_deg, |b, a| {
+                b.spin_into_rad_s((a - b.start_deg).to_radians())
+            })
+        })
+    }
+    fn __eq__(&self, other: PyRef<'_, Self>) -> PyResult<bool> {
+        guard(|| Ok(self.json()? == other.json()?))
+    }
+    fn __hash__(&self) -> PyResult<u64> {
+        use std::hash::{Hash, Hasher};
+        guard(|| {
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            self.json()?.hash(&mut h);
+            Ok(h.finish())
+        })
+    }
+    /// Pickles through its profile@1 JSON (re-certified when loaded).
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, pyo3::types::PyType>, (String,))> {
+        guard(|| Ok((slf.get_type(), (slf.get().json()?,))))
+    }
+    fn __copy__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+    /// A new Profile from this one's JSON (it is immutable, so equal to it).
+    fn __deepcopy__(&self, py: Python<'_>, _memo: &Bound<'_, PyAny>) -> PyResult<Self> {
+        guard(|| Self::parse(py, &self.json()?))
     }
     /// Integer firmware tables: a dict of scalars and numpy integer arrays.
     #[pyo3(signature = (tick_hz=80_000_000, power_w_per_code=None))]
@@ -258,71 +405,92 @@ impl PyProfile {
         tick_hz: i128,
         power_w_per_code: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let t = self.firmware_table(tick_hz, power_w_per_code)?;
-        let d = PyDict::new(py);
-        d.set_item("format", &t.format)?;
-        d.set_item("tick_hz", t.tick_hz)?;
-        d.set_item("frame_ticks", t.frame_ticks)?;
-        d.set_item("power_w_per_code", t.power_w_per_code)?;
-        d.set_item("power_accounting", t.power_accounting.to_string())?;
-        d.set_item("pulse_rate_hz", t.pulse_rate_hz)?;
-        d.set_item("limits", to_py_json(py, &t.limits)?)?;
-        d.set_item("eye_safety", to_py_json(py, &t.eye_safety)?)?;
-        let b = &t.bins;
-        d.set_item(
-            "start_deg",
-            PyArray1::from_vec(py, b.iter().map(|b| b.start_deg).collect()),
-        )?;
-        d.set_item(
-            "width_mdeg",
-            PyArray1::from_vec(py, b.iter().map(|b| b.width_mdeg).collect()),
-        )?;
-        d.set_item(
-            "dwell_ticks",
-            PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks).collect()),
-        )?;
-        d.set_item(
-            "power_code",
-            PyArray1::from_vec(py, b.iter().map(|b| b.power_code).collect()),
-        )?;
-        d.set_item(
-            "dwell_ticks_min",
-            PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks_min).collect()),
-        )?;
-        d.set_item(
-            "dwell_ticks_max",
-            PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks_max).collect()),
-        )?;
-        d.set_item(
-            "power_code_cap",
-            PyArray1::from_vec(py, b.iter().map(|b| b.power_code_cap).collect()),
-        )?;
-        Ok(d)
+        guard(|| {
+            let t = self.firmware_table(tick_hz, power_w_per_code)?;
+            let d = PyDict::new(py);
+            d.set_item("format", &t.format)?;
+            d.set_item("tick_hz", t.tick_hz)?;
+            d.set_item("frame_ticks", t.frame_ticks)?;
+            d.set_item("power_w_per_code", t.power_w_per_code)?;
+            d.set_item("power_accounting", t.power_accounting.to_string())?;
+            d.set_item("pulse_rate_hz", t.pulse_rate_hz)?;
+            d.set_item("limits", to_py_json(py, &t.limits)?)?;
+            d.set_item("eye_safety", to_py_json(py, &t.eye_safety)?)?;
+            let b = &t.bins;
+            d.set_item(
+                "start_deg",
+                PyArray1::from_vec(py, b.iter().map(|b| b.start_deg).collect()),
+            )?;
+            d.set_item(
+                "width_mdeg",
+                PyArray1::from_vec(py, b.iter().map(|b| b.width_mdeg).collect()),
+            )?;
+            d.set_item(
+                "dwell_ticks",
+                PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks).collect()),
+            )?;
+            d.set_item(
+                "power_code",
+                PyArray1::from_vec(py, b.iter().map(|b| b.power_code).collect()),
+            )?;
+            d.set_item(
+                "dwell_ticks_min",
+                PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks_min).collect()),
+            )?;
+            d.set_item(
+                "dwell_ticks_max",
+                PyArray1::from_vec(py, b.iter().map(|b| b.dwell_ticks_max).collect()),
+            )?;
+            d.set_item(
+                "power_code_cap",
+                PyArray1::from_vec(py, b.iter().map(|b| b.power_code_cap).collect()),
+            )?;
+            Ok(d)
+        })
     }
     /// The firmware table as `gaze-lidar/firmware@1` JSON.
     #[pyo3(signature = (tick_hz=80_000_000, power_w_per_code=None))]
     fn firmware_json(&self, tick_hz: i128, power_w_per_code: Option<f64>) -> PyResult<String> {
-        self.firmware_table(tick_hz, power_w_per_code)?
-            .to_json()
-            .map_err(|e| value_error(e.to_string()))
+        guard(|| {
+            self.firmware_table(tick_hz, power_w_per_code)?
+                .to_json()
+                .map_err(|e| value_error(e.to_string()))
+        })
     }
     fn __len__(&self) -> usize {
         self.inner.profile().bins.len()
     }
     fn __repr__(&self) -> String {
         let p = self.inner.profile();
+        let s = self.inner.summary();
         format!(
-            "<gaze_lidar.Profile {} bins, gaze_deg={}, mode={}>",
+            "<gaze_lidar.Profile {} bins, mode={:?}, gaze_deg={}, {} Hz, power {:.4}–{:.4} W, spin {:.4}–{:.4} rad/s>",
             p.bins.len(),
+            p.mode.as_deref().unwrap_or("?"),
             p.gaze_deg.map_or("None".to_owned(), |g| g.to_string()),
-            p.mode.as_deref().unwrap_or("?")
+            p.frame_rate_hz,
+            s.power_w_range[0],
+            s.power_w_range[1],
+            s.spin_rad_s_range[0],
+            s.spin_rad_s_range[1],
         )
     }
 }
 
-/// The certified closed-form profile (the paper's controllers, eq. 3–6).
+/// The paper's closed-form controller (eq. 3–6), certified.
+///
+/// mode "baseline" ignores gaze_deg (the uniform, fail-safe profile); the
+/// others need it (degrees, ISO 8855: 90 looks left; the LiDAR then
+/// favours the side the driver is *not* watching). bins: 4..=36000 equal
+/// bins (region boundaries are added as edges). accounting ("time" or
+/// "angle") overrides the preset's power accounting. Raises ValueError
+/// (e.g. "gaze_deg: NaN is not a finite azimuth …"), Infeasible, or
+/// Rejected (e.g. a spin step on a motor with an acceleration limit).
 #[pyfunction]
-#[pyo3(signature = (preset="paper", mode="range", gaze_deg=Some(90.0), bins=360, accounting=None))]
+#[pyo3(
+    signature = (preset="paper", mode="range", gaze_deg=Some(90.0), bins=360, accounting=None),
+    text_signature = "(preset='paper', mode='range', gaze_deg=90.0, bins=360, accounting=None)"
+)]
 fn profile(
     py: Python<'_>,
     preset: &str,
@@ -331,50 +499,68 @@ fn profile(
     bins: i64,
     accounting: Option<&str>,
 ) -> PyResult<PyProfile> {
-    let mut preset = preset_of(preset)?;
-    let mode = mode_of(mode)?;
-    if let Some(acc) = accounting {
-        preset.lidar.power_accounting = match acc {
-            "time" => PowerAccounting::Time,
-            "angle" => PowerAccounting::Angle,
-            other => {
+    guard(|| {
+        let mut preset = preset_of(preset)?;
+        let mode = mode_of(mode)?;
+        if let Some(acc) = accounting {
+            preset.lidar.power_accounting = match acc {
+                "time" => PowerAccounting::Time,
+                "angle" => PowerAccounting::Angle,
+                other => {
+                    return Err(value_error(format!(
+                        "accounting: '{other}' is not one of time, angle"
+                    )))
+                }
+            };
+        }
+        if let Some(g) = gaze_deg {
+            validate_gaze(g).map_err(|e| plan_error(py, e))?;
+        }
+        let gaze = match (mode, gaze_deg) {
+            (Mode::Baseline, _) => None,
+            (_, Some(g)) => Some(g),
+            (m, None) => {
                 return Err(value_error(format!(
-                    "accounting: '{other}' is not one of time, angle"
+                    "gaze_deg: required for mode {}",
+                    m.name()
                 )))
             }
         };
-    }
-    if let Some(g) = gaze_deg {
-        validate_gaze(g).map_err(|e| plan_error(py, e))?;
-    }
-    let gaze = match (mode, gaze_deg) {
-        (Mode::Baseline, _) => None,
-        (_, Some(g)) => Some(g),
-        (m, None) => {
-            return Err(value_error(format!(
-                "gaze_deg: required for mode {}",
-                m.name()
-            )))
-        }
-    };
-    let bins = usize::try_from(bins)
-        .map_err(|_| value_error(format!("bins: {bins} must lie in [4, 36000]")))?;
-    closed_form(&preset, mode, gaze, bins)
-        .map(|inner| PyProfile { inner })
-        .map_err(|e| plan_error(py, e))
+        let bins = usize::try_from(bins)
+            .map_err(|_| value_error(format!("bins: {bins} must lie in [4, 36000]")))?;
+        closed_form(&preset, mode, gaze, bins)
+            .map(|inner| PyProfile { inner })
+            .map_err(|e| plan_error(py, e))
+    })
 }
 
-/// The optimizer's certified profile (good_lp + HiGHS) for a TOML configuration.
+/// The optimizer's certified profile (good_lp + HiGHS) for a configuration
+/// as `gaze-lidar profile --config` reads it (see examples/configs/):
+/// TOML text, or with json=True the same keys as JSON text.
+/// Releases the GIL while solving. Raises ValueError for a bad key (named),
+/// Infeasible naming the limit. `gaze_lidar.optimize` also takes a dict or
+/// a path.
 #[pyfunction]
-fn optimize(py: Python<'_>, config_toml: &str, gaze_deg: f64) -> PyResult<PyProfile> {
-    use gaze_lidar::optimizer::OptimizerConfig;
-    validate_gaze(gaze_deg).map_err(|e| plan_error(py, e))?;
-    let problem = OptimizerConfig::from_toml(config_toml, "config_toml")
-        .and_then(|c| c.problem())
-        .map_err(|e| opt_error(py, e))?;
-    py.detach(|| gaze_lidar::optimizer::optimize(&problem, gaze_deg))
-        .map(|inner| PyProfile { inner })
-        .map_err(|e| opt_error(py, e))
+#[pyo3(signature = (config_text, gaze_deg, json=false))]
+fn optimize(py: Python<'_>, config_text: &str, gaze_deg: f64, json: bool) -> PyResult<PyProfile> {
+    use gaze_lidar::optimizer::{OptError, OptimizerConfig};
+    guard(|| {
+        validate_gaze(gaze_deg).map_err(|e| plan_error(py, e))?;
+        let config = if json {
+            serde_json::from_str::<OptimizerConfig>(config_text).map_err(|e| OptError::Invalid {
+                field: "config".to_owned(),
+                reason: e.to_string(),
+            })
+        } else {
+            OptimizerConfig::from_toml(config_text, "config")
+        };
+        let problem = config
+            .and_then(|c| c.problem())
+            .map_err(|e| opt_error(py, e))?;
+        detached(py, || gaze_lidar::optimizer::optimize(&problem, gaze_deg))?
+            .map(|inner| PyProfile { inner })
+            .map_err(|e| opt_error(py, e))
+    })
 }
 
 /// The checker's verdict on a profile@1 file.
@@ -418,52 +604,54 @@ impl Verdict {
 #[pyfunction]
 #[pyo3(signature = (profile_json, preset=None, *, no_eye_safety=false))]
 fn check(profile_json: &str, preset: Option<&str>, no_eye_safety: bool) -> PyResult<Verdict> {
-    let profile = CoreProfile::from_json(profile_json, "profile_json")
-        .map_err(|e| value_error(e.to_string()))?;
-    let sensor = preset.map(preset_of).transpose()?;
-    let opts = match &sensor {
-        Some(s) => CheckOptions::for_sensor(&s.lidar),
-        None => CheckOptions::declared(),
-    }
-    .allow_missing_eye_safety(no_eye_safety);
-    Ok(match certify_with(profile.clone(), &opts) {
-        Ok(_) => {
-            let eye = profile
-                .limits
-                .eye_safety
-                .as_ref()
-                .and_then(|p| evaluate_profile(&profile, p).ok());
-            Verdict {
-                certified: true,
-                violations: Vec::new(),
-                limits: Vec::new(),
-                worst_ratio: eye.as_ref().map(|r| r.worst_ratio),
-                binding_rule: eye.as_ref().map(|r| r.binding_rule.to_string()),
-                worst_azimuth_deg: eye.as_ref().map(|r| r.worst_azimuth_deg),
-            }
+    guard(|| {
+        let profile = CoreProfile::from_json(profile_json, "profile_json")
+            .map_err(|e| value_error(e.to_string()))?;
+        let sensor = preset.map(preset_of).transpose()?;
+        let opts = match &sensor {
+            Some(s) => CheckOptions::for_sensor(&s.lidar),
+            None => CheckOptions::declared(),
         }
-        Err(rej) => {
-            let eye = rej.violations.iter().find_map(|v| match v {
-                Violation::EyeSafety {
-                    azimuth_deg,
-                    rule,
-                    ratio,
-                } => Some((*ratio, rule.clone(), *azimuth_deg)),
-                _ => None,
-            });
-            Verdict {
-                certified: false,
-                violations: rej.violations.iter().map(ToString::to_string).collect(),
-                limits: rej
-                    .violations
-                    .iter()
-                    .map(|v| v.limit_key().to_owned())
-                    .collect(),
-                worst_ratio: eye.as_ref().map(|e| e.0),
-                binding_rule: eye.as_ref().map(|e| e.1.clone()),
-                worst_azimuth_deg: eye.as_ref().map(|e| e.2),
+        .allow_missing_eye_safety(no_eye_safety);
+        Ok(match certify_with(profile.clone(), &opts) {
+            Ok(_) => {
+                let eye = profile
+                    .limits
+                    .eye_safety
+                    .as_ref()
+                    .and_then(|p| evaluate_profile(&profile, p).ok());
+                Verdict {
+                    certified: true,
+                    violations: Vec::new(),
+                    limits: Vec::new(),
+                    worst_ratio: eye.as_ref().map(|r| r.worst_ratio),
+                    binding_rule: eye.as_ref().map(|r| r.binding_rule.to_string()),
+                    worst_azimuth_deg: eye.as_ref().map(|r| r.worst_azimuth_deg),
+                }
             }
-        }
+            Err(rej) => {
+                let eye = rej.violations.iter().find_map(|v| match v {
+                    Violation::EyeSafety {
+                        azimuth_deg,
+                        rule,
+                        ratio,
+                    } => Some((*ratio, rule.clone(), *azimuth_deg)),
+                    _ => None,
+                });
+                Verdict {
+                    certified: false,
+                    violations: rej.violations.iter().map(ToString::to_string).collect(),
+                    limits: rej
+                        .violations
+                        .iter()
+                        .map(|v| v.limit_key().to_owned())
+                        .collect(),
+                    worst_ratio: eye.as_ref().map(|e| e.0),
+                    binding_rule: eye.as_ref().map(|e| e.1.clone()),
+                    worst_azimuth_deg: eye.as_ref().map(|e| e.2),
+                }
+            }
+        })
     })
 }
 
@@ -492,38 +680,51 @@ impl PyFrame {
         self.profile.get().inner.profile().gaze_deg
     }
     fn __repr__(&self) -> String {
-        format!("<gaze_lidar.Frame t_s={} state={}>", self.t_s, self.state)
+        // The frame clock counts whole microseconds: show t_s at that
+        // resolution (0.05, not 0.049999999999999996).
+        format!(
+            "<gaze_lidar.Frame t_s={} state={} gaze_deg={}>",
+            (self.t_s * 1e6).round() / 1e6,
+            self.state,
+            self.profile
+                .get()
+                .inner
+                .profile()
+                .gaze_deg
+                .map_or("None".to_owned(), |g| g.to_string())
+        )
     }
 }
 
-/// Gaze samples in, one certified profile per LiDAR frame out (fail-safe on loss).
-#[pyclass(unsendable, module = "gaze_lidar", name = "GazeStream")]
+type Stream = gaze_lidar::gaze::GazeStream<Box<dyn FramePlanner + Send>>;
+
+/// Gaze samples in, one certified profile per LiDAR frame out.
+///
+/// The frame clock drives the fail-safe (the CLI's `stream` rules): frame k
+/// starts at t0 + k·T (t0 the first sample or tick, T the frame period); a
+/// frame is adaptive only if the newest fixation is no older than
+/// timeout_ms when it is decided, and after a loss only once
+/// recover_samples consecutive valid samples arrived (so the first
+/// adaptive frame comes after 4 valid samples by default); otherwise it
+/// runs the uniform baseline. A timestamp jump of more than max_gap_frames
+/// periods emits one fail-safe frame and restarts the clock.
+///
+/// With config_toml, frames are planned by the optimizer's fast path (mode
+/// overrides the objective); otherwise by the preset's closed form.
+///
+/// Thread-safe: an internal lock serialises calls, so a CARLA
+/// `sensor.listen` callback (CARLA's own thread) and the main thread may
+/// share one stream; planning runs with the GIL released.
+#[pyclass(frozen, module = "gaze_lidar", name = "GazeStream")]
 pub struct PyGazeStream {
-    inner: gaze_lidar::gaze::GazeStream<Box<dyn FramePlanner>>,
+    inner: Mutex<Stream>,
+    preset: String,
+    mode: &'static str,
 }
 
-fn frames(py: Python<'_>, frames: Vec<gaze_lidar::gaze::Frame>) -> PyResult<Vec<PyFrame>> {
-    frames
-        .into_iter()
-        .map(|f| {
-            Ok(PyFrame {
-                t_s: f.t_s,
-                state: match f.state {
-                    State::Adaptive => "adaptive",
-                    State::FailSafe => "fail_safe",
-                },
-                profile: Py::new(py, PyProfile { inner: f.profile })?,
-            })
-        })
-        .collect()
-}
-
-#[pymethods]
 impl PyGazeStream {
-    #[new]
-    #[pyo3(signature = (preset="paper", mode="range", timeout_ms=100.0, *, bins=360, recover_samples=4, saccade_deg_s=30.0, max_gap_frames=200, config_toml=None))]
     #[allow(clippy::too_many_arguments)]
-    fn new(
+    fn build(
         py: Python<'_>,
         preset: &str,
         mode: &str,
@@ -534,6 +735,7 @@ impl PyGazeStream {
         max_gap_frames: i64,
         config_toml: Option<&str>,
     ) -> PyResult<Self> {
+        let preset_name = preset.to_owned();
         if !(timeout_ms.is_finite() && timeout_ms > 0.0 && timeout_ms < 1e7) {
             return Err(value_error(format!(
                 "timeout_ms: {timeout_ms} must be finite, > 0 and < 1e7"
@@ -558,7 +760,7 @@ impl PyGazeStream {
             ))
         })?;
         let mode = mode_of(mode)?;
-        let planner: Box<dyn FramePlanner> = match config_toml {
+        let planner: Box<dyn FramePlanner + Send> = match config_toml {
             Some(text) => {
                 use gaze_lidar::optimizer::OptimizerConfig;
                 let mut problem = OptimizerConfig::from_toml(text, "config_toml")
@@ -594,74 +796,234 @@ impl PyGazeStream {
         };
         let config = StreamConfig { max_gap_frames };
         Ok(Self {
-            inner: gaze_lidar::gaze::GazeStream::with_config(planner, filter, failsafe, config),
+            inner: Mutex::new(gaze_lidar::gaze::GazeStream::with_config(
+                planner, filter, failsafe, config,
+            )),
+            preset: preset_name,
+            mode: mode.name(),
         })
     }
 
-    /// Feeds one gaze sample (gaze clock `t_s`); returns the frames that
-    /// start at or before it, each decided from the samples before it.
-    #[pyo3(signature = (t_s, gaze_deg, valid=true))]
-    fn push(
-        &mut self,
+    /// Runs `f` on the stream under its lock, with the GIL released (so a
+    /// thread waiting for the lock never holds the GIL its holder needs).
+    fn locked<T: Send>(
+        &self,
         py: Python<'_>,
-        t_s: f64,
-        gaze_deg: f64,
-        valid: bool,
+        f: impl FnOnce(&mut Stream) -> T + Send,
+    ) -> PyResult<T> {
+        detached(py, || {
+            self.inner.lock().map(|mut s| f(&mut s)).map_err(|_| ())
+        })?
+        .map_err(|()| {
+            InternalError::new_err(
+                "internal error: the stream's lock was poisoned by an earlier internal error; create a new GazeStream",
+            )
+        })
+    }
+}
+
+fn frames(py: Python<'_>, frames: Vec<gaze_lidar::gaze::Frame>) -> PyResult<Vec<PyFrame>> {
+    frames
+        .into_iter()
+        .map(|f| {
+            Ok(PyFrame {
+                t_s: f.t_s,
+                state: match f.state {
+                    State::Adaptive => "adaptive",
+                    State::FailSafe => "fail_safe",
+                },
+                profile: Py::new(py, PyProfile { inner: f.profile })?,
+            })
+        })
+        .collect()
+}
+
+#[pymethods]
+impl PyGazeStream {
+    #[new]
+    #[pyo3(signature = (preset="paper", mode="range", timeout_ms=100.0, *, bins=360, recover_samples=4, saccade_deg_s=30.0, max_gap_frames=200, config_toml=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        preset: &str,
+        mode: &str,
+        timeout_ms: f64,
+        bins: i64,
+        recover_samples: i64,
+        saccade_deg_s: f64,
+        max_gap_frames: i64,
+        config_toml: Option<&str>,
+    ) -> PyResult<Self> {
+        guard(|| {
+            Self::build(
+                py,
+                preset,
+                mode,
+                timeout_ms,
+                bins,
+                recover_samples,
+                saccade_deg_s,
+                max_gap_frames,
+                config_toml,
+            )
+        })
+    }
+
+    /// Feeds one tracker sample (gaze clock t_s, s; gaze_deg in degrees,
+    /// ISO 8855: 90 looks left); returns the frames that start at or before
+    /// it, each decided from the samples before it. valid=False (or a
+    /// non-finite gaze) means the tracker lost the eyes.
+    #[pyo3(signature = (t_s, gaze_deg, valid=true))]
+    fn push(&self, py: Python<'_>, t_s: f64, gaze_deg: f64, valid: bool) -> PyResult<Vec<PyFrame>> {
+        guard(|| {
+            finite("t_s", t_s)?;
+            let sample = GazeSample {
+                t_s,
+                gaze_deg,
+                valid,
+            };
+            let out = self
+                .locked(py, |s| s.push(&sample))?
+                .map_err(|e| gaze_error(py, e))?;
+            frames(py, out)
+        })
+    }
+
+    /// Feeds a recorded gaze track (1-D arrays of equal length, array-likes
+    /// accepted: times t_s in s, gaze_deg in degrees, valid as bools or None
+    /// for all valid) in order, as many push calls would; returns all the
+    /// frames they emit. The GIL is released for the whole batch.
+    #[pyo3(signature = (t_s, gaze_deg, valid=None))]
+    fn push_many<'py>(
+        &self,
+        py: Python<'py>,
+        t_s: &Bound<'py, PyAny>,
+        gaze_deg: &Bound<'py, PyAny>,
+        valid: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Vec<PyFrame>> {
-        finite("t_s", t_s)?;
-        let sample = GazeSample {
-            t_s,
-            gaze_deg,
-            valid,
-        };
-        let out = self.inner.push(&sample).map_err(|e| gaze_error(py, e))?;
-        frames(py, out)
+        guard(|| {
+            let np = py.import("numpy")?;
+            let column =
+                |name: &str, a: &Bound<'py, PyAny>, dtype: &str| -> PyResult<Bound<'py, PyAny>> {
+                    let c = np.call_method1("ascontiguousarray", (a, dtype))?;
+                    let ndim: usize = c.getattr("ndim")?.extract()?;
+                    if ndim != 1 {
+                        return Err(value_error(format!(
+                            "{name}: expected a 1-D array, got {ndim} dimensions"
+                        )));
+                    }
+                    Ok(c)
+                };
+            let t = column("t_s", t_s, "float64")?;
+            let g = column("gaze_deg", gaze_deg, "float64")?;
+            let t: PyReadonlyArray1<'py, f64> = t.extract()?;
+            let g: PyReadonlyArray1<'py, f64> = g.extract()?;
+            let v: Option<PyReadonlyArray1<'py, bool>> = match valid {
+                None => None,
+                Some(v) => Some(column("valid", v, "bool")?.extract()?),
+            };
+            let (t, g) = (t.as_slice()?, g.as_slice()?);
+            let v = v.as_ref().map(|v| v.as_slice()).transpose()?;
+            let n = t.len();
+            if g.len() != n || v.is_some_and(|v| v.len() != n) {
+                return Err(value_error(format!(
+                    "gaze_deg: t_s, gaze_deg and valid must have one length, got {n}, {}{}",
+                    g.len(),
+                    v.map_or(String::new(), |v| format!(", {}", v.len()))
+                )));
+            }
+            if let Some(i) = t.iter().position(|x| !x.is_finite()) {
+                return Err(value_error(format!(
+                    "t_s[{i}]: {} is not a finite number",
+                    t[i]
+                )));
+            }
+            let out = self
+                .locked(py, |s| {
+                    let mut out = Vec::new();
+                    for i in 0..n {
+                        let sample = GazeSample {
+                            t_s: t[i],
+                            gaze_deg: g[i],
+                            valid: v.is_none_or(|v| v[i]),
+                        };
+                        out.extend(s.push(&sample)?);
+                    }
+                    Ok(out)
+                })?
+                .map_err(|e| gaze_error(py, e))?;
+            frames(py, out)
+        })
     }
 
-    /// Runs the frame clock to `now_s` without a sample: the frames due by
-    /// then (fail-safe once the last fixation is older than the timeout).
-    fn tick(&mut self, py: Python<'_>, now_s: f64) -> PyResult<Vec<PyFrame>> {
-        finite("now_s", now_s)?;
-        let out = self.inner.tick(now_s).map_err(|e| gaze_error(py, e))?;
-        frames(py, out)
+    /// Runs the frame clock to now_s without a sample: the frames due by
+    /// then, fail-safe once the last fixation is older than the timeout.
+    /// Call it on each LiDAR frame so silence still yields frames.
+    fn tick(&self, py: Python<'_>, now_s: f64) -> PyResult<Vec<PyFrame>> {
+        guard(|| {
+            finite("now_s", now_s)?;
+            let out = self
+                .locked(py, |s| s.tick(now_s))?
+                .map_err(|e| gaze_error(py, e))?;
+            frames(py, out)
+        })
     }
 
-    /// The frame period on the frame clock, s.
+    /// The frame period on the frame clock (rounded to a microsecond), s.
     #[getter]
-    fn period_s(&self) -> f64 {
-        self.inner.period_us() as f64 * 1e-6
+    fn period_s(&self, py: Python<'_>) -> PyResult<f64> {
+        guard(|| Ok(self.locked(py, |s| s.period_us())? as f64 / 1e6))
     }
 
     /// Counters: samples, invalid, outliers, frames, fail_safe_frames, resyncs, plan_fallbacks.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = self.inner.stats();
-        let d = PyDict::new(py);
-        d.set_item("samples", s.samples)?;
-        d.set_item("invalid", s.invalid)?;
-        d.set_item("outliers", s.outliers)?;
-        d.set_item("frames", s.frames)?;
-        d.set_item("fail_safe_frames", s.fail_safe_frames)?;
-        d.set_item("resyncs", s.resyncs)?;
-        d.set_item("plan_fallbacks", s.plan_fallbacks)?;
-        Ok(d)
+        guard(|| {
+            let s = self.locked(py, |s| s.stats())?;
+            let d = PyDict::new(py);
+            d.set_item("samples", s.samples)?;
+            d.set_item("invalid", s.invalid)?;
+            d.set_item("outliers", s.outliers)?;
+            d.set_item("frames", s.frames)?;
+            d.set_item("fail_safe_frames", s.fail_safe_frames)?;
+            d.set_item("resyncs", s.resyncs)?;
+            d.set_item("plan_fallbacks", s.plan_fallbacks)?;
+            Ok(d)
+        })
     }
 
     /// Warnings since the last call (clock jumps, planning fallbacks), one line each.
-    fn notices(&mut self) -> Vec<String> {
-        self.inner
-            .take_notices()
-            .into_iter()
-            .map(|n| match n {
-                Notice::Resync { from_s, to_s, frames } => format!(
-                    "gaze clock jumped from {from_s} s to {to_s} s ({frames} frames due): one fail-safe frame, frame clock restarted, gaze history discarded"
-                ),
-                Notice::PlanFallback { gaze_deg, error } => format!(
-                    "no certified adaptive profile for gaze {gaze_deg}°, baseline instead: {error}"
-                ),
-                Notice::Late { frames } => format!("output ran late, {frames} frame(s) skipped"),
-            })
-            .collect()
+    fn notices(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        guard(|| {
+            Ok(self
+                .locked(py, |s| s.take_notices())?
+                .into_iter()
+                .map(|n| match n {
+                    Notice::Resync { from_s, to_s, frames } => format!(
+                        "gaze clock jumped from {from_s} s to {to_s} s ({frames} frames due): one fail-safe frame, frame clock restarted, gaze history discarded"
+                    ),
+                    Notice::PlanFallback { gaze_deg, error } => format!(
+                        "no certified adaptive profile for gaze {gaze_deg}°, baseline instead: {error}"
+                    ),
+                    Notice::Late { frames } => format!("output ran late, {frames} frame(s) skipped"),
+                })
+                .collect())
+        })
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        guard(|| {
+            let (period_us, st) = self.locked(py, |s| (s.period_us(), s.stats()))?;
+            Ok(format!(
+                "<gaze_lidar.GazeStream preset={:?} mode={:?} period_s={} samples={} frames={} fail_safe_frames={}>",
+                self.preset,
+                self.mode,
+                period_us as f64 / 1e6,
+                st.samples,
+                st.frames,
+                st.fail_safe_frames
+            ))
+        })
     }
 }
 
@@ -713,52 +1075,50 @@ impl PointsVisitor for AzimuthVisitor {
     }
 }
 
-/// Hands `v` the x, y, z of an N×3 or N×4 float32/float64 array (a flat
-/// slice when contiguous, with the GIL released).
+/// Hands `v` the x, y, z of a C-contiguous N×3 or N×4 float32/float64
+/// array, with the GIL released. Any other layout is refused, never read:
+/// `gaze_lidar`'s Python layer (`gaze_lidar._points.as_points`) brings every
+/// array numpy can view as float (any dtype, byte order, memory order,
+/// strides, structured x/y/z, CARLA's raw buffer) to one of these first.
 fn with_points<'py, V: PointsVisitor>(points: &Bound<'py, PyAny>, v: V) -> PyResult<V::Out> {
-    let shape_error = |dtype: String, shape: Vec<usize>| {
+    let py = points.py();
+    let refused = || {
+        let dtype = points
+            .getattr("dtype")
+            .map(|d| d.to_string())
+            .unwrap_or_else(|_| points.get_type().to_string());
+        let shape = points
+            .getattr("shape")
+            .and_then(|s| s.extract::<Vec<usize>>())
+            .unwrap_or_default();
         value_error(format!(
-            "points: expected an N×4 float32 array (x, y, z, intensity; N×3 and float64 also accepted), got dtype {dtype} and shape {shape:?}"
+            "points: the native layer takes a C-contiguous N×3 or N×4 float32/float64 array in native byte order (gaze_lidar.apply_profile and azimuth_deg convert any other), got dtype {dtype} and shape {shape:?}"
         ))
     };
-    let py = points.py();
     if let Ok(a) = points.extract::<PyReadonlyArray2<'py, f32>>() {
-        let shape = a.shape().to_vec();
-        if !(shape[1] == 3 || shape[1] == 4) {
-            return Err(shape_error("float32".into(), shape));
+        let w = a.shape()[1];
+        if !(w == 3 || w == 4) || !a.is_c_contiguous() {
+            return Err(refused());
         }
-        let w = shape[1];
-        return Ok(match a.as_slice() {
-            Ok(flat) => py.detach(|| {
-                v.visit(
-                    flat.chunks_exact(w)
-                        .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])]),
-                )
-            }),
-            Err(_) => v.visit(
-                a.as_array()
-                    .rows()
-                    .into_iter()
-                    .map(|r| [f64::from(r[0]), f64::from(r[1]), f64::from(r[2])]),
-            ),
+        let flat = a.as_slice().map_err(|_| refused())?;
+        return detached(py, || {
+            v.visit(
+                flat.chunks_exact(w)
+                    .map(|c| [f64::from(c[0]), f64::from(c[1]), f64::from(c[2])]),
+            )
         });
     }
     if let Ok(a) = points.extract::<PyReadonlyArray2<'py, f64>>() {
-        let shape = a.shape().to_vec();
-        if !(shape[1] == 3 || shape[1] == 4) {
-            return Err(shape_error("float64".into(), shape));
+        let w = a.shape()[1];
+        if !(w == 3 || w == 4) || !a.is_c_contiguous() {
+            return Err(refused());
         }
-        return Ok(v.visit(a.as_array().rows().into_iter().map(|r| [r[0], r[1], r[2]])));
+        let flat = a.as_slice().map_err(|_| refused())?;
+        return detached(py, || {
+            v.visit(flat.chunks_exact(w).map(|c| [c[0], c[1], c[2]]))
+        });
     }
-    let dtype = points
-        .getattr("dtype")
-        .map(|d| d.to_string())
-        .unwrap_or_else(|_| points.get_type().to_string());
-    let shape = points
-        .getattr("shape")
-        .and_then(|s| s.extract::<Vec<usize>>())
-        .unwrap_or_default();
-    Err(shape_error(dtype, shape))
+    Err(refused())
 }
 
 /// Azimuth of each point in the crate's convention (ISO 8855, degrees
@@ -770,9 +1130,11 @@ fn azimuth_deg<'py>(
     points: &Bound<'py, PyAny>,
     frame: &str,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let frame = cloud_frame(frame)?;
-    let az = with_points(points, AzimuthVisitor(frame))?;
-    Ok(PyArray1::from_vec(py, az))
+    guard(|| {
+        let frame = cloud_frame(frame)?;
+        let az = with_points(points, AzimuthVisitor(frame))?;
+        Ok(PyArray1::from_vec(py, az))
+    })
 }
 
 /// Which points of an N×4 (x, y, z, intensity) cloud a sensor running
@@ -791,24 +1153,26 @@ fn apply_profile<'py>(
     frame: &str,
     cloud_spin_rad_s: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-    let opts = CloudOptions {
-        rated_range_m,
-        model: model_of(model)?,
-        fog_mor_m,
-        seed: seed_of(seed)?,
-        frame: cloud_frame(frame)?,
-        cloud_spin_rad_s,
-    };
-    let certified = &profile.get().inner;
-    let mask = with_points(
-        points,
-        KeepVisitor {
-            certified,
-            opts: &opts,
-        },
-    )?;
-    mask.map(|m| PyArray1::from_vec(py, m))
-        .map_err(|e| value_error(e.to_string()))
+    guard(|| {
+        let opts = CloudOptions {
+            rated_range_m,
+            model: model_of(model)?,
+            fog_mor_m,
+            seed: seed_of(seed)?,
+            frame: cloud_frame(frame)?,
+            cloud_spin_rad_s,
+        };
+        let certified = &profile.get().inner;
+        let mask = with_points(
+            points,
+            KeepVisitor {
+                certified,
+                opts: &opts,
+            },
+        )?;
+        mask.map(|m| PyArray1::from_vec(py, m))
+            .map_err(|e| value_error(e.to_string()))
+    })
 }
 
 /// `model=`: one return model or a list of them.
@@ -831,7 +1195,10 @@ const SIM_OPTIONS: &[&str] = &[
 /// The paper's intersection experiment: the table rows (one dict per
 /// model × variant × fog level).
 #[pyfunction]
-#[pyo3(signature = (model=Models::One("argus".to_owned()), trials=10, seed=1, **options))]
+#[pyo3(
+    signature = (model=Models::One("argus".to_owned()), trials=10, seed=1, **options),
+    text_signature = "(model='argus', trials=10, seed=1, **options)"
+)]
 fn simulate<'py>(
     py: Python<'py>,
     model: Models,
@@ -839,110 +1206,113 @@ fn simulate<'py>(
     seed: i128,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let models = match model {
-        Models::One(name) => vec![model_of(&name)?],
-        Models::Many(names) => names.iter().map(|n| model_of(n)).collect::<PyResult<_>>()?,
-    };
-    if !(1..=100_000).contains(&trials) {
-        return Err(value_error(format!(
-            "trials: {trials} must lie in 1..=100000"
-        )));
-    }
-    let mut config = SimConfig {
-        models,
-        trials: trials as usize,
-        seed: seed_of(seed)?,
-        ..SimConfig::default()
-    };
-    if let Some(opts) = options {
-        for (k, v) in opts.iter() {
-            let key: String = k.extract()?;
-            let wrong = |what: &str| value_error(format!("{key}: expected {what}"));
-            match key.as_str() {
-                "variants" => {
-                    let names: Vec<String> =
-                        v.extract().map_err(|_| wrong("a list of variant names"))?;
-                    config.variants = names
-                        .iter()
-                        .map(|n| {
-                            [Variant::Baseline, Variant::Range, Variant::Resolution, Variant::Joint, Variant::Optimized]
-                                .into_iter()
-                                .find(|x| x.name() == n)
-                                .ok_or_else(|| value_error(format!(
-                                    "variants: '{n}' is not one of baseline, range, resolution, joint, optimized"
-                                )))
-                        })
-                        .collect::<PyResult<_>>()?;
-                }
-                "fog_pct" => {
-                    let levels: Vec<u32> = v
-                        .extract()
-                        .map_err(|_| wrong("a list of fog levels in %"))?;
-                    for f in &levels {
-                        if !FOG_LEVELS_PCT.contains(f) {
-                            return Err(value_error(format!(
-                                "fog_pct: {f} is not one of the paper's levels 0, 25, 50"
-                            )));
+    guard(|| {
+        let models = match model {
+            Models::One(name) => vec![model_of(&name)?],
+            Models::Many(names) => names.iter().map(|n| model_of(n)).collect::<PyResult<_>>()?,
+        };
+        if !(1..=100_000).contains(&trials) {
+            return Err(value_error(format!(
+                "trials: {trials} must lie in 1..=100000"
+            )));
+        }
+        let mut config = SimConfig {
+            models,
+            trials: trials as usize,
+            seed: seed_of(seed)?,
+            ..SimConfig::default()
+        };
+        if let Some(opts) = options {
+            for (k, v) in opts.iter() {
+                let key: String = k.extract()?;
+                let wrong = |what: &str| value_error(format!("{key}: expected {what}"));
+                match key.as_str() {
+                    "variants" => {
+                        let names: Vec<String> =
+                            v.extract().map_err(|_| wrong("a list of variant names"))?;
+                        config.variants = names
+                            .iter()
+                            .map(|n| {
+                                [Variant::Baseline, Variant::Range, Variant::Resolution, Variant::Joint, Variant::Optimized]
+                                    .into_iter()
+                                    .find(|x| x.name() == n)
+                                    .ok_or_else(|| value_error(format!(
+                                        "variants: '{n}' is not one of baseline, range, resolution, joint, optimized"
+                                    )))
+                            })
+                            .collect::<PyResult<_>>()?;
+                    }
+                    "fog_pct" => {
+                        let levels: Vec<u32> = v
+                            .extract()
+                            .map_err(|_| wrong("a list of fog levels in %"))?;
+                        for f in &levels {
+                            if !FOG_LEVELS_PCT.contains(f) {
+                                return Err(value_error(format!(
+                                    "fog_pct: {f} is not one of the paper's levels 0, 25, 50"
+                                )));
+                            }
                         }
+                        config.fog_pcts = levels;
                     }
-                    config.fog_pcts = levels;
-                }
-                "detect" => {
-                    let s: String = v.extract().map_err(|_| wrong("'k/n'"))?;
-                    let bad =
-                        || value_error(format!("detect: '{s}' is not k/n with 1 <= k <= n <= 100"));
-                    let (k, n) = s.split_once('/').ok_or_else(bad)?;
-                    let k: u32 = k.trim().parse().map_err(|_| bad())?;
-                    let n: u32 = n.trim().parse().map_err(|_| bad())?;
-                    if k == 0 || k > n || n > 100 {
-                        return Err(bad());
+                    "detect" => {
+                        let s: String = v.extract().map_err(|_| wrong("'k/n'"))?;
+                        let bad = || {
+                            value_error(format!("detect: '{s}' is not k/n with 1 <= k <= n <= 100"))
+                        };
+                        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+                        let k: u32 = k.trim().parse().map_err(|_| bad())?;
+                        let n: u32 = n.trim().parse().map_err(|_| bad())?;
+                        if k == 0 || k > n || n > 100 {
+                            return Err(bad());
+                        }
+                        config.detection = KOfN { k, n };
                     }
-                    config.detection = KOfN { k, n };
-                }
-                "bins" => {
-                    let b: usize = v.extract().map_err(|_| wrong("an integer"))?;
-                    config.bins = b;
-                }
-                "preset" => {
-                    let name: String = v.extract().map_err(|_| wrong("a preset name"))?;
-                    config.sensor = preset_of(&name)?;
-                }
-                "scenario_toml" => {
-                    let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
-                    config.scenario = Scenario::from_toml(&text, "scenario_toml")
-                        .map_err(|e| value_error(e.to_string()))?;
-                }
-                "optimizer_toml" => {
-                    use gaze_lidar::optimizer::OptimizerConfig;
-                    let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
-                    let problem = OptimizerConfig::from_toml(&text, "optimizer_toml")
-                        .and_then(|c| c.problem())
-                        .map_err(|e| opt_error(py, e))?;
-                    config.optimizer = Some(problem);
-                }
-                other => {
-                    return Err(value_error(format!(
-                        "{other}: unknown option (known: {})",
-                        SIM_OPTIONS.join(", ")
-                    )))
+                    "bins" => {
+                        let b: usize = v.extract().map_err(|_| wrong("an integer"))?;
+                        config.bins = b;
+                    }
+                    "preset" => {
+                        let name: String = v.extract().map_err(|_| wrong("a preset name"))?;
+                        config.sensor = preset_of(&name)?;
+                    }
+                    "scenario_toml" => {
+                        let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
+                        config.scenario = Scenario::from_toml(&text, "scenario_toml")
+                            .map_err(|e| value_error(e.to_string()))?;
+                    }
+                    "optimizer_toml" => {
+                        use gaze_lidar::optimizer::OptimizerConfig;
+                        let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
+                        let problem = OptimizerConfig::from_toml(&text, "optimizer_toml")
+                            .and_then(|c| c.problem())
+                            .map_err(|e| opt_error(py, e))?;
+                        config.optimizer = Some(problem);
+                    }
+                    other => {
+                        return Err(value_error(format!(
+                            "{other}: unknown option (known: {})",
+                            SIM_OPTIONS.join(", ")
+                        )))
+                    }
                 }
             }
         }
-    }
-    if config.optimizer.is_some() && !config.variants.contains(&Variant::Optimized) {
-        return Err(value_error(
-            "optimizer_toml: configures the optimized variant: add 'optimized' to variants",
-        ));
-    }
-    let result = py.detach(|| sim::run(&config, &|| {})).map_err(|e| {
-        if e.is_input_error() {
-            value_error(e.to_string())
-        } else {
-            Infeasible::new_err(e.to_string())
+        if config.optimizer.is_some() && !config.variants.contains(&Variant::Optimized) {
+            return Err(value_error(
+                "optimizer_toml: configures the optimized variant: add 'optimized' to variants",
+            ));
         }
-    })?;
-    let json = sim::table::render_json(&result).map_err(|e| value_error(e.to_string()))?;
-    json_value(py, &json)?.get_item("rows")
+        let result = py.detach(|| sim::run(&config, &|| {})).map_err(|e| {
+            if e.is_input_error() {
+                value_error(e.to_string())
+            } else {
+                Infeasible::new_err(e.to_string())
+            }
+        })?;
+        let json = sim::table::render_json(&result).map_err(|e| value_error(e.to_string()))?;
+        json_value(py, &json)?.get_item("rows")
+    })
 }
 
 /// The native half of `gaze_lidar`: certified profiles, the checker, the
@@ -952,6 +1322,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("Infeasible", py.get_type::<Infeasible>())?;
     m.add("Rejected", py.get_type::<Rejected>())?;
+    m.add("InternalError", py.get_type::<InternalError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<PyProfile>()?;
     m.add_class::<Verdict>()?;
     m.add_class::<PyFrame>()?;

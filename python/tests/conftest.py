@@ -1,3 +1,5 @@
+from __future__ import annotations
+
 import pathlib
 
 import pytest
@@ -6,6 +8,6 @@ REPO = pathlib.Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="session")
-def repo():
+def repo() -> pathlib.Path:
     """The repository root (examples/ and configs live there)."""
     return REPO

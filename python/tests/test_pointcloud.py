@@ -5,6 +5,10 @@ azimuth β (the crate's convention, counter-clockwise from ahead, 90° = left)
 and range r is (r cos β, -r sin β, z).
 """
 
+from __future__ import annotations
+
+from typing import Any
+import numpy.typing as npt
 import math
 
 import numpy as np
@@ -13,7 +17,7 @@ import pytest
 import gaze_lidar as gl
 
 
-def cloud(azimuth_deg, range_m, z_m=0.0, intensity=1.0):
+def cloud(azimuth_deg: npt.ArrayLike, range_m: npt.ArrayLike, z_m: float = 0.0, intensity: float = 1.0) -> npt.NDArray[np.float32]:
     az = np.radians(np.asarray(azimuth_deg, dtype=np.float64))
     r = np.asarray(range_m, dtype=np.float64)
     horizontal = np.sqrt(np.maximum(r**2 - z_m**2, 0.0))
@@ -25,11 +29,12 @@ def cloud(azimuth_deg, range_m, z_m=0.0, intensity=1.0):
     return pts
 
 
-def true_range(pts):
-    return np.sqrt((pts[:, :3].astype(np.float64) ** 2).sum(axis=1))
+def true_range(pts: npt.NDArray[Any]) -> npt.NDArray[np.float64]:
+    r: npt.NDArray[np.float64] = np.sqrt((pts[:, :3].astype(np.float64) ** 2).sum(axis=1))
+    return r
 
 
-def test_carla_azimuth_convention():
+def test_carla_azimuth_convention() -> None:
     pts = np.array([[10, 0, 0, 1], [0, -10, 0, 1], [-10, 0, 0, 1], [0, 10, 0, 1]], dtype=np.float32)
     np.testing.assert_allclose(gl.azimuth_deg(pts), [0, 90, 180, 270], atol=1e-12)
     np.testing.assert_allclose(gl.azimuth_deg(pts, frame="iso8855"), [0, 270, 180, 90], atol=1e-12)
@@ -38,7 +43,7 @@ def test_carla_azimuth_convention():
     np.testing.assert_allclose(gl.azimuth_deg(cloud(az, 50.0)), az, atol=1e-4)
 
 
-def test_uniform_baseline_keeps_exactly_the_points_within_the_rated_range():
+def test_uniform_baseline_keeps_exactly_the_points_within_the_rated_range() -> None:
     base = gl.profile(mode="baseline", gaze_deg=None)
     rng = np.random.default_rng(1)
     n = 50_000
@@ -58,7 +63,7 @@ def test_uniform_baseline_keeps_exactly_the_points_within_the_rated_range():
     np.testing.assert_array_equal(gl.apply_profile(base, pts2, rated_range_m=100.0), mask)
 
 
-def test_range_control_keeps_farther_points_outside_the_region_of_focus():
+def test_range_control_keeps_farther_points_outside_the_region_of_focus() -> None:
     p = gl.profile(mode="range", gaze_deg=90.0)  # RoF: 60°–120° (left)
     rng = np.random.default_rng(2)
     n = 100_000
@@ -91,7 +96,7 @@ def test_range_control_keeps_farther_points_outside_the_region_of_focus():
     assert not argus_fog[rof].any()
 
 
-def test_resolution_control_thins_the_region_of_focus_by_the_spin_ratio():
+def test_resolution_control_thins_the_region_of_focus_by_the_spin_ratio() -> None:
     p = gl.profile(mode="resolution", gaze_deg=90.0)
     omega_bar = 2 * math.pi * p.frame_rate_hz
     omega_rof = float(p.spin_start_rad_s[p.in_rof][0])
@@ -120,7 +125,7 @@ def test_resolution_control_thins_the_region_of_focus_by_the_spin_ratio():
     assert abs(ratio - omega_roi / omega_rof) < 4 * math.sqrt(ratio * (1 - ratio) / rof.sum())
 
 
-def test_layouts_and_errors():
+def test_layouts_and_errors() -> None:
     p = gl.profile(mode="range", gaze_deg=90.0)
     pts = cloud(np.linspace(0, 359, 100), 50.0)
     want = gl.apply_profile(p, pts, rated_range_m=100.0)
@@ -132,7 +137,9 @@ def test_layouts_and_errors():
     with pytest.raises(ValueError, match="^points: "):
         gl.apply_profile(p, pts[:, :2], rated_range_m=100.0)
     with pytest.raises(ValueError, match="^points: "):
-        gl.apply_profile(p, pts.astype(np.int32), rated_range_m=100.0)
+        gl.apply_profile(p, pts.astype(np.complex64), rated_range_m=100.0)
+    with pytest.raises(ValueError, match="^points: "):
+        gl.apply_profile(p, pts[:, :, None], rated_range_m=100.0)
     bad = pts.copy()
     bad[3, 1] = np.nan
     with pytest.raises(ValueError, match=r"^points\[3\]"):
@@ -144,10 +151,10 @@ def test_layouts_and_errors():
     with pytest.raises(ValueError, match="^fog_mor_m"):
         gl.apply_profile(p, pts, rated_range_m=100.0, model="argus", fog_mor_m=150.0)
     with pytest.raises(ValueError, match="^model"):
-        gl.apply_profile(p, pts, rated_range_m=100.0, model="lambertian")
+        gl.apply_profile(p, pts, rated_range_m=100.0, model="lambertian")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="^frame"):
-        gl.apply_profile(p, pts, rated_range_m=100.0, frame="enu")
+        gl.apply_profile(p, pts, rated_range_m=100.0, frame="enu")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="^seed"):
         gl.apply_profile(p, pts, rated_range_m=100.0, seed=-1)
     with pytest.raises(TypeError):
-        gl.apply_profile(p, pts)  # rated_range_m is required
+        gl.apply_profile(p, pts)  # type: ignore[call-arg]  # rated_range_m is required

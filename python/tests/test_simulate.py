@@ -1,11 +1,14 @@
 """simulate: the experiment's table rows."""
 
+from __future__ import annotations
+
+from typing import Any
 import pytest
 
 import gaze_lidar as gl
 
 
-def test_rows_for_each_cell_and_reproducible():
+def test_rows_for_each_cell_and_reproducible() -> None:
     rows = gl.simulate(model="argus", trials=3, seed=1, variants=["baseline", "range"], fog_pct=[0, 50])
     assert [(r["variant"], r["fog_pct"]) for r in rows] == [
         ("baseline", 0),
@@ -23,7 +26,7 @@ def test_rows_for_each_cell_and_reproducible():
     assert by[("range", 50)]["tta_median_s"] > by[("baseline", 50)]["tta_median_s"]
 
 
-def test_both_models_and_options():
+def test_both_models_and_options() -> None:
     rows = gl.simulate(model=["argus", "physical"], trials=1, seed=2, variants=["joint"], fog_pct=[25], detect="1/1")
     assert sorted(r["model"] for r in rows) == ["argus", "physical"]
 
@@ -41,6 +44,6 @@ def test_both_models_and_options():
         ({"scenario_toml": "speed_kmh = -5"}, "speed_kmh"),
     ],
 )
-def test_bad_options_name_the_field(kwargs, field):
+def test_bad_options_name_the_field(kwargs: dict[str, Any], field: str) -> None:
     with pytest.raises(ValueError, match=field):
         gl.simulate(**kwargs)

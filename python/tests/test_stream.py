@@ -1,19 +1,22 @@
 """GazeStream: the frame clock, fail-safe on silence and loss."""
 
+from __future__ import annotations
+
+import pathlib
 import numpy as np
 import pytest
 
 import gaze_lidar as gl
 
 
-def fixations(stream, until_s, gaze_deg=90.0, rate_hz=200.0):
+def fixations(stream: gl.GazeStream, until_s: float, gaze_deg: float = 90.0, rate_hz: float = 200.0) -> list[gl.Frame]:
     frames = []
     for k in range(int(round(until_s * rate_hz)) + 1):
         frames += stream.push(k / rate_hz, gaze_deg)
     return frames
 
 
-def test_tick_after_silence_returns_fail_safe_frames():
+def test_tick_after_silence_returns_fail_safe_frames() -> None:
     s = gl.GazeStream(preset="paper", mode="range", timeout_ms=100)
     frames = fixations(s, 0.1)
     # Frames at 0 (no gaze yet: fail-safe) and 0.05, 0.1 (adaptive).
@@ -39,7 +42,7 @@ def test_tick_after_silence_returns_fail_safe_frames():
     assert s.tick(0.6) == []
 
 
-def test_tick_is_the_frame_rule_of_a_late_sample():
+def test_tick_is_the_frame_rule_of_a_late_sample() -> None:
     # Silence then one sample (the CLI's replay) gives the same frames as
     # ticking through the silence.
     a = gl.GazeStream()
@@ -49,7 +52,7 @@ def test_tick_is_the_frame_rule_of_a_late_sample():
     assert [(f.t_s, f.state) for f in fa] == [(f.t_s, f.state) for f in fb]
 
 
-def test_tracker_loss_is_fail_safe_at_the_next_frame_and_recovery_needs_samples():
+def test_tracker_loss_is_fail_safe_at_the_next_frame_and_recovery_needs_samples() -> None:
     s = gl.GazeStream(timeout_ms=100)
     fixations(s, 0.1)
     frames = s.push(0.105, 0.0, valid=False)  # eyes lost
@@ -58,11 +61,11 @@ def test_tracker_loss_is_fail_safe_at_the_next_frame_and_recovery_needs_samples(
     for k in range(1, 8):
         frames += s.push(0.15 + k * 0.005, 90.0)
     frames += s.push(0.2, 90.0)
-    assert frames[-1].state == "adaptive"
+    assert frames[-1].state == "adaptive"  # type: ignore[comparison-overlap]  # mypy keeps the earlier narrowing
     assert s.stats["invalid"] == 1
 
 
-def test_a_clock_jump_resynchronizes_with_one_fail_safe_frame():
+def test_a_clock_jump_resynchronizes_with_one_fail_safe_frame() -> None:
     s = gl.GazeStream()
     fixations(s, 0.1)
     frames = s.push(1e6, 90.0)
@@ -73,11 +76,11 @@ def test_a_clock_jump_resynchronizes_with_one_fail_safe_frame():
     assert s.notices() == []
 
 
-def test_bad_arguments():
+def test_bad_arguments() -> None:
     with pytest.raises(ValueError, match="timeout_ms"):
         gl.GazeStream(timeout_ms=0)
     with pytest.raises(ValueError, match="mode"):
-        gl.GazeStream(mode="fast")
+        gl.GazeStream(mode="fast")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="preset"):
         gl.GazeStream(preset="nope")
     with pytest.raises(ValueError, match="^recover_samples"):
@@ -91,7 +94,7 @@ def test_bad_arguments():
         s.tick(float("inf"))
 
 
-def test_optimizer_stream(repo):
+def test_optimizer_stream(repo: pathlib.Path) -> None:
     cfg = (repo / "examples/configs/paper.toml").read_text()
     s = gl.GazeStream(mode="joint", config_toml=cfg)
     frames = fixations(s, 0.1)
@@ -99,7 +102,7 @@ def test_optimizer_stream(repo):
     assert gl.check(frames[-1].profile.to_json()).certified
 
 
-def test_same_frames_as_the_cli_stream(repo):
+def test_same_frames_as_the_cli_stream(repo: pathlib.Path) -> None:
     """The CLI's `stream` (replay) on the same samples: the same frame times
     and states, and tick() through the silence changes nothing."""
     import json
@@ -108,9 +111,10 @@ def test_same_frames_as_the_cli_stream(repo):
 
     cli = repo / "target/release/gaze-lidar"
     if not cli.exists():
-        cli = shutil.which("gaze-lidar")
-        if cli is None:
+        found = shutil.which("gaze-lidar")
+        if found is None:
             pytest.skip("the gaze-lidar binary is not built (cargo build --release)")
+        cli = pathlib.Path(found)
     samples = [(k / 200, 90.0, True) for k in range(21)] + [(0.12, 0.0, False)]
     samples += [(0.13 + k / 200, 270.0, True) for k in range(10)] + [(0.6, 270.0, True)]
     text = "".join(json.dumps({"t_s": t, "gaze_deg": g, "valid": v}) + "\n" for t, g, v in samples)

@@ -13,7 +13,8 @@ use crate::model::angle::AngleError;
 pub use closed_form::closed_form;
 
 /// Which of the paper's controllers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
     /// Uniform power and spin (the non-adaptive LiDAR; also the fail-safe).

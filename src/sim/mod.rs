@@ -13,6 +13,7 @@
 //! results are bit-identical whatever the number of threads.
 
 pub mod carla;
+#[cfg(feature = "cli")]
 pub mod plots;
 pub mod report;
 pub mod returns;
@@ -90,7 +91,8 @@ impl From<crate::optimizer::OptError> for SimError {
 }
 
 /// A LiDAR variant of the experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "snake_case")]
 pub enum Variant {
     /// Uniform (the non-adaptive LiDAR).
@@ -139,7 +141,8 @@ impl Variant {
 }
 
 /// The sensor geometry of the simulation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Geometry {
     /// One horizontal channel in a top view, scaled by the channel count
@@ -152,7 +155,8 @@ pub enum Geometry {
 }
 
 /// When the car from the right counts as detected.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Detector {
     /// Any returned point on the car (k-of-n frames; `carla`: ticks).
@@ -164,7 +168,8 @@ pub enum Detector {
 }
 
 /// When a car arrives (TTA is measured to this moment).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Arrival {
     /// Its front reaches |y| = `conflict_half_width_m`.

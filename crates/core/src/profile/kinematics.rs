@@ -40,6 +40,15 @@ pub trait BinMotion {
             / (2.0 * self.width_deg().to_radians())
     }
 
+    /// Spin `x_rad` into the bin, rad/s: `ω(x) = √(ω_s² + 2ax)`, the same
+    /// law as [`Self::time_into_s`], with `x` clamped to `[0, width]`.
+    fn spin_into_rad_s(&self, x_rad: f64) -> f64 {
+        let x = x_rad.clamp(0.0, self.width_deg().to_radians());
+        (self.spin_start_rad_s().powi(2) + 2.0 * self.accel_rad_s2() * x)
+            .max(0.0)
+            .sqrt()
+    }
+
     /// Time to advance `x_rad` into the bin from its start, s
     /// (`2x / (ω_s + ω(x))`; 0 for `x ≤ 0`).
     fn time_into_s(&self, x_rad: f64) -> f64 {
@@ -510,6 +519,32 @@ mod tests {
             );
             prop_assert_eq!(b.angle_into_rad(t).to_bits(), angle_into_reference(&b, t).to_bits());
             prop_assert_eq!(m.dwell_s.to_bits(), b.dwell_s().to_bits());
+        }
+    }
+
+    proptest! {
+        /// ω(x) is the derivative of the angle law: the time to advance x
+        /// is 2x/(ω_s + ω(x)) (the trapezoid rule, exact at constant
+        /// acceleration), and the bin's ends give its declared spins.
+        #[test]
+        fn spin_into_matches_time_law_and_ends(
+            width in 1e-3f64..360.0,
+            w0 in 1e-2f64..1e3,
+            w1 in 1e-2f64..1e3,
+            f in 0.0f64..=1.0,
+        ) {
+            let b = bin(width, w0, w1);
+            let x = f * width.to_radians();
+            let w_x = b.spin_into_rad_s(x);
+            prop_assert!((b.spin_into_rad_s(0.0) - w0).abs() <= 1e-9 * w0);
+            prop_assert!((b.spin_into_rad_s(width.to_radians()) - w1).abs() <= 1e-9 * w0.max(w1));
+            if x > 0.0 {
+                let t = b.time_into_s(x);
+                prop_assert!((2.0 * x / (w0 + w_x) - t).abs() <= 1e-9 * t);
+            }
+            // Clamped outside the bin.
+            prop_assert_eq!(b.spin_into_rad_s(-1.0), b.spin_into_rad_s(0.0));
+            prop_assert_eq!(b.spin_into_rad_s(1e9), b.spin_into_rad_s(width.to_radians()));
         }
     }
 }
