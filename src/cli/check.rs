@@ -54,7 +54,7 @@ fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
             CliError::input(format!(
                 "--sensor {}: {}",
                 path.display(),
-                e.to_string().lines().collect::<Vec<_>>().join(" ")
+                gaze_lidar::text::toml_error(&text, &e)
             ))
         })?;
         return Ok(Some(spec));

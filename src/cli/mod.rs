@@ -2,20 +2,24 @@
 //!
 //! Exit codes: 0 success; 1 an infeasible request or a rejected profile
 //! (the limit is named); 2 bad input (argument, file, field; with line and
-//! column for files); 1 also for a failed write (a full disk). Errors are
-//! one line on stderr; data goes to stdout or `--out` (written atomically
-//! over regular files: never a partial file; devices and FIFOs are written
-//! in place). A closed stdout pipe (`| head`) ends the output quietly.
+//! column for files; an output path that cannot be written, names the
+//! same file twice or names an input); 1 also for a write that fails once
+//! started (a full disk, stdout on `/dev/full`). Errors are one line on
+//! stderr; data goes to stdout or to output files, which are all checked
+//! before any work and replaced together at the end (see [`output`]). A
+//! closed stdout pipe (`| head`) ends the output quietly.
 
 mod ael;
+mod args;
 mod check;
+mod config;
 pub mod io;
+pub mod output;
 mod profile;
 mod simulate;
 mod stream;
 
 use clap::{Parser, Subcommand};
-use std::path::Path;
 use std::process::ExitCode;
 
 /// An error with its exit code.
@@ -89,21 +93,16 @@ enum Command {
     Stream(stream::Args),
 }
 
-/// Writes `text` to `out` (see [`io::write_output`]), or to stdout.
-pub fn emit(text: &str, out: Option<&Path>) -> Result<(), CliError> {
-    emit_bytes(text.as_bytes(), out)
+/// Writes `text` to stdout.
+pub fn emit(text: &str) -> Result<(), CliError> {
+    emit_bytes(text.as_bytes())
 }
 
-/// Writes `bytes` to `out` (see [`io::write_output`]), or to stdout.
-pub fn emit_bytes(bytes: &[u8], out: Option<&Path>) -> Result<(), CliError> {
-    match out {
-        Some(path) => io::write_output(path, bytes),
-        None => {
-            let mut stdout = io::Stdout::new();
-            stdout.bytes(bytes)?;
-            stdout.finish()
-        }
-    }
+/// Writes `bytes` to stdout.
+pub fn emit_bytes(bytes: &[u8]) -> Result<(), CliError> {
+    let mut stdout = io::Stdout::new();
+    stdout.bytes(bytes)?;
+    stdout.finish()
 }
 
 /// clap's error as one line: the message with its indented continuation

@@ -1,0 +1,76 @@
+//! Numbers in messages: [`Num`] prints a value a user typed (or a limit)
+//! compactly — `1e300`, not 301 digits — and exactly (the shortest text that
+//! reads back as the same `f64`).
+
+use core::fmt;
+
+/// An `f64` for a message: plain decimal when that is short
+/// (`1e-4 <= |x| < 1e7`, and 0), scientific otherwise (`1e300`, `2.5e-9`);
+/// `NaN`, `inf` and `-inf` as such. Both forms are Rust's shortest
+/// round-trip representation, so the value is never rounded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        let magnitude = if x < 0.0 { -x } else { x };
+        if !x.is_finite() || x == 0.0 || (1e-4..1e7).contains(&magnitude) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
+/// [`Num`] of an optional limit: `unlimited` for `None`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limit(pub Option<f64>);
+
+impl fmt::Display for Limit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            Some(x) => Num(x).fmt(f),
+            None => f.write_str("unlimited"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate std;
+    use std::string::ToString;
+
+    /// Differential against the two formats it chooses between, over the
+    /// whole f64 range: never longer than 24 characters, and it reads back
+    /// as the same value.
+    #[test]
+    fn compact_and_exact_over_the_whole_range() {
+        bolero::check!().with_type::<u64>().for_each(|bits| {
+            let x = f64::from_bits(*bits);
+            let s = Num(x).to_string();
+            assert!(s.len() <= 24, "{x:e} → {s}");
+            let back: f64 = s.parse().unwrap();
+            assert!(back == x || (x.is_nan() && back.is_nan()), "{x:e} → {s}");
+        });
+        for (x, want) in [
+            (1e300, "1e300"),
+            (-1e300, "-1e300"),
+            (1000.0, "1000"),
+            (0.001, "0.001"),
+            (2.5e-9, "2.5e-9"),
+            (1e7, "1e7"),
+            (9999999.5, "9999999.5"),
+            (0.0, "0"),
+            (f64::INFINITY, "inf"),
+            (f64::NEG_INFINITY, "-inf"),
+            (f64::MAX, "1.7976931348623157e308"),
+            (f64::MIN_POSITIVE, "2.2250738585072014e-308"),
+        ] {
+            assert_eq!(Num(x).to_string(), want);
+        }
+        assert_eq!(Limit(None).to_string(), "unlimited");
+        assert_eq!(Limit(Some(1e300)).to_string(), "1e300");
+    }
+}
