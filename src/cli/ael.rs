@@ -87,7 +87,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             let p = scan_pass_angle_deg(r.band, d);
             if p > 360.0 {
                 return Err(CliError::input(format!(
-                    "--beam-diameter-mm: {} mm gives a scan pass angle of {}° (aperture {} mm + beam, at {} mm), more than a turn: the beam cannot be that wide",
+                    "--beam-diameter-mm: {} mm gives a scan pass angle of {}° (aperture {} mm + beam, at {} mm), more than a turn (> 360°): the beam cannot be that wide",
                     Num(d),
                     Num(p),
                     Num(r.aperture_diameter_mm),

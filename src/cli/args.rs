@@ -38,3 +38,15 @@ pub fn finite_between(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64, C
         )))
     }
 }
+
+/// A float option, finite and > 0.
+pub fn finite_positive(flag: &str, value: f64) -> Result<f64, CliError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(CliError::input(format!(
+            "{flag}: {} must be finite and > 0",
+            Num(value)
+        )))
+    }
+}

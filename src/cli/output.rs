@@ -206,7 +206,7 @@ fn check_folder(label: &str, dir: &Path) -> Result<bool, CliError> {
         match std::fs::metadata(probe) {
             Ok(m) if m.is_dir() => break,
             Ok(_) => return Err(bad(format!("{} is not a directory", probe.display()))),
-            Err(e) if e.kind() == ErrorKind::NotFound => {
+            Err(e) if matches!(e.kind(), ErrorKind::NotFound | ErrorKind::NotADirectory) => {
                 missing = true;
                 probe = parent_of(probe);
             }

@@ -11,7 +11,7 @@ use gaze_lidar::firmware::{binary, FirmwareConfig, FirmwareError, FirmwareTable}
 
 use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
 
-use super::args::int_in;
+use super::args::{finite_positive, int_in};
 use super::config::Overrides;
 use super::output::Outputs;
 use super::{emit_bytes, CliError};
@@ -103,6 +103,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         Some(t) => int_in("--tick-hz", t, 1, 10_000_000_000_i64)?,
         None => FirmwareConfig::default().tick_hz,
     };
+    if let Some(w) = a.power_w_per_code {
+        finite_positive("--power-w-per-code", w)?;
+    }
     if a.format == Format::FirmwareBin && a.out.is_none() {
         return Err(CliError::input(
             "--format firmware-bin writes binary: give --out FILE",

@@ -290,12 +290,14 @@ pub fn write_all(
     let mut next = || stems.next().unwrap_or_default();
     for &model in &config.models {
         for metric in [Metric::Tta, Metric::Density] {
-            svg_and_png!(dir, next(), (1200, 460), written, |root| {
+            let stem = next();
+            svg_and_png!(dir, stem, (1200, 460), written, |root| {
                 draw_boxes(root, result, config, model, metric)
             });
         }
     }
-    svg_and_png!(dir, next(), (1000, 520), written, |root| {
+    let stem = next();
+    svg_and_png!(dir, stem, (1000, 520), written, |root| {
         draw_profiles(root)
     });
     debug_assert_eq!(

@@ -36,6 +36,28 @@ impl fmt::Display for Limit {
     }
 }
 
+/// An `f64` for a message with `.1` decimals (`Fixed(x, 1)`): `{:.1}`
+/// while that is short and shows the value (`1e-N <= |x| < 1e7`, and 0),
+/// `{:.1e}` otherwise — never 300 digits, never a misleading `0.0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fixed(pub f64, pub usize);
+
+impl fmt::Display for Fixed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (x, prec) = (self.0, self.1);
+        let magnitude = if x < 0.0 { -x } else { x };
+        let mut smallest = 1.0;
+        for _ in 0..prec {
+            smallest /= 10.0;
+        }
+        if !x.is_finite() || x == 0.0 || (smallest..1e7).contains(&magnitude) {
+            write!(f, "{x:.prec$}")
+        } else {
+            write!(f, "{x:.prec$e}")
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -71,6 +93,13 @@ mod tests {
             assert_eq!(Num(x).to_string(), want);
         }
         assert_eq!(Limit(None).to_string(), "unlimited");
+        assert_eq!(Fixed(12.345, 1).to_string(), "12.3");
+        assert_eq!(Fixed(8.6e302, 1).to_string(), "8.6e302");
+        assert_eq!(Fixed(1.2e-5, 3).to_string(), "1.200e-5");
+        assert_eq!(Fixed(0.0, 3).to_string(), "0.000");
+        for x in [1e300, -1e300, 1e-300, 123.456, f64::MAX] {
+            assert!(Fixed(x, 3).to_string().len() <= 16, "{x:e}");
+        }
         assert_eq!(Limit(Some(1e300)).to_string(), "1e300");
     }
 }

@@ -350,9 +350,9 @@ impl fmt::Display for Violation {
                 ratio,
             } => write!(
                 f,
-                "eye_safety: at azimuth {azimuth_deg:.3}° the {rule} is {:.1} % of the Class 1 limit (margin {:.3}×)",
-                ratio * 100.0,
-                1.0 / ratio
+                "eye_safety: at azimuth {azimuth_deg:.3}° the {rule} is {} % of the Class 1 limit (margin {}×)",
+                crate::text::Fixed(ratio * 100.0, 1),
+                crate::text::Fixed(1.0 / ratio, 3)
             ),
             Self::EyeSafetyParams { reason } => write!(f, "limits.eye_safety: {reason}"),
             Self::EyeSafetyMissing => write!(
