@@ -19,8 +19,9 @@
 //!   the timeout (or there is none) → `FailSafe`, and the run of valid
 //!   samples restarts at 0: the gaze was lost, so recovery starts over;
 //! - a sample arriving when the held fixation is already older than the
-//!   timeout likewise restarts the run before it is counted (a loss no
-//!   frame happened to observe still needs a full recovery);
+//!   timeout likewise → `FailSafe` and restarts the run before it is
+//!   counted (a loss no frame happened to observe still needs a full
+//!   recovery);
 //! - at a frame, from `FailSafe`, with a fresh fixation and at least
 //!   `recover_samples` consecutive valid samples → `Adaptive` (hysteresis:
 //!   one good sample after a loss is not enough).
@@ -119,8 +120,10 @@ impl FailSafe {
     /// Feeds one sample at `t_us`.
     pub fn on_sample(&mut self, t_us: u64, kind: SampleKind) {
         if self.last_fixation_us.is_some() && !self.fresh_at(t_us) {
-            // The gaze went stale before this sample: a new run starts here.
+            // The gaze went stale before this sample (a loss no frame
+            // observed): fail-safe, and a new run starts here.
             self.valid_run = 0;
+            self.state = State::FailSafe;
         }
         match kind {
             SampleKind::Fixation => {
