@@ -43,6 +43,7 @@ pub mod planner;
 pub mod pointcloud;
 pub mod profile;
 pub mod sim;
+pub mod text;
 #[cfg(any(test, kani))]
 pub(crate) use gaze_lidar_core::verification;
 

@@ -5,6 +5,12 @@ use std::process::{Command, Output, Stdio};
 
 /// Runs `gaze-lidar` with `args` and optional stdin.
 pub fn run(args: &[&str], stdin: Option<&str>) -> Output {
+    run_bytes(args, stdin.map(str::as_bytes))
+}
+
+/// Runs `gaze-lidar` with `args` and optional stdin bytes (written from a
+/// thread, so a child that stops reading early cannot block the test).
+pub fn run_bytes(args: &[&str], stdin: Option<&[u8]>) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_gaze-lidar"));
     cmd.args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
     cmd.stdin(if stdin.is_some() {
@@ -13,16 +19,43 @@ pub fn run(args: &[&str], stdin: Option<&str>) -> Output {
         Stdio::null()
     });
     let mut child = cmd.spawn().expect("spawn gaze-lidar");
-    if let Some(s) = stdin {
-        use std::io::Write;
-        child
-            .stdin
-            .take()
-            .expect("stdin")
-            .write_all(s.as_bytes())
-            .expect("write stdin");
+    let writer = stdin.map(|s| {
+        let bytes = s.to_vec();
+        let mut pipe = child.stdin.take().expect("stdin");
+        std::thread::spawn(move || {
+            use std::io::Write;
+            // The child may exit before reading everything (an error).
+            let _ = pipe.write_all(&bytes);
+        })
+    });
+    let out = child.wait_with_output().expect("wait gaze-lidar");
+    if let Some(w) = writer {
+        w.join().expect("stdin writer");
     }
-    child.wait_with_output().expect("wait gaze-lidar")
+    out
+}
+
+/// No panic, whatever the outcome.
+pub fn no_panic(o: &Output, what: &str) {
+    let err = stderr(o);
+    assert_ne!(o.status.code(), Some(101), "{what}: exit 101: {err}");
+    assert!(!err.contains("panicked"), "{what}: panic: {err}");
+    assert!(!err.contains("RUST_BACKTRACE"), "{what}: panic: {err}");
+}
+
+/// Exit `code`, one stderr line containing every needle, no panic.
+pub fn expect(o: &Output, code: i32, needles: &[&str], what: &str) {
+    no_panic(o, what);
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(code), "{what}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{what}: one line expected: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{what}: expected '{n}' in: {err}");
+    }
 }
 
 /// Stdout as text.

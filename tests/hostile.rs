@@ -12,32 +12,9 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use common::{run, stderr, stdout};
+use common::{expect, no_panic, run, stderr, stdout};
 
 const BIN: &str = env!("CARGO_BIN_EXE_gaze-lidar");
-
-/// No panic, whatever the outcome.
-fn no_panic(o: &Output, what: &str) {
-    let err = stderr(o);
-    assert_ne!(o.status.code(), Some(101), "{what}: exit 101: {err}");
-    assert!(!err.contains("panicked"), "{what}: panic: {err}");
-    assert!(!err.contains("RUST_BACKTRACE"), "{what}: panic: {err}");
-}
-
-/// Exit `code`, one stderr line containing every needle, no panic.
-fn expect(o: &Output, code: i32, needles: &[&str], what: &str) {
-    no_panic(o, what);
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(code), "{what}: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{what}: one line expected: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{what}: expected '{n}' in: {err}");
-    }
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -175,7 +152,7 @@ fn argument_errors_name_the_argument() {
                 "-1",
             ],
             2,
-            &["power_w_per_code"],
+            &["--power-w-per-code"],
         ),
         (
             &["profile", "--gaze-deg", "90", "--format", "firmware-bin"],

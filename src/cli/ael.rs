@@ -4,6 +4,8 @@ use clap::ValueEnum;
 use std::fmt::Write as _;
 
 use gaze_lidar::eye_safety::ael_report;
+use gaze_lidar::eye_safety::exposure::scan_pass_angle_deg;
+use gaze_lidar::text::Num;
 
 use super::{emit, CliError};
 
@@ -39,19 +41,20 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     if !(a.wavelength_nm.is_finite()) {
         return Err(CliError::input(format!(
             "--wavelength-nm: {} is not a finite number",
-            a.wavelength_nm
+            Num(a.wavelength_nm)
         )));
     }
     if !(a.pulse_duration_s.is_finite() && a.pulse_duration_s > 0.0) {
         return Err(CliError::input(format!(
             "--pulse-duration-s: {} must be finite and > 0",
-            a.pulse_duration_s
+            Num(a.pulse_duration_s)
         )));
     }
     if let Some(r) = a.pulse_rate_hz {
         if !(r.is_finite() && r > 0.0) {
             return Err(CliError::input(format!(
-                "--pulse-rate-hz: {r} must be finite and > 0"
+                "--pulse-rate-hz: {} must be finite and > 0",
+                Num(r)
             )));
         }
         // Pulses of this duration at this rate would overlap: not a pulse train.
@@ -67,15 +70,14 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             return Err(CliError::input(format!("--pulse-rate-hz: {r:e}: {reason}")));
         }
     }
-    let pass_angle_deg = match a.beam_diameter_mm {
-        Some(d) if gaze_lidar::model::valid::positive(d).is_ok() => Some(d),
-        Some(d) => {
+    if let Some(d) = a.beam_diameter_mm {
+        if gaze_lidar::model::valid::positive(d).is_err() {
             return Err(CliError::input(format!(
-                "--beam-diameter-mm: {d} must be finite and > 0 (not subnormal)"
-            )))
+                "--beam-diameter-mm: {} must be finite and > 0 (not subnormal)",
+                Num(d)
+            )));
         }
-        None => None,
-    };
+    }
     let r = ael_report(a.wavelength_nm, a.pulse_duration_s, a.pulse_rate_hz).map_err(|e| {
         let msg = e.to_string();
         if msg.starts_with("wavelength") {
@@ -84,8 +86,22 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             CliError::input(format!("--pulse-duration-s: {msg}"))
         }
     })?;
-    let pass = pass_angle_deg
-        .map(|d| ((r.aperture_diameter_mm + d) / r.aperture_distance_mm).to_degrees());
+    let pass = match a.beam_diameter_mm {
+        Some(d) => {
+            let p = scan_pass_angle_deg(r.band, d);
+            if p > 360.0 {
+                return Err(CliError::input(format!(
+                    "--beam-diameter-mm: {} mm gives a scan pass angle of {}° (aperture {} mm + beam, at {} mm), more than a turn (> 360°): the beam cannot be that wide",
+                    Num(d),
+                    Num(p),
+                    Num(r.aperture_diameter_mm),
+                    Num(r.aperture_distance_mm)
+                )));
+            }
+            Some(p)
+        }
+        None => None,
+    };
     let mut text = String::new();
     // Writing into a String cannot fail.
     macro_rules! o {
@@ -131,6 +147,6 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             o!("note: figures from public re-implementations of the 2014 tables; verify against the standard");
         }
     }
-    emit(&text, None)?;
+    emit(&text)?;
     Ok(0)
 }

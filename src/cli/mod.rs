@@ -2,14 +2,19 @@
 //!
 //! Exit codes: 0 success; 1 an infeasible request or a rejected profile
 //! (the limit is named); 2 bad input (argument, file, field; with line and
-//! column for files); 1 also for a failed write (a full disk). Errors are
-//! one line on stderr; data goes to stdout or `--out` (written atomically
-//! over regular files: never a partial file; devices and FIFOs are written
-//! in place). A closed stdout pipe (`| head`) ends the output quietly.
+//! column for files; an output path that cannot be written, names the
+//! same file twice or names an input); 1 also for a write that fails once
+//! started (a full disk, stdout on `/dev/full`). Errors are one line on
+//! stderr; data goes to stdout or to output files, which are all checked
+//! before any work and replaced together at the end (see [`output`]). A
+//! closed stdout pipe (`| head`) ends the output quietly.
 
 mod ael;
+mod args;
 mod check;
+mod config;
 pub mod io;
+pub mod output;
 mod profile;
 mod sensor;
 mod simulate;
@@ -17,7 +22,6 @@ mod stream;
 mod table;
 
 use clap::{Parser, Subcommand};
-use std::path::Path;
 use std::process::ExitCode;
 
 /// An error with its exit code.
@@ -69,9 +73,20 @@ impl From<gaze_lidar::profile::IoError> for CliError {
     }
 }
 
+/// The exit codes, as `--help` shows them (the README says the same).
+const EXIT_CODES: &str = "Exit codes:
+  0  success
+  1  an infeasible request or a rejected profile (the limit is named); also a
+     write that fails once started (a full disk, stdout on /dev/full): the
+     outputs it was replacing are left as they were
+  2  bad input: an argument, a file or a field (with line:column for files),
+     or an output path that cannot be written, is given twice, or is one of
+     the inputs (checked before any work; nothing is written)
+Errors are one line on stderr.";
+
 /// Turns a driver's gaze into a certified LiDAR scan schedule.
 #[derive(Debug, Parser)]
-#[command(name = "gaze-lidar", version, about, long_about = None)]
+#[command(name = "gaze-lidar", version, about, long_about = None, after_help = EXIT_CODES)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -94,21 +109,16 @@ enum Command {
     Sensor(sensor::Args),
 }
 
-/// Writes `text` to `out` (see [`io::write_output`]), or to stdout.
-pub fn emit(text: &str, out: Option<&Path>) -> Result<(), CliError> {
-    emit_bytes(text.as_bytes(), out)
+/// Writes `text` to stdout.
+pub fn emit(text: &str) -> Result<(), CliError> {
+    emit_bytes(text.as_bytes())
 }
 
-/// Writes `bytes` to `out` (see [`io::write_output`]), or to stdout.
-pub fn emit_bytes(bytes: &[u8], out: Option<&Path>) -> Result<(), CliError> {
-    match out {
-        Some(path) => io::write_output(path, bytes),
-        None => {
-            let mut stdout = io::Stdout::new();
-            stdout.bytes(bytes)?;
-            stdout.finish()
-        }
-    }
+/// Writes `bytes` to stdout.
+pub fn emit_bytes(bytes: &[u8]) -> Result<(), CliError> {
+    let mut stdout = io::Stdout::new();
+    stdout.bytes(bytes)?;
+    stdout.finish()
 }
 
 /// clap's error as one line: the message with its indented continuation

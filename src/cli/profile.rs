@@ -9,6 +9,11 @@ use gaze_lidar::planner::{closed_form, Mode};
 
 use gaze_lidar::firmware::{binary, FirmwareConfig, FirmwareError, FirmwareTable};
 
+use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
+
+use super::args::{finite_positive, int_in};
+use super::config::Overrides;
+use super::output::Outputs;
 use super::{emit_bytes, CliError};
 
 /// Output format of a profile.
@@ -35,27 +40,30 @@ pub enum Accounting {
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// LiDAR preset: paper, vls128.
-    #[arg(long, default_value = "paper")]
-    preset: String,
+    /// LiDAR preset: paper, vls128 [default: paper]; with --config, replaces
+    /// the file's `[lidar] preset`.
+    #[arg(long)]
+    preset: Option<String>,
     /// Controller: the paper's closed forms (default range); with --optimize
-    /// or --config, the optimizer's objective mode.
+    /// or --config, the optimizer's objective mode (replaces the file's).
     #[arg(long, value_enum)]
     mode: Option<Mode>,
     /// Derive the profile with the optimizer (HiGHS) instead of the closed form;
     /// with a preset: its paper-equivalent problem (two power levels, two spin set-points).
     #[arg(long)]
     optimize: bool,
-    /// Optimizer configuration (TOML); implies --optimize.
+    /// Optimizer configuration (TOML); implies --optimize. --preset, --bins,
+    /// --accounting and --mode given with it replace the file's values.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Gaze azimuth, degrees CCW from straight ahead (ISO 8855). Omit for the baseline.
     #[arg(long, allow_hyphen_values = true)]
     gaze_deg: Option<f64>,
-    /// Number of equal bins (4..=36000; with the optimizer 4..=1440); region boundaries are added as edges.
-    #[arg(long, default_value_t = 360, allow_negative_numbers = true)]
-    bins: usize,
-    /// Override the preset's power accounting.
+    /// Number of equal bins (4..=36000; with the optimizer 4..=1440) [default:
+    /// 360, or the --config file's]; region boundaries are added as edges.
+    #[arg(long, allow_hyphen_values = true)]
+    bins: Option<i64>,
+    /// Override the preset's (or the --config file's) power accounting.
     #[arg(long, value_enum)]
     accounting: Option<Accounting>,
     /// Output format.
@@ -64,22 +72,58 @@ pub struct Args {
     /// Write to this file (atomically) instead of stdout.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Firmware timer frequency, Hz.
-    #[arg(long, default_value_t = 80_000_000, allow_negative_numbers = true)]
-    tick_hz: u64,
-    /// Firmware DAC step, W per code (default: power_w_max / 4095).
+    /// Firmware timer frequency, Hz (1..=1e10) [default: 80000000]; firmware formats only.
+    #[arg(long, allow_hyphen_values = true)]
+    tick_hz: Option<i64>,
+    /// Firmware DAC step, W per code (default: power_w_max / 4095); firmware formats only.
     #[arg(long, allow_hyphen_values = true)]
     power_w_per_code: Option<f64>,
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
+    // Outputs first: nothing is computed for a path that cannot be written
+    // or that would replace the configuration.
+    let mut outputs = Outputs::default();
+    outputs
+        .input_opt("--config", a.config.as_deref())
+        .file_opt("--out", a.out.as_deref());
+    outputs.check()?;
+    let firmware_format = matches!(a.format, Format::Firmware | Format::FirmwareBin);
+    for (given, flag) in [
+        (a.tick_hz.is_some(), "--tick-hz"),
+        (a.power_w_per_code.is_some(), "--power-w-per-code"),
+    ] {
+        if given && !firmware_format {
+            return Err(CliError::input(format!(
+                "{flag} applies to --format firmware or firmware-bin only"
+            )));
+        }
+    }
+    let tick_hz: u64 = match a.tick_hz {
+        Some(t) => int_in("--tick-hz", t, 1, 10_000_000_000_i64)?,
+        None => FirmwareConfig::default().tick_hz,
+    };
+    if let Some(w) = a.power_w_per_code {
+        finite_positive("--power-w-per-code", w)?;
+    }
+    if a.format == Format::FirmwareBin && a.out.is_none() {
+        return Err(CliError::input(
+            "--format firmware-bin writes binary: give --out FILE",
+        ));
+    }
+    let bins: Option<usize> = match a.bins {
+        Some(b) => Some(int_in("--bins", b, MIN_BINS as i64, MAX_BINS as i64)?),
+        None => None,
+    };
+    let preset_name = a.preset.as_deref().unwrap_or("paper");
     let mut preset =
-        presets::preset(&a.preset).map_err(|e| CliError::input(format!("--preset: {e}")))?;
-    if let Some(acc) = a.accounting {
-        preset.lidar.power_accounting = match acc {
-            Accounting::Time => PowerAccounting::Time,
-            Accounting::Angle => PowerAccounting::Angle,
-        };
+        presets::preset(preset_name).map_err(|e| CliError::input(format!("--preset: {e}")))?;
+    let accounting = a.accounting.map(|acc| match acc {
+        Accounting::Time => PowerAccounting::Time,
+        Accounting::Angle => PowerAccounting::Angle,
+    });
+    if let Some(acc) = accounting {
+        preset.lidar.power_accounting = acc;
     }
     let mode = a.mode.unwrap_or(Mode::Range);
     if a.gaze_deg.is_none() && mode != Mode::Baseline {
@@ -97,9 +141,15 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         gaze_lidar::planner::validate_gaze(g).map_err(|e| CliError::input(format!("--{e}")))?;
     }
     let certified = if a.optimize || a.config.is_some() {
-        optimized(a, &preset, gaze)?
+        let overrides = Overrides {
+            preset: a.preset.as_deref(),
+            bins,
+            accounting,
+            mode: a.mode,
+        };
+        optimized(a, &preset, gaze, &overrides)?
     } else {
-        closed_form(&preset, mode, gaze, a.bins).map_err(|e| match e {
+        closed_form(&preset, mode, gaze, bins.unwrap_or(360)).map_err(|e| match e {
             gaze_lidar::planner::PlanError::InvalidInput { field, reason } => {
                 CliError::input(format!("--{field}: {reason}"))
             }
@@ -108,7 +158,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     };
     let firmware = || {
         let cfg = FirmwareConfig {
-            tick_hz: a.tick_hz,
+            tick_hz,
             power_w_per_code: a.power_w_per_code,
         };
         FirmwareTable::from_certified(&certified, &cfg).map_err(|e| match e {
@@ -123,16 +173,15 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             .to_json()
             .map_err(|e| CliError::input(e.to_string()))?
             .into_bytes(),
-        Format::FirmwareBin => {
-            if a.out.is_none() {
-                return Err(CliError::input(
-                    "--format firmware-bin writes binary: give --out FILE",
-                ));
-            }
-            binary::encode(&firmware()?)
-        }
+        Format::FirmwareBin => binary::encode(&firmware()?),
     };
-    emit_bytes(&bytes, a.out.as_deref())?;
+    match &a.out {
+        Some(path) => {
+            outputs.set(path, bytes);
+            outputs.commit()?;
+        }
+        None => emit_bytes(&bytes)?,
+    }
     Ok(0)
 }
 
@@ -141,8 +190,9 @@ fn optimized(
     a: &Args,
     preset: &gaze_lidar::model::presets::Preset,
     gaze: Option<f64>,
+    overrides: &Overrides<'_>,
 ) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
-    use gaze_lidar::optimizer::{optimize, OptError, OptimizerConfig, Problem};
+    use gaze_lidar::optimizer::{optimize, OptError, Problem};
     let err = |e: OptError| {
         if e.is_input_error() {
             CliError::input(e.to_string())
@@ -155,20 +205,18 @@ fn optimized(
             "--optimize needs --gaze-deg (the baseline has nothing to optimize)",
         ));
     };
-    let mut problem = match &a.config {
-        Some(path) => {
-            let text = super::io::read_text(path, super::io::MAX_CONFIG_BYTES)?;
-            OptimizerConfig::from_toml(&text, &path.display().to_string())
-                .and_then(|c| c.problem())
-                .map_err(err)?
-        }
+    let problem = match &a.config {
+        Some(path) => super::config::optimizer_problem(path, overrides)?,
         None => {
-            Problem::paper_equivalent(preset, a.mode.unwrap_or(Mode::Range), a.bins).map_err(err)?
+            let bins = super::config::optimizer_bins(overrides.bins.unwrap_or(360))?;
+            let mut p = Problem::paper_equivalent(preset, a.mode.unwrap_or(Mode::Range), bins)
+                .map_err(err)?;
+            if let Some(m) = a.mode {
+                p.objective.mode = m;
+            }
+            p
         }
     };
-    if let Some(m) = a.mode {
-        problem.objective.mode = m;
-    }
     optimize(&problem, gaze).map_err(err)
 }
 
@@ -177,8 +225,7 @@ fn optimized(
     _a: &Args,
     _preset: &gaze_lidar::model::presets::Preset,
     _gaze: Option<f64>,
+    _overrides: &Overrides<'_>,
 ) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
-    Err(CliError::input(
-        "--optimize/--config: this build has no solver (enable the `solver` feature)",
-    ))
+    Err(super::config::no_solver("--optimize/--config"))
 }

@@ -3,14 +3,16 @@
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use gaze_lidar::sim::{
     self, Arrival, Detector, Geometry, KOfN, ModelKind, Sampling, Scenario, SimConfig, Variant,
     FOG_LEVELS_PCT,
 };
 
-use super::io::{read_text, validate_paths, warn, Outputs, MAX_CONFIG_BYTES};
+use super::args::int_in;
+use super::io::{read_text, warn, MAX_CONFIG_BYTES};
+use super::output::Outputs;
 use super::{emit, CliError};
 
 /// Output format of the table.
@@ -36,14 +38,14 @@ pub struct Args {
     #[arg(long)]
     optimizer_config: Option<PathBuf>,
     /// Fog levels in % (paper labels 0, 25, 50); default all.
-    #[arg(long, allow_negative_numbers = true)]
-    fog: Vec<u32>,
-    /// Trials per cell.
-    #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
+    fog: Vec<i64>,
+    /// Trials per cell (1..=100000).
+    #[arg(long, default_value_t = 100, allow_hyphen_values = true)]
     trials: i64,
-    /// Master seed (same seed → identical output).
-    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
-    seed: u64,
+    /// Master seed, 0..=18446744073709551615 (same seed → identical output).
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
+    seed: i128,
     /// Scenario TOML (defaults: the paper's scene).
     #[arg(long)]
     scenario: Option<PathBuf>,
@@ -85,7 +87,7 @@ pub struct Args {
     /// --detector argus --arrival argus-centre --model argus`, the paper's
     /// four variants and fog levels) with this many trials per cell and add
     /// its column and section to the report (0: none).
-    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     paper_pipeline_trials: i64,
     /// Also write the rows as JSON (`{"rows": [...]}`) to this file.
     #[arg(long)]
@@ -113,48 +115,11 @@ fn parse_k_of_n(s: &str) -> Result<KOfN, CliError> {
     Ok(KOfN { k, n })
 }
 
-/// Reads and validates the optimizer configuration (exit 2 for a bad file
-/// or key, 1 when the limits are infeasible — as `profile --config`).
-#[cfg(feature = "solver")]
-fn optimizer_problem(path: &Path) -> Result<gaze_lidar::optimizer::Problem, CliError> {
-    use gaze_lidar::optimizer::OptimizerConfig;
-    let text = read_text(path, MAX_CONFIG_BYTES)?;
-    OptimizerConfig::from_toml(&text, &path.display().to_string())
-        .and_then(|c| c.problem())
-        .map_err(|e| {
-            if e.is_input_error() {
-                CliError::input(e.to_string())
-            } else {
-                CliError::infeasible(e.to_string())
-            }
-        })
-}
-
-/// Checks that the plots folder exists and accepts files, or can be created.
-fn validate_plots_dir(dir: &Path) -> Result<(), CliError> {
-    let bad = |m: String| CliError::input(format!("--plots {}: {m}", dir.display()));
-    let mut probe = dir;
-    loop {
-        match std::fs::metadata(probe) {
-            Ok(m) if m.is_dir() => break,
-            Ok(_) => return Err(bad(format!("{} is not a directory", probe.display()))),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                probe = match probe.parent() {
-                    Some(p) if !p.as_os_str().is_empty() => p,
-                    _ => Path::new("."),
-                };
-            }
-            Err(e) => return Err(bad(e.to_string())),
-        }
-    }
-    tempfile::Builder::new()
-        .prefix(".gaze-lidar-check")
-        .tempdir_in(probe)
-        .map(drop)
-        .map_err(|e| bad(format!("cannot create files in {}: {e}", probe.display())))
-}
-
 pub fn run(a: &Args) -> Result<u8, CliError> {
+    let mut outputs = Outputs::default();
+    outputs
+        .input_opt("--scenario", a.scenario.as_deref())
+        .input_opt("--optimizer-config", a.optimizer_config.as_deref());
     let scenario = match &a.scenario {
         Some(path) => {
             let text = read_text(path, MAX_CONFIG_BYTES)?;
@@ -163,26 +128,26 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
         None => Scenario::default(),
     };
-    if a.trials < 1 || a.trials > 100_000 {
-        return Err(CliError::input(format!(
-            "--trials: {} must lie in 1..=100000",
-            a.trials
-        )));
-    }
-    for f in &a.fog {
-        if !FOG_LEVELS_PCT.contains(f) {
-            return Err(CliError::input(format!(
-                "--fog: {f} is not one of the paper's levels 0, 25, 50"
-            )));
+    let trials: usize = int_in("--trials", a.trials, 1, 100_000)?;
+    let seed: u64 = int_in("--seed", a.seed, 0, u64::MAX)?;
+    let mut fog_pcts: Vec<u32> = Vec::new();
+    for &f in &a.fog {
+        match u32::try_from(f) {
+            Ok(f) if FOG_LEVELS_PCT.contains(&f) => fog_pcts.push(f),
+            _ => {
+                return Err(CliError::input(format!(
+                    "--fog: {f} is not one of the paper's levels 0, 25, 50"
+                )))
+            }
         }
     }
     let detection = parse_k_of_n(&a.detect)?;
-    if !(0..=100_000).contains(&a.paper_pipeline_trials) {
-        return Err(CliError::input(format!(
-            "--paper-pipeline-trials: {} must lie in 0..=100000",
-            a.paper_pipeline_trials
-        )));
-    }
+    let paper_pipeline_trials: usize = int_in(
+        "--paper-pipeline-trials",
+        a.paper_pipeline_trials,
+        0,
+        100_000,
+    )?;
     if a.detector == Detector::Argus && a.geometry != Geometry::Carla {
         return Err(CliError::input(
             "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)",
@@ -201,25 +166,16 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                     "--optimizer-config configures the optimized variant: add --variant optimized",
                 ));
             }
-            Some(optimizer_problem(path)?)
+            Some(super::config::optimizer_problem(
+                path,
+                &super::config::Overrides::default(),
+            )?)
         }
         None => None,
     };
     #[cfg(not(feature = "solver"))]
     if a.optimizer_config.is_some() {
-        return Err(CliError::input(
-            "--optimizer-config: this build has no solver (enable the `solver` feature)",
-        ));
-    }
-    // Every output path is checked before the run: a bad one fails now,
-    // and nothing is replaced.
-    let files: Vec<&Path> = [&a.export_json, &a.export_csv, &a.trials_csv, &a.report]
-        .into_iter()
-        .filter_map(|p| p.as_deref())
-        .collect();
-    validate_paths(files.iter().copied())?;
-    if let Some(dir) = &a.plots {
-        validate_plots_dir(dir)?;
+        return Err(super::config::no_solver("--optimizer-config"));
     }
     let config = SimConfig {
         models: if a.model.is_empty() {
@@ -228,13 +184,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             a.model.clone()
         },
         variants,
-        fog_pcts: if a.fog.is_empty() {
+        fog_pcts: if fog_pcts.is_empty() {
             FOG_LEVELS_PCT.to_vec()
         } else {
-            a.fog.clone()
+            fog_pcts
         },
-        trials: a.trials as usize,
-        seed: a.seed,
+        trials,
+        seed,
         scenario,
         detection,
         brute_force: a.brute_force,
@@ -246,6 +202,19 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         optimizer,
         ..SimConfig::default()
     };
+    // Every output path is checked before the run — against the others
+    // (the plots' file names included) and against the inputs: a bad one
+    // fails now, and nothing is replaced.
+    outputs
+        .file_opt("--export-json", a.export_json.as_deref())
+        .file_opt("--export-csv", a.export_csv.as_deref())
+        .file_opt("--trials-csv", a.trials_csv.as_deref())
+        .file_opt("--report", a.report.as_deref());
+    let plot_names = sim::plots::file_names(&config);
+    if let Some(dir) = &a.plots {
+        outputs.folder("--plots", dir, &plot_names);
+    }
+    outputs.check()?;
     let total =
         (config.models.len() * config.variants.len() * config.fog_pcts.len() * config.trials)
             as u64;
@@ -279,28 +248,27 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
         Format::Csv => sim::table::render_csv(&result).map_err(render)?,
     };
-    // Everything is rendered and staged before anything is replaced.
-    let mut outputs = Outputs::default();
+    // Everything is rendered before anything is replaced.
     if let Some(path) = &a.export_json {
         let json = sim::table::render_json(&result).map_err(|e| CliError::input(e.to_string()))?;
-        outputs.add(path, json);
+        outputs.set(path, json);
     }
     if let Some(path) = &a.export_csv {
-        outputs.add(path, sim::table::render_csv(&result).map_err(render)?);
+        outputs.set(path, sim::table::render_csv(&result).map_err(render)?);
     }
     if let Some(path) = &a.trials_csv {
-        outputs.add(
+        outputs.set(
             path,
             sim::table::render_trials_csv(&result).map_err(render)?,
         );
     }
     if let Some(path) = &a.report {
-        let pipeline = if a.paper_pipeline_trials > 0 {
+        let pipeline = if paper_pipeline_trials > 0 {
             let pc = SimConfig {
                 models: vec![ModelKind::Argus],
                 variants: Variant::PAPER.to_vec(),
                 fog_pcts: FOG_LEVELS_PCT.to_vec(),
-                trials: a.paper_pipeline_trials as usize,
+                trials: paper_pipeline_trials,
                 geometry: Geometry::Carla,
                 detector: Detector::Argus,
                 arrival: Arrival::ArgusCentre,
@@ -357,52 +325,46 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 lifted,
             },
         );
-        outputs.add(path, md);
+        outputs.set(path, md);
     }
-    let plots = match &a.plots {
-        Some(dir) => Some(stage_plots(&result, &config, dir)?),
-        None => None,
-    };
-    emit(&text, None)?;
+    if let Some(dir) = &a.plots {
+        for (name, bytes) in render_plots(&result, &config, &plot_names)? {
+            outputs.set(&dir.join(name), bytes);
+        }
+    }
+    emit(&text)?;
     outputs.commit()?;
     if let Some(path) = &a.report {
         warn(format_args!("wrote {}", path.display()));
     }
-    if let (Some(dir), Some((staging, names))) = (&a.plots, plots) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| CliError::output(format!("--plots {}: {e}", dir.display())))?;
-        for name in names {
-            let dest = dir.join(&name);
-            std::fs::rename(staging.path().join(&name), &dest)
-                .map_err(|e| CliError::output(format!("{}: {e}", dest.display())))?;
-            warn(format_args!("wrote {}", dest.display()));
+    if let Some(dir) = &a.plots {
+        for name in &plot_names {
+            warn(format_args!("wrote {}", dir.join(name).display()));
         }
     }
     Ok(0)
 }
 
-/// Renders the plots into a temporary folder beside `dir` (moved in at the end).
-fn stage_plots(
+/// Renders the plots (in a private temporary folder) and returns their
+/// bytes by file name, in the order of `names`.
+fn render_plots(
     result: &sim::GridResult,
     config: &SimConfig,
-    dir: &Path,
-) -> Result<(tempfile::TempDir, Vec<std::ffi::OsString>), CliError> {
-    let mut base = dir;
-    while !base.is_dir() {
-        base = match base.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-    }
+    names: &[String],
+) -> Result<Vec<(String, Vec<u8>)>, CliError> {
     let staging = tempfile::Builder::new()
-        .prefix(".gaze-lidar-plots")
-        .tempdir_in(base)
-        .map_err(|e| CliError::input(format!("--plots {}: {e}", dir.display())))?;
-    let written = sim::plots::write_all(result, config, staging.path())
+        .prefix("gaze-lidar-plots")
+        .tempdir()
+        .map_err(|e| CliError::output(format!("--plots: temporary folder: {e}")))?;
+    sim::plots::write_all(result, config, staging.path())
         .map_err(|e| CliError::output(e.to_string()))?;
-    let names = written
+    names
         .iter()
-        .filter_map(|p| p.file_name().map(std::ffi::OsStr::to_os_string))
-        .collect();
-    Ok((staging, names))
+        .map(|name| {
+            let path = staging.path().join(name);
+            std::fs::read(&path)
+                .map(|b| (name.clone(), b))
+                .map_err(|e| CliError::output(format!("--plots: {}: {e}", path.display())))
+        })
+        .collect()
 }

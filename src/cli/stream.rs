@@ -6,54 +6,63 @@
 //! arrive — fail-safe once the gaze is stale. Output errors: a closed pipe
 //! ends the stream quietly (exit 0); any other write error is one line, exit 1.
 
-use std::io::{BufRead, Read, Write};
+use std::io::{BufRead, Write};
 use std::path::PathBuf;
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
 use gaze_lidar::gaze::{
     ClosedFormPlanner, FailSafeConfig, FilterConfig, Format, Frame, FramePlanner, GazeError,
-    GazeStream, Input, Notice, Parser, StreamConfig,
+    GazeStream, Input, LineError, Notice, Parser, StreamConfig,
 };
+use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
 use gaze_lidar::model::presets;
 use gaze_lidar::planner::Mode;
+use gaze_lidar::text::Num;
 
+use super::args::{finite_between, int_in};
 use super::CliError;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// LiDAR preset (closed-form controllers).
-    #[arg(long, default_value = "paper")]
-    preset: String,
-    /// Controller for the closed form (default range); with --config, overrides the objective mode.
+    /// LiDAR preset (closed-form controllers) [default: paper]; with
+    /// --config, replaces the file's `[lidar] preset`.
+    #[arg(long)]
+    preset: Option<String>,
+    /// Controller for the closed form (default range); with --config, replaces the file's objective mode.
     #[arg(long, value_enum)]
     mode: Option<Mode>,
-    /// Equal bins.
-    #[arg(long, default_value_t = 360)]
-    bins: usize,
+    /// Equal bins (4..=36000; with --config 4..=1440) [default: 360, or the
+    /// --config file's].
+    #[arg(long, allow_hyphen_values = true)]
+    bins: Option<i64>,
     /// Optimizer configuration (TOML): plan with the optimizer's fast path.
+    /// --preset, --bins and --mode given with it replace the file's values.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Input format.
     #[arg(long, value_enum, default_value_t = Format::Jsonl)]
     format: Format,
-    /// Read a recorded file instead of stdin (a malformed line is then an error).
+    /// Read a recorded file instead of stdin (a malformed line is then an
+    /// error; on stdin it is reported with its number and skipped).
     #[arg(long)]
     input: Option<PathBuf>,
-    /// A fixation older than this when a frame is decided is stale (fail-safe), ms.
-    #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
+    /// A fixation older than this when a frame is decided is stale (fail-safe), ms (0 < T < 1e7).
+    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
     timeout_ms: f64,
-    /// Consecutive valid samples needed to leave fail-safe.
-    #[arg(long, default_value_t = 4)]
-    recover_samples: u32,
-    /// I-VT saccade threshold, °/s.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    /// Consecutive valid samples needed to leave fail-safe (1..=100000).
+    #[arg(long, default_value_t = 4, allow_hyphen_values = true)]
+    recover_samples: i64,
+    /// I-VT saccade threshold, °/s (0 < v < 1e6).
+    #[arg(long, default_value_t = 30.0, allow_hyphen_values = true)]
     saccade_deg_s: f64,
     /// Replay: a timestamp jump making more than this many frames (plus the
     /// one at the sample) due at once emits one fail-safe frame, a warning,
-    /// and restarts the frame clock.
-    #[arg(long, default_value_t = 200)]
-    max_gap_frames: u64,
+    /// and restarts the frame clock (0..=1000000). --realtime --input: a
+    /// gap longer than this many frames (plus one) in the file is not waited for.
+    #[arg(long, default_value_t = 200, allow_hyphen_values = true)]
+    max_gap_frames: i64,
     /// Live: frames on the wall clock (t_s = seconds since start), fail-safe
     /// frames while no fresh gaze arrives, one flushed line per frame. With
     /// --input, the file is fed at the pace of its timestamps.
@@ -61,23 +70,42 @@ pub struct Args {
     realtime: bool,
 }
 
-fn planner(a: &Args) -> Result<Box<dyn FramePlanner>, CliError> {
+/// The options, range-checked.
+struct Settings {
+    bins: Option<usize>,
+    timeout_us: u64,
+    recover_samples: u32,
+    saccade_deg_s: f64,
+    max_gap_frames: u64,
+}
+
+fn settings(a: &Args) -> Result<Settings, CliError> {
+    let timeout_ms = finite_between("--timeout-ms", a.timeout_ms, 0.0, 1e7)?;
+    let bins = match a.bins {
+        // With --config the optimizer's range applies (checked with the file).
+        Some(b) if a.config.is_some() => Some(int_in("--bins", b, 0, i64::MAX)?),
+        Some(b) => Some(int_in("--bins", b, MIN_BINS as i64, MAX_BINS as i64)?),
+        None => None,
+    };
+    Ok(Settings {
+        bins,
+        timeout_us: (timeout_ms * 1000.0).round().max(1.0) as u64,
+        recover_samples: int_in("--recover-samples", a.recover_samples, 1, 100_000)?,
+        saccade_deg_s: finite_between("--saccade-deg-s", a.saccade_deg_s, 0.0, 1e6)?,
+        max_gap_frames: int_in("--max-gap-frames", a.max_gap_frames, 0, 1_000_000)?,
+    })
+}
+
+fn planner(a: &Args, s: &Settings) -> Result<Box<dyn FramePlanner>, CliError> {
     if let Some(path) = &a.config {
-        return optimizer_planner(a, path);
+        return optimizer_planner(a, s, path);
     }
-    let preset =
-        presets::preset(&a.preset).map_err(|e| CliError::input(format!("--preset: {e}")))?;
-    if !(gaze_lidar::model::angle::MIN_BINS..=gaze_lidar::model::angle::MAX_BINS).contains(&a.bins)
-    {
-        return Err(CliError::input(format!(
-            "--bins: {} must lie in [4, 36000]",
-            a.bins
-        )));
-    }
+    let preset = presets::preset(a.preset.as_deref().unwrap_or("paper"))
+        .map_err(|e| CliError::input(format!("--preset: {e}")))?;
     Ok(Box::new(ClosedFormPlanner {
         preset,
         mode: a.mode.unwrap_or(Mode::Range),
-        bins: a.bins,
+        bins: s.bins.unwrap_or(360),
     }))
 }
 
@@ -90,14 +118,18 @@ fn cli_error(e: GazeError) -> CliError {
 }
 
 #[cfg(feature = "solver")]
-fn optimizer_planner(a: &Args, path: &std::path::Path) -> Result<Box<dyn FramePlanner>, CliError> {
-    use gaze_lidar::optimizer::OptimizerConfig;
-    let mut problem = OptimizerConfig::read(path)
-        .and_then(|c| c.problem())
-        .map_err(|e| cli_error(e.into()))?;
-    if let Some(m) = a.mode {
-        problem.objective.mode = m;
-    }
+fn optimizer_planner(
+    a: &Args,
+    s: &Settings,
+    path: &std::path::Path,
+) -> Result<Box<dyn FramePlanner>, CliError> {
+    let overrides = super::config::Overrides {
+        preset: a.preset.as_deref(),
+        bins: s.bins,
+        accounting: None,
+        mode: a.mode,
+    };
+    let problem = super::config::optimizer_problem(path, &overrides)?;
     let p = gaze_lidar::gaze::OptimizerPlanner::new(problem).map_err(cli_error)?;
     Ok(Box::new(p))
 }
@@ -105,11 +137,10 @@ fn optimizer_planner(a: &Args, path: &std::path::Path) -> Result<Box<dyn FramePl
 #[cfg(not(feature = "solver"))]
 fn optimizer_planner(
     _a: &Args,
+    _s: &Settings,
     _path: &std::path::Path,
 ) -> Result<Box<dyn FramePlanner>, CliError> {
-    Err(CliError::input(
-        "--config: this build has no solver (enable the `solver` feature)",
-    ))
+    Err(super::config::no_solver("--config"))
 }
 
 /// One line on stderr; a failing stderr is not worth dying for.
@@ -117,9 +148,16 @@ fn warn(message: &str) {
     let _ = writeln!(std::io::stderr().lock(), "gaze-lidar: {message}");
 }
 
-fn report(notices: Vec<Notice>, max_gap_frames: u64) {
+fn report(notices: Vec<Notice>, max_gap_frames: u64, live: bool) {
     for n in notices {
         match n {
+            // Live, the frame clock is the wall clock: it never restarts
+            // and no extra frame is emitted; only the gaze history goes.
+            Notice::Resync { from_s, to_s, .. } if live => warn(&format!(
+                "warning: gaze clock ran backwards from {} s to {} s: gaze history discarded (fail-safe until the gaze recovers)",
+                Num(from_s),
+                Num(to_s)
+            )),
             Notice::Resync {
                 from_s,
                 to_s,
@@ -131,11 +169,15 @@ fn report(notices: Vec<Notice>, max_gap_frames: u64) {
                     format!("made {frames} frames due (more than --max-gap-frames {max_gap_frames} + 1)")
                 };
                 warn(&format!(
-                    "warning: gaze clock jumped from {from_s} s to {to_s} s and {why}: one fail-safe frame, frame clock restarted at {to_s} s, gaze history discarded"
+                    "warning: gaze clock jumped from {} s to {} s and {why}: one fail-safe frame, frame clock restarted at {} s, gaze history discarded",
+                    Num(from_s),
+                    Num(to_s),
+                    Num(to_s)
                 ));
             }
             Notice::PlanFallback { gaze_deg, error } => warn(&format!(
-                "warning: no certified adaptive profile for gaze {gaze_deg}°, baseline instead: {error}"
+                "warning: no certified adaptive profile for gaze {}°, baseline instead: {error}",
+                Num(gaze_deg)
             )),
             Notice::Late { frames } => warn(&format!(
                 "warning: output ran late, {frames} frame(s) skipped"
@@ -155,41 +197,19 @@ fn write_frame(out: &mut dyn Write, f: &Frame, flush: bool) -> Result<(), GazeEr
     Ok(())
 }
 
-fn validate(a: &Args) -> Result<(), CliError> {
-    if !(a.timeout_ms.is_finite() && a.timeout_ms > 0.0 && a.timeout_ms < 1e7) {
-        return Err(CliError::input(format!(
-            "--timeout-ms: {} must be finite, > 0 and < 1e7",
-            a.timeout_ms
-        )));
-    }
-    if !(a.saccade_deg_s.is_finite() && a.saccade_deg_s > 0.0) {
-        return Err(CliError::input(format!(
-            "--saccade-deg-s: {} must be finite and > 0",
-            a.saccade_deg_s
-        )));
-    }
-    if a.max_gap_frames > 1_000_000 {
-        return Err(CliError::input(format!(
-            "--max-gap-frames: {} must be at most 1000000",
-            a.max_gap_frames
-        )));
-    }
-    Ok(())
-}
-
 pub fn run(a: &Args) -> Result<u8, CliError> {
-    validate(a)?;
-    let planner = planner(a)?;
+    let settings = settings(a)?;
+    let planner = planner(a, &settings)?;
     let filter = FilterConfig {
-        saccade_deg_s: a.saccade_deg_s,
+        saccade_deg_s: settings.saccade_deg_s,
         ..FilterConfig::default()
     };
     let failsafe = FailSafeConfig {
-        timeout_us: (a.timeout_ms * 1000.0) as u64,
-        recover_samples: a.recover_samples,
+        timeout_us: settings.timeout_us,
+        recover_samples: settings.recover_samples,
     };
     let config = StreamConfig {
-        max_gap_frames: a.max_gap_frames,
+        max_gap_frames: settings.max_gap_frames,
     };
     let stream = GazeStream::with_config(planner, filter, failsafe, config);
     let (reader, origin, strict): (Box<dyn BufRead + Send>, String, bool) = match &a.input {
@@ -208,22 +228,26 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             false,
         ),
     };
+    let skipped = Arc::new(AtomicU64::new(0));
     let source = Source {
         reader,
         origin,
         strict,
         parser: Parser::new(a.format),
         line_no: 0,
+        buf: Vec::new(),
+        skipped: Arc::clone(&skipped),
     };
     let result = if a.realtime {
-        live(a, stream, source)
+        live(a, &settings, stream, source)
     } else {
-        replay(a, stream, source)
+        replay(&settings, stream, source)
     };
     match result {
         Ok(stats) => {
+            let skipped = skipped.load(Ordering::Relaxed);
             warn(&format!(
-                "{} samples ({} invalid, {} outliers) → {} frames, {} in fail-safe{}",
+                "{} samples ({} invalid, {} outliers) → {} frames, {} in fail-safe{}{}",
                 stats.samples,
                 stats.invalid,
                 stats.outliers,
@@ -233,19 +257,24 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                     format!(", {} clock resynchronizations", stats.resyncs)
                 } else {
                     String::new()
+                },
+                if skipped > 0 {
+                    format!(", {skipped} malformed lines skipped")
+                } else {
+                    String::new()
                 }
             ));
             Ok(0)
         }
         // Downstream closed the pipe (`| head`): stop quietly.
         Err(GazeError::Output(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(0),
-        Err(GazeError::Output(e)) => Err(CliError::infeasible(format!("stdout: {e}"))),
+        Err(GazeError::Output(e)) => Err(CliError::output(format!("stdout: {e}"))),
         Err(e) => Err(cli_error(e)),
     }
 }
 
 /// Longest input line accepted (a gaze sample is well under 1 KiB).
-const MAX_LINE_BYTES: u64 = 64 * 1024;
+const MAX_LINE_BYTES: usize = 64 * 1024;
 
 struct Source {
     reader: Box<dyn BufRead + Send>,
@@ -253,38 +282,83 @@ struct Source {
     strict: bool,
     parser: Parser,
     line_no: usize,
+    /// The current line's bytes (at most `MAX_LINE_BYTES`).
+    buf: Vec<u8>,
+    /// Lines reported and skipped (live input only).
+    skipped: Arc<AtomicU64>,
+}
+
+/// One line of input, read as bytes.
+enum RawLine {
+    /// The end of the input.
+    End,
+    /// A whole line (newline included, if any) of at most `MAX_LINE_BYTES`.
+    Line,
+    /// A line longer than `MAX_LINE_BYTES`: its first bytes are kept, the
+    /// rest was read and dropped up to its newline (memory stays bounded).
+    TooLong,
 }
 
 impl Source {
-    /// The next sample, `Ok(None)` at the end of the input.
-    fn next(&mut self) -> Result<Option<gaze_lidar::gaze::GazeSample>, GazeError> {
-        let mut line = String::new();
+    /// Reads one line into `buf` as bytes, never holding more than
+    /// `MAX_LINE_BYTES` of it.
+    fn read_raw(&mut self) -> std::io::Result<RawLine> {
+        self.buf.clear();
+        let mut any = false;
+        let mut too_long = false;
         loop {
-            line.clear();
-            self.line_no += 1;
-            let read_error = |line_no, source| GazeError::Read {
-                origin: self.origin.clone(),
-                line: line_no,
-                source,
+            let available = match self.reader.fill_buf() {
+                Ok(b) => b,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
             };
-            let n = self
-                .reader
-                .by_ref()
-                .take(MAX_LINE_BYTES + 1)
-                .read_line(&mut line)
-                .map_err(|e| read_error(self.line_no, e))?;
-            if n == 0 {
-                return Ok(None);
+            if available.is_empty() {
+                break;
             }
-            if n as u64 > MAX_LINE_BYTES {
-                return Err(read_error(
-                    self.line_no,
-                    std::io::Error::other(format!(
-                        "line longer than {MAX_LINE_BYTES} bytes (not a gaze sample)"
-                    )),
-                ));
+            any = true;
+            let (n, newline) = match available.iter().position(|&b| b == b'\n') {
+                Some(i) => (i + 1, true),
+                None => (available.len(), false),
+            };
+            if !too_long {
+                if self.buf.len() + n > MAX_LINE_BYTES {
+                    too_long = true;
+                } else {
+                    self.buf.extend_from_slice(&available[..n]);
+                }
             }
-            match self.parser.line(&line) {
+            self.reader.consume(n);
+            if newline {
+                break;
+            }
+        }
+        Ok(match (any, too_long) {
+            (false, _) => RawLine::End,
+            (true, false) => RawLine::Line,
+            (true, true) => RawLine::TooLong,
+        })
+    }
+
+    /// The next sample, `Ok(None)` at the end of the input. A line that is
+    /// not a sample (too long, not UTF-8, a byte-order mark, malformed) is
+    /// an error in a recorded file and a skipped line, reported with its
+    /// number, on stdin.
+    fn next(&mut self) -> Result<Option<gaze_lidar::gaze::GazeSample>, GazeError> {
+        loop {
+            self.line_no += 1;
+            let raw = self.read_raw().map_err(|source| GazeError::Read {
+                origin: self.origin.clone(),
+                line: self.line_no,
+                source,
+            })?;
+            let parsed = match raw {
+                RawLine::End => return Ok(None),
+                RawLine::TooLong => Err(LineError::Bytes(format!(
+                    "line longer than {MAX_LINE_BYTES} bytes (not a gaze sample)"
+                ))),
+                RawLine::Line => self.parse_line(),
+            };
+            match parsed {
                 Ok(Some(s)) => return Ok(Some(s)),
                 Ok(None) => {}
                 Err(source) if self.strict => {
@@ -294,8 +368,28 @@ impl Source {
                         source,
                     })
                 }
-                Err(e) => warn(&format!("{}:{}: skipped: {e}", self.origin, self.line_no)),
+                Err(e) => {
+                    self.skipped.fetch_add(1, Ordering::Relaxed);
+                    warn(&format!("{}:{}: skipped: {e}", self.origin, self.line_no));
+                }
             }
+        }
+    }
+
+    fn parse_line(&mut self) -> Result<Option<gaze_lidar::gaze::GazeSample>, LineError> {
+        if self.line_no == 1 && self.buf.starts_with(super::io::UTF8_BOM) {
+            return Err(LineError::Bytes(
+                "starts with a UTF-8 byte-order mark (bytes EF BB BF): send the data without a BOM"
+                    .into(),
+            ));
+        }
+        match std::str::from_utf8(&self.buf) {
+            Ok(text) => self.parser.line(text),
+            Err(e) => Err(LineError::Bytes(format!(
+                "not UTF-8 text (invalid byte 0x{:02X} at column {})",
+                self.buf[e.valid_up_to()],
+                e.valid_up_to() + 1
+            ))),
         }
     }
 }
@@ -303,7 +397,7 @@ impl Source {
 type Stats = gaze_lidar::gaze::StreamStats;
 
 fn replay(
-    a: &Args,
+    s: &Settings,
     mut stream: GazeStream<Box<dyn FramePlanner>>,
     mut source: Source,
 ) -> Result<Stats, GazeError> {
@@ -311,7 +405,7 @@ fn replay(
     let mut emit = |f: Frame| write_frame(&mut out, &f, false);
     while let Some(sample) = source.next()? {
         let r = stream.push_each(&sample, &mut emit);
-        report(stream.take_notices(), a.max_gap_frames);
+        report(stream.take_notices(), s.max_gap_frames, false);
         r?;
     }
     out.flush().map_err(GazeError::Output)?;
@@ -320,6 +414,7 @@ fn replay(
 
 fn live(
     a: &Args,
+    s: &Settings,
     mut stream: GazeStream<Box<dyn FramePlanner>>,
     mut source: Source,
 ) -> Result<Stats, GazeError> {
@@ -327,7 +422,13 @@ fn live(
     // instead of holding the whole input in memory.
     let (tx, rx) = mpsc::sync_channel(gaze_lidar::gaze::stream::LIVE_DRAIN_MAX - 1);
     let pace = a.input.is_some();
-    let max_wait = Duration::from_micros(stream.period_us().saturating_mul(a.max_gap_frames));
+    // A recorded file is fed at the pace of its timestamps; a gap longer
+    // than a replay jump (max_gap_frames + 1 periods) is not waited for.
+    let max_wait = Duration::from_micros(
+        stream
+            .period_us()
+            .saturating_mul(s.max_gap_frames.saturating_add(1)),
+    );
     let start = Instant::now();
     // The reader thread blocks on the input; it ends with the input (closing
     // the channel) or with the process.
@@ -362,12 +463,12 @@ fn live(
         }
     });
     let mut out = std::io::stdout().lock();
-    let max_gap = a.max_gap_frames;
+    let max_gap = s.max_gap_frames;
     stream.run_live(
         &rx,
         start,
         &mut |f: Frame| write_frame(&mut out, &f, true),
-        &mut |n| report(vec![n], max_gap),
+        &mut |n| report(vec![n], max_gap, true),
     )?;
     Ok(stream.stats())
 }

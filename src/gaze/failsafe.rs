@@ -16,7 +16,12 @@
 //!   a saccade sample counts as valid (the tracker has the eyes) but does
 //!   **not** refresh it: the estimate holds the last fixation, which ages;
 //! - at a frame decided at time `t`, if the newest fixation is older than
-//!   the timeout (or there is none) → `FailSafe`;
+//!   the timeout (or there is none) → `FailSafe`, and the run of valid
+//!   samples restarts at 0: the gaze was lost, so recovery starts over;
+//! - a sample arriving when the held fixation is already older than the
+//!   timeout likewise → `FailSafe` and restarts the run before it is
+//!   counted (a loss no frame happened to observe still needs a full
+//!   recovery);
 //! - at a frame, from `FailSafe`, with a fresh fixation and at least
 //!   `recover_samples` consecutive valid samples → `Adaptive` (hysteresis:
 //!   one good sample after a loss is not enough).
@@ -114,6 +119,12 @@ impl FailSafe {
 
     /// Feeds one sample at `t_us`.
     pub fn on_sample(&mut self, t_us: u64, kind: SampleKind) {
+        if self.last_fixation_us.is_some() && !self.fresh_at(t_us) {
+            // The gaze went stale before this sample (a loss no frame
+            // observed): fail-safe, and a new run starts here.
+            self.valid_run = 0;
+            self.state = State::FailSafe;
+        }
         match kind {
             SampleKind::Fixation => {
                 self.valid_run = self.valid_run.saturating_add(1);
@@ -140,6 +151,10 @@ impl FailSafe {
     pub fn at_frame(&mut self, t_us: u64) -> State {
         if !self.fresh_at(t_us) {
             self.state = State::FailSafe;
+            if self.last_fixation_us.is_some() {
+                // The gaze went stale (a loss): recovery needs a new run.
+                self.valid_run = 0;
+            }
         } else if self.state == State::FailSafe && self.valid_run >= self.config.recover_samples {
             self.state = State::Adaptive;
         }
@@ -230,8 +245,9 @@ mod verification {
     /// REQ-FS-1: a frame is adaptive only if a fixation no older than the
     /// timeout when the frame is decided (so no older than timeout + one
     /// frame while the frame runs) and enough consecutive valid samples
-    /// precede it; saccade samples never refresh a held fixation; any
-    /// invalid sample forces fail-safe until recovery; times never overflow.
+    /// since the gaze was last lost (invalid or stale) precede it; saccade
+    /// samples never refresh a held fixation; any invalid sample forces
+    /// fail-safe until recovery; times never overflow.
     #[cfg_attr(kani, kani::proof, kani::unwind(7))]
     #[cfg_attr(not(kani), test)]
     fn adaptive_only_with_fresh_recovered_gaze() {
@@ -252,9 +268,9 @@ mod verification {
             for &(dt, k, frame) in &events {
                 // Time never goes backwards; saturates instead of wrapping.
                 t = t.saturating_add(u64::from(dt));
+                let fresh = last_fix.is_some_and(|lf| t - lf <= config.timeout_us);
                 if frame {
                     let s = m.at_frame(t);
-                    let fresh = last_fix.is_some_and(|lf| t - lf <= config.timeout_us);
                     if s == State::Adaptive {
                         cover!(true, "adaptive at a frame");
                         assert!(fresh, "adaptive on stale gaze");
@@ -262,13 +278,18 @@ mod verification {
                     }
                     if !fresh {
                         cover!(last_fix.is_some(), "stale gaze forces fail-safe");
-                        cover!(
-                            last_fix.is_some() && run > 0 && m.valid_run() == run,
-                            "stale fixation with valid samples since"
-                        );
                         assert_eq!(s, State::FailSafe);
+                        if last_fix.is_some() {
+                            // A loss: the recovery run starts over.
+                            cover!(run > 0, "staleness resets a valid run");
+                            run = 0;
+                        }
                     }
                 } else {
+                    if last_fix.is_some() && !fresh {
+                        cover!(run > 0, "a sample after a silent loss restarts the run");
+                        run = 0;
+                    }
                     m.on_sample(t, kind(k));
                     match kind(k) {
                         SampleKind::Fixation => {
@@ -295,7 +316,8 @@ mod verification {
         crate::verification::assert_covered(&[
             "adaptive at a frame",
             "stale gaze forces fail-safe",
-            "stale fixation with valid samples since",
+            "staleness resets a valid run",
+            "a sample after a silent loss restarts the run",
             "saccade holds a fixation",
             "invalid sample",
         ]);

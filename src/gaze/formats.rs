@@ -78,6 +78,10 @@ pub enum LineError {
     /// The header lacks a required column.
     #[error("header: missing column '{0}'")]
     Header(String),
+    /// The line's bytes are not a text line at all (not UTF-8, too long,
+    /// a byte-order mark).
+    #[error("{0}")]
+    Bytes(String),
 }
 
 #[derive(Deserialize)]

@@ -17,7 +17,7 @@ pub const LEVI_E2_DEG: f64 = 2.72;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum AcuityError {
     /// A parameter is out of its domain.
-    #[error("acuity {field} = {value}: {reason}")]
+    #[error("acuity {field} = {}: {reason}", crate::text::Num(*.value))]
     BadParameter {
         /// Parameter name as in the config.
         field: &'static str,

@@ -36,6 +36,7 @@ use crate::eye_safety::EyeSafetyParams;
 use crate::model::acuity::FocusModel;
 use crate::model::lidar::PowerAccounting;
 use crate::model::presets;
+use crate::text::Num;
 
 /// A limit value in TOML: a number, or the word `"unlimited"`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -107,7 +108,15 @@ fn limit(field: &str, v: &LimitValue) -> Result<Option<f64>, OptError> {
         LimitValue::Word(w) if w == "unlimited" => Ok(None),
         other => Err(OptError::Invalid {
             field: format!("limits.{field}"),
-            reason: format!("{other:?} is neither a finite number >= 0 nor \"unlimited\""),
+            reason: match other {
+                LimitValue::Value(x) => format!(
+                    "{} is neither a finite number >= 0 nor \"unlimited\"",
+                    Num(*x)
+                ),
+                LimitValue::Word(w) => {
+                    format!("{w:?} is neither a finite number >= 0 nor \"unlimited\"")
+                }
+            },
         }),
     }
 }
@@ -118,7 +127,7 @@ fn positive(field: &str, v: f64) -> Result<f64, OptError> {
     } else {
         Err(OptError::Invalid {
             field: field.into(),
-            reason: format!("{v} must be finite and > 0"),
+            reason: format!("{} must be finite and > 0", Num(v)),
         })
     }
 }
@@ -129,7 +138,7 @@ fn nonneg(field: &str, v: f64) -> Result<f64, OptError> {
     } else {
         Err(OptError::Invalid {
             field: field.into(),
-            reason: format!("{v} must be finite and >= 0"),
+            reason: format!("{} must be finite and >= 0", Num(v)),
         })
     }
 }
@@ -139,7 +148,7 @@ impl OptimizerConfig {
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, OptError> {
         toml::from_str(text).map_err(|e| OptError::Invalid {
             field: origin.to_owned(),
-            reason: e.to_string().replace('\n', " ").trim().to_owned(),
+            reason: crate::text::toml_error(text, &e),
         })
     }
 
@@ -191,6 +200,28 @@ impl OptimizerConfig {
         }
         if let Some(v) = &l.power_slew_w_per_deg_max {
             lim.power_slew_w_per_deg_max = limit("power_slew_w_per_deg_max", v)?;
+        }
+        // Ranges that contradict themselves are a bad file, not an
+        // infeasible request (whichever of the two the file sets).
+        if lim.power_w_min > lim.power_w_max {
+            return Err(OptError::Invalid {
+                field: "limits.power_w_min".into(),
+                reason: format!(
+                    "{} W is above limits.power_w_max {} W",
+                    Num(lim.power_w_min),
+                    Num(lim.power_w_max)
+                ),
+            });
+        }
+        if lim.spin_rad_s_min > lim.spin_rad_s_max {
+            return Err(OptError::Invalid {
+                field: "limits.spin_rad_s_min".into(),
+                reason: format!(
+                    "{} rad/s is above limits.spin_rad_s_max {} rad/s",
+                    Num(lim.spin_rad_s_min),
+                    Num(lim.spin_rad_s_max)
+                ),
+            });
         }
         if let Some(v) = &l.eye_safety {
             v.validate().map_err(|e| OptError::Invalid {

@@ -251,7 +251,30 @@ macro_rules! svg_and_png {
     }};
 }
 
-/// Writes every figure into `dir` (created if missing); returns the files.
+/// The stems of the figures [`write_all`] draws, in order.
+fn stems(config: &SimConfig) -> Vec<String> {
+    let mut stems = Vec::new();
+    for &model in &config.models {
+        for stem in ["tta", "density"] {
+            stems.push(format!("{stem}_{}", model.name()));
+        }
+    }
+    stems.push("profiles_polar".to_owned());
+    stems
+}
+
+/// The file names [`write_all`] writes for `config` (an SVG and a PNG per
+/// figure), known before the run so a caller can check them up front.
+#[must_use]
+pub fn file_names(config: &SimConfig) -> Vec<String> {
+    stems(config)
+        .into_iter()
+        .flat_map(|stem| [format!("{stem}.svg"), format!("{stem}.png")])
+        .collect()
+}
+
+/// Writes every figure into `dir` (created if missing); returns the files
+/// (those of [`file_names`], in that order).
 pub fn write_all(
     result: &GridResult,
     config: &SimConfig,
@@ -263,19 +286,26 @@ pub fn write_all(
         message: e.to_string(),
     })?;
     let mut written = Vec::new();
+    let mut stems = stems(config).into_iter();
+    let mut next = || stems.next().unwrap_or_default();
     for &model in &config.models {
-        for (metric, stem) in [(Metric::Tta, "tta"), (Metric::Density, "density")] {
-            svg_and_png!(
-                dir,
-                format!("{stem}_{}", model.name()),
-                (1200, 460),
-                written,
-                |root| { draw_boxes(root, result, config, model, metric) }
-            );
+        for metric in [Metric::Tta, Metric::Density] {
+            let stem = next();
+            svg_and_png!(dir, stem, (1200, 460), written, |root| {
+                draw_boxes(root, result, config, model, metric)
+            });
         }
     }
-    svg_and_png!(dir, "profiles_polar", (1000, 520), written, |root| {
+    let stem = next();
+    svg_and_png!(dir, stem, (1000, 520), written, |root| {
         draw_profiles(root)
     });
+    debug_assert_eq!(
+        written
+            .iter()
+            .filter_map(|p| p.file_name()?.to_str().map(str::to_owned))
+            .collect::<Vec<_>>(),
+        file_names(config)
+    );
     Ok(written)
 }

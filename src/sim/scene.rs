@@ -115,7 +115,7 @@ pub enum ScenarioError {
         message: String,
     },
     /// A value is out of range.
-    #[error("scenario.{field} = {value}: {reason}")]
+    #[error("scenario.{field} = {}: {reason}", crate::text::Num(*.value))]
     Value {
         /// Key.
         field: &'static str,
@@ -148,7 +148,7 @@ impl Scenario {
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, ScenarioError> {
         let s: Self = toml::from_str(text).map_err(|e| ScenarioError::Toml {
             path: origin.to_owned(),
-            message: e.to_string().replace('\n', " ").trim().to_owned(),
+            message: crate::text::toml_error(text, &e),
         })?;
         s.validate()?;
         Ok(s)

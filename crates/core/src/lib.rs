@@ -37,5 +37,6 @@ pub mod firmware;
 pub mod model;
 #[cfg(feature = "std")]
 pub mod profile;
+pub mod text;
 #[doc(hidden)]
 pub mod verification;

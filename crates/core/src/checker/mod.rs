@@ -246,12 +246,12 @@ impl fmt::Display for Violation {
                 field,
                 value,
                 reason,
-            } => write!(f, "{field} = {value}: {reason}"),
+            } => write!(f, "{field} = {value}: {reason}", value = crate::text::Num(*value)),
             Self::BadLimit {
                 field,
                 value,
                 reason,
-            } => write!(f, "limits.{field} = {value}: {reason}"),
+            } => write!(f, "limits.{field} = {value}: {reason}", value = crate::text::Num(*value)),
             Self::BinCount { count } => write!(
                 f,
                 "bins: {count} bins; a profile needs 1 to {MAX_PROFILE_BINS}"
@@ -261,7 +261,7 @@ impl fmt::Display for Violation {
                 field,
                 value,
                 reason,
-            } => write!(f, "bins[{bin}].{field} = {value}: {reason}"),
+            } => write!(f, "bins[{bin}].{field} = {value}: {reason}", value = crate::text::Num(*value)),
             Self::Coverage {
                 bin,
                 expected_start_deg,
@@ -269,9 +269,9 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}].start_deg = {start_deg}: bins must cover [0, 360) contiguously, expected {expected_start_deg}"
-            ),
+            , expected_start_deg = crate::text::Num(*expected_start_deg), start_deg = crate::text::Num(*start_deg)),
             Self::CoverageEnd { end_deg } => {
-                write!(f, "bins: the last bin ends at {end_deg}°, not 360°")
+                write!(f, "bins: the last bin ends at {end_deg}°, not 360°", end_deg = crate::text::Num(*end_deg))
             }
             Self::FramePeriod {
                 period_s,
@@ -279,7 +279,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "frame period: the bins' dwell times sum to {period_s} s, but 1/frame_rate_hz = {expected_s} s"
-            ),
+            , period_s = crate::text::Num(*period_s), expected_s = crate::text::Num(*expected_s)),
             Self::AveragePower {
                 accounting,
                 average_w,
@@ -287,7 +287,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "average_power_w: {accounting}-averaged power {average_w} W exceeds the budget {budget_w} W"
-            ),
+            , average_w = crate::text::Num(*average_w), budget_w = crate::text::Num(*budget_w)),
             Self::PowerMin {
                 bin,
                 power_w,
@@ -295,7 +295,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}].power_w = {power_w} W is below limits.power_w_min {limit_w} W"
-            ),
+            , power_w = crate::text::Num(*power_w), limit_w = crate::text::Num(*limit_w)),
             Self::PowerMax {
                 bin,
                 power_w,
@@ -303,7 +303,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}].power_w = {power_w} W exceeds limits.power_w_max {limit_w} W"
-            ),
+            , power_w = crate::text::Num(*power_w), limit_w = crate::text::Num(*limit_w)),
             Self::SpinMin {
                 bin,
                 spin_rad_s,
@@ -311,7 +311,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}] spin {spin_rad_s} rad/s is below limits.spin_rad_s_min {limit_rad_s} rad/s"
-            ),
+            , spin_rad_s = crate::text::Num(*spin_rad_s), limit_rad_s = crate::text::Num(*limit_rad_s)),
             Self::SpinMax {
                 bin,
                 spin_rad_s,
@@ -319,7 +319,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}] spin {spin_rad_s} rad/s exceeds limits.spin_rad_s_max {limit_rad_s} rad/s"
-            ),
+            , spin_rad_s = crate::text::Num(*spin_rad_s), limit_rad_s = crate::text::Num(*limit_rad_s)),
             Self::SpinStep {
                 bin,
                 end_rad_s,
@@ -328,7 +328,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}] spin steps from {end_rad_s} to {next_start_rad_s} rad/s at its end edge: a step is an infinite acceleration, limits.spin_accel_rad_s2_max is {limit_rad_s2} rad/s²"
-            ),
+            , end_rad_s = crate::text::Num(*end_rad_s), next_start_rad_s = crate::text::Num(*next_start_rad_s), limit_rad_s2 = crate::text::Num(*limit_rad_s2)),
             Self::SpinAccel {
                 bin,
                 accel_rad_s2,
@@ -336,7 +336,7 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}] needs |acceleration| {accel_rad_s2} rad/s², above limits.spin_accel_rad_s2_max {limit_rad_s2} rad/s²"
-            ),
+            , limit_rad_s2 = crate::text::Num(*limit_rad_s2), accel_rad_s2 = crate::text::Num(*accel_rad_s2)),
             Self::PowerSlew {
                 bin,
                 slew_w_per_deg,
@@ -344,16 +344,16 @@ impl fmt::Display for Violation {
             } => write!(
                 f,
                 "bins[{bin}]→next power slew {slew_w_per_deg} W/deg exceeds limits.power_slew_w_per_deg_max {limit_w_per_deg} W/deg"
-            ),
+            , slew_w_per_deg = crate::text::Num(*slew_w_per_deg), limit_w_per_deg = crate::text::Num(*limit_w_per_deg)),
             Self::EyeSafety {
                 azimuth_deg,
                 rule,
                 ratio,
             } => write!(
                 f,
-                "eye_safety: at azimuth {azimuth_deg:.3}° the {rule} is {:.1} % of the Class 1 limit (margin {:.3}×)",
-                ratio * 100.0,
-                1.0 / ratio
+                "eye_safety: at azimuth {azimuth_deg:.3}° the {rule} is {} % of the Class 1 limit (margin {}×)",
+                crate::text::Fixed(ratio * 100.0, 1),
+                crate::text::Fixed(1.0 / ratio, 3)
             ),
             Self::EyeSafetyParams { reason } => write!(f, "limits.eye_safety: {reason}"),
             Self::EyeSafetyMissing => write!(
@@ -365,12 +365,11 @@ impl fmt::Display for Violation {
                 declared,
                 sensor,
             } => {
-                let show = |x: &Option<f64>| x.map_or("unlimited".to_owned(), |v| v.to_string());
                 write!(
                     f,
                     "limits.{field} = {} is looser than the sensor's {}",
-                    show(declared),
-                    show(sensor)
+                    crate::text::Limit(*declared),
+                    crate::text::Limit(*sensor)
                 )
             }
             Self::SensorMismatch { field, detail } => write!(f, "{field}: {detail}"),

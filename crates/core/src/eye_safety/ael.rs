@@ -19,10 +19,10 @@ use thiserror::Error;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum AelError {
     /// Wavelength outside the supported bands.
-    #[error("wavelength_nm = {0}: supported bands are 700–1050 nm and 1400–1800 nm")]
+    #[error("wavelength_nm = {}: supported bands are 700–1050 nm and 1400–1800 nm", crate::text::Num(*.0))]
     Wavelength(f64),
     /// Duration out of the tabulated domain.
-    #[error("{what} = {value} s: {reason}")]
+    #[error("{what} = {} s: {reason}", crate::text::Num(*.value))]
     Duration {
         /// Which duration.
         what: &'static str,

@@ -80,9 +80,16 @@ pub fn laser(params: &EyeSafetyParams, pulse_rate_hz: f64) -> Result<Laser, EyeS
 /// Pass angle of the Condition 3 aperture plus the beam, degrees (≤ 360).
 #[must_use]
 pub fn pass_angle_deg(params: &EyeSafetyParams, laser: &Laser) -> f64 {
-    ((laser.band.aperture_mm() + params.beam_diameter_mm) / APERTURE_DISTANCE_MM)
-        .to_degrees()
-        .min(360.0)
+    scan_pass_angle_deg(laser.band, params.beam_diameter_mm).min(360.0)
+}
+
+/// The angle the head turns while the beam (diameter `beam_diameter_mm` at
+/// the aperture) sweeps across the Condition 3 aperture of `band`, 100 mm
+/// from the scan centre: (aperture + beam) / 100 mm, in degrees — not
+/// clamped (above 360° the beam is wider than the scan circle allows).
+#[must_use]
+pub fn scan_pass_angle_deg(band: ael::Band, beam_diameter_mm: f64) -> f64 {
+    ((band.aperture_mm() + beam_diameter_mm) / APERTURE_DISTANCE_MM).to_degrees()
 }
 
 /// The bins of a profile as the bound sees them.

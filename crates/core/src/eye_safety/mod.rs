@@ -52,7 +52,7 @@ pub enum EyeSafetyError {
     #[error(transparent)]
     Ael(#[from] AelError),
     /// A parameter is invalid.
-    #[error("eye_safety.{field} = {value}: {reason}")]
+    #[error("eye_safety.{field} = {}: {reason}", crate::text::Num(*.value))]
     Param {
         /// Field.
         field: &'static str,

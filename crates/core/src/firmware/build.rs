@@ -99,7 +99,8 @@ impl FirmwareTable {
             return Err(FirmwareError::Config {
                 field: "power_w_per_code",
                 reason: format!(
-                    "{step} must be finite and > 0, not subnormal (power_w_max must be > 0 for the default)"
+                    "{} must be finite and > 0, not subnormal (power_w_max must be > 0 for the default)",
+                    crate::text::Num(step)
                 ),
             });
         }

@@ -30,7 +30,7 @@ pub const MAX_BINS: usize = 36_000;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum AngleError {
     /// An angle argument was NaN or infinite.
-    #[error("{what} must be a finite angle in degrees, got {value}")]
+    #[error("{what} must be a finite angle in degrees, got {}", crate::text::Num(*.value))]
     NotFinite {
         /// Which argument.
         what: &'static str,
@@ -38,7 +38,7 @@ pub enum AngleError {
         value: f64,
     },
     /// An arc width outside `[0, 360]`.
-    #[error("arc width_deg must lie in [0, 360], got {0}")]
+    #[error("arc width_deg must lie in [0, 360], got {}", crate::text::Num(*.0))]
     BadWidth(f64),
     /// A bin count outside [`MIN_BINS`]..=[`MAX_BINS`].
     #[error("bin count must lie in [{MIN_BINS}, {MAX_BINS}], got {0}")]

@@ -1,0 +1,92 @@
+//! `--config FILE.toml` (`--optimizer-config` in `simulate`): the optimizer
+//! problem, read the same way by `profile`, `stream` and `simulate`.
+//!
+//! The rule for flags that the file also sets: **a flag given on the
+//! command line overrides the file** — `--preset` its `[lidar] preset`,
+//! `--bins` its `bins`, `--accounting` its `[lidar] power_accounting`,
+//! `--mode` its `[objective] mode` — and is checked, and named in errors,
+//! as the flag. A flag that cannot apply to the file is refused (exit 2,
+//! naming both). Nothing given is silently ignored.
+
+use std::path::Path;
+
+use gaze_lidar::model::lidar::PowerAccounting;
+use gaze_lidar::planner::Mode;
+
+use super::io::{read_text, MAX_CONFIG_BYTES};
+use super::CliError;
+
+/// Command-line values that override the file's.
+#[derive(Debug, Clone, Default)]
+pub struct Overrides<'a> {
+    /// `--preset`.
+    pub preset: Option<&'a str>,
+    /// `--bins`.
+    pub bins: Option<usize>,
+    /// `--accounting`.
+    pub accounting: Option<PowerAccounting>,
+    /// `--mode`.
+    pub mode: Option<Mode>,
+}
+
+/// Checks `--bins` for the optimizer (4..=1440), naming the flag.
+#[cfg(feature = "solver")]
+pub fn optimizer_bins(bins: usize) -> Result<usize, CliError> {
+    gaze_lidar::optimizer::validate_bins(bins, "--bins")
+        .map(|()| bins)
+        .map_err(|e| CliError::input(e.to_string()))
+}
+
+/// Reads and validates the file and applies `overrides`: exit 2 for a bad
+/// file, key or flag; 1 when the limits are infeasible.
+#[cfg(feature = "solver")]
+pub fn optimizer_problem(
+    path: &Path,
+    overrides: &Overrides<'_>,
+) -> Result<gaze_lidar::optimizer::Problem, CliError> {
+    use gaze_lidar::optimizer::{OptError, OptimizerConfig};
+    let err = |e: OptError| {
+        if e.is_input_error() {
+            CliError::input(e.to_string())
+        } else {
+            CliError::infeasible(e.to_string())
+        }
+    };
+    let text = read_text(path, MAX_CONFIG_BYTES)?;
+    let mut config = OptimizerConfig::from_toml(&text, &path.display().to_string()).map_err(err)?;
+    if let Some(name) = overrides.preset {
+        gaze_lidar::model::presets::preset(name)
+            .map_err(|e| CliError::input(format!("--preset: {e}")))?;
+        config.lidar.preset = Some(name.to_owned());
+    }
+    if let Some(bins) = overrides.bins {
+        config.bins = Some(optimizer_bins(bins)?);
+    }
+    if let Some(acc) = overrides.accounting {
+        config.lidar.power_accounting = Some(acc);
+    }
+    let mut problem = config.problem().map_err(|e| match e {
+        OptError::Invalid { field, reason } => {
+            CliError::input(format!("{}: {field}: {reason}", path.display()))
+        }
+        other => err(other),
+    })?;
+    if let Some(m) = overrides.mode {
+        if m == Mode::Baseline {
+            return Err(CliError::input(format!(
+                "--mode baseline and --config {}: the baseline has nothing to optimize (use range, resolution or joint, or drop --config)",
+                path.display()
+            )));
+        }
+        problem.objective.mode = m;
+    }
+    Ok(problem)
+}
+
+/// Without the solver there is no optimizer configuration.
+#[cfg(not(feature = "solver"))]
+pub fn no_solver(flag: &str) -> CliError {
+    CliError::input(format!(
+        "{flag}: this build has no solver (enable the `solver` feature)"
+    ))
+}
