@@ -8,6 +8,7 @@ use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::model::{presets, sensor};
 
 use super::io::{read_text, MAX_CONFIG_BYTES};
+use super::output::Outputs;
 use super::{emit, CliError};
 
 #[derive(Debug, clap::Args)]
@@ -22,8 +23,17 @@ pub struct Args {
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
     let p = presets::preset(&a.preset).map_err(|e| CliError::input(format!("--preset: {e}")))?;
+    let mut outputs = Outputs::default();
+    outputs.file_opt("--out", a.out.as_deref());
+    outputs.check()?;
     let text = sensor::to_toml(&p.lidar).map_err(|e| CliError::input(e.to_string()))?;
-    emit(&text, a.out.as_deref())?;
+    match &a.out {
+        Some(path) => {
+            outputs.set(path, text);
+            outputs.commit()?;
+        }
+        None => emit(&text)?,
+    }
     Ok(0)
 }
 
