@@ -70,6 +70,11 @@ pub struct Args {
     /// Firmware DAC step, W per code (default: power_w_max / 4095).
     #[arg(long, allow_hyphen_values = true)]
     power_w_per_code: Option<f64>,
+    /// With the optimizer: write the final power step's program to
+    /// DIR/problem.mps (free MPS) and its exact certificate to
+    /// DIR/certificate.json (created if missing; all files or none).
+    #[arg(long, value_name = "DIR")]
+    certificate: Option<PathBuf>,
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
@@ -96,8 +101,18 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     if let Some(g) = a.gaze_deg {
         gaze_lidar::planner::validate_gaze(g).map_err(|e| CliError::input(format!("--{e}")))?;
     }
+    if a.certificate.is_some() && !(a.optimize || a.config.is_some()) {
+        return Err(CliError::input(
+            "--certificate: only the optimizer (--optimize or --config) solves a program to certify",
+        ));
+    }
+    let mut extra = Vec::new();
     let certified = if a.optimize || a.config.is_some() {
-        optimized(a, &preset, gaze)?
+        let (c, cert) = optimized(a, &preset, gaze)?;
+        if let Some(dir) = &a.certificate {
+            extra = certificate_files(dir, cert)?;
+        }
+        c
     } else {
         closed_form(&preset, mode, gaze, a.bins).map_err(|e| match e {
             gaze_lidar::planner::PlanError::InvalidInput { field, reason } => {
@@ -132,8 +147,47 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             binary::encode(&firmware()?)
         }
     };
-    emit_bytes(&bytes, a.out.as_deref())?;
+    if extra.is_empty() {
+        emit_bytes(&bytes, a.out.as_deref())?;
+    } else {
+        let mut outs = super::io::Outputs::default();
+        for (path, b) in extra {
+            outs.add(&path, b);
+        }
+        if let Some(out) = &a.out {
+            outs.add(out, bytes.clone());
+        }
+        outs.commit()?;
+        if a.out.is_none() {
+            emit_bytes(&bytes, None)?;
+        }
+    }
     Ok(0)
+}
+
+/// `DIR/problem.mps` and `DIR/certificate.json` (the directory is created).
+#[cfg(feature = "solver")]
+fn certificate_files(
+    dir: &std::path::Path,
+    cert: Result<gaze_lidar::optimizer::certificate::Certified, String>,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, CliError> {
+    let cert = cert.map_err(|e| CliError::input(format!("--certificate: {e}")))?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::output(format!("--certificate {}: {e}", dir.display())))?;
+    let json = serde_json::to_string_pretty(&cert.file())
+        .map_err(|e| CliError::output(format!("certificate.json: {e}")))?;
+    Ok(vec![
+        (dir.join("problem.mps"), cert.lp.to_mps().into_bytes()),
+        (dir.join("certificate.json"), (json + "\n").into_bytes()),
+    ])
+}
+
+#[cfg(not(feature = "solver"))]
+fn certificate_files(
+    _dir: &std::path::Path,
+    _cert: Result<(), String>,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, CliError> {
+    Err(CliError::input("--certificate: this build has no solver"))
 }
 
 #[cfg(feature = "solver")]
@@ -141,8 +195,14 @@ fn optimized(
     a: &Args,
     preset: &gaze_lidar::model::presets::Preset,
     gaze: Option<f64>,
-) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
-    use gaze_lidar::optimizer::{optimize, OptError, OptimizerConfig, Problem};
+) -> Result<
+    (
+        gaze_lidar::checker::CertifiedProfile,
+        Result<gaze_lidar::optimizer::certificate::Certified, String>,
+    ),
+    CliError,
+> {
+    use gaze_lidar::optimizer::{optimize_with_certificate, OptError, OptimizerConfig, Problem};
     let err = |e: OptError| {
         if e.is_input_error() {
             CliError::input(e.to_string())
@@ -169,7 +229,7 @@ fn optimized(
     if let Some(m) = a.mode {
         problem.objective.mode = m;
     }
-    optimize(&problem, gaze).map_err(err)
+    optimize_with_certificate(&problem, gaze).map_err(err)
 }
 
 #[cfg(not(feature = "solver"))]
@@ -177,7 +237,7 @@ fn optimized(
     _a: &Args,
     _preset: &gaze_lidar::model::presets::Preset,
     _gaze: Option<f64>,
-) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
+) -> Result<(gaze_lidar::checker::CertifiedProfile, Result<(), String>), CliError> {
     Err(CliError::input(
         "--optimize/--config: this build has no solver (enable the `solver` feature)",
     ))

@@ -133,6 +133,7 @@ pub fn rotate(p: &Profile, k: usize, gaze_deg: f64) -> Profile {
         bins,
         gaze_deg: Some(gaze_deg),
         summary: None,
+        optimality: None,
         ..p.clone()
     }
 }
