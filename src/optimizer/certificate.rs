@@ -565,6 +565,7 @@ impl Certified {
             upper_bound: to_f64_up(&ub),
             gap: to_f64_up(&gap),
             exact: gap.is_zero(),
+            global: None,
         }
     }
 

@@ -50,16 +50,16 @@ const DWELL_COUNT_MARGIN: f64 = 1e-6;
 /// Dwell-step iterations when the acceleration limit is finite.
 const SLP_ROUNDS: usize = 5;
 
-struct Grid {
-    n: usize,
-    width_deg: Vec<f64>,
-    theta: Vec<f64>,
+pub(super) struct Grid {
+    pub(super) n: usize,
+    pub(super) width_deg: Vec<f64>,
+    pub(super) theta: Vec<f64>,
     start_deg: Vec<f64>,
-    weight: Vec<f64>,
+    pub(super) weight: Vec<f64>,
     in_rof: Vec<bool>,
 }
 
-fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
+pub(super) fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
     super::validate_bins(problem.bins, "bins")?;
     let b = Binning::uniform(problem.bins).map_err(|e| OptError::Invalid {
         field: "bins".into(),

@@ -42,6 +42,7 @@
 pub mod certificate;
 pub mod config;
 pub mod fast;
+pub mod global;
 mod lp;
 
 use serde::{Deserialize, Serialize};
@@ -248,6 +249,12 @@ pub fn optimize_with_certificate(
             })
         }
     };
+    if profile.optimality.is_some() {
+        let global = global::bound(problem, gaze_deg, &profile).ok();
+        if let Some(opt) = profile.optimality.as_mut() {
+            opt.global = global;
+        }
+    }
     Ok((certify(profile)?, cert))
 }
 

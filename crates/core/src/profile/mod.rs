@@ -138,6 +138,25 @@ pub struct Optimality {
     pub gap: f64,
     /// Whether the exact gap is 0 (the answer is proven optimal).
     pub exact: bool,
+    /// The joint problem's figures (power × dwell, a global bound from a
+    /// McCormick relaxation; `specs/optimizer.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub global: Option<GlobalOptimality>,
+}
+
+/// Global figures: `objective` of the answer under the model objective
+/// (the true √ utilities, floating point, lowered by a relative 1e-12) and
+/// an `upper_bound` of every certifiable profile's, from a relaxation whose
+/// bound is checked in exact arithmetic (rounded up).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GlobalOptimality {
+    /// Model objective of the answer.
+    pub objective: f64,
+    /// Upper bound of the optimum.
+    pub upper_bound: f64,
+    /// `upper_bound − objective`.
+    pub gap: f64,
 }
 
 fn required_f64<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {

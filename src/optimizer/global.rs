@@ -1,0 +1,224 @@
+//! A global upper bound of the joint problem (issue 24 item 3).
+//!
+//! Block-coordinate ascent stops at a stationary point of a bilinear
+//! problem. This module bounds the true optimum from above with one LP, a
+//! *relaxation*: every profile the checker accepts (for this problem) is
+//! feasible for it, and its objective is at least the model's.
+//!
+//! Model objective (the one the steps approximate from below with chords):
+//! `J = λ_R Σ θ_i w_i √x_i + λ_ρ Σ θ_i w_i √r_i`, `x_i = p_i/P̄`, density
+//! ratio `r_i = t_i·2π/(θ_i T)`. With `τ_i = t_i N/T`:
+//! - `√` is concave, so every tangent lies above it: `u_i ≤ tangent_k(x_i)`
+//!   and `v_i ≤ tangent_k(r_i)` over-estimate the utilities;
+//! - `x_i` lies in `[min, max]` of the allowed powers (levels or limits),
+//!   `τ_i` in the spin limits' (set-points') box; a block the mode does not
+//!   move is fixed at its start value;
+//! - frame `Σ τ_i = N`; budget `Σ θ_i x_i ≤ 2π` (angle) or, under time
+//!   accounting, `Σ τ_i x_i ≤ N`, bilinear: each product `w_i = τ_i x_i` is
+//!   replaced by its McCormick under-estimators
+//!   `w_i ≥ τ_lo x_i + x_lo τ_i − τ_lo x_lo`, `w_i ≥ τ_hi x_i + x_hi τ_i − τ_hi x_hi`
+//!   (valid on the box), with `Σ w_i ≤ N`;
+//! - slew `|x_j − x_i| ≤ s (Δ_i+Δ_j)/2 / P̄`;
+//! - every row is widened by the checker's relative tolerance (1e-9), so
+//!   whatever the checker accepts is inside;
+//! - **dropped** (a relaxation may drop rows): eye safety and the spin
+//!   acceleration limit. Where they bind, the gap includes their price.
+//!
+//! The LP's own bound is certified exactly ([`super::certificate::check`]),
+//! so `upper_bound` is proven for the relaxation, hence for the problem.
+//! `objective` is `J` of the profile handed out, evaluated in floating
+//! point and lowered by a relative 1e-12 (a few ulps per term cover it).
+
+use std::f64::consts::TAU;
+
+use super::certificate::{check, to_f64_up, LinearProgram};
+use super::lp::{grid, Grid};
+use super::{OptError, Problem};
+use crate::model::angle::next_index;
+use crate::model::lidar::PowerAccounting;
+use crate::profile::{GlobalOptimality, Profile};
+
+/// Tangents per utility and bin.
+const TANGENTS: usize = 24;
+/// The checker's relative tolerance, by which every row is widened.
+const WIDEN: f64 = 1e-9;
+/// Relative lowering of the floating-point objective (rounding cover).
+const OBJECTIVE_MARGIN: f64 = 1e-12;
+
+/// Tangent rows `u ≤ √a + (k·v − a)/(2√a)` of `√(k·v)` for `v ∈ [lo, hi]`,
+/// as (slope in v, intercept) pairs; points spread evenly in `√`.
+fn tangents(k: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
+    let (a, b) = ((k * lo).max(0.0).sqrt(), (k * hi).max(0.0).sqrt());
+    (0..=TANGENTS)
+        .filter_map(|j| {
+            let s = a + (b - a) * j as f64 / TANGENTS as f64;
+            (s > 0.0).then(|| (k / (2.0 * s), s / 2.0))
+        })
+        .collect()
+}
+
+/// The model objective `J` of a profile (floating point).
+fn objective_of(problem: &Problem, g: &Grid, profile: &Profile) -> f64 {
+    let lid = &problem.lidar;
+    let period = 1.0 / lid.frame_rate_hz;
+    let o = &problem.objective;
+    profile
+        .bins
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let dwell = b
+                .dwell_s
+                .unwrap_or(2.0 * g.theta[i] / (b.spin_start_rad_s + b.spin_end_rad_s));
+            let r = dwell * TAU / (g.theta[i] * period);
+            g.theta[i]
+                * g.weight[i]
+                * (o.range_weight * (b.power_w / lid.average_power_w).max(0.0).sqrt()
+                    + o.resolution_weight * r.max(0.0).sqrt())
+        })
+        .sum()
+}
+
+/// The global figures for `profile` (the optimizer's answer for `gaze_deg`).
+pub(super) fn bound(
+    problem: &Problem,
+    gaze_deg: f64,
+    profile: &Profile,
+) -> Result<GlobalOptimality, OptError> {
+    let upper_bound = upper_bound(problem, gaze_deg)?;
+    let j = model_objective(problem, gaze_deg, profile)?;
+    let objective = j - OBJECTIVE_MARGIN * j.abs();
+    Ok(GlobalOptimality {
+        objective,
+        upper_bound,
+        gap: upper_bound - objective,
+    })
+}
+
+/// The model objective `J` of a profile on this problem's bins (floating
+/// point, not lowered).
+pub fn model_objective(
+    problem: &Problem,
+    gaze_deg: f64,
+    profile: &Profile,
+) -> Result<f64, OptError> {
+    let g = grid(problem, gaze_deg)?;
+    if profile.bins.len() != g.n {
+        return Err(OptError::Invalid {
+            field: "bins".into(),
+            reason: format!("{} bins, the problem has {}", profile.bins.len(), g.n),
+        });
+    }
+    Ok(objective_of(problem, &g, profile))
+}
+
+/// A proven upper bound (rounded up) of `J` over every profile of this
+/// problem the checker accepts, from the relaxation in the module docs.
+pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
+    let g = grid(problem, gaze_deg)?;
+    let lid = &problem.lidar;
+    let l = &lid.limits;
+    let p_mean = lid.average_power_w;
+    let n = g.n as f64;
+    let period = 1.0 / lid.frame_rate_hz;
+    let unit = period / n;
+    let mode = problem.objective.mode;
+    // Power box (normalised).
+    let (x_lo, x_hi) = if !mode.controls_range() {
+        let p0 = p_mean.clamp(l.power_w_min, l.power_w_max) / p_mean;
+        (p0, p0)
+    } else if problem.levels.power_w.is_empty() {
+        (l.power_w_min / p_mean, l.power_w_max / p_mean)
+    } else {
+        let allowed = problem
+            .levels
+            .power_w
+            .iter()
+            .copied()
+            .filter(|&v| v >= l.power_w_min && v <= l.power_w_max);
+        let (lo, hi) = allowed.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        (lo / p_mean, hi / p_mean)
+    };
+    // Spin box → τ box per bin.
+    let (w_lo, w_hi) = if !mode.controls_resolution() {
+        (lid.mean_spin_rad_s(), lid.mean_spin_rad_s())
+    } else if problem.levels.spin_rad_s.is_empty() {
+        (l.spin_rad_s_min, l.spin_rad_s_max)
+    } else {
+        problem
+            .levels
+            .spin_rad_s
+            .iter()
+            .copied()
+            .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    if !(x_lo <= x_hi && w_lo <= w_hi && w_hi > 0.0) {
+        return Err(OptError::Infeasible("empty power or spin box".into()));
+    }
+    let o = &problem.objective;
+    let mut lp = LinearProgram::default();
+    let mut xs = Vec::with_capacity(g.n);
+    let mut taus = Vec::with_capacity(g.n);
+    for i in 0..g.n {
+        let t_lo = g.theta[i] / w_hi / unit;
+        let t_hi = if w_lo > 0.0 {
+            (g.theta[i] / w_lo / unit).min(n)
+        } else {
+            n
+        };
+        let x = lp.add_col(x_lo, x_hi, 0.0, false);
+        let tau = lp.add_col(t_lo, t_hi, 0.0, false);
+        let cw = g.theta[i] * g.weight[i];
+        let u = lp.add_col(0.0, x_hi.sqrt(), o.range_weight * cw, false);
+        for (a, b) in tangents(1.0, x_lo, x_hi) {
+            lp.add_row(&[(u, 1.0), (x, -a)], f64::NEG_INFINITY, b);
+        }
+        // r = k·τ, k = unit·2π/(θ·T).
+        let k = unit * TAU / (g.theta[i] * period);
+        let v = lp.add_col(0.0, (k * t_hi).sqrt(), o.resolution_weight * cw, false);
+        for (a, b) in tangents(k, t_lo, t_hi) {
+            lp.add_row(&[(v, 1.0), (tau, -a)], f64::NEG_INFINITY, b);
+        }
+        xs.push((x, x_lo, x_hi));
+        taus.push((tau, t_lo, t_hi));
+    }
+    let frame: Vec<(usize, f64)> = taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
+    lp.add_row(&frame, n * (1.0 - WIDEN), n * (1.0 + WIDEN));
+    match lid.power_accounting {
+        PowerAccounting::Angle => {
+            let spend: Vec<(usize, f64)> = (0..g.n).map(|i| (xs[i].0, g.theta[i])).collect();
+            lp.add_row(&spend, f64::NEG_INFINITY, TAU * (1.0 + WIDEN));
+        }
+        PowerAccounting::Time => {
+            let mut spend = Vec::with_capacity(g.n);
+            for i in 0..g.n {
+                let (x, xl, xh) = xs[i];
+                let (t, tl, th) = taus[i];
+                let w = lp.add_col(xl * tl, xh * th, 0.0, false);
+                // w ≥ tl·x + xl·τ − tl·xl and w ≥ th·x + xh·τ − th·xh.
+                lp.add_row(&[(w, 1.0), (x, -tl), (t, -xl)], -tl * xl, f64::INFINITY);
+                lp.add_row(&[(w, 1.0), (x, -th), (t, -xh)], -th * xh, f64::INFINITY);
+                spend.push((w, 1.0));
+            }
+            lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + WIDEN));
+        }
+    }
+    if let (Some(s), true) = (l.power_slew_w_per_deg_max, mode.controls_range()) {
+        for i in 0..g.n {
+            let j = next_index(i, g.n);
+            let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + WIDEN);
+            lp.add_row(&[(xs[j].0, 1.0), (xs[i].0, -1.0)], -lim, lim);
+        }
+    }
+    let solved = lp.solve("global bound")?;
+    let exact = check(&lp, &solved.x, &solved.y);
+    let ub = exact
+        .upper_bound
+        .ok_or_else(|| OptError::Solver("global bound: no finite dual bound".into()))?;
+    Ok(to_f64_up(&ub))
+}
