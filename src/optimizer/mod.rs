@@ -223,6 +223,22 @@ pub fn optimize(problem: &Problem, gaze_deg: f64) -> Result<CertifiedProfile, Op
     optimize_with_certificate(problem, gaze_deg).map(|(c, _)| c)
 }
 
+/// [`optimize`] without the optimality figures (no certificate, no global
+/// bound): for the fast path's canonical solutions, whose rotated copies
+/// carry none anyway.
+pub(crate) fn optimize_unrated(
+    problem: &Problem,
+    gaze_deg: f64,
+) -> Result<CertifiedProfile, OptError> {
+    crate::planner::validate_gaze(gaze_deg).map_err(|e| OptError::Invalid {
+        field: "gaze-deg".into(),
+        reason: e.to_string(),
+    })?;
+    let (mut profile, _) = lp::solve(problem, gaze_deg)?;
+    fit_to_eye_safety_bound(&mut profile);
+    Ok(certify(profile)?)
+}
+
 /// [`optimize`], also handing out the final power step's program and its
 /// exact certificate, or why there is none (the power does not move, or
 /// the answer is not exactly feasible for the program).
