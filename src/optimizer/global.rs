@@ -24,7 +24,7 @@
 //! - **dropped** (a relaxation may drop rows): eye safety and the spin
 //!   acceleration limit. Where they bind, the gap includes their price.
 //!
-//! The LP's own bound is certified exactly ([`super::certificate::check`]),
+//! (Separable problems skip the LP: see `lagrangian_bound`.) The LP's own bound is certified exactly ([`super::certificate::check`]),
 //! so `upper_bound` is proven for the relaxation, hence for the problem.
 //! `objective` is `J` of the profile handed out, evaluated in floating
 //! point and lowered by a relative 1e-12 (a few ulps per term cover it);
@@ -59,6 +59,72 @@ fn tangents(k: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
             (s > 0.0).then(|| (-next_down(-(k / (2.0 * s))), s / 2.0))
         })
         .collect()
+}
+
+/// One separable term `c·√(s·v)` with `v ∈ [lo, hi]` and weight `a` in
+/// its single row.
+struct Term {
+    c: f64,
+    s: f64,
+    a: f64,
+    lo: f64,
+    hi: f64,
+}
+
+impl Term {
+    /// The maximiser of `c√(s v) − m·a·v` over the box.
+    fn argmax(&self, m: f64) -> f64 {
+        if m <= 0.0 || self.c <= 0.0 {
+            return if m <= 0.0 { self.hi } else { self.lo };
+        }
+        let v = (self.c * self.s.sqrt() / (2.0 * m * self.a)).powi(2);
+        v.clamp(self.lo, self.hi)
+    }
+}
+
+/// Weak duality for `max Σ c_i√(s_i v_i)` s.t. `Σ a_i v_i ≤ b`, boxes
+/// (`a_i > 0`): for every `m ≥ 0`, the optimum is at most
+/// `m·b + Σ_i max_{v∈box} (c_i√(s_i v) − m a_i v)`. `m` is found by
+/// bisection (any `m` is valid; this one makes it tight: the problem is
+/// concave, so the bound meets the optimum); each inner maximum is taken at
+/// its (clamped) stationary point, and the sum is raised by a relative 1e-12
+/// of its terms' magnitudes (float evaluation; the maximiser's own rounding
+/// costs second order). `None` if the row cannot be met at the boxes' floor.
+fn lagrangian_bound(terms: &[Term], b: f64) -> Option<f64> {
+    let used = |m: f64| terms.iter().map(|t| t.a * t.argmax(m)).sum::<f64>();
+    if terms.iter().map(|t| t.a * t.lo).sum::<f64>() > b {
+        return None;
+    }
+    let m = if used(0.0) <= b {
+        0.0
+    } else {
+        let mut hi = 1.0;
+        let mut k = 0;
+        while used(hi) > b && k < 2000 {
+            hi *= 2.0;
+            k += 1;
+        }
+        let mut lo = 0.0;
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if used(mid) > b {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    };
+    let mut total = m * b;
+    let mut magnitude = total.abs();
+    for t in terms {
+        let v = t.argmax(m);
+        let gain = t.c * (t.s * v).sqrt();
+        let cost = m * t.a * v;
+        total += gain - cost;
+        magnitude += gain.abs() + cost.abs();
+    }
+    total.is_finite().then_some(total + 1e-12 * magnitude)
 }
 
 /// The model objective `J` of a profile (floating point).
@@ -165,6 +231,60 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         return Err(OptError::Infeasible("empty power or spin box".into()));
     }
     let o = &problem.objective;
+    let slew_moves = mode.controls_range() && l.power_slew_w_per_deg_max.is_some();
+    let coupled = lid.power_accounting == PowerAccounting::Time
+        && mode.controls_range()
+        && mode.controls_resolution();
+    if !slew_moves && !coupled {
+        // Separable: power against one budget row, dwell against the frame.
+        let tau_box = |i: usize| {
+            let t_lo = g.theta[i] / w_hi / unit;
+            let t_hi = if w_lo > 0.0 {
+                (g.theta[i] / w_lo / unit).min(n)
+            } else {
+                n
+            };
+            (t_lo, t_hi)
+        };
+        let power: Vec<Term> = (0..g.n)
+            .map(|i| Term {
+                c: o.range_weight * g.theta[i] * g.weight[i],
+                s: 1.0,
+                a: match lid.power_accounting {
+                    PowerAccounting::Angle => g.theta[i],
+                    // τ fixed here (time accounting is not coupled).
+                    PowerAccounting::Time => tau_box(i).1,
+                },
+                lo: x_lo,
+                hi: x_hi,
+            })
+            .collect();
+        let budget = match lid.power_accounting {
+            PowerAccounting::Angle => TAU,
+            PowerAccounting::Time => n,
+        } * (1.0 + WIDEN);
+        let dwell: Vec<Term> = (0..g.n)
+            .map(|i| {
+                let (lo, hi) = tau_box(i);
+                Term {
+                    c: o.resolution_weight * g.theta[i] * g.weight[i],
+                    s: unit * TAU / (g.theta[i] * period),
+                    a: 1.0,
+                    lo,
+                    hi,
+                }
+            })
+            .collect();
+        // The dwell part's row is the frame, an equality: Σ τ ≥ N(1−WIDEN)
+        // is dropped (a relaxation), Σ τ ≤ N(1+WIDEN) kept; its multiplier
+        // is ≥ 0 because the utility grows with τ.
+        if let (Some(bp), Some(bd)) = (
+            lagrangian_bound(&power, budget),
+            lagrangian_bound(&dwell, n * (1.0 + WIDEN)),
+        ) {
+            return Ok((bp + bd) * (1.0 + OBJECTIVE_MARGIN));
+        }
+    }
     let mut lp = LinearProgram::default();
     let mut xs = Vec::with_capacity(g.n);
     let mut taus = Vec::with_capacity(g.n);
