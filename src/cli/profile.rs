@@ -78,6 +78,11 @@ pub struct Args {
     /// Firmware DAC step, W per code (default: power_w_max / 4095); firmware formats only.
     #[arg(long, allow_hyphen_values = true)]
     power_w_per_code: Option<f64>,
+    /// With the optimizer: write the final power step's program to
+    /// DIR/problem.mps (free MPS) and its exact certificate to
+    /// DIR/certificate.json (created if missing; all files or none).
+    #[arg(long, value_name = "DIR")]
+    certificate: Option<PathBuf>,
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
@@ -87,6 +92,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     outputs
         .input_opt("--config", a.config.as_deref())
         .file_opt("--out", a.out.as_deref());
+    if let Some(dir) = &a.certificate {
+        outputs.folder(
+            "--certificate",
+            dir,
+            &["problem.mps".to_owned(), "certificate.json".to_owned()],
+        );
+    }
     outputs.check()?;
     let firmware_format = matches!(a.format, Format::Firmware | Format::FirmwareBin);
     for (given, flag) in [
@@ -140,6 +152,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     if let Some(g) = a.gaze_deg {
         gaze_lidar::planner::validate_gaze(g).map_err(|e| CliError::input(format!("--{e}")))?;
     }
+    if a.certificate.is_some() && !(a.optimize || a.config.is_some()) {
+        return Err(CliError::input(
+            "--certificate: only the optimizer (--optimize or --config) solves a program to certify",
+        ));
+    }
+    let mut extra = Vec::new();
     let certified = if a.optimize || a.config.is_some() {
         let overrides = Overrides {
             preset: a.preset.as_deref(),
@@ -147,7 +165,11 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             accounting,
             mode: a.mode,
         };
-        optimized(a, &preset, gaze, &overrides)?
+        let (c, cert) = optimized(a, &preset, gaze, &overrides)?;
+        if let Some(dir) = &a.certificate {
+            extra = certificate_files(dir, cert)?;
+        }
+        c
     } else {
         closed_form(&preset, mode, gaze, bins.unwrap_or(360)).map_err(|e| match e {
             gaze_lidar::planner::PlanError::InvalidInput { field, reason } => {
@@ -175,14 +197,43 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             .into_bytes(),
         Format::FirmwareBin => binary::encode(&firmware()?),
     };
+    for (path, b) in extra {
+        outputs.set(&path, b);
+    }
     match &a.out {
         Some(path) => {
             outputs.set(path, bytes);
             outputs.commit()?;
         }
-        None => emit_bytes(&bytes)?,
+        None => {
+            outputs.commit()?;
+            emit_bytes(&bytes)?;
+        }
     }
     Ok(0)
+}
+
+/// `DIR/problem.mps` and `DIR/certificate.json` (the directory is created).
+#[cfg(feature = "solver")]
+fn certificate_files(
+    dir: &std::path::Path,
+    cert: Result<gaze_lidar::optimizer::certificate::Certified, String>,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, CliError> {
+    let cert = cert.map_err(|e| CliError::input(format!("--certificate: {e}")))?;
+    let json = serde_json::to_string_pretty(&cert.file())
+        .map_err(|e| CliError::output(format!("certificate.json: {e}")))?;
+    Ok(vec![
+        (dir.join("problem.mps"), cert.lp.to_mps().into_bytes()),
+        (dir.join("certificate.json"), (json + "\n").into_bytes()),
+    ])
+}
+
+#[cfg(not(feature = "solver"))]
+fn certificate_files(
+    _dir: &std::path::Path,
+    _cert: Result<(), String>,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, CliError> {
+    Err(CliError::input("--certificate: this build has no solver"))
 }
 
 #[cfg(feature = "solver")]
@@ -191,8 +242,14 @@ fn optimized(
     preset: &gaze_lidar::model::presets::Preset,
     gaze: Option<f64>,
     overrides: &Overrides<'_>,
-) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
-    use gaze_lidar::optimizer::{optimize, OptError, Problem};
+) -> Result<
+    (
+        gaze_lidar::checker::CertifiedProfile,
+        Result<gaze_lidar::optimizer::certificate::Certified, String>,
+    ),
+    CliError,
+> {
+    use gaze_lidar::optimizer::{optimize_with_certificate, OptError, Problem};
     let err = |e: OptError| {
         if e.is_input_error() {
             CliError::input(e.to_string())
@@ -217,7 +274,7 @@ fn optimized(
             p
         }
     };
-    optimize(&problem, gaze).map_err(err)
+    optimize_with_certificate(&problem, gaze).map_err(err)
 }
 
 #[cfg(not(feature = "solver"))]
@@ -226,6 +283,6 @@ fn optimized(
     _preset: &gaze_lidar::model::presets::Preset,
     _gaze: Option<f64>,
     _overrides: &Overrides<'_>,
-) -> Result<gaze_lidar::checker::CertifiedProfile, CliError> {
+) -> Result<(gaze_lidar::checker::CertifiedProfile, Result<(), String>), CliError> {
     Err(super::config::no_solver("--optimize/--config"))
 }

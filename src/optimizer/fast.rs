@@ -16,7 +16,7 @@
 
 use std::collections::BTreeMap;
 
-use super::{optimize, OptError, Problem};
+use super::{optimize, optimize_unrated, OptError, Problem};
 use crate::checker::{certify, CertifiedProfile};
 use crate::model::angle::{rotate_index, wrap_deg, FULL_TURN_DEG};
 use crate::profile::Profile;
@@ -86,7 +86,8 @@ impl FastPlanner {
         let canonical = match self.cache.get(&u64::from(q)) {
             Some(p) => p,
             None => {
-                let c = optimize(&self.problem, f64::from(q) * width / f64::from(PHASE_STEPS))?;
+                let c =
+                    optimize_unrated(&self.problem, f64::from(q) * width / f64::from(PHASE_STEPS))?;
                 self.fresh_solves += 1;
                 self.cache
                     .entry(u64::from(q))
@@ -133,6 +134,7 @@ pub fn rotate(p: &Profile, k: usize, gaze_deg: f64) -> Profile {
         bins,
         gaze_deg: Some(gaze_deg),
         summary: None,
+        optimality: None,
         ..p.clone()
     }
 }
@@ -162,7 +164,7 @@ impl PhaseTable {
         let solved: Vec<(u32, Profile)> = phases
             .par_iter()
             .map(|&q| {
-                optimize(problem, f64::from(q) * width / f64::from(PHASE_STEPS))
+                optimize_unrated(problem, f64::from(q) * width / f64::from(PHASE_STEPS))
                     .map(|c| (q, c.into_inner()))
             })
             .collect::<Result<_, _>>()?;

@@ -10,6 +10,7 @@
 // variables); indices read like the formulation.
 #![allow(clippy::needless_range_loop)]
 
+use super::certificate::{next_down, Certified, LinearProgram};
 use good_lp::solvers::highs::highs;
 use good_lp::{
     constraint, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
@@ -27,6 +28,10 @@ use crate::profile::{Bin, Profile, Region, PROFILE_FORMAT};
 
 /// Relative margin kept from continuous bounds, budget and caps.
 const MARGIN: f64 = 1e-6;
+/// Relative slack on the budget row of a level (MILP) power step: a few
+/// ulps of rounding in `Σ θ_i·level_i`, 1,000× inside the checker's
+/// `REL_TOL` (1e-9).
+const LEVEL_BUDGET_SLACK: f64 = 1e-12;
 /// Tie-break added to the weights, growing with signed eccentricity: makes
 /// the optimum unique where the acuity is symmetric about the gaze, and is
 /// itself rotation-equivariant (a function of eccentricity only), so a
@@ -45,16 +50,16 @@ const DWELL_COUNT_MARGIN: f64 = 1e-6;
 /// Dwell-step iterations when the acceleration limit is finite.
 const SLP_ROUNDS: usize = 5;
 
-struct Grid {
-    n: usize,
-    width_deg: Vec<f64>,
-    theta: Vec<f64>,
+pub(super) struct Grid {
+    pub(super) n: usize,
+    pub(super) width_deg: Vec<f64>,
+    pub(super) theta: Vec<f64>,
     start_deg: Vec<f64>,
-    weight: Vec<f64>,
+    pub(super) weight: Vec<f64>,
     in_rof: Vec<bool>,
 }
 
-fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
+pub(super) fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
     super::validate_bins(problem.bins, "bins")?;
     let b = Binning::uniform(problem.bins).map_err(|e| OptError::Invalid {
         field: "bins".into(),
@@ -370,7 +375,7 @@ fn power_step(
     g: &Grid,
     eye: Option<&Eye>,
     t: &[f64],
-) -> Result<Vec<f64>, OptError> {
+) -> Result<(Vec<f64>, PowerLp), OptError> {
     let lid = &problem.lidar;
     let l = &lid.limits;
     let p_mean = lid.average_power_w;
@@ -378,24 +383,27 @@ fn power_step(
     let caps = eye.map_or_else(|| vec![f64::INFINITY; g.n], |e| e.power_caps(t));
     let lam = problem.objective.range_weight;
     let levels = &problem.levels.power_w;
-    let mut vars = ProblemVariables::new();
-    let mut objective = Expression::from(0.0);
-    let mut cons = Vec::new();
-    // x_i = p_i / P̄ as an expression (continuous var or Σ levels).
-    let mut x: Vec<Expression> = Vec::with_capacity(g.n);
-    let mut level_vars: Vec<Vec<(f64, Variable)>> = Vec::new();
+    let mut lp = LinearProgram::default();
+    // x_i = p_i / P̄ as a linear form (a continuous column or Σ levels·z).
+    let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
+    let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
     for i in 0..g.n {
         let hi = l.power_w_max.min(caps[i]);
         if levels.is_empty() {
             let lo_x = l.power_w_min / p_mean;
             let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
-            let xi = vars.add(variable().min(lo_x).max(hi_x));
-            let u = vars.add(variable());
-            for (a, b) in sqrt_chords(lo_x, hi_x) {
-                cons.push(constraint!(u <= a * xi + b));
+            let xi = lp.add_col(lo_x, hi_x, 0.0, false);
+            // The utility's column is boxed (so the certificate's bound is
+            // finite); the box never binds: at an optimum u is the chords'
+            // minimum, within [√lo_x, √hi_x].
+            let u_hi = 2.0 * hi_x.sqrt() + 1.0;
+            let u = lp.add_col(0.0, u_hi, lam * g.theta[i] * g.weight[i], false);
+            let chords = sqrt_chords(lo_x, hi_x);
+            for &(a, b) in &chords {
+                lp.add_row(&[(u, 1.0), (xi, -a)], f64::NEG_INFINITY, b);
             }
-            objective.add_mul(lam * g.theta[i] * g.weight[i], u);
-            x.push(Expression::from(xi));
+            x.push(vec![(xi, 1.0)]);
+            bins.push(PowerBin::Continuous { x: xi, u, chords });
         } else {
             let allowed: Vec<f64> = levels
                 .iter()
@@ -408,66 +416,82 @@ fn power_step(
                     l.power_w_min, hi
                 )));
             }
-            let zs: Vec<(f64, Variable)> = allowed
+            let zs: Vec<(f64, usize)> = allowed
                 .iter()
-                .map(|&lv| (lv, vars.add(variable().binary())))
+                .map(|&lv| {
+                    let cost = lam * g.theta[i] * g.weight[i] * (lv / p_mean).sqrt();
+                    (lv, lp.add_col(0.0, 1.0, cost, true))
+                })
                 .collect();
-            let mut xe = Expression::from(0.0);
-            let mut one = Expression::from(0.0);
-            for &(lv, z) in &zs {
-                xe.add_mul(lv / p_mean, z);
-                one.add_mul(1.0, z);
-                objective.add_mul(lam * g.theta[i] * g.weight[i] * (lv / p_mean).sqrt(), z);
-            }
-            cons.push(constraint!(one == 1.0));
-            x.push(xe);
-            level_vars.push(zs);
+            let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
+            lp.add_row(&one, 1.0, 1.0);
+            x.push(zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect());
+            bins.push(PowerBin::Levels(zs));
         }
     }
+    let scaled = |k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>| {
+        out.extend(form.iter().map(|&(j, a)| (j, k * a)));
+    };
     // Budget.
-    let budget_margin = if levels.is_empty() { 1.0 - MARGIN } else { 1.0 };
-    let mut spend = Expression::from(0.0);
+    // Levels: the budget exactly, plus [`LEVEL_BUDGET_SLACK`] (far inside
+    // the checker's REL_TOL) so that a level choice that meets it in
+    // floating point (the closed form's does, to the last bit) also meets
+    // it in the exact arithmetic of the certificate.
+    let budget_margin = if levels.is_empty() {
+        1.0 - MARGIN
+    } else {
+        1.0 + LEVEL_BUDGET_SLACK
+    };
+    let mut spend = Vec::new();
     let budget = match lid.power_accounting {
         PowerAccounting::Angle => {
             for i in 0..g.n {
-                spend += g.theta[i] * x[i].clone();
+                scaled(g.theta[i], &x[i], &mut spend);
             }
             TAU * budget_margin
         }
         PowerAccounting::Time => {
             for i in 0..g.n {
-                spend += (t[i] / period) * x[i].clone();
+                scaled(t[i] / period, &x[i], &mut spend);
             }
             budget_margin
         }
     };
-    cons.push(constraint!(spend <= budget));
+    lp.add_row(&spend, f64::NEG_INFINITY, budget);
     // Slew.
     if let Some(s) = l.power_slew_w_per_deg_max {
         for i in 0..g.n {
             let j = next_index(i, g.n);
             let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - MARGIN);
-            cons.push(constraint!(x[j].clone() - x[i].clone() <= lim));
-            cons.push(constraint!(x[i].clone() - x[j].clone() <= lim));
+            let mut d = Vec::new();
+            scaled(1.0, &x[j], &mut d);
+            scaled(-1.0, &x[i], &mut d);
+            lp.add_row(&d, -lim, lim);
         }
     }
     // Eye safety: energy per pass (T2 and time base).
     if let Some(e) = eye {
         for w in &e.windows {
-            let mut en = Expression::from(0.0);
+            let mut en = Vec::new();
             for &(j, f) in w {
-                en += (f * t[j] * p_mean) * x[j].clone();
+                scaled(f * t[j] * p_mean, &x[j], &mut en);
             }
-            cons.push(constraint!(en <= e.pass_energy_max_j * (1.0 - MARGIN)));
+            lp.add_row(&en, f64::NEG_INFINITY, e.pass_energy_max_j * (1.0 - MARGIN));
         }
     }
-    let model = configured(vars.maximise(objective).using(highs), cons);
-    let sol = solve_model(model, "power")?;
-    let mut p: Vec<f64> = if levels.is_empty() {
-        x.iter().map(|xe| sol.eval(xe) * p_mean).collect()
-    } else {
-        level_vars.iter().map(|zs| chosen(&sol, zs)).collect()
-    };
+    let solved = lp.solve("power")?;
+    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * solved.x[j]).sum::<f64>();
+    let mut p: Vec<f64> = bins
+        .iter()
+        .zip(&x)
+        .map(|(b, form)| match b {
+            PowerBin::Continuous { .. } => eval(form) * p_mean,
+            PowerBin::Levels(zs) => zs
+                .iter()
+                .max_by(|a, b| solved.x[a.1].total_cmp(&solved.x[b.1]))
+                .map_or(0.0, |&(level, _)| level),
+        })
+        .collect();
     if levels.is_empty() {
         for (i, pi) in p.iter_mut().enumerate() {
             *pi = pi.clamp(l.power_w_min, l.power_w_max.min(caps[i]));
@@ -484,7 +508,102 @@ fn power_step(
             }
         }
     }
-    Ok(p)
+    Ok((
+        p,
+        PowerLp {
+            lp,
+            bins,
+            p_mean,
+            floor_w: l.power_w_min,
+            y: solved.y,
+            solver_dual_bound: solved.solver_dual_bound,
+        },
+    ))
+}
+
+/// How a bin's power enters the power step's program.
+enum PowerBin {
+    /// `x = p/P̄` column, utility column `u ≤ a·x + b` per chord.
+    Continuous {
+        x: usize,
+        u: usize,
+        chords: Vec<(f64, f64)>,
+    },
+    /// One binary per allowed level (W, column).
+    Levels(Vec<(f64, usize)>),
+}
+
+/// The final power step's program, with what it takes to certify any power
+/// vector against it.
+pub(super) struct PowerLp {
+    lp: LinearProgram,
+    bins: Vec<PowerBin>,
+    p_mean: f64,
+    floor_w: f64,
+    y: Vec<f64>,
+    solver_dual_bound: Option<f64>,
+}
+
+/// Shrink steps tried (towards the power floor) when rounding leaves a
+/// row a few ulps over.
+const REPAIR_TRIES: usize = 40;
+
+impl PowerLp {
+    /// The program's point for powers `p` (W): `x = p/P̄`, `u` the chords'
+    /// minimum rounded down; `None` when a power is not an allowed level.
+    fn point(&self, p: &[f64]) -> Option<Vec<f64>> {
+        let mut v = vec![0.0; self.lp.cost.len()];
+        for (b, &pi) in self.bins.iter().zip(p) {
+            match b {
+                PowerBin::Continuous { x, u, chords } => {
+                    let xi = (pi / self.p_mean).clamp(self.lp.col_lo[*x], self.lp.col_hi[*x]);
+                    v[*x] = xi;
+                    let m = chords
+                        .iter()
+                        .map(|&(a, c)| a * xi + c)
+                        .fold(f64::INFINITY, f64::min);
+                    // Rounded down twice over: the exact check decides.
+                    v[*u] = next_down(next_down(m)).clamp(0.0, self.lp.col_hi[*u]);
+                }
+                PowerBin::Levels(zs) => {
+                    let k = zs.iter().position(|&(lv, _)| lv == pi)?;
+                    v[zs[k].1] = 1.0;
+                }
+            }
+        }
+        Some(v)
+    }
+
+    /// Certifies the powers `p` (the profile's) against this program: the
+    /// point is checked exactly, shrinking continuous powers towards the
+    /// floor by a few ulps where rounding left a row over.
+    /// Returns the certificate and the powers it is for (`p`, or `p` shrunk
+    /// by a few ulps; never higher).
+    pub(super) fn certify(&self, p: &[f64]) -> Result<(Certified, Vec<f64>), String> {
+        let floor = self.floor_w;
+        let mut q = p.to_vec();
+        for k in 0..REPAIR_TRIES {
+            let v = self.point(&q).ok_or_else(|| {
+                "a power is not one of the hardware levels (the eye-safety fit scaled it)"
+                    .to_owned()
+            })?;
+            match Certified::new(self.lp.clone(), v, self.y.clone(), self.solver_dual_bound) {
+                Ok(c) => return Ok((c, q)),
+                Err(e)
+                    if k + 1 == REPAIR_TRIES
+                        || self.bins.iter().any(|b| matches!(b, PowerBin::Levels(_))) =>
+                {
+                    return Err(e.to_string())
+                }
+                Err(_) => {}
+            }
+            let shrink = 1.0 - f64::EPSILON * f64::from(1u32 << k.min(30));
+            for qi in &mut q {
+                *qi = floor + (*qi - floor).max(0.0) * shrink;
+            }
+        }
+        Err("the power step's answer could not be certified exactly".into())
+    }
 }
 
 /// Dwell step: power `p` fixed; `current` is the iterate for linearisation.
@@ -627,8 +746,12 @@ fn dwell_step(
     Ok(t)
 }
 
-/// Solves and builds the (uncertified) profile.
-pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Profile, OptError> {
+/// Solves and builds the (uncertified) profile, with the final power
+/// step's program (none when the power does not move).
+pub(super) fn solve(
+    problem: &Problem,
+    gaze_deg: f64,
+) -> Result<(Profile, Option<PowerLp>), OptError> {
     let g = grid(problem, gaze_deg)?;
     let lid = &problem.lidar;
     let eye = eye(problem, &g)?;
@@ -640,11 +763,16 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Profile, OptErro
         .clamp(lid.limits.power_w_min, lid.limits.power_w_max);
     let mut p: Vec<f64> = vec![p_start; g.n];
     let mode = problem.objective.mode;
+    let mut last: Option<PowerLp> = None;
     let smooth_spin = lid.limits.spin_accel_rad_s2_max.is_some();
     let spin_rounds = if smooth_spin { SLP_ROUNDS } else { 1 };
     match mode {
         Mode::Baseline => {}
-        Mode::Range => p = power_step(problem, &g, eye.as_ref(), &t)?,
+        Mode::Range => {
+            let (pp, plp) = power_step(problem, &g, eye.as_ref(), &t)?;
+            p = pp;
+            last = Some(plp);
+        }
         Mode::Resolution => {
             for _ in 0..spin_rounds {
                 t = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
@@ -653,7 +781,9 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Profile, OptErro
         Mode::Joint => {
             for _ in 0..spin_rounds.max(2) {
                 t = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
-                p = power_step(problem, &g, eye.as_ref(), &t)?;
+                let (pp, plp) = power_step(problem, &g, eye.as_ref(), &t)?;
+                p = pp;
+                last = Some(plp);
             }
         }
     }
@@ -677,7 +807,9 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Profile, OptErro
                 .zip(&g.theta)
                 .map(|(w, th)| 2.0 * th / (w.0 + w.1))
                 .collect();
-            p = power_step(problem, &g, eye.as_ref(), &exact)?;
+            let (pp, plp) = power_step(problem, &g, eye.as_ref(), &exact)?;
+            p = pp;
+            last = Some(plp);
         }
         spins
     } else {
@@ -701,7 +833,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Profile, OptErro
             dwell_s: Some(2.0 * g.theta[i] / (spins[i].0 + spins[i].1)),
         })
         .collect();
-    Ok(Profile {
+    let profile = Profile {
         format: PROFILE_FORMAT.to_owned(),
         frame_rate_hz: lid.frame_rate_hz,
         pulse_rate_hz: lid.pulse_rate_hz,
@@ -712,5 +844,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Profile, OptErro
         bins,
         mode: Some(format!("optimized {}", mode.name())),
         summary: None,
-    })
+        optimality: None,
+    };
+    Ok((profile, last))
 }

@@ -39,8 +39,10 @@
 //! spins between bins and rescaled so the frame period is exact. The
 //! checker has the last word: a solution that fails it is an error.
 
+pub mod certificate;
 pub mod config;
 pub mod fast;
+pub mod global;
 mod lp;
 
 use serde::{Deserialize, Serialize};
@@ -215,15 +217,61 @@ impl Problem {
     }
 }
 
-/// Optimizes for `gaze_deg` and certifies the result.
+/// Optimizes for `gaze_deg` and certifies the result; its `optimality`
+/// block states the final power step's exact gap (see [`certificate`]).
 pub fn optimize(problem: &Problem, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
+    optimize_with_certificate(problem, gaze_deg).map(|(c, _)| c)
+}
+
+/// [`optimize`] without the optimality figures (no certificate, no global
+/// bound): for the fast path's canonical solutions, whose rotated copies
+/// carry none anyway.
+pub(crate) fn optimize_unrated(
+    problem: &Problem,
+    gaze_deg: f64,
+) -> Result<CertifiedProfile, OptError> {
     crate::planner::validate_gaze(gaze_deg).map_err(|e| OptError::Invalid {
         field: "gaze-deg".into(),
         reason: e.to_string(),
     })?;
-    let mut profile = lp::solve(problem, gaze_deg)?;
+    let (mut profile, _) = lp::solve(problem, gaze_deg)?;
     fit_to_eye_safety_bound(&mut profile);
     Ok(certify(profile)?)
+}
+
+/// [`optimize`], also handing out the final power step's program and its
+/// exact certificate, or why there is none (the power does not move, or
+/// the answer is not exactly feasible for the program).
+pub fn optimize_with_certificate(
+    problem: &Problem,
+    gaze_deg: f64,
+) -> Result<(CertifiedProfile, Result<certificate::Certified, String>), OptError> {
+    crate::planner::validate_gaze(gaze_deg).map_err(|e| OptError::Invalid {
+        field: "gaze-deg".into(),
+        reason: e.to_string(),
+    })?;
+    let (mut profile, power_lp) = lp::solve(problem, gaze_deg)?;
+    fit_to_eye_safety_bound(&mut profile);
+    let cert = match power_lp {
+        None => Err("this mode has no power step to certify (the power does not move)".into()),
+        Some(plp) => {
+            let p: Vec<f64> = profile.bins.iter().map(|b| b.power_w).collect();
+            plp.certify(&p).map(|(c, q)| {
+                for (b, qi) in profile.bins.iter_mut().zip(q) {
+                    b.power_w = qi;
+                }
+                profile.optimality = Some(c.optimality());
+                c
+            })
+        }
+    };
+    if profile.optimality.is_some() {
+        let global = global::bound(problem, gaze_deg, &profile).ok();
+        if let Some(opt) = profile.optimality.as_mut() {
+            opt.global = global;
+        }
+    }
+    Ok((certify(profile)?, cert))
 }
 
 /// Relative head-room left under the Class 1 limit after fitting, so that a

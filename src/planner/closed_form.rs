@@ -148,6 +148,7 @@ pub fn build_profile(
         bins,
         mode: Some(format!("closed-form {}", mode.name())),
         summary: None,
+        optimality: None,
     })
 }
 

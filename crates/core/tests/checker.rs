@@ -60,6 +60,7 @@ fn uniform() -> Profile {
             .collect(),
         mode: None,
         summary: None,
+        optimality: None,
     }
 }
 

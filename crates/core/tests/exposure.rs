@@ -169,6 +169,7 @@ fn a_profile_is_read_as_its_segments_at_its_pulse_rate() {
             .collect(),
         mode: None,
         summary: None,
+        optimality: None,
     };
     let back = segments(&p);
     assert_eq!(back.len(), s.len());

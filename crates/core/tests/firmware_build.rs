@@ -75,6 +75,7 @@ fn profile(widths: &[f64], accounting: PowerAccounting, lim: Limits) -> Profile 
         bins,
         mode: None,
         summary: None,
+        optimality: None,
     }
 }
 

@@ -64,6 +64,7 @@ fn profile() -> Profile {
         bins: vec![bin(0.0, 360.0, 62.5, 62.5)],
         mode: Some("test".into()),
         summary: None,
+        optimality: None,
     }
 }
 

@@ -115,6 +115,48 @@ pub struct Profile {
     /// Derived figures; informational on input (the checker recomputes them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub summary: Option<Summary>,
+    /// How close to optimal an optimized profile is; informational (the
+    /// checker neither needs nor checks it; `specs/optimizer.md` says what
+    /// each figure proves).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub optimality: Option<Optimality>,
+}
+
+/// The optimizer's optimality figures for the LP (or MILP) of its final
+/// power step, in the objective's units: `objective` of the profile's
+/// powers and an `upper_bound` of that program's optimum, both checked in
+/// exact rational arithmetic (`objective` rounded down, `upper_bound` and
+/// `gap` rounded up to doubles).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Optimality {
+    /// Objective of the answer (a feasible point, exact, rounded down).
+    pub objective: f64,
+    /// Proven upper bound of the optimum (rounded up).
+    pub upper_bound: f64,
+    /// `upper_bound − objective` (exact difference, rounded up).
+    pub gap: f64,
+    /// Whether the exact gap is 0 (the answer is proven optimal).
+    pub exact: bool,
+    /// The joint problem's figures (power × dwell, a global bound from a
+    /// McCormick relaxation; `specs/optimizer.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub global: Option<GlobalOptimality>,
+}
+
+/// Global figures: `objective` of the answer under the model objective
+/// (the true √ utilities, floating point, lowered by a relative 1e-12) and
+/// an `upper_bound` of every certifiable profile's, from a relaxation whose
+/// bound is checked in exact arithmetic (rounded up).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GlobalOptimality {
+    /// Model objective of the answer.
+    pub objective: f64,
+    /// Upper bound of the optimum.
+    pub upper_bound: f64,
+    /// `upper_bound − objective`.
+    pub gap: f64,
 }
 
 fn required_f64<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {

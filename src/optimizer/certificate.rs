@@ -1,0 +1,597 @@
+//! Linear programs with an optimality certificate checked in exact rational
+//! arithmetic, and their export (free MPS + `certificate.json`).
+//!
+//! A [`LinearProgram`] is `max cᵀx` subject to `r_lo ≤ A x ≤ r_hi` and
+//! `x_lo ≤ x ≤ x_hi` (some columns integral). HiGHS solves it in floating
+//! point; nothing it says is trusted. The certificate is built from:
+//!
+//! - **a primal point** `x` (HiGHS's, repaired by the caller to meet every
+//!   bound and row): every number is converted *exactly* to a rational and
+//!   every row and bound is checked exactly ([`check`]); its objective
+//!   `cᵀx` is then an exact lower bound of the optimum;
+//! - **row multipliers** `y` (HiGHS's row duals of the LP, or of the LP
+//!   relaxation for a MILP). For *any* `y`, with the reduced costs
+//!   `d = c − Aᵀy` computed exactly,
+//!   `cᵀx = yᵀ(Ax) + dᵀx ≤ Σ_r max(y_r r_lo, y_r r_hi) + Σ_j max(d_j x_lo_j, d_j x_hi_j)`
+//!   for every feasible `x` (each term is a linear function maximised over
+//!   its interval), so the right-hand side, evaluated exactly, is an upper
+//!   bound of the optimum (of the MILP too: its feasible set lies in the
+//!   relaxation's). A multiplier whose sign would need an infinite row bound
+//!   is set to 0 first (any `y` is allowed; this one only loosens nothing
+//!   that was finite). Dual feasibility is therefore not an assumption but
+//!   the finiteness of this sum; every column the optimizer builds is boxed,
+//!   so the bound is always finite.
+//!
+//! `gap = upper_bound − objective ≥ 0` is exact; it is 0 only when the
+//! floats happen to be exactly optimal, and otherwise states how far from
+//! the optimum the answer can be.
+
+use num_bigint::BigInt;
+use num_rational::BigRational;
+use num_traits::{Signed, Zero};
+
+use serde::Serialize;
+
+use super::OptError;
+
+/// One row: `lo ≤ Σ coef·x ≤ hi` (either side may be infinite).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// (column, coefficient) pairs, one per column at most.
+    pub coefs: Vec<(usize, f64)>,
+    /// Lower bound (may be `-∞`).
+    pub lo: f64,
+    /// Upper bound (may be `+∞`).
+    pub hi: f64,
+}
+
+/// `max cᵀx` s.t. rows and column bounds; some columns integral.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LinearProgram {
+    /// Objective coefficients `c`.
+    pub cost: Vec<f64>,
+    /// Column lower bounds.
+    pub col_lo: Vec<f64>,
+    /// Column upper bounds.
+    pub col_hi: Vec<f64>,
+    /// Integral columns.
+    pub integer: Vec<bool>,
+    /// Rows.
+    pub rows: Vec<Row>,
+}
+
+impl LinearProgram {
+    /// Adds a column; returns its index.
+    pub fn add_col(&mut self, lo: f64, hi: f64, cost: f64, integer: bool) -> usize {
+        self.cost.push(cost);
+        self.col_lo.push(lo);
+        self.col_hi.push(hi);
+        self.integer.push(integer);
+        self.cost.len() - 1
+    }
+
+    /// Adds `lo ≤ Σ coefs ≤ hi`; coefficients on the same column are summed.
+    pub fn add_row(&mut self, coefs: &[(usize, f64)], lo: f64, hi: f64) {
+        let mut merged: Vec<(usize, f64)> = Vec::with_capacity(coefs.len());
+        for &(j, a) in coefs {
+            if let Some(e) = merged.iter_mut().find(|e| e.0 == j) {
+                e.1 += a;
+            } else {
+                merged.push((j, a));
+            }
+        }
+        merged.retain(|e| e.1 != 0.0);
+        self.rows.push(Row {
+            coefs: merged,
+            lo,
+            hi,
+        });
+    }
+
+    /// Whether any column is integral.
+    #[must_use]
+    pub fn is_mip(&self) -> bool {
+        self.integer.iter().any(|&b| b)
+    }
+
+    fn highs_model(&self, relax: bool) -> highs::Model {
+        let mut pb = highs::RowProblem::default();
+        let cols: Vec<highs::Col> = (0..self.cost.len())
+            .map(|j| {
+                pb.add_column_with_integrality(
+                    self.cost[j],
+                    self.col_lo[j]..=self.col_hi[j],
+                    self.integer[j] && !relax,
+                )
+            })
+            .collect();
+        for r in &self.rows {
+            pb.add_row(r.lo..=r.hi, r.coefs.iter().map(|&(j, a)| (cols[j], a)));
+        }
+        let mut m = pb.optimise(highs::Sense::Maximise);
+        // Pinned for determinism (one thread, fixed seed); MILPs to optimality.
+        m.set_option("threads", 1);
+        m.set_option("random_seed", 0);
+        m.set_option("mip_rel_gap", 0.0);
+        m.set_option("mip_abs_gap", 1e-12);
+        m
+    }
+
+    /// Solves with HiGHS; for a MILP also solves the LP relaxation for the
+    /// row multipliers of the certificate.
+    pub fn solve(&self, what: &str) -> Result<Solved, OptError> {
+        let run = |relax: bool| -> Result<highs::SolvedModel, OptError> {
+            let solved = self
+                .highs_model(relax)
+                .try_solve()
+                .map_err(|e| OptError::Solver(format!("{what} step: {e:?}")))?;
+            match solved.status() {
+                highs::HighsModelStatus::Optimal => Ok(solved),
+                highs::HighsModelStatus::Infeasible => Err(OptError::Infeasible(format!(
+                    "the {what} step has no solution within the limits (power_w_min/max, the budget, spin limits, slew, acceleration and eye safety together)"
+                ))),
+                s => Err(OptError::Solver(format!("{what} step: HiGHS status {s:?}"))),
+            }
+        };
+        let main = run(false)?;
+        let sol = main.get_solution();
+        let x = sol.columns().to_vec();
+        let solver_objective = main.objective_value();
+        let (y, solver_dual_bound) = if self.is_mip() {
+            let bound = main.double_info_value(c"mip_dual_bound").ok();
+            let relaxed = run(true)?;
+            (relaxed.get_solution().dual_rows().to_vec(), bound)
+        } else {
+            (sol.dual_rows().to_vec(), None)
+        };
+        Ok(Solved {
+            x,
+            y,
+            solver_objective,
+            solver_dual_bound,
+        })
+    }
+
+    /// The program in free MPS (shortest round-trip numbers, so HiGHS reads
+    /// back exactly these doubles). Columns `x0…`, rows `r0…` in index order;
+    /// `OBJSENSE MAX`.
+    #[must_use]
+    pub fn to_mps(&self) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let _ = writeln!(s, "NAME gaze_lidar_power_step");
+        let _ = writeln!(s, "OBJSENSE\n    MAX");
+        let _ = writeln!(s, "ROWS\n N obj");
+        for (i, r) in self.rows.iter().enumerate() {
+            let kind = match (r.lo.is_finite(), r.hi.is_finite()) {
+                (true, true) if r.lo == r.hi => 'E',
+                (_, true) => 'L',
+                (true, false) => 'G',
+                (false, false) => 'N',
+            };
+            let _ = writeln!(s, " {kind} r{i}");
+        }
+        // Column-wise entries.
+        let mut by_col: Vec<Vec<(usize, f64)>> = vec![Vec::new(); self.cost.len()];
+        for (i, r) in self.rows.iter().enumerate() {
+            for &(j, a) in &r.coefs {
+                by_col[j].push((i, a));
+            }
+        }
+        let _ = writeln!(s, "COLUMNS");
+        let mut in_int = false;
+        for (j, entries) in by_col.iter().enumerate() {
+            if self.integer[j] != in_int {
+                let tag = if self.integer[j] { "INTORG" } else { "INTEND" };
+                let _ = writeln!(s, " MARKER 'MARKER' '{tag}'");
+                in_int = self.integer[j];
+            }
+            // Always name the column (a zero cost keeps empty columns listed).
+            let _ = writeln!(s, " x{j} obj {:?}", self.cost[j]);
+            for &(i, a) in entries {
+                let _ = writeln!(s, " x{j} r{i} {a:?}");
+            }
+        }
+        if in_int {
+            let _ = writeln!(s, " MARKER 'MARKER' 'INTEND'");
+        }
+        let _ = writeln!(s, "RHS");
+        for (i, r) in self.rows.iter().enumerate() {
+            let rhs = if r.hi.is_finite() { r.hi } else { r.lo };
+            if rhs.is_finite() && rhs != 0.0 {
+                let _ = writeln!(s, " rhs r{i} {rhs:?}");
+            }
+        }
+        let ranged: Vec<(usize, f64)> = self
+            .rows
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.lo.is_finite() && r.hi.is_finite() && r.lo != r.hi)
+            .map(|(i, r)| (i, r.hi - r.lo))
+            .collect();
+        if !ranged.is_empty() {
+            let _ = writeln!(s, "RANGES");
+            for (i, w) in ranged {
+                let _ = writeln!(s, " rng r{i} {w:?}");
+            }
+        }
+        let _ = writeln!(s, "BOUNDS");
+        for j in 0..self.cost.len() {
+            let (lo, hi) = (self.col_lo[j], self.col_hi[j]);
+            if lo == hi {
+                let _ = writeln!(s, " FX bnd x{j} {lo:?}");
+                continue;
+            }
+            if lo.is_finite() {
+                let _ = writeln!(s, " LO bnd x{j} {lo:?}");
+            } else {
+                let _ = writeln!(s, " MI bnd x{j}");
+            }
+            if hi.is_finite() {
+                let _ = writeln!(s, " UP bnd x{j} {hi:?}");
+            } else {
+                let _ = writeln!(s, " PL bnd x{j}");
+            }
+        }
+        let _ = writeln!(s, "ENDATA");
+        s
+    }
+}
+
+/// HiGHS's floating-point answer (untrusted).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solved {
+    /// Primal values, column order.
+    pub x: Vec<f64>,
+    /// Row duals in HiGHS's convention (`c − Aᵀy` are its reduced costs),
+    /// of the LP relaxation for a MILP.
+    pub y: Vec<f64>,
+    /// HiGHS's objective value.
+    pub solver_objective: f64,
+    /// HiGHS's MIP dual bound (a MILP only; a float, not checked).
+    pub solver_dual_bound: Option<f64>,
+}
+
+/// The exact verdict on a primal point and row multipliers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Exact {
+    /// Every bound, row and integrality holds exactly.
+    pub primal_feasible: bool,
+    /// The first bound, row or integrality that does not (column or row index).
+    pub violation: Option<String>,
+    /// `cᵀx`, exact.
+    pub objective: BigRational,
+    /// The dual bound from `y` (see the module docs), exact; `None` when it
+    /// is infinite (a needed column bound is infinite).
+    pub upper_bound: Option<BigRational>,
+}
+
+impl Exact {
+    /// `upper_bound − objective`, exact.
+    #[must_use]
+    pub fn gap(&self) -> Option<BigRational> {
+        self.upper_bound.as_ref().map(|u| u - &self.objective)
+    }
+}
+
+fn q(v: f64) -> BigRational {
+    // Every finite double is a dyadic rational: exact conversion.
+    BigRational::from_float(v).unwrap_or_else(BigRational::zero)
+}
+
+/// An exact dyadic rational `m·2^e`: every double is one, and so are their
+/// sums and products. Arithmetic without the gcd a general rational needs
+/// after every operation (the check runs on every solve).
+#[derive(Debug, Clone, PartialEq)]
+struct Dyadic {
+    m: BigInt,
+    e: i64,
+}
+
+impl Dyadic {
+    fn zero() -> Self {
+        Self {
+            m: BigInt::zero(),
+            e: 0,
+        }
+    }
+
+    /// `v` exactly (`v` finite).
+    fn of(v: f64) -> Self {
+        use num_traits::float::FloatCore;
+        let (mant, exp, sign) = FloatCore::integer_decode(v);
+        let m = BigInt::from(mant);
+        Self {
+            m: if sign < 0 { -m } else { m },
+            e: i64::from(exp),
+        }
+    }
+
+    fn mul(&self, o: &Self) -> Self {
+        Self {
+            m: &self.m * &o.m,
+            e: self.e + o.e,
+        }
+    }
+
+    fn add(&self, o: &Self) -> Self {
+        if self.m.is_zero() {
+            return o.clone();
+        }
+        if o.m.is_zero() {
+            return self.clone();
+        }
+        let e = self.e.min(o.e);
+        let shift = |d: &Self| -> BigInt {
+            let k = usize::try_from(d.e - e).unwrap_or(0);
+            &d.m << k
+        };
+        Self {
+            m: shift(self) + shift(o),
+            e,
+        }
+    }
+
+    fn neg(&self) -> Self {
+        Self {
+            m: -&self.m,
+            e: self.e,
+        }
+    }
+
+    /// `self − o` has this sign.
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.add(&o.neg()).m.sign().cmp(&num_bigint::Sign::NoSign)
+    }
+
+    fn rational(&self) -> BigRational {
+        if self.e >= 0 {
+            let k = usize::try_from(self.e).unwrap_or(0);
+            BigRational::from_integer(&self.m << k)
+        } else {
+            let k = usize::try_from(-self.e).unwrap_or(0);
+            BigRational::new(self.m.clone(), BigInt::from(1) << k)
+        }
+    }
+}
+
+/// Best linear bound `max(a·lo, a·hi)` of `a·v` over `v ∈ [lo, hi]`;
+/// `None` when it is `+∞`.
+fn sup_linear(a: &Dyadic, lo: f64, hi: f64) -> Option<Dyadic> {
+    match a.m.sign() {
+        num_bigint::Sign::NoSign => Some(Dyadic::zero()),
+        num_bigint::Sign::Plus => hi.is_finite().then(|| a.mul(&Dyadic::of(hi))),
+        num_bigint::Sign::Minus => lo.is_finite().then(|| a.mul(&Dyadic::of(lo))),
+    }
+}
+
+/// Checks `x` and `y` for `lp` in exact rational arithmetic.
+#[must_use]
+pub fn check(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Exact {
+    use std::cmp::Ordering::{Greater, Less};
+    let n = lp.cost.len();
+    let finite = x.len() == n && x.iter().all(|v| v.is_finite()) && y.iter().all(|v| v.is_finite());
+    if !finite {
+        return Exact {
+            primal_feasible: false,
+            violation: Some("a value is not finite, or x has the wrong length".into()),
+            objective: BigRational::zero(),
+            upper_bound: None,
+        };
+    }
+    let xq: Vec<Dyadic> = x.iter().map(|&v| Dyadic::of(v)).collect();
+    let mut violation = (y.len() != lp.rows.len()).then(|| "y has the wrong length".to_owned());
+    for (j, &xj) in x.iter().enumerate() {
+        if xj < lp.col_lo[j] || xj > lp.col_hi[j] || (lp.integer[j] && xj.fract() != 0.0) {
+            violation.get_or_insert_with(|| format!("column x{j} = {xj:?}"));
+        }
+    }
+    for (i, r) in lp.rows.iter().enumerate() {
+        let ax = r.coefs.iter().fold(Dyadic::zero(), |acc, &(j, a)| {
+            acc.add(&Dyadic::of(a).mul(&xq[j]))
+        });
+        if (r.lo.is_finite() && ax.cmp(&Dyadic::of(r.lo)) == Less)
+            || (r.hi.is_finite() && ax.cmp(&Dyadic::of(r.hi)) == Greater)
+        {
+            violation.get_or_insert_with(|| {
+                format!(
+                    "row r{i} (≈ {:?} in [{:?}, {:?}])",
+                    rat_to_f64(&ax.rational()),
+                    r.lo,
+                    r.hi
+                )
+            });
+        }
+    }
+    let objective = (0..n).fold(Dyadic::zero(), |acc, j| {
+        acc.add(&Dyadic::of(lp.cost[j]).mul(&xq[j]))
+    });
+    // Reduced costs d = c − Aᵀy, exactly, with y repaired to finite sides.
+    let mut d: Vec<Dyadic> = lp.cost.iter().map(|&c| Dyadic::of(c)).collect();
+    let mut ub = Some(Dyadic::zero());
+    for (r, &yr) in lp.rows.iter().zip(y) {
+        // A multiplier on an infinite side counts as 0.
+        let usable = (yr <= 0.0 || r.hi.is_finite()) && (yr >= 0.0 || r.lo.is_finite());
+        if !usable || yr == 0.0 {
+            continue;
+        }
+        let yq = Dyadic::of(yr);
+        for &(j, a) in &r.coefs {
+            d[j] = d[j].add(&yq.mul(&Dyadic::of(a)).neg());
+        }
+        ub = ub.and_then(|u| sup_linear(&yq, r.lo, r.hi).map(|s| u.add(&s)));
+    }
+    for (j, dj) in d.iter().enumerate() {
+        ub = ub.and_then(|u| sup_linear(dj, lp.col_lo[j], lp.col_hi[j]).map(|s| u.add(&s)));
+    }
+    Exact {
+        primal_feasible: violation.is_none(),
+        violation,
+        objective: objective.rational(),
+        upper_bound: ub.map(|u| u.rational()),
+    }
+}
+
+/// The nearest double at or below `v` (a conservative rendering of an
+/// exact figure that is reported as a float).
+#[must_use]
+pub fn to_f64_down(v: &BigRational) -> f64 {
+    let f = rat_to_f64(v);
+    if q(f) > *v {
+        next_down(f)
+    } else {
+        f
+    }
+}
+
+/// The nearest double at or above `v`.
+#[must_use]
+pub fn to_f64_up(v: &BigRational) -> f64 {
+    let f = rat_to_f64(v);
+    if q(f) < *v {
+        -next_down(-f)
+    } else {
+        f
+    }
+}
+
+/// The largest double below finite `f` (`f64::next_down`, stable only
+/// since Rust 1.86; the crate supports 1.85).
+#[must_use]
+pub fn next_down(f: f64) -> f64 {
+    if f == 0.0 {
+        return -f64::from_bits(1);
+    }
+    let b = f.to_bits();
+    f64::from_bits(if f > 0.0 { b - 1 } else { b + 1 })
+}
+
+fn rat_to_f64(v: &BigRational) -> f64 {
+    use num_traits::ToPrimitive;
+    v.to_f64()
+        .unwrap_or(if v.is_negative() { f64::MIN } else { f64::MAX })
+}
+
+/// The exact rational as `"numerator/denominator"` (lowest terms).
+#[must_use]
+pub fn rational_string(v: &BigRational) -> String {
+    let (n, d): (&BigInt, &BigInt) = (v.numer(), v.denom());
+    format!("{n}/{d}")
+}
+
+/// `certificate.json`: the exported power-step LP's answer and its bound.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CertificateFile {
+    /// Always `gaze-lidar/certificate@1`.
+    pub format: String,
+    /// What `problem.mps` is.
+    pub problem: String,
+    /// `maximise`.
+    pub sense: String,
+    /// How `y` is signed.
+    pub dual_sign_convention: String,
+    /// `cᵀx`, rounded down to a double (the exact value is `objective_exact`).
+    pub objective: f64,
+    /// The dual bound, rounded up to a double.
+    pub upper_bound: f64,
+    /// `upper_bound − objective` exact, rounded up.
+    pub gap: f64,
+    /// Exact `cᵀx` as `p/q`.
+    pub objective_exact: String,
+    /// Exact dual bound as `p/q`.
+    pub upper_bound_exact: String,
+    /// Exact gap as `p/q`.
+    pub gap_exact: String,
+    /// HiGHS's own MIP dual bound (a MILP only; not checked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub solver_dual_bound: Option<f64>,
+    /// Primal values in the MPS column order (`x0`, `x1`, …).
+    pub x: Vec<f64>,
+    /// Row multipliers in the MPS row order (`r0`, `r1`, …).
+    pub y: Vec<f64>,
+}
+
+/// The certified answer of one LP (or MILP).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Certified {
+    /// The program.
+    pub lp: LinearProgram,
+    /// The primal point (exactly feasible).
+    pub x: Vec<f64>,
+    /// The row multipliers.
+    pub y: Vec<f64>,
+    /// The exact figures.
+    pub exact: Exact,
+    /// HiGHS's MIP dual bound, if a MILP.
+    pub solver_dual_bound: Option<f64>,
+}
+
+impl Certified {
+    /// Checks `x`, `y` exactly; an error if `x` is not exactly feasible or
+    /// the bound is infinite (neither happens for the optimizer's programs).
+    pub fn new(
+        lp: LinearProgram,
+        x: Vec<f64>,
+        y: Vec<f64>,
+        solver_dual_bound: Option<f64>,
+    ) -> Result<Self, OptError> {
+        let exact = check(&lp, &x, &y);
+        if let Some(v) = &exact.violation {
+            return Err(OptError::Solver(format!(
+                "the primal point is not exactly feasible: {v}"
+            )));
+        }
+        if exact.upper_bound.is_none() {
+            return Err(OptError::Solver(
+                "the row duals give no finite bound (an unbounded column)".into(),
+            ));
+        }
+        Ok(Self {
+            lp,
+            x,
+            y,
+            exact,
+            solver_dual_bound,
+        })
+    }
+
+    /// The `optimality` figures (objective rounded down, bound and gap up).
+    #[must_use]
+    pub fn optimality(&self) -> crate::profile::Optimality {
+        let ub = self.exact.upper_bound.clone().unwrap_or_default();
+        let gap = self.exact.gap().unwrap_or_default();
+        crate::profile::Optimality {
+            objective: to_f64_down(&self.exact.objective),
+            upper_bound: to_f64_up(&ub),
+            gap: to_f64_up(&gap),
+            exact: gap.is_zero(),
+            global: None,
+        }
+    }
+
+    /// `certificate.json`'s content.
+    #[must_use]
+    pub fn file(&self) -> CertificateFile {
+        let ub = self.exact.upper_bound.clone().unwrap_or_default();
+        let gap = self.exact.gap().unwrap_or_default();
+        CertificateFile {
+            format: "gaze-lidar/certificate@1".into(),
+            problem: if self.lp.is_mip() {
+                "the final power step (a MILP over hardware power levels); y are the row duals of its LP relaxation, so upper_bound bounds the MILP too".into()
+            } else {
+                "the final power step (an LP)".into()
+            },
+            sense: "maximise".into(),
+            dual_sign_convention: "HiGHS's: reduced costs d = c - A^T y; for every feasible x, c^T x <= sum_r max(y_r*lo_r, y_r*hi_r) + sum_j max(d_j*lo_j, d_j*hi_j) = upper_bound (a multiplier whose side has an infinite bound counts as 0)".into(),
+            objective: to_f64_down(&self.exact.objective),
+            upper_bound: to_f64_up(&ub),
+            gap: to_f64_up(&gap),
+            objective_exact: rational_string(&self.exact.objective),
+            upper_bound_exact: rational_string(&ub),
+            gap_exact: rational_string(&gap),
+            solver_dual_bound: self.solver_dual_bound,
+            x: self.x.clone(),
+            y: self.y.clone(),
+        }
+    }
+}

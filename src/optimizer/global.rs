@@ -1,0 +1,361 @@
+//! A global upper bound of the joint problem (issue 24 item 3).
+//!
+//! Block-coordinate ascent stops at a stationary point of a bilinear
+//! problem. This module bounds the true optimum from above with one LP, a
+//! *relaxation*: every profile the checker accepts (for this problem) is
+//! feasible for it, and its objective is at least the model's.
+//!
+//! Model objective (the one the steps approximate from below with chords):
+//! `J = λ_R Σ θ_i w_i √x_i + λ_ρ Σ θ_i w_i √r_i`, `x_i = p_i/P̄`, density
+//! ratio `r_i = t_i·2π/(θ_i T)`. With `τ_i = t_i N/T`:
+//! - `√` is concave, so every tangent lies above it: `u_i ≤ tangent_k(x_i)`
+//!   and `v_i ≤ tangent_k(r_i)` over-estimate the utilities;
+//! - `x_i` lies in `[min, max]` of the allowed powers (levels or limits),
+//!   `τ_i` in the spin limits' (set-points') box; a block the mode does not
+//!   move is fixed at its start value;
+//! - frame `Σ τ_i = N`; budget `Σ θ_i x_i ≤ 2π` (angle) or, under time
+//!   accounting, `Σ τ_i x_i ≤ N`, bilinear: each product `w_i = τ_i x_i` is
+//!   replaced by its McCormick under-estimators
+//!   `w_i ≥ τ_lo x_i + x_lo τ_i − τ_lo x_lo`, `w_i ≥ τ_hi x_i + x_hi τ_i − τ_hi x_hi`
+//!   (valid on the box), with `Σ w_i ≤ N`;
+//! - slew `|x_j − x_i| ≤ s (Δ_i+Δ_j)/2 / P̄`;
+//! - every row is widened by the checker's relative tolerance (1e-9), so
+//!   whatever the checker accepts is inside;
+//! - **dropped** (a relaxation may drop rows): eye safety and the spin
+//!   acceleration limit. Where they bind, the gap includes their price.
+//!
+//! (Separable problems skip the LP: see `lagrangian_bound`.) The LP's own bound is certified exactly ([`super::certificate::check`]),
+//! so `upper_bound` is proven for the relaxation, hence for the problem.
+//! `objective` is `J` of the profile handed out, evaluated in floating
+//! point and lowered by a relative 1e-12 (a few ulps per term cover it);
+//! the bound is raised by the same (the rows' constants are floats too;
+//! tangent slopes are rounded up, so each row stays above its tangent).
+
+use std::f64::consts::TAU;
+
+use super::certificate::{check, next_down, to_f64_up, LinearProgram};
+use super::lp::{grid, Grid};
+use super::{OptError, Problem};
+use crate::model::angle::next_index;
+use crate::model::lidar::PowerAccounting;
+use crate::profile::{GlobalOptimality, Profile};
+
+/// Tangents per utility and bin.
+const TANGENTS: usize = 12;
+/// The checker's relative tolerance, by which every row is widened.
+const WIDEN: f64 = 1e-9;
+/// Relative lowering of the floating-point objective, and raising of the
+/// bound (rounding cover).
+const OBJECTIVE_MARGIN: f64 = 1e-12;
+
+/// Tangent rows `u ≤ √a + (k·v − a)/(2√a)` of `√(k·v)` for `v ∈ [lo, hi]`,
+/// as (slope in v, intercept) pairs; points spread evenly in `√`.
+fn tangents(k: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
+    let (a, b) = ((k * lo).max(0.0).sqrt(), (k * hi).max(0.0).sqrt());
+    (0..=TANGENTS)
+        .filter_map(|j| {
+            let s = a + (b - a) * j as f64 / TANGENTS as f64;
+            // Slope rounded up (v ≥ 0): the line stays above the tangent.
+            (s > 0.0).then(|| (-next_down(-(k / (2.0 * s))), s / 2.0))
+        })
+        .collect()
+}
+
+/// One separable term `c·√(s·v)` with `v ∈ [lo, hi]` and weight `a` in
+/// its single row.
+struct Term {
+    c: f64,
+    s: f64,
+    a: f64,
+    lo: f64,
+    hi: f64,
+}
+
+impl Term {
+    /// The maximiser of `c√(s v) − m·a·v` over the box.
+    fn argmax(&self, m: f64) -> f64 {
+        if m <= 0.0 || self.c <= 0.0 {
+            return if m <= 0.0 { self.hi } else { self.lo };
+        }
+        let v = (self.c * self.s.sqrt() / (2.0 * m * self.a)).powi(2);
+        v.clamp(self.lo, self.hi)
+    }
+}
+
+/// Weak duality for `max Σ c_i√(s_i v_i)` s.t. `Σ a_i v_i ≤ b`, boxes
+/// (`a_i > 0`): for every `m ≥ 0`, the optimum is at most
+/// `m·b + Σ_i max_{v∈box} (c_i√(s_i v) − m a_i v)`. `m` is found by
+/// bisection (any `m` is valid; this one makes it tight: the problem is
+/// concave, so the bound meets the optimum); each inner maximum is taken at
+/// its (clamped) stationary point, and the sum is raised by a relative 1e-12
+/// of its terms' magnitudes (float evaluation; the maximiser's own rounding
+/// costs second order). `None` if the row cannot be met at the boxes' floor.
+fn lagrangian_bound(terms: &[Term], b: f64) -> Option<f64> {
+    let used = |m: f64| terms.iter().map(|t| t.a * t.argmax(m)).sum::<f64>();
+    if terms.iter().map(|t| t.a * t.lo).sum::<f64>() > b {
+        return None;
+    }
+    let m = if used(0.0) <= b {
+        0.0
+    } else {
+        let mut hi = 1.0;
+        let mut k = 0;
+        while used(hi) > b && k < 2000 {
+            hi *= 2.0;
+            k += 1;
+        }
+        let mut lo = 0.0;
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if used(mid) > b {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    };
+    let mut total = m * b;
+    let mut magnitude = total.abs();
+    for t in terms {
+        let v = t.argmax(m);
+        let gain = t.c * (t.s * v).sqrt();
+        let cost = m * t.a * v;
+        total += gain - cost;
+        magnitude += gain.abs() + cost.abs();
+    }
+    total.is_finite().then_some(total + 1e-12 * magnitude)
+}
+
+/// The model objective `J` of a profile (floating point).
+fn objective_of(problem: &Problem, g: &Grid, profile: &Profile) -> f64 {
+    let lid = &problem.lidar;
+    let period = 1.0 / lid.frame_rate_hz;
+    let o = &problem.objective;
+    profile
+        .bins
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let dwell = b
+                .dwell_s
+                .unwrap_or(2.0 * g.theta[i] / (b.spin_start_rad_s + b.spin_end_rad_s));
+            let r = dwell * TAU / (g.theta[i] * period);
+            g.theta[i]
+                * g.weight[i]
+                * (o.range_weight * (b.power_w / lid.average_power_w).max(0.0).sqrt()
+                    + o.resolution_weight * r.max(0.0).sqrt())
+        })
+        .sum()
+}
+
+/// The global figures for `profile` (the optimizer's answer for `gaze_deg`).
+pub(super) fn bound(
+    problem: &Problem,
+    gaze_deg: f64,
+    profile: &Profile,
+) -> Result<GlobalOptimality, OptError> {
+    let upper_bound = upper_bound(problem, gaze_deg)?;
+    let j = model_objective(problem, gaze_deg, profile)?;
+    let objective = j - OBJECTIVE_MARGIN * j.abs();
+    Ok(GlobalOptimality {
+        objective,
+        upper_bound,
+        gap: upper_bound - objective,
+    })
+}
+
+/// The model objective `J` of a profile on this problem's bins (floating
+/// point, not lowered).
+pub fn model_objective(
+    problem: &Problem,
+    gaze_deg: f64,
+    profile: &Profile,
+) -> Result<f64, OptError> {
+    let g = grid(problem, gaze_deg)?;
+    if profile.bins.len() != g.n {
+        return Err(OptError::Invalid {
+            field: "bins".into(),
+            reason: format!("{} bins, the problem has {}", profile.bins.len(), g.n),
+        });
+    }
+    Ok(objective_of(problem, &g, profile))
+}
+
+/// A proven upper bound (rounded up) of `J` over every profile of this
+/// problem the checker accepts, from the relaxation in the module docs.
+pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
+    let g = grid(problem, gaze_deg)?;
+    let lid = &problem.lidar;
+    let l = &lid.limits;
+    let p_mean = lid.average_power_w;
+    let n = g.n as f64;
+    let period = 1.0 / lid.frame_rate_hz;
+    let unit = period / n;
+    let mode = problem.objective.mode;
+    // Power box (normalised).
+    let (x_lo, x_hi) = if !mode.controls_range() {
+        let p0 = p_mean.clamp(l.power_w_min, l.power_w_max) / p_mean;
+        (p0, p0)
+    } else if problem.levels.power_w.is_empty() {
+        (l.power_w_min / p_mean, l.power_w_max / p_mean)
+    } else {
+        let allowed = problem
+            .levels
+            .power_w
+            .iter()
+            .copied()
+            .filter(|&v| v >= l.power_w_min && v <= l.power_w_max);
+        let (lo, hi) = allowed.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        (lo / p_mean, hi / p_mean)
+    };
+    // Spin box → τ box per bin.
+    let (w_lo, w_hi) = if !mode.controls_resolution() {
+        (lid.mean_spin_rad_s(), lid.mean_spin_rad_s())
+    } else if problem.levels.spin_rad_s.is_empty() {
+        (l.spin_rad_s_min, l.spin_rad_s_max)
+    } else {
+        problem
+            .levels
+            .spin_rad_s
+            .iter()
+            .copied()
+            .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    if !(x_lo <= x_hi && w_lo <= w_hi && w_hi > 0.0) {
+        return Err(OptError::Infeasible("empty power or spin box".into()));
+    }
+    let o = &problem.objective;
+    let slew_moves = mode.controls_range() && l.power_slew_w_per_deg_max.is_some();
+    let coupled = lid.power_accounting == PowerAccounting::Time
+        && mode.controls_range()
+        && mode.controls_resolution();
+    if !slew_moves && !coupled {
+        // Separable: power against one budget row, dwell against the frame.
+        let tau_box = |i: usize| {
+            let t_lo = g.theta[i] / w_hi / unit;
+            let t_hi = if w_lo > 0.0 {
+                (g.theta[i] / w_lo / unit).min(n)
+            } else {
+                n
+            };
+            (t_lo, t_hi)
+        };
+        let power: Vec<Term> = (0..g.n)
+            .map(|i| Term {
+                c: o.range_weight * g.theta[i] * g.weight[i],
+                s: 1.0,
+                a: match lid.power_accounting {
+                    PowerAccounting::Angle => g.theta[i],
+                    // τ fixed here (time accounting is not coupled).
+                    PowerAccounting::Time => tau_box(i).1,
+                },
+                lo: x_lo,
+                hi: x_hi,
+            })
+            .collect();
+        let budget = match lid.power_accounting {
+            PowerAccounting::Angle => TAU,
+            PowerAccounting::Time => n,
+        } * (1.0 + WIDEN);
+        let dwell: Vec<Term> = (0..g.n)
+            .map(|i| {
+                let (lo, hi) = tau_box(i);
+                Term {
+                    c: o.resolution_weight * g.theta[i] * g.weight[i],
+                    s: unit * TAU / (g.theta[i] * period),
+                    a: 1.0,
+                    lo,
+                    hi,
+                }
+            })
+            .collect();
+        // The dwell part's row is the frame, an equality: Σ τ ≥ N(1−WIDEN)
+        // is dropped (a relaxation), Σ τ ≤ N(1+WIDEN) kept; its multiplier
+        // is ≥ 0 because the utility grows with τ.
+        if let (Some(bp), Some(bd)) = (
+            lagrangian_bound(&power, budget),
+            lagrangian_bound(&dwell, n * (1.0 + WIDEN)),
+        ) {
+            return Ok((bp + bd) * (1.0 + OBJECTIVE_MARGIN));
+        }
+    }
+    let mut lp = LinearProgram::default();
+    let mut xs = Vec::with_capacity(g.n);
+    let mut taus = Vec::with_capacity(g.n);
+    for i in 0..g.n {
+        let t_lo = g.theta[i] / w_hi / unit;
+        let t_hi = if w_lo > 0.0 {
+            (g.theta[i] / w_lo / unit).min(n)
+        } else {
+            n
+        };
+        let x = lp.add_col(x_lo, x_hi, 0.0, false);
+        let tau = lp.add_col(t_lo, t_hi, 0.0, false);
+        let cw = g.theta[i] * g.weight[i];
+        // A fixed block needs no tangents: its utility is a box bound
+        // (√ rounded up by a relative 1e-15, above the true root).
+        let up = |v: f64| v.sqrt() * (1.0 + 1e-15);
+        if x_lo < x_hi {
+            let u = lp.add_col(0.0, x_hi.sqrt(), o.range_weight * cw, false);
+            for (a, b) in tangents(1.0, x_lo, x_hi) {
+                lp.add_row(&[(u, 1.0), (x, -a)], f64::NEG_INFINITY, b);
+            }
+        } else {
+            lp.add_col(0.0, up(x_hi), o.range_weight * cw, false);
+        }
+        // r = k·τ, k = unit·2π/(θ·T).
+        let k = unit * TAU / (g.theta[i] * period);
+        if t_lo < t_hi {
+            let v = lp.add_col(0.0, (k * t_hi).sqrt(), o.resolution_weight * cw, false);
+            for (a, b) in tangents(k, t_lo, t_hi) {
+                lp.add_row(&[(v, 1.0), (tau, -a)], f64::NEG_INFINITY, b);
+            }
+        } else {
+            lp.add_col(0.0, up(k * t_hi), o.resolution_weight * cw, false);
+        }
+        xs.push((x, x_lo, x_hi));
+        taus.push((tau, t_lo, t_hi));
+    }
+    let frame: Vec<(usize, f64)> = taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
+    lp.add_row(&frame, n * (1.0 - WIDEN), n * (1.0 + WIDEN));
+    match lid.power_accounting {
+        PowerAccounting::Angle => {
+            let spend: Vec<(usize, f64)> = (0..g.n).map(|i| (xs[i].0, g.theta[i])).collect();
+            lp.add_row(&spend, f64::NEG_INFINITY, TAU * (1.0 + WIDEN));
+        }
+        PowerAccounting::Time => {
+            let mut spend = Vec::with_capacity(g.n);
+            for i in 0..g.n {
+                let (x, xl, xh) = xs[i];
+                let (t, tl, th) = taus[i];
+                let w = lp.add_col(xl * tl, xh * th, 0.0, false);
+                // w ≥ tl·x + xl·τ − tl·xl and w ≥ th·x + xh·τ − th·xh.
+                lp.add_row(&[(w, 1.0), (x, -tl), (t, -xl)], -tl * xl, f64::INFINITY);
+                lp.add_row(&[(w, 1.0), (x, -th), (t, -xh)], -th * xh, f64::INFINITY);
+                spend.push((w, 1.0));
+            }
+            lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + WIDEN));
+        }
+    }
+    if let (Some(s), true) = (l.power_slew_w_per_deg_max, mode.controls_range()) {
+        for i in 0..g.n {
+            let j = next_index(i, g.n);
+            let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + WIDEN);
+            lp.add_row(&[(xs[j].0, 1.0), (xs[i].0, -1.0)], -lim, lim);
+        }
+    }
+    let solved = lp.solve("global bound")?;
+    let exact = check(&lp, &solved.x, &solved.y);
+    let ub = exact
+        .upper_bound
+        .ok_or_else(|| OptError::Solver("global bound: no finite dual bound".into()))?;
+    // Raised by OBJECTIVE_MARGIN: covers the float evaluation of the model's
+    // constants (k, √ of a fixed block) the rows were built from.
+    Ok(to_f64_up(&ub) * (1.0 + OBJECTIVE_MARGIN))
+}

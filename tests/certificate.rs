@@ -1,0 +1,525 @@
+//! Issue 24 items 2 and 4: every power step's program comes with a
+//! certificate checked in exact rational arithmetic, and
+//! `profile --certificate DIR` exports it. The exported files are checked
+//! here from the outside: `problem.mps` is read back by HiGHS itself (its
+//! own MPS reader, through the C API) and re-solved; `problem.mps` is also
+//! parsed by this file's own reader and `certificate.json` checked against
+//! it in rationals by this file's own arithmetic.
+#![cfg(feature = "solver")]
+
+mod common;
+
+use common::{run, stderr};
+use gaze_lidar::optimizer::certificate::{check, LinearProgram};
+use num_bigint::BigInt;
+use num_rational::BigRational;
+use num_traits::{Signed, Zero};
+use std::collections::HashMap;
+use std::path::Path;
+
+const CONFIGS: [&str; 4] = ["paper", "multi_level", "smooth", "vls128_eye"];
+
+fn q(v: f64) -> BigRational {
+    BigRational::from_float(v).expect("finite")
+}
+
+fn parse_rational(s: &str) -> BigRational {
+    let (n, d) = s.split_once('/').expect("p/q");
+    BigRational::new(n.parse::<BigInt>().unwrap(), d.parse::<BigInt>().unwrap())
+}
+
+/// A plain free-MPS reader (the subset HiGHS's reader and ours share:
+/// OBJSENSE, N/L/G/E rows, integer markers, RHS, RANGES, LO/UP/FX/MI/PL).
+struct Mps {
+    maximise: bool,
+    cost: Vec<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    integer: Vec<bool>,
+    rows: Vec<MpsRow>,
+}
+
+/// (kind, coefficients, rhs, range)
+type MpsRow = (char, Vec<(usize, f64)>, f64, Option<f64>);
+
+fn read_mps(text: &str) -> Mps {
+    let mut m = Mps {
+        maximise: false,
+        cost: vec![],
+        lo: vec![],
+        hi: vec![],
+        integer: vec![],
+        rows: vec![],
+    };
+    let mut row_ix: HashMap<String, usize> = HashMap::new();
+    let mut col_ix: HashMap<String, usize> = HashMap::new();
+    let mut obj_name = String::new();
+    let mut section = String::new();
+    let mut int_mode = false;
+    for line in text.lines() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        if !line.starts_with(' ') {
+            section = line.split_whitespace().next().unwrap().to_owned();
+            continue;
+        }
+        let f: Vec<&str> = line.split_whitespace().collect();
+        match section.as_str() {
+            "OBJSENSE" => m.maximise = f[0] == "MAX",
+            "ROWS" => {
+                let kind = f[0].chars().next().unwrap();
+                if kind == 'N' {
+                    obj_name = f[1].to_owned();
+                } else {
+                    row_ix.insert(f[1].to_owned(), m.rows.len());
+                    m.rows.push((kind, vec![], 0.0, None));
+                }
+            }
+            "COLUMNS" => {
+                if f[1] == "'MARKER'" {
+                    int_mode = f[2] == "'INTORG'";
+                    continue;
+                }
+                let j = *col_ix.entry(f[0].to_owned()).or_insert_with(|| {
+                    m.cost.push(0.0);
+                    m.lo.push(0.0);
+                    m.hi.push(f64::INFINITY);
+                    m.integer.push(int_mode);
+                    m.cost.len() - 1
+                });
+                for pair in f[1..].chunks(2) {
+                    let v: f64 = pair[1].parse().unwrap();
+                    if pair[0] == obj_name {
+                        m.cost[j] = v;
+                    } else {
+                        m.rows[row_ix[pair[0]]].1.push((j, v));
+                    }
+                }
+            }
+            "RHS" => {
+                for pair in f[1..].chunks(2) {
+                    m.rows[row_ix[pair[0]]].2 = pair[1].parse().unwrap();
+                }
+            }
+            "RANGES" => {
+                for pair in f[1..].chunks(2) {
+                    m.rows[row_ix[pair[0]]].3 = Some(pair[1].parse().unwrap());
+                }
+            }
+            "BOUNDS" => {
+                let j = col_ix[f[2]];
+                match f[0] {
+                    "LO" => m.lo[j] = f[3].parse().unwrap(),
+                    "UP" => m.hi[j] = f[3].parse().unwrap(),
+                    "FX" => {
+                        m.lo[j] = f[3].parse().unwrap();
+                        m.hi[j] = m.lo[j];
+                    }
+                    "MI" => m.lo[j] = f64::NEG_INFINITY,
+                    "PL" => m.hi[j] = f64::INFINITY,
+                    other => panic!("bound type {other}"),
+                }
+            }
+            other => panic!("section {other}"),
+        }
+    }
+    m
+}
+
+impl Mps {
+    /// Row interval per the MPS rules.
+    fn interval(&self, r: usize) -> (f64, f64) {
+        let (kind, _, rhs, range) = &self.rows[r];
+        match (kind, range) {
+            ('L', None) => (f64::NEG_INFINITY, *rhs),
+            ('G', None) => (*rhs, f64::INFINITY),
+            ('E', None) => (*rhs, *rhs),
+            ('L', Some(w)) => (rhs - w.abs(), *rhs),
+            ('G', Some(w)) => (*rhs, rhs + w.abs()),
+            ('E', Some(w)) if *w >= 0.0 => (*rhs, rhs + w),
+            ('E', Some(w)) => (rhs + w, *rhs),
+            _ => (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+}
+
+/// The certificate's figures, recomputed here: (primal feasible, cᵀx, bound).
+fn exact_figures(m: &Mps, x: &[f64], y: &[f64]) -> (bool, BigRational, Option<BigRational>) {
+    let n = m.cost.len();
+    assert_eq!(x.len(), n, "x has one value per MPS column");
+    assert_eq!(y.len(), m.rows.len(), "y has one value per MPS row");
+    let xq: Vec<BigRational> = x.iter().map(|&v| q(v)).collect();
+    let mut feasible = true;
+    for (j, &xj) in x.iter().enumerate() {
+        feasible &= m.lo[j] <= xj && xj <= m.hi[j];
+        feasible &= !m.integer[j] || xj.fract() == 0.0;
+    }
+    let mut d: Vec<BigRational> = m.cost.iter().map(|&c| q(c)).collect();
+    let mut bound = Some(BigRational::zero());
+    let sup = |a: &BigRational, lo: f64, hi: f64| -> Option<BigRational> {
+        if a.is_zero() {
+            Some(BigRational::zero())
+        } else if a.is_positive() {
+            hi.is_finite().then(|| a * q(hi))
+        } else {
+            lo.is_finite().then(|| a * q(lo))
+        }
+    };
+    for (r, row) in m.rows.iter().enumerate() {
+        let (lo, hi) = m.interval(r);
+        let ax = row
+            .1
+            .iter()
+            .fold(BigRational::zero(), |s, &(j, a)| s + q(a) * &xq[j]);
+        feasible &= (!lo.is_finite() || ax >= q(lo)) && (!hi.is_finite() || ax <= q(hi));
+        // The certificate's rule: a multiplier on an infinite side counts as 0.
+        let yr = y[r];
+        if yr == 0.0 || (yr > 0.0 && !hi.is_finite()) || (yr < 0.0 && !lo.is_finite()) {
+            continue;
+        }
+        let yq = q(yr);
+        for &(j, a) in &row.1 {
+            d[j] -= &yq * q(a);
+        }
+        bound = bound.and_then(|b| sup(&yq, lo, hi).map(|s| b + s));
+    }
+    for (j, dj) in d.iter().enumerate() {
+        bound = bound.and_then(|b| sup(dj, m.lo[j], m.hi[j]).map(|s| b + s));
+    }
+    let obj = (0..n).fold(BigRational::zero(), |s, j| s + q(m.cost[j]) * &xq[j]);
+    (feasible, obj, bound)
+}
+
+/// HiGHS reads `path` with its own MPS reader and solves it afresh.
+fn highs_objective_of_file(path: &Path) -> f64 {
+    use std::ffi::CString;
+    let file = CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: the documented HiGHS C API; the handle lives until destroy.
+    unsafe {
+        let h = highs_sys::Highs_create();
+        let quiet = CString::new("output_flag").unwrap();
+        highs_sys::Highs_setBoolOptionValue(h, quiet.as_ptr(), 0);
+        let threads = CString::new("threads").unwrap();
+        highs_sys::Highs_setIntOptionValue(h, threads.as_ptr(), 1);
+        let st = highs_sys::Highs_readModel(h, file.as_ptr());
+        assert_eq!(st, 0, "HiGHS read {}", path.display());
+        let st = highs_sys::Highs_run(h);
+        assert_eq!(st, 0, "HiGHS solved {}", path.display());
+        let ms = highs_sys::Highs_getModelStatus(h);
+        assert_eq!(ms, 7, "HiGHS model status optimal (7)");
+        let v = highs_sys::Highs_getObjectiveValue(h);
+        highs_sys::Highs_destroy(h);
+        v
+    }
+}
+
+#[test]
+fn exported_certificates_check_exactly_and_highs_reads_the_same_program() {
+    for name in CONFIGS {
+        let dir = tempfile::tempdir().unwrap();
+        let cert_dir = dir.path().join("cert");
+        let out = dir.path().join("profile.json");
+        let config = format!("examples/configs/{name}.toml");
+        let o = run(
+            &[
+                "profile",
+                "--config",
+                &config,
+                "--gaze-deg",
+                "90",
+                "--certificate",
+                cert_dir.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            None,
+        );
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let mps_path = cert_dir.join("problem.mps");
+        let m = read_mps(&std::fs::read_to_string(&mps_path).unwrap());
+        assert!(m.maximise, "{name}: OBJSENSE MAX");
+        let c: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(cert_dir.join("certificate.json")).unwrap(),
+        )
+        .unwrap();
+        let nums = |k: &str| -> Vec<f64> {
+            c[k].as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect()
+        };
+        let (x, y) = (nums("x"), nums("y"));
+        let (feasible, obj, bound) = exact_figures(&m, &x, &y);
+        assert!(feasible, "{name}: x is exactly feasible");
+        let bound = bound.expect("finite dual bound");
+        assert_eq!(
+            obj,
+            parse_rational(c["objective_exact"].as_str().unwrap()),
+            "{name}"
+        );
+        assert_eq!(
+            bound,
+            parse_rational(c["upper_bound_exact"].as_str().unwrap()),
+            "{name}"
+        );
+        let gap = &bound - &obj;
+        assert!(!gap.is_negative(), "{name}: weak duality");
+        assert_eq!(
+            gap,
+            parse_rational(c["gap_exact"].as_str().unwrap()),
+            "{name}"
+        );
+        // The rounded figures bracket the exact ones.
+        let f = |k: &str| c[k].as_f64().unwrap();
+        assert!(q(f("objective")) <= obj && q(f("upper_bound")) >= bound && q(f("gap")) >= gap);
+        // HiGHS, reading the file afresh, finds the same optimum, and it
+        // lies between the certified objective and the certified bound.
+        let fresh = highs_objective_of_file(&mps_path);
+        let rel = (fresh - f("objective")).abs() / fresh.abs().max(1e-300);
+        assert!(
+            rel <= 1e-9,
+            "{name}: HiGHS {fresh} vs certificate {}",
+            f("objective")
+        );
+        assert!(
+            fresh <= f("upper_bound") * (1.0 + 1e-12),
+            "{name}: HiGHS {fresh} above the certified bound {}",
+            f("upper_bound")
+        );
+        // An LP's gap is rounding only; a MILP's is bounded by its LP
+        // relaxation (the integrality gap).
+        eprintln!(
+            "{name}: objective {} upper_bound {} gap {} (relative {:.3e}), {} columns, {} rows, MILP: {}",
+            f("objective"),
+            f("upper_bound"),
+            f("gap"),
+            f("gap") / f("objective").abs(),
+            m.cost.len(),
+            m.rows.len(),
+            m.integer.iter().any(|&b| b)
+        );
+        if !m.integer.iter().any(|&b| b) {
+            assert!(
+                f("gap") <= 1e-9 * f("objective").abs(),
+                "{name}: gap {}",
+                f("gap")
+            );
+        }
+        // profile@1 carries the same figures.
+        let p: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let opt = &p["optimality"];
+        assert_eq!(opt["objective"].as_f64(), Some(f("objective")), "{name}");
+        assert_eq!(
+            opt["upper_bound"].as_f64(),
+            Some(f("upper_bound")),
+            "{name}"
+        );
+        assert_eq!(opt["gap"].as_f64(), Some(f("gap")), "{name}");
+        assert_eq!(opt["exact"].as_bool(), Some(gap.is_zero()), "{name}");
+        // And the checker accepts the profile with its optimality block.
+        let o = run(&["check", out.to_str().unwrap()], None);
+        assert!(o.status.success(), "{name}: check: {}", stderr(&o));
+    }
+}
+
+/// max 3x + 2y  s.t.  x + y ≤ 4,  x + 3y ≤ 7,  0 ≤ x ≤ 3,  0 ≤ y ≤ 10.
+/// Optimum x = 3, y = 1, value 11; multipliers (2, 0), reduced costs (1, 0).
+fn small() -> LinearProgram {
+    let mut lp = LinearProgram::default();
+    let x = lp.add_col(0.0, 3.0, 3.0, false);
+    let y = lp.add_col(0.0, 10.0, 2.0, false);
+    lp.add_row(&[(x, 1.0), (y, 1.0)], f64::NEG_INFINITY, 4.0);
+    lp.add_row(&[(x, 1.0), (y, 3.0)], f64::NEG_INFINITY, 7.0);
+    lp
+}
+
+#[test]
+fn the_exact_check_knows_a_hand_solved_program() {
+    let lp = small();
+    let r = |n: i64| BigRational::from_integer(n.into());
+    let e = check(&lp, &[3.0, 1.0], &[2.0, 0.0]);
+    assert!(e.primal_feasible);
+    assert_eq!(e.objective, r(11));
+    assert_eq!(e.upper_bound, Some(r(11)));
+    // Other multipliers: still a bound, a looser one (2.5·4 + 0.5·3 + 0·10 = 11.5).
+    let e = check(&lp, &[3.0, 1.0], &[2.5, 0.0]);
+    assert_eq!(e.upper_bound, Some(BigRational::new(23.into(), 2.into())));
+    // A point one ulp over a row is not feasible.
+    let e = check(&lp, &[3.0, 1.0_f64.next_up()], &[2.0, 0.0]);
+    assert!(!e.primal_feasible);
+    // Over a column bound neither.
+    assert!(!check(&lp, &[3.0_f64.next_up(), 0.0], &[2.0, 0.0]).primal_feasible);
+    // A multiplier of the wrong sign on a one-sided row is dropped (counts 0):
+    // bound 3·3 + 2·10 = 29.
+    assert_eq!(
+        check(&lp, &[3.0, 1.0], &[-1.0, 0.0]).upper_bound,
+        Some(r(29))
+    );
+    // HiGHS's own duals, in the convention the certificate states, close the gap.
+    let s = lp.solve("test").unwrap();
+    let e = check(&lp, &s.x, &s.y);
+    assert!(e.primal_feasible);
+    assert_eq!(e.gap(), Some(BigRational::zero()), "y = {:?}", s.y);
+    // Where the true dual is not a double (1/3), the gap is stated, > 0 and tiny.
+    let mut lp = LinearProgram::default();
+    let x = lp.add_col(0.0, 10.0, 1.0, false);
+    lp.add_row(&[(x, 3.0)], f64::NEG_INFINITY, 1.0);
+    let s = lp.solve("test").unwrap();
+    let e = check(&lp, &s.x, &s.y);
+    assert!(e.primal_feasible);
+    let gap = e.gap().unwrap();
+    assert!(gap.is_positive() && gap < BigRational::new(1.into(), (1_i64 << 50).into()));
+}
+
+#[test]
+fn the_mps_export_round_trips_through_highs() {
+    let lp = small();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("small.mps");
+    std::fs::write(&path, lp.to_mps()).unwrap();
+    assert_eq!(highs_objective_of_file(&path), 11.0);
+    // Ranged, equality and integer rows too.
+    let mut lp = LinearProgram::default();
+    let a = lp.add_col(0.0, 5.0, 1.0, true);
+    let b = lp.add_col(-1.0, 2.5, 1.0, false);
+    lp.add_row(&[(a, 2.0), (b, 1.0)], 1.0, 6.5);
+    lp.add_row(&[(b, 1.0)], f64::NEG_INFINITY, 2.0);
+    std::fs::write(&path, lp.to_mps()).unwrap();
+    // max a + b: b ≤ 2, 2a + b ≤ 6.5 → a = 2 (integral), b = 2 → 4.
+    assert_eq!(highs_objective_of_file(&path), 4.0);
+    let s = lp.solve("test").unwrap();
+    assert_eq!(s.x, vec![2.0, 2.0]);
+    let e = check(&lp, &s.x, &s.y);
+    assert!(e.primal_feasible);
+    // y from the relaxation (a = 2.25, b = 2 → 4.25): a valid bound ≥ 4.
+    assert!(e.upper_bound.unwrap() >= BigRational::from_integer(4.into()));
+}
+
+/// Issue 24 item 3: the global bound is an upper bound of the model
+/// objective over every point its constraints allow. On a small instance
+/// (12 bins) of each shipped config, the optimizer's answer and thousands
+/// of feasible perturbations of it (box, budget, frame and slew kept;
+/// moves that trade power or dwell between two bins) never exceed it.
+#[test]
+fn the_global_bound_is_never_exceeded_on_small_instances() {
+    use gaze_lidar::model::lidar::PowerAccounting;
+    use gaze_lidar::optimizer::global::{model_objective, upper_bound};
+    use gaze_lidar::optimizer::{optimize, OptimizerConfig};
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(24);
+    for name in CONFIGS {
+        let text = std::fs::read_to_string(format!("examples/configs/{name}.toml")).unwrap();
+        let mut problem = OptimizerConfig::from_toml(&text, name)
+            .unwrap()
+            .problem()
+            .unwrap();
+        problem.bins = 12;
+        let gaze = 90.0;
+        let answer = optimize(&problem, gaze).unwrap().profile().clone();
+        let ub = upper_bound(&problem, gaze).unwrap();
+        let j0 = model_objective(&problem, gaze, &answer).unwrap();
+        assert!(j0 <= ub, "{name}: answer {j0} above the bound {ub}");
+        let lid = &problem.lidar;
+        let l = &lid.limits;
+        let mode = problem.objective.mode;
+        let n = answer.bins.len();
+        let theta: Vec<f64> = answer
+            .bins
+            .iter()
+            .map(|b| b.width_deg.to_radians())
+            .collect();
+        let period = 1.0 / lid.frame_rate_hz;
+        let (p_lo, p_hi) = if problem.levels.power_w.is_empty() {
+            (l.power_w_min, l.power_w_max)
+        } else {
+            let v = &problem.levels.power_w;
+            (
+                v.iter()
+                    .copied()
+                    .fold(f64::INFINITY, f64::min)
+                    .max(l.power_w_min),
+                v.iter().copied().fold(0.0, f64::max).min(l.power_w_max),
+            )
+        };
+        let feasible = |p: &[f64], t: &[f64]| -> bool {
+            let frame: f64 = t.iter().sum();
+            let spend = match lid.power_accounting {
+                PowerAccounting::Angle => {
+                    p.iter().zip(&theta).map(|(a, b)| a * b).sum::<f64>() / std::f64::consts::TAU
+                }
+                PowerAccounting::Time => p.iter().zip(t).map(|(a, b)| a * b).sum::<f64>() / period,
+            };
+            let slew_ok = l.power_slew_w_per_deg_max.is_none_or(|s| {
+                (0..n).all(|i| {
+                    let j = (i + 1) % n;
+                    (p[j] - p[i]).abs()
+                        <= s * 0.5 * (answer.bins[i].width_deg + answer.bins[j].width_deg)
+                })
+            });
+            let spin_ok = (0..n).all(|i| {
+                let w = theta[i] / t[i];
+                w >= l.spin_rad_s_min * (1.0 - 1e-12) && w <= l.spin_rad_s_max * (1.0 + 1e-12)
+            });
+            (frame - period).abs() <= 1e-12 * period
+                && spend <= lid.average_power_w
+                && p.iter().all(|&v| v >= p_lo && v <= p_hi)
+                && slew_ok
+                && spin_ok
+        };
+        let p0: Vec<f64> = answer.bins.iter().map(|b| b.power_w).collect();
+        let t0: Vec<f64> = answer.bins.iter().map(|b| b.dwell_s.unwrap()).collect();
+        let mut tried = 0;
+        let mut best = j0;
+        for _ in 0..4000 {
+            let (mut p, mut t) = (p0.clone(), t0.clone());
+            let (i, j) = (rng.random_range(0..n), rng.random_range(0..n));
+            if i == j {
+                continue;
+            }
+            let scale: f64 = rng.random_range(-0.3..0.3);
+            if mode.controls_range() {
+                // Trade power between i and j at equal spend.
+                let dp = scale * (p_hi - p_lo);
+                let wi = if lid.power_accounting == PowerAccounting::Angle {
+                    theta[i]
+                } else {
+                    t[i]
+                };
+                let wj = if lid.power_accounting == PowerAccounting::Angle {
+                    theta[j]
+                } else {
+                    t[j]
+                };
+                p[i] += dp;
+                p[j] -= dp * wi / wj;
+            }
+            if mode.controls_resolution() && rng.random_bool(0.5) {
+                let dt = scale * t[i].min(t[j]);
+                t[i] += dt;
+                t[j] -= dt;
+            }
+            if !feasible(&p, &t) {
+                continue;
+            }
+            tried += 1;
+            let mut prof = answer.clone();
+            for (k, b) in prof.bins.iter_mut().enumerate() {
+                b.power_w = p[k];
+                b.dwell_s = Some(t[k]);
+                b.spin_start_rad_s = theta[k] / t[k];
+                b.spin_end_rad_s = theta[k] / t[k];
+            }
+            let jv = model_objective(&problem, gaze, &prof).unwrap();
+            best = best.max(jv);
+            assert!(
+                jv <= ub,
+                "{name}: a feasible point reaches {jv} above the bound {ub}"
+            );
+        }
+        eprintln!("{name} (12 bins): answer {j0}, best of {tried} feasible perturbations {best}, bound {ub}");
+        assert!(tried > 100, "{name}: only {tried} feasible perturbations");
+    }
+}
