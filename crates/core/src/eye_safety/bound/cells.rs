@@ -10,9 +10,10 @@ use super::count::{max_pulses_in, passes_in_window, StepMemo, PRUNE_SLACK, TOUCH
 use super::envelope::Envelope;
 use super::laser::{Laser, PerJouleCache};
 use super::order::{sort_runs, wrap_index};
-use super::seg::{spin_sq_line, wrap360, Seg};
+use super::seg::{spin_sq_line, Seg};
 use super::sliding::SlidingMax;
 use crate::eye_safety::ael;
+use crate::model::angle::wrap_deg;
 use crate::profile::kinematics::Timeline;
 
 /// One cell's exact figures.
@@ -85,17 +86,17 @@ impl<'a> Cells<'a> {
         // φ-cells: azimuths where a pass edge, or a pass edge shifted by Δ in
         // time, meets a bin edge.
         let mut cuts: Vec<f64> = Vec::with_capacity(4 * n + 1);
-        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg + h)));
-        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg - h)));
+        cuts.extend(segs.iter().map(|s| wrap_deg(s.start_deg + h)));
+        cuts.extend(segs.iter().map(|s| wrap_deg(s.start_deg - h)));
         let mut hint = 0;
         cuts.extend((0..n).map(|i| {
             let t = tl.bin_start_time_s(i) + delta;
-            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) + h)
+            wrap_deg(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) + h)
         }));
         let mut hint = 0;
         cuts.extend((0..n).map(|i| {
             let t = tl.bin_start_time_s(i) + frame_s - delta;
-            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) - h)
+            wrap_deg(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) - h)
         }));
         // Four runs, each increasing but for one wrap: a merge, linear.
         let cuts = sort_runs(cuts, &[0, n, 2 * n, 3 * n, 4 * n]);
@@ -388,7 +389,7 @@ impl<'a> Cells<'a> {
         CellExact {
             tau_s: cell_tau,
             tau_min_s: cell_tau_min,
-            e: (cell_e.0.min(cap), wrap360(cell_e.1)),
+            e: (cell_e.0.min(cap), wrap_deg(cell_e.1)),
             e_env: cell_e.0,
             // Off the curved cells the sweep's Rule 1 figure is exact.
             single: if self.rows[c].curved {

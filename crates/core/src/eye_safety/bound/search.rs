@@ -5,8 +5,8 @@
 //! "Search").
 
 use super::cells::{CellRow, Cells};
-use super::seg::wrap360;
 use super::Search;
+use crate::model::angle::wrap_deg;
 
 /// The maxima over cells: Rule 1 (ratio, azimuth), pass energy
 /// (J, azimuth), envelope integral over a pass (J), pass duration (s).
@@ -21,7 +21,7 @@ impl Cells<'_> {
     /// The three maxima, each with the first cell (in azimuth order)
     /// attaining it.
     pub(super) fn search(&self, search: Search) -> CellBest {
-        let mid_of = |c: usize| wrap360(0.5 * (self.cut(c) + self.cut(c + 1)));
+        let mid_of = |c: usize| wrap_deg(0.5 * (self.cut(c) + self.cut(c + 1)));
         match search {
             Search::Exhaustive => {
                 let mut best = CellBest {
