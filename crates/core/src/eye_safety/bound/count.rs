@@ -18,6 +18,8 @@
 //! | [`REACH_SLACK`] | 1e-9 | relative, of a turn's time | each walk's reach | the float inversions of the head's motion (time at an azimuth and back) |
 //! | [`TOUCH_SNAP_DEG`] | 1e-9 | deg | the arc a cell's pulses come from (Rule 1, pulse caps) | the rounding of the cuts (an ulp of 360° is 5.7e-14°) |
 //! | `firmware::eye::LIMIT_MARGIN` | 1e-9 | relative, on each integer limit before it is rounded down | `IntEyeLimits::derive` | the float rounding of the limits derived from this model |
+//! | (literal in `firmware::eye`) | 1e-12 | relative, up, on the pass arc in mdeg before its `ceil` | `IntEyeLimits::derive` | an arc that is an integer mdeg up to rounding is not taken one mdeg short |
+//! | (literals in `firmware::eye`) | 1e-12 | relative, down, on the shortest span of `k` pulses or `m` passes before its AEL | `IntEyeLimits::derive` | a span rounded up would read a larger AEL; shorter spans are the conservative side |
 //!
 //! How they relate: each is at least a thousand times the float rounding it
 //! covers (relative errors of a few units of `2⁻⁵³ ≈ 1.1e-16` per
@@ -28,7 +30,10 @@
 //! they can make the bound looser but never lower; the two 1e-9 margins on
 //! the result ([`COUNT_MARGIN`] on counts, [`RATIO_MARGIN`] on ratios) are
 //! each far above the relative error of what they round, so no rounding in
-//! between can land a count or a ratio below the exact one.
+//! between can land a count or a ratio below the exact one. The firmware's
+//! three 1e-12 literals are still literals in `firmware::eye::derive`
+//! (that code is being reworked for the AEL infimum; they are listed here so
+//! the table is complete).
 
 /// Relative margin by which every floor-count is rounded up (see module docs).
 pub const COUNT_MARGIN: f64 = 1e-9;
