@@ -721,7 +721,7 @@ impl Greedy<'_> {
 #[cfg(feature = "std")]
 mod derive {
     use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
-    use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
+    use crate::eye_safety::ael::{self, T2_S, TIME_BASE_S};
     use crate::eye_safety::bound::Laser;
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
     use crate::eye_safety::EyeSafetyError;
@@ -773,19 +773,16 @@ mod derive {
         Some(c as u64)
     }
 
-    /// `AEL_inf(t) = inf AEL` over `[t, 100 s]`: each Table 3 row grows with
-    /// `t`, so it is the AEL at `t` or at a row edge after it (the table steps
-    /// down at 5 µs in 700–1050 nm).
+    /// `AEL_inf(t) = inf AEL` over `[t, 100 s]`, by the model's one AEL
+    /// infimum ([`ael::ael_inf_j`]; durations below the pulse's own take
+    /// the pulse's AEL, as `Laser::ael_j` does).
     fn ael_inf(laser: &Laser, t_s: f64) -> f64 {
-        let mut v = laser.ael_j(t_s);
-        for row in laser.rows() {
-            for e in [row.t_lo_s, row.t_hi_s] {
-                if e > t_s && e <= TIME_BASE_S {
-                    v = v.min(laser.ael_j(e));
-                }
-            }
-        }
-        v
+        ael::ael_inf_j(
+            laser.band,
+            laser.c4,
+            t_s.max(laser.pulse_duration_s),
+            TIME_BASE_S,
+        )
     }
 
     impl IntEyeLimits {
