@@ -1,0 +1,440 @@
+//! The azimuth cells and the sweep: the circle is cut where a pass edge
+//! (or a pass edge shifted by `Δ` in time) meets a bin edge; inside a cell
+//! both pass edges stay in fixed bins and fixed envelope pieces, so `τ(φ)`
+//! and `E(φ)` have their maxima at the cell ends or at one stationary point
+//! (`specs/eye_safety.md`, "Cells and spin extremes"). One sweep in azimuth
+//! order gives every cell's end values, its Rule 1 figure and cheap upper
+//! bounds for the branch and bound; [`Cells::exact`] evaluates one cell.
+
+use super::count::{max_pulses_in, passes_in_window, StepMemo, PRUNE_SLACK, TOUCH_SNAP_DEG};
+use super::envelope::Envelope;
+use super::laser::{Laser, PerJouleCache};
+use super::order::{sort_runs, wrap_index};
+use super::seg::{spin_sq_line, wrap360, Seg};
+use super::sliding::SlidingMax;
+use crate::eye_safety::ael;
+use crate::profile::kinematics::Timeline;
+
+/// One cell's exact figures.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CellExact {
+    /// Largest pass duration over the cell, s.
+    pub(super) tau_s: f64,
+    /// Smallest pass duration over the cell, s.
+    pub(super) tau_min_s: f64,
+    /// Largest pass energy (envelope and pulse-count bounds), J, and the
+    /// azimuth (wrapped) where the envelope bound peaks.
+    pub(super) e: (f64, f64),
+    /// Largest envelope integral over a pass (not capped by the pulse
+    /// count: the periodic bound of [`Laser::multi_pass_ratio`] needs it), J.
+    pub(super) e_env: f64,
+    /// Rule 1 ratio of the cell (before the margin).
+    pub(super) single: f64,
+}
+
+/// The azimuth cells between consecutive breakpoints. One sweep in azimuth
+/// order gives, per cell, the hottest bin touching its union arc, `τ` and
+/// `E` at its ends, whether `τ` or `E` can have a stationary point inside
+/// (a pass edge in a bin with angular acceleration), and a cheap upper bound
+/// of each figure for the branch and bound.
+pub(super) struct Cells<'a> {
+    pub(super) tl: &'a Timeline<'a, Seg>,
+    pub(super) env: &'a Envelope,
+    pub(super) laser: &'a Laser,
+    pub(super) h: f64,
+    pub(super) delta: f64,
+    cuts: Vec<f64>,
+    /// `τ` and `E` at each cut, `[0, len]`.
+    pub(super) tau_pt: Vec<f64>,
+    pub(super) e_pt: Vec<f64>,
+    /// Each cell's figures from the sweep.
+    pub(super) rows: Vec<CellRow>,
+    per_j: PerJouleCache,
+}
+
+/// A cell as the sweep leaves it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CellRow {
+    /// Highest power of the bins touching the cell's union arc, W.
+    pub(super) p: f64,
+    /// Whether a pass edge crosses a bin with angular acceleration.
+    pub(super) curved: bool,
+    /// Upper bounds of the cell's `tau_s`, `e.0`, `e_env` and `single`
+    /// (the exact `tau_s`, `e_env` and `single` when it is not curved;
+    /// `e.0` is then still capped per bin by the exact evaluation).
+    pub(super) tau_ub: f64,
+    pub(super) e_ub: f64,
+    pub(super) env_ub: f64,
+    pub(super) single_ub: f64,
+    /// A lower bound of the cell's smallest pass duration (exact when the
+    /// cell is not curved), s.
+    pub(super) tau_lb: f64,
+}
+
+impl<'a> Cells<'a> {
+    pub(super) fn new(
+        tl: &'a Timeline<'a, Seg>,
+        env: &'a Envelope,
+        h: f64,
+        laser: &'a Laser,
+    ) -> Self {
+        let segs = tl.bins();
+        let n = segs.len();
+        let delta = 1.0 / laser.pulse_rate_hz;
+        let frame_s = tl.period_s();
+        // φ-cells: azimuths where a pass edge, or a pass edge shifted by Δ in
+        // time, meets a bin edge.
+        let mut cuts: Vec<f64> = Vec::with_capacity(4 * n + 1);
+        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg + h)));
+        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg - h)));
+        let mut hint = 0;
+        cuts.extend((0..n).map(|i| {
+            let t = tl.bin_start_time_s(i) + delta;
+            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) + h)
+        }));
+        let mut hint = 0;
+        cuts.extend((0..n).map(|i| {
+            let t = tl.bin_start_time_s(i) + frame_s - delta;
+            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) - h)
+        }));
+        // Four runs, each increasing but for one wrap: a merge, linear.
+        let cuts = sort_runs(cuts, &[0, n, 2 * n, 3 * n, 4 * n]);
+        let mut cells = Self {
+            tl,
+            env,
+            laser,
+            h,
+            delta,
+            cuts,
+            tau_pt: Vec::new(),
+            e_pt: Vec::new(),
+            rows: Vec::new(),
+            per_j: PerJouleCache::default(),
+        };
+        cells.sweep();
+        cells
+    }
+
+    pub(super) fn len(&self) -> usize {
+        self.cuts.len()
+    }
+
+    /// Cut `c` for `c` in `[0, len]`, the last one a turn after the first.
+    pub(super) fn cut(&self, c: usize) -> f64 {
+        cut_of(&self.cuts, c)
+    }
+
+    /// The sweep (all positions nondecrease with the cell, so every lookup
+    /// is a forward step: linear time overall). A cell whose pass edges both
+    /// cross bins of constant spin has its exact figures here (at its ends).
+    /// Otherwise (curved), over `φ ∈ [u, v]`:
+    /// `dτ/dφ = 1/ω(φ + h) − 1/ω(φ − h)` and
+    /// `dE/dφ = P̄_r/ω(φ + h) − P̄_l/ω(φ − h)`, with the envelope pieces
+    /// `P̄_r`, `P̄_l` fixed over the cell and `ω` monotone along each edge's
+    /// bin (`ω²` is linear there), so each figure exceeds the larger of its
+    /// end values by at most the cell width times the smaller of its
+    /// largest forward and backward slopes: the bounds. Rule 1 grows with
+    /// the pulse and pass counts (C5 falls with the count).
+    ///
+    /// Two passes: the pass edges' times and envelope integrals at every
+    /// cut, then the cells. Without a bin with angular acceleration no cell
+    /// is curved, and the bins under the edges are not looked up.
+    fn sweep(&mut self) {
+        let tl = self.tl;
+        let env = self.env;
+        let segs = tl.bins();
+        let n = segs.len() as i64;
+        let (h, delta) = (self.h, self.delta);
+        let frame_s = tl.period_s();
+        let f_p = self.laser.pulse_rate_hz;
+        let t2 = ael::T2_S.min(ael::TIME_BASE_S);
+        let e_slack = PRUNE_SLACK * env.total_j();
+        let t_slack = PRUNE_SLACK * frame_s;
+        // Bins with angular acceleration (`ω²` not constant); with none, no
+        // cell is curved and the edges' bins need not be looked up.
+        let bin_curved: Vec<bool> = segs.iter().map(|s| spin_sq_line(s).1 != 0.0).collect();
+        let any_curved = bin_curved.contains(&true);
+        let cuts = &self.cuts;
+        let m = cuts.len();
+        // At every cut: the pass edges' times, the envelope integrals there
+        // and (for the curved cells' bounds) the envelope's power at the
+        // left and the right edge.
+        let mut edge_p: Vec<(f64, f64)> = Vec::with_capacity(if any_curved { m + 1 } else { 0 });
+        let (mut h0, mut h1, mut h2, mut h3) = (0usize, 0usize, 0usize, 0usize);
+        let (mut tau_pt, mut e_pt) = (Vec::with_capacity(m + 1), Vec::with_capacity(m + 1));
+        for c in 0..=m {
+            let theta = cut_of(cuts, c);
+            let t_lo = tl.time_at_unwrapped_from_s(theta - h, &mut h0);
+            let t_hi = tl.time_at_unwrapped_from_s(theta + h, &mut h1);
+            let at_lo = env.locate_from(t_lo, &mut h2);
+            let at_hi = env.locate_from(t_hi + delta, &mut h3);
+            tau_pt.push(t_hi - t_lo);
+            e_pt.push(env.integral_at(at_hi) - env.integral_at(at_lo));
+            if any_curved {
+                edge_p.push((env.p_w[at_lo.2], env.p_w[at_hi.2]));
+            }
+        }
+        // Rule 1 near a cut (`touch`): the azimuths within `2s` of cut `c`
+        // (`s` = TOUCH_SNAP_DEG) send passes into the arc
+        // `[θ_c − h − 3s, θ_c + h + 3s]` (one `s` for the rounding of the
+        // cut), and their duration exceeds `τ(θ_c)` by at most `2s` times
+        // the largest rate `|dτ/dφ| ≤ 2/ω_min` (`tau_touch`, doubled, plus
+        // the rounding slack); the inside of a cell, `[u + 2s, v − 2s]`,
+        // sends them into `(u − h + s, v + h − s)`. Off the curved cells
+        // this lets Rule 1 pair each end's hottest touched bin with that
+        // end's own counts instead of the cell's largest ones.
+        let spin_min = segs
+            .iter()
+            .map(|s| s.spin_start_rad_s.min(s.spin_end_rad_s))
+            .fold(f64::INFINITY, f64::min);
+        let tau_touch = 8.0 * TOUCH_SNAP_DEG.to_radians() / spin_min + t_slack;
+        // The hottest bin near each cut, on demand (forward queries).
+        let mut near = SlidingMax::new();
+        let (mut ha, mut hb) = (0usize, 0usize);
+        let mut p_near = |c: usize| {
+            let theta = cut_of(cuts, c);
+            let lo = unwrapped_bin(tl, theta - h - 3.0 * TOUCH_SNAP_DEG, &mut ha);
+            let hi = unwrapped_bin(tl, theta + h + 3.0 * TOUCH_SNAP_DEG, &mut hb);
+            near.max_over(lo, hi.max(lo), |k| segs[wrap_index(k, n)].power_w)
+        };
+        // Unwrapped bin `k`'s start, deg.
+        let start_of = |k: i64| 360.0 * k.div_euclid(n) as f64 + segs[wrap_index(k, n)].start_deg;
+        let mut inside = SlidingMax::new();
+        // Per cell. The counts are nondecreasing functions of `τ` (products
+        // by positive constants, sums and floors are monotone in floating
+        // point too), so a value between two arguments of one count has it.
+        let mut window = SlidingMax::new();
+        let (mut h4, mut h5, mut h6, mut h7) = (0usize, 0usize, 0usize, 0usize);
+        let mut per_pass_of = StepMemo::default();
+        let mut passes_of = StepMemo::default();
+        let mut rows = Vec::with_capacity(m);
+        for c in 0..m {
+            let (u, v) = (cut_of(cuts, c), cut_of(cuts, c + 1));
+            let lo = unwrapped_bin(tl, u - h - TOUCH_SNAP_DEG, &mut h4);
+            let hi = unwrapped_bin(tl, v + h + TOUCH_SNAP_DEG, &mut h5);
+            let p = window.max_over(lo, hi.max(lo), |k| segs[wrap_index(k, n)].power_w);
+            let mid = 0.5 * (u + v);
+            let edges = any_curved
+                .then(|| {
+                    let right = tl.locate_unwrapped_from(mid + h, &mut h6);
+                    let left = tl.locate_unwrapped_from(mid - h, &mut h7);
+                    (right, left)
+                })
+                .filter(|(right, left)| bin_curved[right.1] || bin_curved[left.1]);
+            // `ends(..)`'s two values, without the azimuth.
+            let ends_tau = 0.0f64.max(tau_pt[c]).max(tau_pt[c + 1]);
+            let ends_tau_min = tau_pt[c].min(tau_pt[c + 1]);
+            let mut ends_e = 0.0f64;
+            for x in [e_pt[c], e_pt[c + 1]] {
+                if x > ends_e {
+                    ends_e = x;
+                }
+            }
+            let (tau, e, tau_lb) = if let Some((right, left)) = edges {
+                let (seg_r, seg_l) = (&segs[right.1], &segs[left.1]);
+                // ω at both ends of each edge's arc, on that edge's bin.
+                let spin = |seg: &Seg, k: f64, theta: f64| {
+                    let (a, b) = spin_sq_line(seg);
+                    let x = (theta - (360.0 * k + seg.start_deg)).clamp(0.0, seg.width_deg);
+                    (a + b * x).max(0.0).sqrt()
+                };
+                let (wr_u, wr_v) = (spin(seg_r, right.0, u + h), spin(seg_r, right.0, v + h));
+                let (wl_u, wl_v) = (spin(seg_l, left.0, u - h), spin(seg_l, left.0, v - h));
+                let (wr_min, wr_max) = (wr_u.min(wr_v), wr_u.max(wr_v));
+                let (wl_min, wl_max) = (wl_u.min(wl_v), wl_u.max(wl_v));
+                let ((pl_u, pr_u), (pl_v, pr_v)) = (edge_p[c], edge_p[c + 1]);
+                let (pr_min, pr_max) = (pr_u.min(pr_v), pr_u.max(pr_v));
+                let (pl_min, pl_max) = (pl_u.min(pl_v), pl_u.max(pl_v));
+                let width_rad = (v - u).to_radians();
+                let rise = |fwd: f64, back: f64| width_rad * fwd.max(0.0).min(back.max(0.0));
+                // τ falls below its smaller end value by at most the same
+                // (the smaller of its largest descent either way).
+                let tau_rise = rise(1.0 / wr_min - 1.0 / wl_max, 1.0 / wl_min - 1.0 / wr_max);
+                let tau = ends_tau + tau_rise + t_slack;
+                let tau_lb = ends_tau_min - tau_rise - t_slack;
+                let e = ends_e
+                    + rise(
+                        pr_max / wr_min - pl_min / wl_max,
+                        pl_max / wl_min - pr_min / wr_max,
+                    )
+                    + e_slack;
+                (tau, e, tau_lb)
+            } else {
+                (ends_tau, ends_e, ends_tau_min)
+            };
+            let per_pass = per_pass_of.get(tau, |t| max_pulses_in(t, f_p));
+            let passes = passes_of.get(tau, |t| passes_in_window(t2, t, frame_s));
+            let per_j = self.per_j.get(self.laser, per_pass, passes);
+            let mut single = p * delta * per_j;
+            if edges.is_none() {
+                // Rule 1 off the curved cells, tighter: the cell's largest
+                // counts with the bins the passes of its inside meet, and
+                // each end's counts with the bins its passes touch (see
+                // `touch`).
+                // The union arc's bins `[lo, hi]` but a first one that
+                // ends, or a last one that starts, within `s` of the inside
+                // (a superset of the inside's bins).
+                let lo_in = if start_of(lo + 1) <= u - h + TOUCH_SNAP_DEG {
+                    lo + 1
+                } else {
+                    lo
+                };
+                let hi_in = if start_of(hi) >= v + h - TOUCH_SNAP_DEG && hi > lo_in {
+                    hi - 1
+                } else {
+                    hi
+                };
+                // With the hottest bin inside, the first figure below is
+                // `single` itself: nothing to gain.
+                let p_in = if (lo_in, hi_in) == (lo, hi) {
+                    p
+                } else {
+                    inside.max_over(lo_in, hi_in.max(lo_in), |k| segs[wrap_index(k, n)].power_w)
+                };
+                if p_in < p {
+                    let mut at = |p_w: f64, tau_s: f64| {
+                        let k = max_pulses_in(tau_s, f_p);
+                        let q = passes_in_window(t2, tau_s, frame_s);
+                        p_w * delta * self.per_j.get(self.laser, k, q)
+                    };
+                    single = at(p_in, tau)
+                        .max(at(p_near(c), tau_pt[c] + tau_touch))
+                        .max(at(p_near(c + 1), tau_pt[c + 1] + tau_touch))
+                        .min(single);
+                }
+            }
+            rows.push(CellRow {
+                p,
+                curved: edges.is_some(),
+                tau_ub: tau,
+                e_ub: e.min(per_pass * p * delta),
+                env_ub: e,
+                single_ub: single,
+                tau_lb,
+            });
+        }
+        self.tau_pt = tau_pt;
+        self.e_pt = e_pt;
+        self.rows = rows;
+    }
+
+    /// Unwrapped time of the head at unwrapped azimuth `theta`.
+    pub(super) fn time_at(&self, theta: f64) -> f64 {
+        self.tl.time_at_unwrapped_s(theta)
+    }
+
+    /// `ω²(φ + off)` over the cell containing `mid + off`, as `a + b·φ`.
+    fn spin_sq_at(&self, mid: f64, off: f64) -> (f64, f64) {
+        let (k, j, _) = self.tl.locate_unwrapped(mid + off);
+        let seg = &self.tl.bins()[j];
+        let (a, b) = spin_sq_line(seg);
+        let anchor = 360.0 * k + seg.start_deg;
+        (a + b * (off - anchor), b)
+    }
+
+    /// The exact figures of cell `c`: `τ` and `E` at the cell ends and at
+    /// their stationary points inside (see the module docs), the pulse count
+    /// from the cell's largest `τ`, and Rule 1.
+    pub(super) fn exact(&self, c: usize) -> CellExact {
+        let (u, v) = (self.cut(c), self.cut(c + 1));
+        let CellExact {
+            tau_s: mut cell_tau,
+            tau_min_s: mut cell_tau_min,
+            e: mut cell_e,
+            ..
+        } = ends(&self.cuts, &self.tau_pt, &self.e_pt, c);
+        if self.rows[c].curved {
+            let mid = 0.5 * (u + v);
+            let right = self.spin_sq_at(mid, self.h);
+            let left = self.spin_sq_at(mid, -self.h);
+            let pr = self.env.power_at(self.time_at(mid + self.h) + self.delta);
+            let pl = self.env.power_at(self.time_at(mid - self.h));
+            for (wr, wl) in [(1.0, 1.0), (pr, pl)] {
+                // wr²·ω²(φ − h) = wl²·ω²(φ + h)
+                let den = wr * wr * left.1 - wl * wl * right.1;
+                if den != 0.0 {
+                    let phi = (wl * wl * right.0 - wr * wr * left.0) / den;
+                    if phi > u && phi < v {
+                        let t_lo = self.time_at(phi - self.h);
+                        let t_hi = self.time_at(phi + self.h);
+                        cell_tau = cell_tau.max(t_hi - t_lo);
+                        cell_tau_min = cell_tau_min.min(t_hi - t_lo);
+                        let e =
+                            self.env.integral_to(t_hi + self.delta) - self.env.integral_to(t_lo);
+                        if e > cell_e.0 {
+                            cell_e = (e, phi);
+                        }
+                    }
+                }
+            }
+        }
+        let p = self.rows[c].p;
+        let per_pass = max_pulses_in(cell_tau, self.laser.pulse_rate_hz);
+        let passes = passes_in_window(
+            ael::T2_S.min(ael::TIME_BASE_S),
+            cell_tau,
+            self.tl.period_s(),
+        );
+        // A pass also holds at most `per_pass` pulses of at most `p·Δ`, and
+        // at most the pulses each bin's share of it holds (`pulse_capped`).
+        // The per-bin sum can round one ulp above `per_pass·p·Δ` (the
+        // sweep's bound `e_ub`, same operations): take the smaller, so the
+        // exact value never exceeds its bound and the pruned search finds
+        // what the exhaustive one finds.
+        let coarse = per_pass * p * self.delta;
+        let cap = self
+            .pulse_capped_j(u, v, per_pass)
+            .map_or(coarse, |e| e.min(coarse));
+        CellExact {
+            tau_s: cell_tau,
+            tau_min_s: cell_tau_min,
+            e: (cell_e.0.min(cap), wrap360(cell_e.1)),
+            e_env: cell_e.0,
+            // Off the curved cells the sweep's Rule 1 figure is exact.
+            single: if self.rows[c].curved {
+                p * self.delta * self.per_j.peek(self.laser, per_pass, passes)
+            } else {
+                self.rows[c].single_ub
+            },
+        }
+    }
+}
+
+/// Unwrapped index (`turn·n + bin`) of the bin holding unwrapped `theta`.
+pub(super) fn unwrapped_bin(tl: &Timeline<'_, Seg>, theta: f64, hint: &mut usize) -> i64 {
+    let (k, i, _) = tl.locate_unwrapped_from(theta, hint);
+    k as i64 * tl.bins().len() as i64 + i as i64
+}
+
+/// Cut `c` for `c` in `[0, len]`, the last one a turn after the first.
+fn cut_of(cuts: &[f64], c: usize) -> f64 {
+    let m = cuts.len();
+    if c < m {
+        cuts[c]
+    } else {
+        cuts[c - m] + 360.0
+    }
+}
+
+/// `τ` and the envelope `E` (with its azimuth, the first maximum) over the
+/// two ends of cell `c`, from their values at the cuts.
+#[inline]
+fn ends(cuts: &[f64], tau_pt: &[f64], e_pt: &[f64], c: usize) -> CellExact {
+    let mut tau = 0.0f64;
+    let mut tau_min = f64::INFINITY;
+    let mut e = (0.0f64, cut_of(cuts, c));
+    for k in [c, c + 1] {
+        tau = tau.max(tau_pt[k]);
+        tau_min = tau_min.min(tau_pt[k]);
+        if e_pt[k] > e.0 {
+            e = (e_pt[k], cut_of(cuts, k));
+        }
+    }
+    CellExact {
+        tau_s: tau,
+        tau_min_s: tau_min,
+        e,
+        e_env: e.0,
+        single: 0.0,
+    }
+}

@@ -1,0 +1,194 @@
+//! The envelope `P̄(t) = max P over [t − Δ, t]` over one frame period, as
+//! pieces with prefix integrals, extended periodically: every pulse's
+//! energy is at most `∫ P̄` over the `Δ` after it, and these cells are
+//! disjoint, so any time set `S` receives at most `∫ P̄` over `S ⊕ [0, Δ]`
+//! (`specs/eye_safety.md`, "Envelope").
+
+use super::order::{sort_runs, split_index, wrap_index};
+use super::seg::Seg;
+use super::sliding::Queue;
+use crate::profile::kinematics::Timeline;
+
+/// The max-filtered power `P̄` over one period, as pieces `[t_k, t_{k+1})`
+/// with prefix integrals, extended periodically.
+pub(super) struct Envelope {
+    /// Piece starts in `[0, T_f)`, then `T_f`.
+    t_s: Vec<f64>,
+    /// `P̄` on each piece, W.
+    pub(super) p_w: Vec<f64>,
+    /// `∫ P̄` from 0 to each piece start, then the period's total.
+    cum_j: Vec<f64>,
+    pub(super) frame_s: f64,
+}
+
+impl Envelope {
+    pub(super) fn new(tl: &Timeline<'_, Seg>, delta_s: f64) -> Self {
+        let segs = tl.bins();
+        let n = segs.len();
+        let frame_s = tl.period_s();
+        let p_max = segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
+        if delta_s >= frame_s {
+            return Self {
+                t_s: vec![0.0, frame_s],
+                p_w: vec![p_max],
+                cum_j: vec![0.0, p_max * frame_s],
+                frame_s,
+            };
+        }
+        // Candidate breakpoints: bin starts and bin starts + Δ (wrapped).
+        let mut cand: Vec<f64> = Vec::with_capacity(2 * n + 1);
+        cand.extend((0..n).map(|i| tl.bin_start_time_s(i)));
+        cand.extend((0..n).map(|i| {
+            let s = tl.bin_start_time_s(i) + delta_s;
+            if s >= frame_s {
+                s - frame_s
+            } else {
+                s
+            }
+        }));
+        // Increasing runs (the second wraps once): a merge, linear.
+        let mut cand = sort_runs(cand, &[0, n, 2 * n]);
+        if cand[0] > 0.0 {
+            cand.insert(0, 0.0);
+        }
+        // Sliding-window maximum over the unrolled bins (3 periods: bin
+        // index k covers [cum(k mod n) + (k div n − 1)·T_f, ...)).
+        // The deque holds (power, end time) of the bins in it.
+        let (mut turn, mut bin) = (0usize, 0usize); // next bin to push, as k div n, k mod n
+        let offset = |turn: usize| (turn as f64 - 1.0) * frame_s;
+        let mut deque: Queue<(f64, f64)> = Queue::default();
+        // The bins of the period before that end by the first piece's
+        // window (`c_0 − Δ`) never count: they would be pushed and popped
+        // again at the first piece (they come first, and a bin only pops
+        // earlier ones), so they are skipped.
+        while turn == 0 && tl.bin_start_time_s(bin + 1) + offset(turn) <= cand[0] - delta_s {
+            bin += 1;
+            if bin == n {
+                (turn, bin) = (turn + 1, 0);
+            }
+        }
+        let m = cand.len();
+        let mut p_w = Vec::with_capacity(m);
+        for j in 0..m {
+            let lo = cand[j] - delta_s;
+            let hi = if j + 1 < m { cand[j + 1] } else { frame_s };
+            // On the open piece (c_j, c_{j+1}), P̄ is the max over bins
+            // meeting [t − Δ, t]: those starting before c_{j+1} and ending
+            // after c_j − Δ.
+            while turn < 3 && tl.bin_start_time_s(bin) + offset(turn) < hi {
+                let p = segs[bin].power_w;
+                while deque.back().is_some_and(|&(q, _)| q <= p) {
+                    deque.pop_back();
+                }
+                deque.push_back((p, tl.bin_start_time_s(bin + 1) + offset(turn)));
+                bin += 1;
+                if bin == n {
+                    (turn, bin) = (turn + 1, 0);
+                }
+            }
+            while deque.front().is_some_and(|&(_, end)| end <= lo) {
+                deque.pop_front();
+            }
+            p_w.push(deque.front().map_or(p_max, |&(p, _)| p));
+        }
+        let mut t_s = cand;
+        t_s.push(frame_s);
+        let mut cum_j = Vec::with_capacity(m + 1);
+        let mut e = 0.0;
+        cum_j.push(0.0);
+        for j in 0..m {
+            e += p_w[j] * (t_s[j + 1] - t_s[j]);
+            cum_j.push(e);
+        }
+        Self {
+            t_s,
+            p_w,
+            cum_j,
+            frame_s,
+        }
+    }
+
+    pub(super) fn pieces(&self) -> usize {
+        self.p_w.len()
+    }
+
+    /// `∫ P̄` over one period, J.
+    pub(super) fn total_j(&self) -> f64 {
+        self.cum_j[self.pieces()]
+    }
+
+    /// For unwrapped `t`: whole periods before it, its offset in the
+    /// period, and the piece containing that offset.
+    fn locate(&self, t: f64) -> (f64, f64, usize) {
+        let (k, r) = self.split(t);
+        (k, r, self.piece_of(r))
+    }
+
+    /// As [`Self::locate`], searching forward from piece `*hint` (the piece
+    /// of an earlier offset in the same period): the same piece, in amortised
+    /// constant time for increasing times.
+    #[inline]
+    pub(super) fn locate_from(&self, t: f64, hint: &mut usize) -> (f64, f64, usize) {
+        let (k, r) = self.split(t);
+        let m = self.pieces();
+        let mut j = (*hint).min(m - 1);
+        if self.t_s[j] > r {
+            j = self.piece_of(r);
+        } else {
+            while j + 1 < m && self.t_s[j + 1] <= r {
+                j += 1;
+            }
+        }
+        *hint = j;
+        (k, r, j)
+    }
+
+    #[inline]
+    fn split(&self, t: f64) -> (f64, f64) {
+        if (0.0..self.frame_s).contains(&t) {
+            // The common case, without a call to `floor` (same result).
+            return (0.0, t);
+        }
+        let k = (t / self.frame_s).floor();
+        (k, t - k * self.frame_s)
+    }
+
+    fn piece_of(&self, r: f64) -> usize {
+        self.t_s
+            .partition_point(|&c| c <= r)
+            .saturating_sub(1)
+            .min(self.pieces() - 1)
+    }
+
+    #[inline]
+    pub(super) fn integral_at(&self, (k, r, j): (f64, f64, usize)) -> f64 {
+        k * self.total_j() + self.cum_j[j] + self.p_w[j] * (r - self.t_s[j])
+    }
+
+    /// `∫₀^t P̄` for unwrapped `t`.
+    pub(super) fn integral_to(&self, t: f64) -> f64 {
+        self.integral_at(self.locate(t))
+    }
+
+    /// `P̄` on the piece containing unwrapped `t`.
+    pub(super) fn power_at(&self, t: f64) -> f64 {
+        self.p_w[self.locate(t).2]
+    }
+
+    /// Unwrapped breakpoint `idx` (piece starts, periodic).
+    pub(super) fn bp(&self, idx: i64) -> f64 {
+        let m = self.pieces() as i64;
+        let (k, j) = split_index(idx, m);
+        self.t_s[j] + k as f64 * self.frame_s
+    }
+
+    /// Unwrapped index of the piece containing unwrapped `t`.
+    pub(super) fn unwrapped_piece(&self, t: f64, hint: &mut usize) -> i64 {
+        let (k, _, j) = self.locate_from(t, hint);
+        k as i64 * self.pieces() as i64 + j as i64
+    }
+
+    pub(super) fn p_of(&self, idx: i64) -> f64 {
+        self.p_w[wrap_index(idx, self.pieces() as i64)]
+    }
+}

@@ -1,0 +1,438 @@
+//! The laser's limit maths: the AEL of Table 3 at a duration (the smaller
+//! row at a row edge), Rule 1 (C5 and the `T_i` groups), the multi-pass
+//! rules A (envelope) and C (pass count) up to the time base, and the
+//! [`Rule`]s a figure is reported under (`specs/eye_safety.md`, "Rule 1",
+//! "Rule 2").
+
+use super::count::{max_pulses_in, passes_in_window};
+use crate::eye_safety::ael::{self, Band, Row};
+
+/// The laser and band constants every rule needs.
+#[derive(Debug, Clone, Copy)]
+pub struct Laser {
+    /// Band.
+    pub band: Band,
+    /// C4.
+    pub c4: f64,
+    /// Pulse duration, s.
+    pub pulse_duration_s: f64,
+    /// Pulse rate, Hz.
+    pub pulse_rate_hz: f64,
+}
+
+impl Laser {
+    /// AEL for an exposure of `t_s` (clamped to the pulse duration below and
+    /// the table's end above), restrictive at row edges.
+    #[must_use]
+    pub fn ael_j(&self, t_s: f64) -> f64 {
+        let t = t_s
+            .max(self.pulse_duration_s)
+            .max(self.band.min_duration_s())
+            .min(ael::T_MAX_TABLE_S);
+        ael::table3_j(self.band, self.c4, t)
+    }
+
+    /// Table 3 rows of the band.
+    #[must_use]
+    pub fn rows(&self) -> [Row; 4] {
+        ael::rows(self.band, self.c4)
+    }
+
+    /// AEL row edges (and the pulse duration) inside `(lo, hi)`.
+    pub(super) fn edges_within(&self, lo: f64, hi: f64) -> impl Iterator<Item = f64> {
+        let rows = self.rows();
+        let p = self.pulse_duration_s;
+        rows.into_iter()
+            .flat_map(|r| [r.t_lo_s, r.t_hi_s])
+            .chain(std::iter::once(p))
+            .filter(move |&t| t > lo && t < hi)
+    }
+
+    /// The smallest AEL over `[lo_s, hi_s]`: the AEL grows within each row
+    /// of Table 3 but may fall at a row edge (905 nm at 5 µs, where
+    /// [`Self::ael_j`] takes the smaller row), so the ends and the edges
+    /// between are every candidate.
+    pub(super) fn min_ael_over(&self, lo_s: f64, hi_s: f64) -> f64 {
+        let mut a = self.ael_j(lo_s).min(self.ael_j(hi_s));
+        for t in self.edges_within(lo_s, hi_s) {
+            a = a.min(self.ael_j(t));
+        }
+        a
+    }
+
+    /// `sup τ/AEL(τ)` over `0 < τ ≤ tau_hi_s`: on every row of Table 3 the
+    /// AEL is `c·τ^p` with `0 ≤ p ≤ 1`, so `τ/AEL(τ)` is nondecreasing
+    /// within a row (and below the clamp at the pulse duration, where the
+    /// AEL is constant), and the supremum is at `tau_hi_s` or at a row edge
+    /// below it (where [`Self::ael_j`] takes the smaller row). Bounds
+    /// `E/AEL(τ) ≤ (E/τ)·K` for every `τ ≤ tau_hi_s`.
+    pub(super) fn mean_power_factor(&self, tau_hi_s: f64) -> f64 {
+        let mut k = tau_hi_s / self.ael_j(tau_hi_s);
+        for t in self.edges_within(0.0, tau_hi_s) {
+            k = k.max(t / self.ael_j(t));
+        }
+        k
+    }
+
+    /// Pulses grouped into one effective pulse (summed within `T_i`, 700–1050 nm):
+    /// the most pulses a closed `T_i` window holds, at most `per_pass`.
+    #[must_use]
+    pub fn group(&self, per_pass: f64) -> f64 {
+        if self.band == Band::RetinalNir && self.pulse_duration_s <= self.band.t_i_s() {
+            max_pulses_in(self.band.t_i_s(), self.pulse_rate_hz).min(per_pass.max(1.0))
+        } else {
+            1.0
+        }
+    }
+
+    /// Rule 1 ratio for pulses (or groups) of at most `pulse_energy_j` each
+    /// (one pulse; the group is applied here), with at most `per_pass`
+    /// pulses in any pass and `passes_t2` passes meeting any T2 window:
+    /// `pulse_energy_j ×` [`Self::single_pulse_ratio_per_j`].
+    #[must_use]
+    pub fn single_pulse_ratio(&self, pulse_energy_j: f64, per_pass: f64, passes_t2: f64) -> f64 {
+        pulse_energy_j * self.single_pulse_ratio_per_j(per_pass, passes_t2)
+    }
+
+    /// Rule 1 ratio per joule of pulse energy. Nondecreasing in both counts:
+    /// C5 falls as the pulse count grows, and the `T_i` group grows with the
+    /// pulses per pass until it reaches its cap, after which the number of
+    /// groups grows.
+    #[must_use]
+    pub fn single_pulse_ratio_per_j(&self, per_pass: f64, passes_t2: f64) -> f64 {
+        let t_max = ael::T2_S.min(ael::TIME_BASE_S);
+        let g = self.group(per_pass);
+        // C5 = 1 for pulses longer than T_i (2014 small-source rule).
+        let c5_of = |n: f64| {
+            if self.pulse_duration_s > self.band.t_i_s() {
+                1.0
+            } else {
+                ael::c5(self.band, n, t_max)
+            }
+        };
+        let n_pulses = per_pass * passes_t2;
+        let single = 1.0 / (c5_of(n_pulses) * self.ael_j(self.pulse_duration_s));
+        if g > 1.0 {
+            // Greedy grouping from the first pulse: ⌈K/g⌉ groups per pass.
+            let n_groups = (per_pass / g).ceil() * passes_t2;
+            let group = g / (c5_of(n_groups) * self.ael_j(self.band.t_i_s()));
+            single.max(group)
+        } else {
+            single
+        }
+    }
+
+    /// The largest ratio `min(cap_j, e0_j + slope_w·(T − t0))/AEL(T)` over
+    /// `T ∈ [t0, t1]`, the energy being linear until it reaches `cap_j`
+    /// and flat after: evaluated at the segment ends, at the cap and at every
+    /// AEL row edge in between (the ratio has no interior maximum).
+    pub(super) fn linear_capped_max(
+        &self,
+        t0: f64,
+        t1: f64,
+        e0_j: f64,
+        slope_w: f64,
+        cap_j: f64,
+    ) -> (f64, f64) {
+        if t1.is_nan() || t0.is_nan() || t1 < t0 {
+            return (0.0, t0);
+        }
+        let energy = |t: f64| (e0_j + slope_w * (t - t0)).min(cap_j);
+        let mut best = (0.0, t0);
+        let mut consider = |t: f64| {
+            let r = energy(t) / self.ael_j(t);
+            if r > best.0 {
+                best = (r, t);
+            }
+        };
+        consider(t0);
+        consider(t1);
+        if slope_w > 0.0 && e0_j < cap_j {
+            let t_cap = t0 + (cap_j - e0_j) / slope_w;
+            if t_cap > t0 && t_cap < t1 {
+                consider(t_cap);
+            }
+        }
+        for t in self.edges_within(t0, t1) {
+            consider(t);
+        }
+        best
+    }
+
+    /// Rule 2 over windows spanning several passes, up to the time base:
+    /// returns (ratio, window duration). Windows from
+    /// `T_f − max(τ, Δ)` on (where a window can first meet two passes) are
+    /// bounded two ways, each valid for every window, and the smaller
+    /// supremum is returned (`sup min(A, C) ≤ min(sup A, sup C)`):
+    ///
+    /// - **A, envelope:** `q·E + min(E, P̂·r)` with `L = T + Δ = q·T_f + r`
+    ///   and `E` = [`PassFigures::envelope_j`], the integral of the received
+    ///   envelope over one period (see the module docs);
+    /// - **C, pass count:** at most [`passes_in_window`] passes meet a window,
+    ///   each carrying at most [`PassFigures::pulses_j`].
+    ///
+    /// A must use the envelope integral, not the pulse-capped pass energy:
+    /// the pulses of a pass sit anywhere in it, so `m` capped passes can fit
+    /// in `(m − 1)·T_f + r` with `P̂·r` below one capped pass (found by the
+    /// differential test: 9 passes of 3 pulses at 2049 Hz in 0.3563 s).
+    #[must_use]
+    pub fn multi_pass_ratio(&self, frame_s: f64, pass: PassFigures, p_hat_w: f64) -> (f64, f64) {
+        let delta = 1.0 / self.pulse_rate_hz;
+        let tb = ael::TIME_BASE_S;
+        let t_start = (frame_s - pass.duration_s.max(delta)).max(0.0);
+        if pass.envelope_j <= 0.0 || pass.pulses_j <= 0.0 || t_start >= tb {
+            return (0.0, t_start);
+        }
+        let a = self.envelope_family_max(frame_s, pass.envelope_j, p_hat_w, t_start);
+        let c = self.pass_count_max(frame_s, pass, t_start);
+        if a.0 <= c.0 {
+            a
+        } else {
+            c
+        }
+    }
+
+    /// The time-base figure: the smaller of the two multi-pass energy
+    /// bounds over a window of the time base, over its AEL.
+    #[must_use]
+    pub fn time_base_ratio(&self, frame_s: f64, pass: PassFigures, p_hat_w: f64) -> f64 {
+        let delta = 1.0 / self.pulse_rate_hz;
+        let tb = ael::TIME_BASE_S;
+        let e = pass
+            .envelope_energy(tb, frame_s, delta, p_hat_w)
+            .min(pass.count_energy(tb, frame_s));
+        e / self.ael_j(tb)
+    }
+
+    /// `sup A(T)/AEL(T)` over `[t_start, T_b]` (see [`Self::multi_pass_ratio`]):
+    /// within a row of Table 3 (`c·T^p`, `0 ≤ p ≤ 1`) the ratio has no
+    /// interior maximum on a linear piece of `A`, and over the family of
+    /// piece ends `T = q·T_f + r_f − Δ` it is quasi-convex in `q`, so the
+    /// row edges, `t_start`, `T_b` and the first and last two `q` of each
+    /// row and family are every candidate.
+    fn envelope_family_max(
+        &self,
+        frame_s: f64,
+        e_j: f64,
+        p_hat_w: f64,
+        t_start: f64,
+    ) -> (f64, f64) {
+        let delta = 1.0 / self.pulse_rate_hz;
+        let r_star = if p_hat_w > 0.0 {
+            (e_j / p_hat_w).min(frame_s)
+        } else {
+            frame_s
+        };
+        let fig = PassFigures {
+            envelope_j: e_j,
+            pulses_j: e_j,
+            duration_s: 0.0,
+        };
+        self.row_sup(
+            t_start,
+            |t| fig.envelope_energy(t, frame_s, delta, p_hat_w),
+            |lo, hi| {
+                // Family points T = q·T_f + r_f − Δ, r_f ∈ {0, r*}: first and last q in the row.
+                let mut ts = Vec::with_capacity(8);
+                for r_f in [0.0, r_star] {
+                    let q_lo = ((lo + delta - r_f) / frame_s).ceil().max(0.0);
+                    let q_hi = ((hi + delta - r_f) / frame_s).floor();
+                    for q in [q_lo, q_lo + 1.0, q_hi - 1.0, q_hi] {
+                        if q >= 0.0 && q <= q_hi && q >= q_lo {
+                            ts.push(q * frame_s + r_f - delta);
+                        }
+                    }
+                }
+                ts
+            },
+        )
+    }
+
+    /// `sup C(T)/AEL(T)` over `[t_start, T_b]`: `C` steps up at
+    /// `T_k = k·T_f − τ` (to `k + 1` passes) and is flat between, where the
+    /// ratio is largest at the step or at a row edge; over the steps of one
+    /// row, `(k + 1)·e/(c·(k·T_f − τ)^p)` is quasi-convex in `k`, so the
+    /// first and last two steps of each row are every candidate.
+    fn pass_count_max(&self, frame_s: f64, pass: PassFigures, t_start: f64) -> (f64, f64) {
+        let tau = pass.duration_s.max(0.0);
+        self.row_sup(
+            t_start,
+            |t| pass.count_energy(t, frame_s),
+            |lo, hi| {
+                let k_lo = ((lo + tau) / frame_s).ceil().max(1.0);
+                let k_hi = ((hi + tau) / frame_s).floor();
+                [k_lo, k_lo + 1.0, k_hi - 1.0, k_hi]
+                    .into_iter()
+                    .filter(|&k| k >= 1.0 && k >= k_lo && k <= k_hi)
+                    .map(|k| k * frame_s - tau)
+                    .collect()
+            },
+        )
+    }
+
+    /// The largest `energy(T)/AEL(T)` over `T ∈ [t_start, T_b]` among
+    /// `t_start`, `T_b`, every row's edges and the row's own candidates
+    /// `inner(lo, hi)`: (ratio, duration).
+    fn row_sup(
+        &self,
+        t_start: f64,
+        energy: impl Fn(f64) -> f64,
+        inner: impl Fn(f64, f64) -> Vec<f64>,
+    ) -> (f64, f64) {
+        let tb = ael::TIME_BASE_S;
+        let mut best = (0.0, t_start);
+        let mut consider = |t: f64| {
+            if t >= t_start && t <= tb {
+                let r = energy(t) / self.ael_j(t);
+                if r > best.0 {
+                    best = (r, t);
+                }
+            }
+        };
+        consider(t_start);
+        consider(tb);
+        for row in self.rows() {
+            let lo = row.t_lo_s.max(t_start);
+            let hi = row.t_hi_s.min(tb);
+            if lo > hi {
+                continue;
+            }
+            consider(lo);
+            consider(hi);
+            for t in inner(lo, hi) {
+                consider(t);
+            }
+        }
+        best
+    }
+
+    /// Ratio of a stationary beam (every pulse enters the aperture: a
+    /// stalled rotor, or the `ael` report) of power `power_w`.
+    #[must_use]
+    pub fn stationary_ratio(&self, power_w: f64) -> (f64, Rule) {
+        let delta = 1.0 / self.pulse_rate_hz;
+        let t2 = ael::T2_S.min(ael::TIME_BASE_S);
+        // All pulses of T2 in one "pass".
+        let per_pass = max_pulses_in(t2, self.pulse_rate_hz);
+        let single = self.single_pulse_ratio(power_w * delta, per_pass, 1.0);
+        let (train, t) = self.linear_capped_max(
+            self.pulse_duration_s,
+            ael::TIME_BASE_S,
+            power_w * (self.pulse_duration_s + delta),
+            power_w,
+            f64::INFINITY,
+        );
+        if single >= train {
+            (single, Rule::SinglePulse)
+        } else {
+            (train, Rule::for_duration(t, f64::INFINITY))
+        }
+    }
+}
+
+/// What the multi-pass rules know of one aperture's passes, as maxima over
+/// every aperture azimuth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassFigures {
+    /// Largest integral of the received envelope over one pass widened by a
+    /// pulse spacing (`E(φ)` of the module docs), J.
+    pub envelope_j: f64,
+    /// Largest energy the pulses of one pass can carry (the envelope capped
+    /// by the pass's pulse count), J; at most `envelope_j`.
+    pub pulses_j: f64,
+    /// Longest pass, s.
+    pub duration_s: f64,
+}
+
+impl PassFigures {
+    /// Bound A: the energy of the pulses an aperture receives in any window
+    /// of `t_s`, from the envelope's periodicity: `q·E + min(E, P̂·r)`,
+    /// `L = T + Δ = q·T_f + r`.
+    #[must_use]
+    pub fn envelope_energy(&self, t_s: f64, frame_s: f64, delta_s: f64, p_hat_w: f64) -> f64 {
+        let l = t_s + delta_s;
+        let q = (l / frame_s).floor();
+        let r = (l - q * frame_s).max(0.0);
+        q * self.envelope_j + self.envelope_j.min(p_hat_w * r)
+    }
+
+    /// Bound C: at most [`passes_in_window`] passes meet a window of `t_s`,
+    /// each with at most [`Self::pulses_j`].
+    #[must_use]
+    pub fn count_energy(&self, t_s: f64, frame_s: f64) -> f64 {
+        passes_in_window(t_s, self.duration_s.max(0.0), frame_s) * self.pulses_j
+    }
+}
+
+/// An eye-safety rule, by the window it bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum Rule {
+    /// Each pulse (or `T_i` group) against the C5-corrected single-pulse AEL.
+    SinglePulse,
+    /// Pulse-train energy in windows shorter than one revolution (within a pass).
+    PassTrain,
+    /// Pulse-train energy in windows of one revolution up to T2 = 10 s.
+    T2Train,
+    /// Pulse-train energy in windows beyond T2 up to the 100 s time base
+    /// (the average-power rule).
+    TimeBase,
+}
+
+impl Rule {
+    /// The rule whose windows contain duration `t_s` (frame period `frame_s`).
+    #[must_use]
+    pub fn for_duration(t_s: f64, frame_s: f64) -> Self {
+        if t_s < frame_s {
+            Self::PassTrain
+        } else if t_s <= ael::T2_S {
+            Self::T2Train
+        } else {
+            Self::TimeBase
+        }
+    }
+}
+
+impl std::fmt::Display for Rule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::SinglePulse => "single-pulse energy (C5-corrected)",
+            Self::PassTrain => "pulse-train energy within one pass",
+            Self::T2Train => "pulse-train energy over several passes (up to T2 = 10 s)",
+            Self::TimeBase => "average power over the 100 s time base",
+        })
+    }
+}
+
+/// [`Laser::single_pulse_ratio_per_j`] for the few distinct (pulse count,
+/// pass count) pairs a profile has (a memo: the same value as a fresh call).
+#[derive(Default)]
+pub(super) struct PerJouleCache {
+    last: Option<((f64, f64), f64)>,
+    map: std::collections::HashMap<(u64, u64), f64>,
+}
+
+impl PerJouleCache {
+    pub(super) fn get(&mut self, laser: &Laser, per_pass: f64, passes: f64) -> f64 {
+        if let Some((key, v)) = self.last {
+            if key == (per_pass, passes) {
+                return v;
+            }
+        }
+        let v = *self
+            .map
+            .entry((per_pass.to_bits(), passes.to_bits()))
+            .or_insert_with(|| laser.single_pulse_ratio_per_j(per_pass, passes));
+        self.last = Some(((per_pass, passes), v));
+        v
+    }
+
+    /// As [`Self::get`] without memoizing a new pair.
+    pub(super) fn peek(&self, laser: &Laser, per_pass: f64, passes: f64) -> f64 {
+        self.map
+            .get(&(per_pass.to_bits(), passes.to_bits()))
+            .copied()
+            .unwrap_or_else(|| laser.single_pulse_ratio_per_j(per_pass, passes))
+    }
+}

@@ -1,0 +1,229 @@
+//! Rule 2 within one pass: the window walks from the envelope's steps
+//! (`specs/eye_safety.md`, "Walks"), each followed piece by piece up to its
+//! reach, in decreasing order of their bound when pruned.
+
+use super::count::{PRUNE_SLACK, REACH_SLACK};
+use super::envelope::Envelope;
+use super::laser::Laser;
+use super::search::Best;
+use super::seg::Seg;
+use super::sliding::SlidingMax;
+use super::Search;
+use crate::profile::kinematics::Timeline;
+
+/// Envelope pieces a window walk visits before it continues with the slope
+/// of the hottest piece within its reach (sound, looser); bounds the work on
+/// very fine profiles.
+pub const WALK_MAX_PIECES: usize = 96;
+
+/// Rule 2 for windows shorter than one revolution (see [`Walks::search`]).
+pub(super) struct Walks<'a> {
+    pub(super) env: &'a Envelope,
+    pub(super) tl: &'a Timeline<'a, Seg>,
+    pub(super) laser: &'a Laser,
+    /// The pass angle `2h`, deg.
+    pub(super) two_h_deg: f64,
+    /// The largest pass energy `E⁺`, J.
+    pub(super) e_pass: f64,
+    /// Longest window a walk follows: a pass plus one pulse spacing, s.
+    pub(super) l_max: f64,
+}
+
+impl Walks<'_> {
+    /// The supremum of `min(E⁺, ∫ P̄ over J)/AEL(T)` over the windows that
+    /// fit in one pass, after `best` (the whole-pass windows,
+    /// [`Cells::full_pass`]).
+    ///
+    /// A window `W` of duration `T` meets the pass `I_φ = [a, a + τ(φ)]` of
+    /// aperture `φ` in pulses whose envelope cells lie in
+    /// `J = (W ⊕ [0, Δ]) ∩ (I_φ ⊕ [0, Δ]) = [u, u + ℓ]`, `ℓ ≤ T + Δ`; the
+    /// head is at `θ(u) ≥ φ − h` at `u`, so the pass ends by
+    /// `t(θ(u) + 2h)` and `ℓ ≤ R(u) = t(θ(u) + 2h) + Δ − u`. The ratio is at
+    /// most `g(u, ℓ) = min(E⁺, ∫_J P̄)/AEL(ℓ − Δ)` over `0 < ℓ ≤ R(u)`. For a
+    /// fixed `ℓ`, `∫_J P̄` is piecewise linear in `u` and its maxima over
+    /// each interval of feasible `u` lie where `u` is an up-step of `P̄` or
+    /// `u + ℓ` a down-step (the walks: forward from up-steps up to `R(u)`,
+    /// backward from down-steps `b` up to `b − t(θ(b − Δ) − 2h)`, the same
+    /// condition), or at the interval's ends, where `ℓ = R(u)`: `J` is then
+    /// the whole pass of `θ(u) + h` (the `best` given).
+    ///
+    /// Pruned: a walk's windows hold at most `min(E⁺, p·L)` with `p` the
+    /// highest `P̄` it can reach, so its ratio is at most
+    /// `G(p) = sup_T min(E⁺, p·(T + Δ))/AEL(T)` (over `T` up to `l_max`),
+    /// nondecreasing in `p`; walks are followed in decreasing `p` until
+    /// `G(p)` falls below the best.
+    pub(super) fn search(&self, search: Search, mut best: Best) -> Best {
+        let laser = self.laser;
+        let delta = 1.0 / laser.pulse_rate_hz;
+        let t_walk = self.l_max - delta;
+        if t_walk <= 0.0 {
+            return best;
+        }
+        let walks = self.walks();
+        match search {
+            Search::Exhaustive => {
+                for &w in &walks {
+                    self.walk(w, &mut best);
+                }
+            }
+            Search::Pruned => {
+                let mut order: Vec<usize> = (0..walks.len()).collect();
+                order.sort_unstable_by(|&a, &b| {
+                    walks[b].p_span.total_cmp(&walks[a].p_span).then(a.cmp(&b))
+                });
+                let mut g = (f64::NAN, 0.0);
+                for k in order {
+                    let w = walks[k];
+                    if g.0 != w.p_span {
+                        let (r, _) = laser.linear_capped_max(
+                            0.0,
+                            t_walk,
+                            w.p_span * delta,
+                            w.p_span,
+                            self.e_pass,
+                        );
+                        g = (w.p_span, r * (1.0 + PRUNE_SLACK));
+                    }
+                    if g.1 < best.0 {
+                        break;
+                    }
+                    self.walk(w, &mut best);
+                }
+            }
+        }
+        best
+    }
+
+    /// Every walk: its start piece, direction, reach (the longest `ℓ` it
+    /// follows, widened by [`REACH_SLACK`]) and the highest `P̄` within it.
+    /// Walks start only at steps of `P̄` (and at the first piece, so a
+    /// constant envelope has one). The reaches' far ends are made monotone
+    /// in the walk order (widened: a running maximum forward, a running
+    /// minimum from the end backward) for the sliding maxima.
+    fn walks(&self) -> Vec<WalkSpec> {
+        let env = self.env;
+        let tl = self.tl;
+        let delta = 1.0 / self.laser.pulse_rate_hz;
+        let slack = REACH_SLACK * env.frame_s;
+        let m = env.pieces() as i64;
+        // (start piece, far end of the reach) of each forward and backward walk.
+        let mut fwd_ends: Vec<(i64, f64)> = Vec::new();
+        let mut back_starts: Vec<(i64, f64)> = Vec::new();
+        let (mut ha, mut hb, mut hc, mut hd) = (0usize, 0usize, 0usize, 0usize);
+        let mut p_prev = env.p_of(-1);
+        for i in 0..m {
+            let p_i = env.p_w[i as usize];
+            let up = p_i > p_prev;
+            let down = p_i < p_prev;
+            p_prev = p_i;
+            let b0 = env.bp(i);
+            if up || i == 0 {
+                let theta = tl.azimuth_at_unwrapped_from_deg(b0, &mut ha);
+                let end =
+                    tl.time_at_unwrapped_from_s(theta + self.two_h_deg, &mut hb) + delta + slack;
+                let end = end.min(b0 + self.l_max);
+                let end = fwd_ends.last().map_or(end, |&(_, e)| end.max(e));
+                fwd_ends.push((i, end));
+            }
+            if down {
+                let theta = tl.azimuth_at_unwrapped_from_deg(b0 - delta, &mut hc);
+                let start = tl.time_at_unwrapped_from_s(theta - self.two_h_deg, &mut hd) - slack;
+                back_starts.push((i, start.max(b0 - self.l_max)));
+            }
+        }
+        for k in (0..back_starts.len().saturating_sub(1)).rev() {
+            back_starts[k].1 = back_starts[k].1.min(back_starts[k + 1].1);
+        }
+        let mut out = Vec::with_capacity(fwd_ends.len() + back_starts.len());
+        let (mut fwd, mut back) = (SlidingMax::new(), SlidingMax::new());
+        let (mut h_fwd, mut h_back) = (0usize, 0usize);
+        for &(i, end) in &fwd_ends {
+            let b0 = env.bp(i);
+            let j = env.unwrapped_piece(end, &mut h_fwd).max(i);
+            out.push(WalkSpec {
+                start: i,
+                dir: 1,
+                reach_s: end - b0,
+                p_span: fwd.max_over(i, j, |k| env.p_of(k)),
+            });
+        }
+        for &(i, start) in &back_starts {
+            let b0 = env.bp(i);
+            let j = env.unwrapped_piece(start, &mut h_back).min(i - 1);
+            out.push(WalkSpec {
+                start: i,
+                dir: -1,
+                reach_s: b0 - start,
+                p_span: back.max_over(j, i - 1, |k| env.p_of(k)),
+            });
+        }
+        out
+    }
+
+    /// One walk: the window energy is linear in `L` between breakpoints, up
+    /// to the walk's reach; after `WALK_MAX_PIECES` pieces it is bounded by
+    /// the slope `p_span` (the highest `P̄` within the reach).
+    fn walk(&self, w: WalkSpec, best: &mut Best) {
+        let env = self.env;
+        let laser = self.laser;
+        let delta = 1.0 / laser.pulse_rate_hz;
+        let e_pass = self.e_pass;
+        let reach = w.reach_s;
+        let t_reach = reach - delta;
+        let b0 = env.bp(w.start);
+        let (mut e, mut l, mut idx) = (0.0f64, 0.0f64, w.start);
+        for _ in 0..WALK_MAX_PIECES {
+            let (next_idx, piece_p) = if w.dir > 0 {
+                (idx + 1, env.p_of(idx))
+            } else {
+                (idx - 1, env.p_of(idx - 1))
+            };
+            let seg_end = (env.bp(next_idx) - b0).abs().min(reach);
+            if seg_end > delta {
+                let l0 = l.max(delta);
+                let e0 = e + piece_p * (l0 - l);
+                best.take(laser.linear_capped_max(
+                    l0 - delta,
+                    seg_end - delta,
+                    e0,
+                    piece_p,
+                    e_pass,
+                ));
+            }
+            e += piece_p * (seg_end - l);
+            l = seg_end;
+            if e >= e_pass {
+                // From here on the window holds at most E⁺: the ratio is
+                // largest where it gets there.
+                let t_c = if piece_p > 0.0 {
+                    (l - (e - e_pass) / piece_p - delta).max(0.0)
+                } else {
+                    (l - delta).max(0.0)
+                };
+                best.take(laser.linear_capped_max(t_c, t_reach.max(t_c), e_pass, 0.0, e_pass));
+                return;
+            }
+            if l >= reach {
+                return;
+            }
+            idx = next_idx;
+        }
+        // Truncated: longer windows gain at most `p_span` per second.
+        let l0 = l.max(delta);
+        let e0 = e + w.p_span * (l0 - l);
+        best.take(laser.linear_capped_max(l0 - delta, t_reach, e0, w.p_span, e_pass));
+    }
+}
+
+/// One window walk of [`Walks`].
+#[derive(Debug, Clone, Copy)]
+struct WalkSpec {
+    /// Envelope breakpoint it starts at (unwrapped piece index).
+    start: i64,
+    /// +1 forward (window starts there), −1 backward (window ends there).
+    dir: i64,
+    /// The longest window span `L` it follows, s.
+    reach_s: f64,
+    /// Highest `P̄` within the reach, W.
+    p_span: f64,
+}
