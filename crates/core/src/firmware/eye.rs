@@ -721,8 +721,7 @@ impl Greedy<'_> {
 #[cfg(feature = "std")]
 mod derive {
     use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
-    use crate::eye_safety::ael::{self, T2_S, TIME_BASE_S};
-    use crate::eye_safety::bound::Laser;
+    use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
     use crate::eye_safety::EyeSafetyError;
     use crate::firmware::FirmwareTable;
@@ -771,18 +770,6 @@ mod derive {
         let c = x.ceil();
         let c = if c == x && residual > 0.0 { c + 1.0 } else { c };
         Some(c as u64)
-    }
-
-    /// `AEL_inf(t) = inf AEL` over `[t, 100 s]`, by the model's one AEL
-    /// infimum ([`ael::ael_inf_j`]; durations below the pulse's own take
-    /// the pulse's AEL, as `Laser::ael_j` does).
-    fn ael_inf(laser: &Laser, t_s: f64) -> f64 {
-        ael::ael_inf_j(
-            laser.band,
-            laser.c4,
-            t_s.max(laser.pulse_duration_s),
-            TIME_BASE_S,
-        )
     }
 
     impl IntEyeLimits {
@@ -850,7 +837,7 @@ mod derive {
                 let t = (k - 1) as f64 / f_p * (1.0 - 1e-12);
                 train.push(TrainLimit {
                     pulses_from: k,
-                    energy_max_quanta: to_quanta(ael_inf(&laser, t)),
+                    energy_max_quanta: to_quanta(laser.ael_inf_j(t, TIME_BASE_S)),
                 });
                 if k >= k_max {
                     break;
@@ -881,7 +868,7 @@ mod derive {
                 if t > TIME_BASE_S {
                     break;
                 }
-                let per_pass = to_quanta(ael_inf(&laser, t)) / (m as u64);
+                let per_pass = to_quanta(laser.ael_inf_j(t, TIME_BASE_S)) / (m as u64);
                 if per_pass < pass_energy_max_quanta {
                     pass_energy_max_quanta = per_pass;
                     pass_energy_rule = if t <= T2_S {

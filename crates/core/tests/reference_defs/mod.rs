@@ -541,7 +541,11 @@ impl DefReference {
         let all = self.train(phi, clock, turns);
         let timing = std::env::var_os("GAZE_LIDAR_REF_TIMING").is_some();
         if timing {
-            eprintln!("  defs: {} pulses generated in {:?}", all.len(), t_gen.elapsed());
+            eprintln!(
+                "  defs: {} pulses generated in {:?}",
+                all.len(),
+                t_gen.elapsed()
+            );
         }
         let mut best = DWorst {
             ratio: 0.0,
