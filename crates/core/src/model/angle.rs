@@ -49,14 +49,18 @@ pub enum AngleError {
 #[must_use]
 pub fn wrap_deg(angle_deg: f64) -> f64 {
     // Fast paths, bit-identical to `rem_euclid` (whose `%` is exact, and
-    // `x − 360` is exact for x in [360, 720) by Sterbenz's lemma): the hot
-    // loops of the simulator call this per pulse.
+    // `x − 360` is exact for x in [360, 720) by Sterbenz's lemma) but at
+    // −360 (+0 here, −0 there): the hot loops of the simulator call this per
+    // pulse, and the eye-safety bound per cut.
     if (0.0..FULL_TURN_DEG).contains(&angle_deg) {
         return angle_deg;
     }
     if (-FULL_TURN_DEG..0.0).contains(&angle_deg) {
         let w = angle_deg + FULL_TURN_DEG;
         return if w >= FULL_TURN_DEG { 0.0 } else { w };
+    }
+    if (FULL_TURN_DEG..2.0 * FULL_TURN_DEG).contains(&angle_deg) {
+        return angle_deg - FULL_TURN_DEG;
     }
     let w = angle_deg.rem_euclid(FULL_TURN_DEG);
     // rem_euclid can return exactly 360.0 for tiny negative inputs (rounding).
@@ -764,12 +768,22 @@ mod tests {
         }
 
         #[test]
-        fn wrap_fast_paths_match_rem_euclid(a in -1000.0f64..1000.0) {
+        fn wrap_fast_paths_match_rem_euclid(a in prop_oneof![
+            -1000.0f64..1000.0, -1e4f64..1e4, -720.0f64..720.0, -1e-12f64..1e-12,
+            Just(-0.0), Just(0.0), Just(360.0), Just(720.0), Just(-1e-300),
+            Just(359.999_999_999_999_94), Just(719.999_999_999_999_9), Just(f64::NAN),
+            Just(f64::INFINITY),
+        ]) {
             let reference = {
                 let w = a.rem_euclid(FULL_TURN_DEG);
                 if w >= FULL_TURN_DEG { 0.0 } else { w }
             };
-            prop_assert_eq!(wrap_deg(a).to_bits(), reference.to_bits());
+            if a == -FULL_TURN_DEG {
+                // `rem_euclid` gives −0 there.
+                prop_assert_eq!(wrap_deg(a).to_bits(), 0.0f64.to_bits());
+            } else {
+                prop_assert_eq!(wrap_deg(a).to_bits(), reference.to_bits());
+            }
         }
 
         #[test]

@@ -10,9 +10,10 @@ use super::count::{max_pulses_in, passes_in_window, StepMemo, PRUNE_SLACK, TOUCH
 use super::envelope::Envelope;
 use super::laser::{Laser, PerJouleCache};
 use super::order::{sort_runs, wrap_index};
-use super::seg::{spin_sq_line, wrap360, Seg};
+use super::seg::{spin_sq_line, Seg};
 use super::sliding::SlidingMax;
 use crate::eye_safety::ael;
+use crate::model::angle::wrap_deg;
 use crate::profile::kinematics::Timeline;
 
 /// One cell's exact figures.
@@ -85,17 +86,17 @@ impl<'a> Cells<'a> {
         // φ-cells: azimuths where a pass edge, or a pass edge shifted by Δ in
         // time, meets a bin edge.
         let mut cuts: Vec<f64> = Vec::with_capacity(4 * n + 1);
-        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg + h)));
-        cuts.extend(segs.iter().map(|s| wrap360(s.start_deg - h)));
+        cuts.extend(segs.iter().map(|s| wrap_deg(s.start_deg + h)));
+        cuts.extend(segs.iter().map(|s| wrap_deg(s.start_deg - h)));
         let mut hint = 0;
         cuts.extend((0..n).map(|i| {
             let t = tl.bin_start_time_s(i) + delta;
-            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) + h)
+            wrap_deg(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) + h)
         }));
         let mut hint = 0;
         cuts.extend((0..n).map(|i| {
             let t = tl.bin_start_time_s(i) + frame_s - delta;
-            wrap360(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) - h)
+            wrap_deg(tl.azimuth_at_unwrapped_from_deg(t, &mut hint) - h)
         }));
         // Four runs, each increasing but for one wrap: a merge, linear.
         let cuts = sort_runs(cuts, &[0, n, 2 * n, 3 * n, 4 * n]);
@@ -388,7 +389,7 @@ impl<'a> Cells<'a> {
         CellExact {
             tau_s: cell_tau,
             tau_min_s: cell_tau_min,
-            e: (cell_e.0.min(cap), wrap360(cell_e.1)),
+            e: (cell_e.0.min(cap), wrap_deg(cell_e.1)),
             e_env: cell_e.0,
             // Off the curved cells the sweep's Rule 1 figure is exact.
             single: if self.rows[c].curved {
@@ -436,5 +437,188 @@ fn ends(cuts: &[f64], tau_pt: &[f64], e_pt: &[f64], c: usize) -> CellExact {
         e,
         e_env: e.0,
         single: 0.0,
+    }
+}
+
+/// The cells of `segs` (bins used as they are, not coalesced) for half
+/// pass angle `h`, a laser of `f_p` Hz, handed to `f`.
+#[cfg(test)]
+pub(super) fn with_cells<R>(segs: &[Seg], h: f64, f_p: f64, f: impl FnOnce(&Cells<'_>) -> R) -> R {
+    let laser = Laser {
+        band: ael::Band::RetinalNir,
+        c4: 1.0,
+        pulse_duration_s: 5e-9,
+        pulse_rate_hz: f_p,
+    };
+    let tl = Timeline::from_bins(segs);
+    let env = Envelope::new(&tl, 1.0 / f_p);
+    let cells = Cells::new(&tl, &env, h, &laser);
+    f(&cells)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eye_safety::bound::seg::seg;
+    use proptest::prelude::*;
+
+    /// `ω` rises from `w` at 0° to `2w` at 180° (constant acceleration,
+    /// `ω² = w²(1 + x/60)` with `x` in degrees) and falls back to `w` at
+    /// 360°, mirrored: the head is slowest at 0°.
+    const W: f64 = 2.0 * std::f64::consts::PI;
+
+    fn mirrored(p_a: f64, p_b: f64) -> [Seg; 2] {
+        [
+            seg(0.0, 180.0, p_a, W, 2.0 * W),
+            seg(180.0, 180.0, p_b, 2.0 * W, W),
+        ]
+    }
+
+    /// Time from 0° to `d` degrees into the accelerating bin (and, mirrored,
+    /// from `360 − d` to 360°): `2x/(ω_s + ω(x))`, by hand.
+    fn t_of(d: f64) -> f64 {
+        2.0 * d.to_radians() / (W + W * (1.0 + d / 60.0).sqrt())
+    }
+
+    /// The cell `[350°, 370°]` (cuts at `360 − h` and `0 + h`, h = 10°) is
+    /// curved, and its pass duration `τ(360 + y) = t(10 − y) + t(10 + y)` is
+    /// largest inside it, at `y = 0` (`t` is concave): the ends give less.
+    /// Its pass energy, with A 5 % hotter than B, `E(y) = P_B·t(10 − y) +
+    /// P_A·(t(10 + y) + Δ)`, is largest where
+    /// `ω(10 + y)/ω(10 − y) = P_A/P_B`: `(70 + y)/(70 − y) = 1.05²`,
+    /// `y = 7.175/2.1025 = 3.4126…°`. Mutants 1358:89 (the sweep's `ω` at
+    /// the right edge's far end taken at `v − h`: the bound of `τ` falls
+    /// below the interior maximum) and 1467:57 (the envelope power at the
+    /// right edge read at `mid − h`: `E`'s stationary point becomes `τ`'s)
+    /// of the old `bound.rs` (11a69c7).
+    #[test]
+    fn curved_cell_takes_its_interior_maxima_by_hand() {
+        let (p_a, p_b) = (1.05e-3, 1e-3);
+        let f_p = 1e5;
+        let delta = 1.0 / f_p;
+        let segs = mirrored(p_a, p_b);
+        with_cells(&segs, 10.0, f_p, |cells| {
+            let c = (0..cells.len())
+                .find(|&c| cells.cut(c) == 350.0)
+                .expect("a cut at 350°");
+            assert_eq!(cells.cut(c + 1), 370.0);
+            assert!(cells.rows[c].curved);
+            let x = cells.exact(c);
+            let tau = 2.0 * t_of(10.0);
+            assert!((x.tau_s - tau).abs() <= 1e-12 * tau, "{} vs {tau}", x.tau_s);
+            // Both ends are shorter (by 3.5 %: `t(20) < 2·t(10)`), so the maximum is inside.
+            assert!(cells.tau_pt[c].max(cells.tau_pt[c + 1]) < tau * 0.999);
+            let y = 70.0 * (1.05f64.powi(2) - 1.0) / (1.05f64.powi(2) + 1.0);
+            let e = p_b * t_of(10.0 - y) + p_a * (t_of(10.0 + y) + delta);
+            assert!((x.e_env - e).abs() <= 1e-12 * e, "{} vs {e}", x.e_env);
+            let e_mid = p_b * t_of(10.0) + p_a * (t_of(10.0) + delta);
+            assert!(
+                e > e_mid * (1.0 + 1e-6),
+                "the maximum is off the cell's middle"
+            );
+            // The sweep's bounds are above the exact values.
+            let row = cells.rows[c];
+            assert!(row.tau_ub >= x.tau_s && row.env_ub >= x.e_env && row.e_ub >= x.e.0);
+            assert!(row.tau_lb <= x.tau_min_s && row.single_ub >= x.single);
+        });
+    }
+
+    /// Rule 1 pairs a hot bin touched only at a cell's end with that end's
+    /// own pulse count. Bins: H `[0, 10)` at 10 mW and S `[10, 11)` at 1 mW,
+    /// both at 200 rad/s, F `[11, 360)` at 1 mW and 10 rad/s; h = 5°, 10 kHz
+    /// (the `Δ`-shifted cuts land beyond 16°). On the cell `[15, 16]` (cuts
+    /// `H_end + h`, `S_end + h`) the left pass edge runs through S and the
+    /// right one through F, so `τ` grows from `1°/200 + 9°/10` = 15.80 ms
+    /// (158 pulses) to `10°/10` = 17.45 ms (175 pulses); 17 passes meet a
+    /// 10 s window (`T_f` = 0.610 s). H is touched by the pass at 15° alone:
+    /// the figure is H's power with 158 pulses, `P_H·Δ/(C5(158·17)·AEL)`,
+    /// not with 175 (`C5 = 5·N^−¼`: `(175/158)^¼` = 1.026 times more).
+    /// Mutant 1394:49 of the old `bound.rs` (11a69c7), `lo_in`'s `<=` →
+    /// `>`, keeps H in the cell's inside and pairs it with 175 pulses.
+    #[test]
+    fn rule_one_pairs_a_bin_touched_at_one_end_with_that_end_s_count() {
+        let f_p = 1e4;
+        let segs = [
+            seg(0.0, 10.0, 10e-3, 200.0, 200.0),
+            seg(10.0, 1.0, 1e-3, 200.0, 200.0),
+            seg(11.0, 349.0, 1e-3, 10.0, 10.0),
+        ];
+        with_cells(&segs, 5.0, f_p, |cells| {
+            let c = (0..cells.len())
+                .find(|&c| cells.cut(c) == 15.0)
+                .expect("a cut at 15°");
+            assert_eq!(cells.cut(c + 1), 16.0);
+            let row = cells.rows[c];
+            assert!(!row.curved);
+            let frame = cells.tl.period_s();
+            assert_eq!(max_pulses_in(cells.tau_pt[c], f_p), 158.0);
+            assert_eq!(max_pulses_in(cells.tau_pt[c + 1], f_p), 175.0);
+            for tau in [cells.tau_pt[c], cells.tau_pt[c + 1]] {
+                assert_eq!(passes_in_window(10.0, tau, frame), 17.0);
+            }
+            let laser = cells.laser;
+            let want = 10e-3 / f_p * laser.single_pulse_ratio_per_j(158.0, 17.0);
+            assert!(
+                (row.single_ub - want).abs() <= 1e-12 * want,
+                "{} vs {want}",
+                row.single_ub
+            );
+            let loose = 10e-3 / f_p * laser.single_pulse_ratio_per_j(175.0, 17.0);
+            assert!((loose / want - (175.0f64 / 158.0).powf(0.25)).abs() < 1e-9);
+            assert_eq!(cells.exact(c).single, row.single_ub);
+        });
+    }
+
+    proptest! {
+        /// On every cell of profiles with in-bin acceleration: the sweep's
+        /// bounds are at least the exact figures (which the branch and
+        /// bound relies on), and the exact `τ` and `E` are at least their
+        /// values on a dense grid of azimuths of the cell (`τ(φ) =
+        /// t(φ + h) − t(φ − h)`, `E(φ) = ∫ P̄` over `[t(φ − h), t(φ + h) + Δ]`,
+        /// restated from the timeline and the envelope).
+        #[test]
+        fn cell_figures_bound_a_dense_scan(
+            bins in proptest::collection::vec((0.2f64..1.0, 0.0f64..5e-3, 2.0f64..60.0), 2..8),
+            h in 0.2f64..20.0,
+            f_p in prop_oneof![Just(1e3), 1e4f64..3e5],
+        ) {
+            let total: f64 = bins.iter().map(|b| b.0).sum();
+            let n = bins.len();
+            let mut start = 0.0;
+            let segs: Vec<Seg> = (0..n)
+                .map(|i| {
+                    let (w, p, w0) = bins[i];
+                    let width = 360.0 * w / total;
+                    let s = seg(start, width, p, w0, bins[(i + 1) % n].2);
+                    start += width;
+                    s
+                })
+                .collect();
+            let delta = 1.0 / f_p;
+            with_cells(&segs, h, f_p, |cells| {
+                for c in 0..cells.len() {
+                    let x = cells.exact(c);
+                    let row = cells.rows[c];
+                    let tol_t = 1e-12 * cells.tl.period_s();
+                    let tol_e = 1e-12 * cells.env.total_j();
+                    prop_assert!(row.tau_ub >= x.tau_s, "cell {c}: {row:?} {x:?}");
+                    prop_assert!(row.env_ub >= x.e_env, "cell {c}: {row:?} {x:?}");
+                    prop_assert!(row.e_ub >= x.e.0, "cell {c}: {row:?} {x:?}");
+                    prop_assert!(row.single_ub >= x.single, "cell {c}: {row:?} {x:?}");
+                    prop_assert!(row.tau_lb <= x.tau_min_s, "cell {c}: {row:?} {x:?}");
+                    let (u, v) = (cells.cut(c), cells.cut(c + 1));
+                    for k in 0..=32 {
+                        let phi = u + (v - u) * f64::from(k) / 32.0;
+                        let t_lo = cells.time_at(phi - h);
+                        let t_hi = cells.time_at(phi + h);
+                        let e = cells.env.integral_to(t_hi + delta) - cells.env.integral_to(t_lo);
+                        prop_assert!(x.tau_s >= t_hi - t_lo - tol_t, "cell {c} at {phi}");
+                        prop_assert!(x.tau_min_s <= t_hi - t_lo + tol_t, "cell {c} at {phi}");
+                        prop_assert!(x.e_env >= e - tol_e, "cell {c} at {phi}");
+                    }
+                }
+                Ok(())
+            })?;
+        }
     }
 }

@@ -192,3 +192,133 @@ impl Envelope {
         self.p_w[wrap_index(idx, self.pieces() as i64)]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eye_safety::bound::seg::seg;
+    use proptest::prelude::*;
+
+    /// `A = [0, 180)` at 2 W and π rad/s (1 s), `B = [180, 360)` at 1 W and
+    /// 2π rad/s (0.5 s): `T_f = 1.5 s`; with `Δ = 0.1 s`, `P̄` is 2 W on
+    /// `[0, 1.1)` (A, and A's power for one `Δ` into B) and 1 W on
+    /// `[1.1, 1.5)`: 2.6 J a period.
+    fn two_bins() -> [Seg; 2] {
+        let pi = std::f64::consts::PI;
+        [
+            seg(0.0, 180.0, 2.0, pi, pi),
+            seg(180.0, 180.0, 1.0, 2.0 * pi, 2.0 * pi),
+        ]
+    }
+
+    fn close(got: f64, want: f64) {
+        assert!((got - want).abs() <= 1e-12, "{got} vs {want}");
+    }
+
+    /// Mutants 804:9 (`Envelope::locate` replaced by a constant) and 856:9
+    /// (`Envelope::power_at` → 0) of the old `bound.rs` (11a69c7): the
+    /// curved cells' exact figures read the envelope through them, and no
+    /// core test did. Values by hand (see [`two_bins`]), in three periods.
+    #[test]
+    fn locate_power_and_integral_by_hand() {
+        let segs = two_bins();
+        let tl = Timeline::from_bins(&segs);
+        let env = Envelope::new(&tl, 0.1);
+        close(env.total_j(), 2.6);
+        // (whole periods, offset, piece): pieces start at 0, 0.1, 1.0, 1.1.
+        for (t, k, r, j) in [
+            (0.5, 0.0, 0.5, 1usize),
+            (1.3, 0.0, 1.3, 3),
+            (2.0, 1.0, 0.5, 1),
+            (-0.2, -1.0, 1.3, 3),
+            (3.05, 2.0, 0.05, 0),
+        ] {
+            let (gk, gr, gj) = env.locate(t);
+            assert_eq!((gk, gj), (k, j), "locate({t})");
+            close(gr, r);
+            assert_eq!(env.locate_from(t, &mut 0), (gk, gr, gj));
+        }
+        for (t, p) in [
+            (0.5, 2.0),
+            (1.3, 1.0),
+            (2.0, 2.0),
+            (-0.2, 1.0),
+            (3.05, 2.0),
+            (1.05, 2.0),
+        ] {
+            assert_eq!(env.power_at(t), p, "power_at({t})");
+        }
+        // ∫₀^t P̄: 2 W to 1.1 s, then 1 W.
+        for (t, e) in [
+            (0.5, 1.0),
+            (1.3, 2.4),
+            (2.0, 3.6),
+            (-0.2, -0.2),
+            (3.05, 5.3),
+        ] {
+            close(env.integral_to(t), e);
+        }
+    }
+
+    /// `P̄` by its definition: the largest power of the bins the head is in
+    /// at some time of `[t − Δ − w, t]` (the windows ending in `[t − w, t]`;
+    /// bins of the periods before and after included).
+    fn envelope_by_scan(tl: &Timeline<'_, Seg>, w: f64, delta: f64, t: f64) -> f64 {
+        let n = tl.bins().len();
+        let frame = tl.period_s();
+        let mut p = 0.0f64;
+        for turn in -2i32..=1 {
+            for i in 0..n {
+                let a = tl.bin_start_time_s(i) + f64::from(turn) * frame;
+                let b = tl.bin_start_time_s(i + 1) + f64::from(turn) * frame;
+                if a <= t && b > t - delta - w {
+                    p = p.max(tl.bins()[i].power_w);
+                }
+            }
+        }
+        p
+    }
+
+    proptest! {
+        /// The envelope (a merge of sorted runs and a monotone-deque
+        /// sliding maximum) against its definition by a scan of the bins,
+        /// on every piece, and its total against a plain sum.
+        #[test]
+        fn envelope_is_the_max_filter_by_scan(
+            bins in proptest::collection::vec((0.1f64..1.0, 0.0f64..3.0, 1.0f64..20.0, 1.0f64..20.0), 1..12),
+            delta_frac in prop_oneof![1e-4f64..0.3, 0.3f64..1.2],
+        ) {
+            let total: f64 = bins.iter().map(|b| b.0).sum();
+            let mut start = 0.0;
+            let segs: Vec<Seg> = bins
+                .iter()
+                .map(|&(w, p, w0, w1)| {
+                    let width = 360.0 * w / total;
+                    let s = seg(start, width, p, w0, w1);
+                    start += width;
+                    s
+                })
+                .collect();
+            let tl = Timeline::from_bins(&segs);
+            let delta = delta_frac * tl.period_s();
+            let env = Envelope::new(&tl, delta);
+            let mut e = 0.0;
+            for j in 0..env.pieces() {
+                let (a, b) = (env.t_s[j], env.t_s[j + 1]);
+                prop_assert!(a < b);
+                let mid = 0.5 * (a + b);
+                // At least the largest power the window `[t − Δ, t]` meets
+                // at the piece's middle (sound), at most the largest over
+                // the closed piece widened by the rounding of `c ± Δ` (a bin
+                // ending on `c_j − Δ` may count: looser, never lower).
+                let tol = 1e-12 * tl.period_s();
+                let p_mid = envelope_by_scan(&tl, 0.0, delta, mid);
+                let p_closed = envelope_by_scan(&tl, b - a + tol, delta + tol, b);
+                prop_assert!(p_mid <= env.p_w[j] && env.p_w[j] <= p_closed, "piece {} [{}, {}]: {} not in [{}, {}]", j, a, b, env.p_w[j], p_mid, p_closed);
+                prop_assert_eq!(env.power_at(mid), env.p_w[j]);
+                e += env.p_w[j] * (b - a);
+            }
+            prop_assert!((env.total_j() - e).abs() <= 1e-12 * e.max(1.0));
+        }
+    }
+}

@@ -480,3 +480,36 @@ impl PerJouleCache {
             .unwrap_or_else(|| laser.single_pulse_ratio_per_j(per_pass, passes))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Mutant 475:32 of the old `bound.rs` (11a69c7): `pass_count_max`'s
+    /// candidates `k·T_f − τ` (where a window first meets `k + 1` passes)
+    /// taken as `k·T_f + τ`. By hand, 1400–1500 nm, `T_f` = 10 ms, `τ` =
+    /// 1 ms, 0.1 mJ a pass: on the row 1 ms–0.35 s (`4.4e-3·T^0.25`) the
+    /// ratio `(k + 1)·E/AEL(k·T_f − τ)` grows with `k`, largest at the last
+    /// step, `T = 0.349 s` with 36 passes: `3.6e-3/(4.4e-3·0.349^0.25)` =
+    /// 1.06450. The row edge 0.35 s gives 1.0637 and the next row
+    /// (`1e-2·T`, first step 0.359 s, 37 passes) 1.0306.
+    #[test]
+    fn pass_count_max_takes_the_step_k_frames_less_a_pass() {
+        let laser = Laser {
+            band: Band::Ir1400,
+            c4: 1.0,
+            pulse_duration_s: 1e-9,
+            pulse_rate_hz: 1e5,
+        };
+        let pass = PassFigures {
+            envelope_j: 1e-4,
+            pulses_j: 1e-4,
+            duration_s: 1e-3,
+        };
+        let (r, t) = laser.pass_count_max(0.01, pass, 0.009);
+        let want = 36.0 * 1e-4 / (4.4e-3 * 0.349f64.powf(0.25));
+        assert!((r - want).abs() <= 1e-12 * want, "{r} vs {want}");
+        assert!((t - 0.349).abs() <= 1e-12, "{t}");
+        assert!((r - 1.0645).abs() < 1e-4, "{r}");
+    }
+}

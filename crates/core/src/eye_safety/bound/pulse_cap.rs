@@ -115,27 +115,9 @@ impl Cells<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::envelope::Envelope;
-    use super::super::laser::Laser;
+    use super::super::cells::with_cells;
     use super::super::seg::{seg, Seg};
     use super::*;
-    use crate::eye_safety::ael::Band;
-    use crate::profile::kinematics::Timeline;
-
-    /// The cells of `segs` (bins used as they are, not coalesced) for half
-    /// pass angle `h`, a laser of `f_p` Hz, handed to `f`.
-    fn with_cells<R>(segs: &[Seg], h: f64, f_p: f64, f: impl FnOnce(&Cells<'_>) -> R) -> R {
-        let laser = Laser {
-            band: Band::RetinalNir,
-            c4: 1.0,
-            pulse_duration_s: 5e-9,
-            pulse_rate_hz: f_p,
-        };
-        let tl = Timeline::from_bins(segs);
-        let env = Envelope::new(&tl, 1.0 / f_p);
-        let cells = Cells::new(&tl, &env, h, &laser);
-        f(&cells)
-    }
 
     /// `10` rev/s: 3600 °/s.
     const SPIN_10_HZ: f64 = 20.0 * std::f64::consts::PI;

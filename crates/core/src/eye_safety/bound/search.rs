@@ -5,8 +5,8 @@
 //! "Search").
 
 use super::cells::{CellRow, Cells};
-use super::seg::wrap360;
 use super::Search;
+use crate::model::angle::wrap_deg;
 
 /// The maxima over cells: Rule 1 (ratio, azimuth), pass energy
 /// (J, azimuth), envelope integral over a pass (J), pass duration (s).
@@ -21,7 +21,7 @@ impl Cells<'_> {
     /// The three maxima, each with the first cell (in azimuth order)
     /// attaining it.
     pub(super) fn search(&self, search: Search) -> CellBest {
-        let mid_of = |c: usize| wrap360(0.5 * (self.cut(c) + self.cut(c + 1)));
+        let mid_of = |c: usize| wrap_deg(0.5 * (self.cut(c) + self.cut(c + 1)));
         match search {
             Search::Exhaustive => {
                 let mut best = CellBest {
@@ -320,5 +320,25 @@ mod tests {
                 first_max_sorted(ub.len(), |c| ub[c], |c| ub[c], exact)
             );
         }
+    }
+
+    /// Mutant 2011:14 of the old `bound.rs` (11a69c7), `Best::take`'s
+    /// `r > self.0` (to `>=`, `<` or `==`): the larger ratio wins, a tie
+    /// goes to the shorter window only, a smaller ratio never replaces.
+    #[test]
+    fn best_takes_the_larger_ratio_then_the_shorter_window() {
+        let mut b = Best(0.0, 0.0);
+        b.take((1.0, 2.0));
+        assert_eq!((b.0, b.1), (1.0, 2.0));
+        b.take((0.5, 1.0)); // smaller: kept out
+        assert_eq!((b.0, b.1), (1.0, 2.0));
+        b.take((1.0, 3.0)); // tie, longer window: kept out
+        assert_eq!((b.0, b.1), (1.0, 2.0));
+        b.take((1.0, 1.5)); // tie, shorter window: taken
+        assert_eq!((b.0, b.1), (1.0, 1.5));
+        b.take((2.0, 9.0)); // larger, whatever its window
+        assert_eq!((b.0, b.1), (2.0, 9.0));
+        b.take((f64::NAN, 0.0)); // never a NaN
+        assert_eq!((b.0, b.1), (2.0, 9.0));
     }
 }

@@ -1,7 +1,6 @@
 //! The bins as the bound sees them ([`Seg`]: a start, a width, a power and
 //! the spin at both edges, moving as [`BinMotion`] says), with runs of equal
-//! bins merged first ([`coalesce`]), and the wrap of an azimuth into
-//! `[0, 360)`.
+//! bins merged first ([`coalesce`]).
 
 use crate::profile::kinematics::BinMotion;
 
@@ -82,28 +81,6 @@ pub(super) fn spin_sq_line(seg: &Seg) -> (f64, f64) {
     )
 }
 
-/// `a` wrapped into `[0, 360)`.
-pub(super) fn wrap360(a: f64) -> f64 {
-    // `rem_euclid` takes `r = a % 360` (exact), then `r + 360` if `r < 0`.
-    // Within a turn of `[0, 360)`, `a % 360` is `a` (`|a| < 360`) or
-    // `a − 360` (`360 ≤ a < 720`, a subtraction that is exact by Sterbenz's
-    // lemma): the same value without the library's `fmod`.
-    let w = if (0.0..360.0).contains(&a) {
-        a
-    } else if a > -360.0 && a < 0.0 {
-        a + 360.0
-    } else if (360.0..720.0).contains(&a) {
-        a - 360.0
-    } else {
-        a.rem_euclid(360.0)
-    };
-    if w >= 360.0 {
-        0.0
-    } else {
-        w
-    }
-}
-
 /// A bin of `width` degrees from `start` at `power`, spinning from
 /// `w0` to `w1` rad/s.
 #[cfg(test)]
@@ -120,7 +97,6 @@ pub(super) fn seg(start: f64, width: f64, power: f64, w0: f64, w1: f64) -> Seg {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use proptest::prelude::*;
 
     fn fields(s: &Seg) -> [f64; 5] {
         [
@@ -130,19 +106,6 @@ mod tests {
             s.spin_start_rad_s,
             s.spin_end_rad_s,
         ]
-    }
-
-    proptest! {
-        #[test]
-        fn wrap360_is_rem_euclid(a in prop_oneof![
-            -1e4f64..1e4, -720.0f64..720.0, -1e-12f64..1e-12,
-            Just(-360.0), Just(-0.0), Just(0.0), Just(360.0), Just(720.0),
-            Just(-1e-300), Just(359.999_999_999_999_94), Just(f64::NAN), Just(f64::INFINITY),
-        ]) {
-            let w = a.rem_euclid(360.0);
-            let expected = if w >= 360.0 { 0.0 } else { w };
-            prop_assert_eq!(wrap360(a).to_bits(), expected.to_bits());
-        }
     }
 
     /// Runs of one power and one constant spin merge (widths summed, the

@@ -1,5 +1,5 @@
 //! Rule 2 over the windows that hold one whole pass (the boundary of the
-//! walks' reach): `min(E(φ), E⁺)/AEL(τ(φ))` per cell, and its pruned
+//! walks' reach): `min(E(φ), E⁺)/AEL_inf(τ(φ))` per cell, and its pruned
 //! maximum over the cells (`specs/eye_safety.md`, "Whole-pass windows").
 
 use super::cells::Cells;
@@ -10,7 +10,7 @@ use super::Search;
 impl Cells<'_> {
     /// Rule 2 over the windows that hold one whole pass (the boundary of
     /// the walks' reach, see [`Walks::search`]): an upper bound of
-    /// `min(E(φ), E⁺)/AEL(τ(φ))` over the azimuths `φ` of cell `c`, with the
+    /// `min(E(φ), E⁺)/AEL_inf(τ(φ))` over the azimuths `φ` of cell `c`, with the
     /// `τ` where it is taken. Off the curved cells `E` and `τ` are affine in
     /// `φ` (both pass edges in bins of constant spin, the envelope pieces
     /// fixed), so on each row of Table 3 `E/AEL(τ) = (e₀ + e₁x)/(c·(τ₀ +
