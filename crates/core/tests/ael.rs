@@ -424,5 +424,5 @@ fn assumption_t_i_is_a_row_edge_and_t2_within_the_time_base() {
             rs[k].value_j(ti).min(rs[k + 1].value_j(ti))
         );
     }
-    assert!(ael::T2_S < ael::TIME_BASE_S && ael::TIME_BASE_S < ael::T_MAX_TABLE_S);
+    const { assert!(ael::T2_S < ael::TIME_BASE_S && ael::TIME_BASE_S < ael::T_MAX_TABLE_S) };
 }

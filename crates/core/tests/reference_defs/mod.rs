@@ -284,6 +284,9 @@ fn ticks(clock: DClock, fp: f64, tf: f64, q: usize, a: f64, b: f64, out: &mut Ve
     }
 }
 
+/// A filtered train: pulse times and prefix energies.
+type Filtered = (Vec<f64>, Vec<f64>);
+
 /// The reference.
 pub struct DefReference {
     head: Head,
@@ -561,7 +564,7 @@ impl DefReference {
         }
         // Filtered trains per aperture diameter (times, prefix energies), up
         // to `t_max` (the last pulse any window using it can reach).
-        let filtered = |d_mm: f64, t_max: f64| -> (Vec<f64>, Vec<f64>) {
+        let filtered = |d_mm: f64, t_max: f64| -> Filtered {
             let h = self.half_deg(d_mm);
             let mut ts = Vec::new();
             let mut pre = vec![0.0];
@@ -592,7 +595,7 @@ impl DefReference {
             }
         }
         let lengths = self.lengths(self.per_decade, pass_span, pulses_max.min(50_000));
-        let mut cache: Vec<(f64, (Vec<f64>, Vec<f64>))> = Vec::new();
+        let mut cache: Vec<(f64, Filtered)> = Vec::new();
         let t_first = wide_t[0];
         // The longest window each aperture diameter serves.
         let mut reach: Vec<(f64, f64)> = Vec::new();

@@ -77,9 +77,7 @@ impl Laser {
     #[must_use]
     pub fn one_pass_window_max_s(&self, frame_s: f64, tau_max_s: f64) -> f64 {
         let delta = 1.0 / self.pulse_rate_hz;
-        (frame_s - tau_max_s.max(delta))
-            .max(0.0)
-            .min(ael::TIME_BASE_S)
+        (frame_s - tau_max_s.max(delta)).clamp(0.0, ael::TIME_BASE_S)
     }
 
     /// `sup τ/AEL_inf(τ)` over `0 < τ ≤ tau_hi_s`, `AEL_inf(τ)` the
