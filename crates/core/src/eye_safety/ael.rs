@@ -325,17 +325,19 @@ pub fn table3_j(band: Band, c4: f64, t_s: f64) -> f64 {
 /// `exponent ≥ 0`: nondecreasing within the row, so the infimum over an
 /// interval is at its ends or at a row edge inside it, where [`table3_j`]
 /// takes the smaller of the two rows (the limit of the left row at its end
-/// is never below that). Durations below the band's first row take the
-/// first row, as [`table3_j`] does.
+/// is never below that). So it is the smallest of the AEL at `lo_s` and at
+/// every row edge in `(lo_s, hi_s]`; the AEL at `hi_s` itself is never
+/// smaller (it is at least its row's value at the row's first edge, or,
+/// with no edge in between, at least the AEL at `lo_s`, in the same row).
+/// Durations below the band's first row take the first row, as
+/// [`table3_j`] does.
 #[must_use]
 pub fn ael_inf_j(band: Band, c4: f64, lo_s: f64, hi_s: f64) -> f64 {
-    let hi_s = hi_s.max(lo_s);
-    let mut v = table3_j(band, c4, lo_s).min(table3_j(band, c4, hi_s));
+    let mut v = table3_j(band, c4, lo_s);
     for row in rows(band, c4) {
-        for e in [row.t_lo_s, row.t_hi_s] {
-            if e > lo_s && e < hi_s {
-                v = v.min(table3_j(band, c4, e));
-            }
+        let e = row.t_hi_s;
+        if e > lo_s && e <= hi_s {
+            v = v.min(table3_j(band, c4, e));
         }
     }
     v
