@@ -19,6 +19,7 @@ pub mod bound;
 pub mod exposure;
 #[cfg(feature = "std")]
 pub mod report;
+pub mod rule;
 
 use serde::{Deserialize, Serialize};
 #[cfg(feature = "std")]
@@ -27,9 +28,10 @@ use thiserror::Error;
 #[cfg(feature = "std")]
 pub use ael::AelError;
 #[cfg(feature = "std")]
-pub use exposure::{evaluate_profile, evaluate_segments, ExposureReport, Rule};
+pub use exposure::{evaluate_profile, evaluate_segments, ExposureReport};
 #[cfg(feature = "std")]
 pub use report::{ael_report, AelReport, StationaryBeam};
+pub use rule::Rule;
 
 /// Laser and optics parameters the eye-safety check needs; stored in a
 /// profile's `limits.eye_safety` so any tool can re-check a profile from the file.

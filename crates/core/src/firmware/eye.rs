@@ -26,7 +26,6 @@
 //!   pass_energy_max`. All sums are `u128`.
 
 use alloc::vec::Vec;
-use core::fmt;
 
 use serde::{Deserialize, Serialize};
 
@@ -44,32 +43,9 @@ pub const MAX_PULSES_PER_TURN: u64 = 1 << 40;
 /// Millihertz per hertz.
 pub const MILLIHZ_PER_HZ: u64 = 1000;
 
-/// The rule an integer check belongs to (the same rules as
-/// `eye_safety::Rule`, named by the window they bound).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-#[non_exhaustive]
-pub enum IntRule {
-    /// Each pulse (or `T_i` group) against the C5-corrected single-pulse AEL.
-    SinglePulse,
-    /// Pulse-train energy within one pass.
-    PassTrain,
-    /// Pulse-train energy over several passes, up to T2 = 10 s.
-    T2Train,
-    /// Pulse-train energy over several passes, beyond T2 up to the 100 s time base.
-    TimeBase,
-}
-
-impl fmt::Display for IntRule {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::SinglePulse => "single-pulse energy (C5-corrected)",
-            Self::PassTrain => "pulse-train energy within one pass",
-            Self::T2Train => "pulse-train energy over several passes (up to T2 = 10 s)",
-            Self::TimeBase => "average power over the 100 s time base",
-        })
-    }
-}
+/// The rule an integer check belongs to: the float bound's
+/// [`Rule`](crate::eye_safety::Rule) (one type for both checkers).
+pub use crate::eye_safety::Rule as IntRule;
 
 /// The energy limit of windows holding `pulses_from ..` pulses of one pass
 /// (up to the next bucket's `pulses_from`, exclusive).

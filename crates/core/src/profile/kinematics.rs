@@ -40,6 +40,18 @@ pub trait BinMotion {
             / (2.0 * self.width_deg().to_radians())
     }
 
+    /// `ω²` along the bin as a line in the angle from its start in
+    /// degrees, `(c₀, c₁)` with `ω²(x) = c₀ + c₁·x`: [`spin_sq`] at 0 and
+    /// its slope `2a` per radian, per degree. The eye-safety bound's curved
+    /// cells solve for their stationary points with it.
+    fn spin_sq_line_deg(&self) -> (f64, f64) {
+        let two_a = 2.0 * self.accel_rad_s2();
+        (
+            spin_sq(self.spin_start_rad_s(), two_a, 0.0),
+            two_a * core::f64::consts::PI / 180.0,
+        )
+    }
+
     /// Time to advance `x_rad` into the bin from its start, s
     /// (`2x / (ω_s + ω(x))`; 0 for `x ≤ 0`).
     fn time_into_s(&self, x_rad: f64) -> f64 {
@@ -131,13 +143,22 @@ impl Motion {
     }
 }
 
+/// `ω²` at `x_rad` into a bin entered at `w_s` rad/s with angular
+/// acceleration `two_a / 2`: `ω_s² + 2a·x` (constant acceleration). The one
+/// statement of this line ([`BinMotion::spin_sq_line_deg`] is it per degree).
+#[inline]
+#[must_use]
+pub fn spin_sq(w_s: f64, two_a: f64, x_rad: f64) -> f64 {
+    w_s.powi(2) + two_a * x_rad
+}
+
 /// [`BinMotion::time_into_s`] from the spin at the start and `2a`.
 #[inline]
 fn time_into_s(w_s: f64, two_a: f64, x_rad: f64) -> f64 {
     if x_rad <= 0.0 {
         return 0.0;
     }
-    let w_x = (w_s.powi(2) + two_a * x_rad).max(0.0).sqrt();
+    let w_x = spin_sq(w_s, two_a, x_rad).max(0.0).sqrt();
     2.0 * x_rad / (w_s + w_x)
 }
 
@@ -148,14 +169,19 @@ fn angle_into_rad(w_s: f64, accel: f64, dwell_s: f64, width_deg: f64, t_s: f64) 
     (w_s * t + 0.5 * accel * t * t).clamp(0.0, width_deg.to_radians())
 }
 
-/// Whole turns below an unwrapped azimuth and the azimuth within the turn.
-fn split_turns(theta_deg: f64) -> (f64, f64) {
-    if (0.0..FULL_TURN_DEG).contains(&theta_deg) {
+/// `x` split into whole periods and the rest: `(k, x − k·period)` with
+/// `k = ⌊x/period⌋` (an unwrapped time into frame periods, an unwrapped
+/// azimuth into turns). The one split into periods: the timeline, and the
+/// eye-safety bound's envelope, call it.
+#[inline]
+#[must_use]
+pub fn split_periods(x: f64, period: f64) -> (f64, f64) {
+    if (0.0..period).contains(&x) {
         // The common case, without a call to `floor` (same result).
-        return (0.0, theta_deg);
+        return (0.0, x);
     }
-    let k = (theta_deg / FULL_TURN_DEG).floor();
-    (k, theta_deg - FULL_TURN_DEG * k)
+    let k = (x / period).floor();
+    (k, x - k * period)
 }
 
 /// Time to advance `x_rad` into `bin` from its start.
@@ -273,7 +299,7 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
     /// bin in deg).
     #[must_use]
     pub fn locate_unwrapped(&self, theta_deg: f64) -> (f64, usize, f64) {
-        let (k, a) = split_turns(theta_deg);
+        let (k, a) = split_periods(theta_deg, FULL_TURN_DEG);
         let i = self.bin_index(a);
         (k, i, a - self.bins[i].start_deg())
     }
@@ -283,7 +309,7 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
     /// time for a nondecreasing sequence of azimuths.
     #[inline]
     pub fn locate_unwrapped_from(&self, theta_deg: f64, hint: &mut usize) -> (f64, usize, f64) {
-        let (k, a) = split_turns(theta_deg);
+        let (k, a) = split_periods(theta_deg, FULL_TURN_DEG);
         let n = self.bins.len();
         let mut i = (*hint).min(n - 1);
         if self.bins[i].start_deg() > a {
@@ -323,7 +349,7 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
     /// Unwrapped azimuth at unwrapped time `t_s`, deg.
     #[must_use]
     pub fn azimuth_at_unwrapped_deg(&self, t_s: f64) -> f64 {
-        let (k, t) = self.split_periods(t_s);
+        let (k, t) = split_periods(t_s, self.period_s());
         self.azimuth_at_located(k, t, self.bin_at_time(t))
     }
 
@@ -331,7 +357,7 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
     /// `*hint` (then set to the bin found): the same value, in amortised
     /// constant time for a nondecreasing sequence of times.
     pub fn azimuth_at_unwrapped_from_deg(&self, t_s: f64, hint: &mut usize) -> f64 {
-        let (k, t) = self.split_periods(t_s);
+        let (k, t) = split_periods(t_s, self.period_s());
         let n = self.bins.len();
         let mut i = (*hint).min(n - 1);
         if self.cum_time_s[i] > t {
@@ -343,14 +369,6 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
         }
         *hint = i;
         self.azimuth_at_located(k, t, i)
-    }
-
-    fn split_periods(&self, t_s: f64) -> (f64, f64) {
-        if (0.0..self.period_s()).contains(&t_s) {
-            return (0.0, t_s);
-        }
-        let k = (t_s / self.period_s()).floor();
-        (k, t_s - k * self.period_s())
     }
 
     fn azimuth_at_located(&self, k: f64, t: f64, i: usize) -> f64 {
@@ -491,6 +509,32 @@ mod tests {
     }
 
     proptest! {
+        /// The one split into periods against its plain statement
+        /// (`floor`, then the rest): bit for bit but for the sign of a
+        /// zero (`−0` gives `(0, −0)`, not `(−0, …)`). Below one period
+        /// `x/period ≤ 1 − 2⁻⁵³` rounds below 1, so the fast path's `k = 0`
+        /// is the floor's.
+        #[test]
+        fn split_periods_is_floor_and_rest(
+            x in prop_oneof![-1e4f64..1e4, 0.0f64..1.0, Just(0.0), Just(-0.0), Just(360.0), Just(f64::NAN)],
+            period in prop_oneof![1e-3f64..10.0, Just(360.0), Just(0.05)],
+        ) {
+            let k = (x / period).floor();
+            let r = x - k * period;
+            let (gk, gr) = split_periods(x, period);
+            if x == 0.0 {
+                prop_assert!(gk == 0.0 && gr == 0.0);
+            } else {
+                prop_assert_eq!(gk.to_bits(), k.to_bits());
+                prop_assert_eq!(gr.to_bits(), r.to_bits());
+            }
+            // Just below a period: still the first period.
+            let below = period - period * f64::EPSILON / 2.0;
+            if below < period {
+                prop_assert_eq!(split_periods(below, period).0, (below / period).floor());
+            }
+        }
+
         #[test]
         fn cached_motion_is_the_per_call_formula(
             width in prop_oneof![1e-6f64..360.0, Just(1.0)],

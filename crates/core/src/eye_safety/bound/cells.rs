@@ -10,11 +10,11 @@ use super::count::{max_pulses_in, passes_in_window, StepMemo, PRUNE_SLACK, TOUCH
 use super::envelope::Envelope;
 use super::laser::{Laser, PerJouleCache};
 use super::order::{sort_runs, wrap_index};
-use super::seg::{spin_sq_line, Seg};
+use super::seg::Seg;
 use super::sliding::SlidingMax;
 use crate::eye_safety::ael;
 use crate::model::angle::wrap_deg;
-use crate::profile::kinematics::Timeline;
+use crate::profile::kinematics::{BinMotion, Timeline};
 
 /// One cell's exact figures.
 #[derive(Debug, Clone, Copy)]
@@ -153,7 +153,7 @@ impl<'a> Cells<'a> {
         let t_slack = PRUNE_SLACK * frame_s;
         // Bins with angular acceleration (`ω²` not constant); with none, no
         // cell is curved and the edges' bins need not be looked up.
-        let bin_curved: Vec<bool> = segs.iter().map(|s| spin_sq_line(s).1 != 0.0).collect();
+        let bin_curved: Vec<bool> = segs.iter().map(|s| s.spin_sq_line_deg().1 != 0.0).collect();
         let any_curved = bin_curved.contains(&true);
         let cuts = &self.cuts;
         let m = cuts.len();
@@ -235,7 +235,7 @@ impl<'a> Cells<'a> {
                 let (seg_r, seg_l) = (&segs[right.1], &segs[left.1]);
                 // ω at both ends of each edge's arc, on that edge's bin.
                 let spin = |seg: &Seg, k: f64, theta: f64| {
-                    let (a, b) = spin_sq_line(seg);
+                    let (a, b) = seg.spin_sq_line_deg();
                     let x = (theta - (360.0 * k + seg.start_deg)).clamp(0.0, seg.width_deg);
                     (a + b * x).max(0.0).sqrt()
                 };
@@ -328,7 +328,7 @@ impl<'a> Cells<'a> {
     fn spin_sq_at(&self, mid: f64, off: f64) -> (f64, f64) {
         let (k, j, _) = self.tl.locate_unwrapped(mid + off);
         let seg = &self.tl.bins()[j];
-        let (a, b) = spin_sq_line(seg);
+        let (a, b) = seg.spin_sq_line_deg();
         let anchor = 360.0 * k + seg.start_deg;
         (a + b * (off - anchor), b)
     }

@@ -7,7 +7,7 @@
 use super::order::{sort_runs, split_index, wrap_index};
 use super::seg::Seg;
 use super::sliding::Queue;
-use crate::profile::kinematics::Timeline;
+use crate::profile::kinematics::{split_periods, Timeline};
 
 /// The max-filtered power `P̄` over one period, as pieces `[t_k, t_{k+1})`
 /// with prefix integrals, extended periodically.
@@ -120,7 +120,7 @@ impl Envelope {
     /// For unwrapped `t`: whole periods before it, its offset in the
     /// period, and the piece containing that offset.
     fn locate(&self, t: f64) -> (f64, f64, usize) {
-        let (k, r) = self.split(t);
+        let (k, r) = split_periods(t, self.frame_s);
         (k, r, self.piece_of(r))
     }
 
@@ -129,7 +129,7 @@ impl Envelope {
     /// constant time for increasing times.
     #[inline]
     pub(super) fn locate_from(&self, t: f64, hint: &mut usize) -> (f64, f64, usize) {
-        let (k, r) = self.split(t);
+        let (k, r) = split_periods(t, self.frame_s);
         let m = self.pieces();
         let mut j = (*hint).min(m - 1);
         if self.t_s[j] > r {
@@ -141,16 +141,6 @@ impl Envelope {
         }
         *hint = j;
         (k, r, j)
-    }
-
-    #[inline]
-    fn split(&self, t: f64) -> (f64, f64) {
-        if (0.0..self.frame_s).contains(&t) {
-            // The common case, without a call to `floor` (same result).
-            return (0.0, t);
-        }
-        let k = (t / self.frame_s).floor();
-        (k, t - k * self.frame_s)
     }
 
     fn piece_of(&self, r: f64) -> usize {

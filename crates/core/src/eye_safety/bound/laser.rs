@@ -6,6 +6,7 @@
 
 use super::count::{max_pulses_in, passes_in_window};
 use crate::eye_safety::ael::{self, Band, Row};
+pub use crate::eye_safety::rule::Rule;
 
 /// The laser and band constants every rule needs.
 #[derive(Debug, Clone, Copy)]
@@ -403,47 +404,6 @@ impl PassFigures {
     #[must_use]
     pub fn count_energy(&self, t_s: f64, frame_s: f64) -> f64 {
         passes_in_window(t_s, self.duration_s.max(0.0), frame_s) * self.pulses_j
-    }
-}
-
-/// An eye-safety rule, by the window it bounds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-#[non_exhaustive]
-pub enum Rule {
-    /// Each pulse (or `T_i` group) against the C5-corrected single-pulse AEL.
-    SinglePulse,
-    /// Pulse-train energy in windows shorter than one revolution (within a pass).
-    PassTrain,
-    /// Pulse-train energy in windows of one revolution up to T2 = 10 s.
-    T2Train,
-    /// Pulse-train energy in windows beyond T2 up to the 100 s time base
-    /// (the average-power rule).
-    TimeBase,
-}
-
-impl Rule {
-    /// The rule whose windows contain duration `t_s` (frame period `frame_s`).
-    #[must_use]
-    pub fn for_duration(t_s: f64, frame_s: f64) -> Self {
-        if t_s < frame_s {
-            Self::PassTrain
-        } else if t_s <= ael::T2_S {
-            Self::T2Train
-        } else {
-            Self::TimeBase
-        }
-    }
-}
-
-impl std::fmt::Display for Rule {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Self::SinglePulse => "single-pulse energy (C5-corrected)",
-            Self::PassTrain => "pulse-train energy within one pass",
-            Self::T2Train => "pulse-train energy over several passes (up to T2 = 10 s)",
-            Self::TimeBase => "average power over the 100 s time base",
-        })
     }
 }
 

@@ -213,3 +213,51 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eye_safety::ael::Band;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The pruned search (sweep bounds, branch and bound, walks in
+        /// decreasing order of their bound) against the exhaustive one
+        /// (every cell and every walk evaluated): the whole result, bit for
+        /// bit, on random profiles with steps, runs and in-bin
+        /// acceleration, every band. (The root crate's
+        /// `pruned_search_is_bit_identical_to_exhaustive` runs more.)
+        #[test]
+        fn pruned_search_is_exhaustive_search(
+            bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 2.0f64..80.0, any::<bool>()), 1..24),
+            band in prop_oneof![Just(Band::RetinalNir), Just(Band::Ir1400), Just(Band::Ir1500)],
+            f_p in prop_oneof![Just(1e3), 1e3f64..5e5],
+            half_deg in 0.05f64..5.0,
+        ) {
+            let total: f64 = bins.iter().map(|b| b.0).sum();
+            let n = bins.len();
+            let mut start = 0.0;
+            let segs: Vec<Seg> = (0..n)
+                .map(|i| {
+                    let (w, p, w0, accel) = bins[i];
+                    let width = 360.0 * w / total;
+                    let w1 = if accel { bins[(i + 1) % n].2 } else { w0 };
+                    let s = Seg {
+                        start_deg: start,
+                        width_deg: width,
+                        power_w: p,
+                        spin_start_rad_s: w0,
+                        spin_end_rad_s: w1,
+                    };
+                    start += width;
+                    s
+                })
+                .collect();
+            let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+            let pruned = evaluate_with(&segs, half_deg, &laser, Search::Pruned);
+            let exhaustive = evaluate_with(&segs, half_deg, &laser, Search::Exhaustive);
+            prop_assert_eq!(pruned.worst_ratio.to_bits(), exhaustive.worst_ratio.to_bits());
+            prop_assert_eq!(pruned, exhaustive);
+        }
+    }
+}

@@ -73,14 +73,6 @@ pub(super) fn coalesce(segs: &[Seg]) -> std::borrow::Cow<'_, [Seg]> {
     std::borrow::Cow::Owned(out)
 }
 
-/// `ω²` at `x_deg` into `seg` as `a + b·x_deg` (linear: constant acceleration).
-pub(super) fn spin_sq_line(seg: &Seg) -> (f64, f64) {
-    (
-        seg.spin_start_rad_s.powi(2),
-        2.0 * seg.accel_rad_s2() * std::f64::consts::PI / 180.0,
-    )
-}
-
 /// A bin of `width` degrees from `start` at `power`, spinning from
 /// `w0` to `w1` rad/s.
 #[cfg(test)]

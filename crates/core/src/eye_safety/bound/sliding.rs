@@ -98,6 +98,27 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
+        /// The sliding maximum against a scan of each window, over query
+        /// windows whose ends never decrease (as the sweeps make them),
+        /// on a periodic sequence read through negative and large indices.
+        #[test]
+        fn sliding_max_is_a_scan(
+            values in proptest::collection::vec(prop_oneof![0.0f64..5.0, Just(1.0), Just(0.0)], 1..30),
+            steps in proptest::collection::vec((0i64..4, 0i64..6), 1..60),
+            start in -40i64..40,
+        ) {
+            let n = values.len() as i64;
+            let value = |k: i64| values[k.rem_euclid(n) as usize];
+            let mut m = SlidingMax::new();
+            let (mut lo, mut hi) = (start, start);
+            for (dlo, dhi) in steps {
+                lo += dlo;
+                hi = (hi + dhi).max(lo);
+                let scan = (lo..=hi).map(value).fold(f64::NEG_INFINITY, f64::max);
+                prop_assert_eq!(m.max_over(lo, hi, value), scan);
+            }
+        }
+
         /// The queue (with its compaction) is a `VecDeque` used at both
         /// ends, pushed at the back: the same front and back after every
         /// operation, over runs long enough to compact many times.
