@@ -1,6 +1,7 @@
 //! Issue 3 acceptance: AEL figures, per-azimuth exposure, check integration.
 
 mod common;
+#[path = "../crates/core/tests/reference/mod.rs"]
 mod reference;
 
 use common::{assert_bad_input, run, stdout};

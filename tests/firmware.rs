@@ -2,6 +2,7 @@
 
 mod common;
 mod independent;
+#[path = "../crates/core/tests/reference/mod.rs"]
 mod reference;
 
 use common::{run, stdout};

@@ -61,7 +61,8 @@ fn pass_angle_is_aperture_plus_beam_over_100_mm() {
         beam_diameter_mm: 1.5,
     };
     let l = laser(&p1550, 20_000.0).unwrap();
-    let expected = (5.0f64 / 100.0).to_degrees();
+    // 1550 nm: Table 10's largest aperture, 1.5·10^0.375 = 3.5571 mm, + 1.5 mm.
+    let expected = ((1.5 * 10f64.powf(0.375) + 1.5) / 100.0).to_degrees();
     assert!((pass_angle_deg(&p1550, &l) - expected).abs() < 1e-12);
     // A beam wider than the circle is capped at a full turn.
     let huge = EyeSafetyParams {

@@ -51,8 +51,19 @@ pub const ALPHA_MIN_RAD: f64 = 1.5e-3;
 pub const TIME_BASE_S: f64 = 100.0;
 /// Condition 3 aperture for 400–1400 nm: 7 mm (Table 10).
 pub const APERTURE_RETINAL_MM: f64 = 7.0;
-/// Condition 3 aperture for 1400–4000 nm: 3.5 mm (Table 10).
-pub const APERTURE_IR_MM: f64 = 3.5;
+/// Condition 3 aperture the bound uses for 1400–4000 nm, mm: the largest of
+/// Table 10's apertures over every exposure duration (the conservative
+/// choice: a wider aperture meets every pass for longer and holds every pulse
+/// a narrower one holds). Table 10 gives 1 mm to 0.35 s, `1.5·t^0.375` mm
+/// from 0.35 s to 10 s and 3.5 mm from 10 s on ([`table10_aperture_mm`]);
+/// `1.5·t^0.375` exceeds 3.5 mm from 9.578 s and tends to
+/// `1.5·10^0.375` = 3.5571 mm at 10 s, its supremum. The bound takes one
+/// pass arc for every window, so it takes that supremum for every duration
+/// (following the table by duration would need a pass arc per window
+/// length; it would be tighter below 0.35 s, never looser).
+pub const APERTURE_IR_MM: f64 = 3.557_060_558_492_482_4;
+/// Table 10's Condition 3 aperture for 1400–4000 nm at 10 s and beyond, mm.
+pub const APERTURE_IR_LONG_MM: f64 = 3.5;
 /// Condition 3 distance from the reference point (scan mirror): 100 mm (Table 10).
 pub const APERTURE_DISTANCE_MM: f64 = 100.0;
 
@@ -73,7 +84,9 @@ impl Band {
         }
     }
 
-    /// Measurement aperture diameter of Condition 3, mm (Table 10).
+    /// Measurement aperture diameter of Condition 3 the bound uses, mm: Table
+    /// 10's, the largest over every exposure duration (see
+    /// [`APERTURE_IR_MM`]; 7 mm throughout 400–1400 nm).
     #[must_use]
     pub fn aperture_mm(self) -> f64 {
         match self {
@@ -99,6 +112,26 @@ impl Band {
             Self::RetinalNir => 5e-6,
             Self::Ir1400 => 1e-3,
             Self::Ir1500 => 10.0,
+        }
+    }
+}
+
+/// Table 10's Condition 3 aperture diameter for an exposure of `t_s`, mm:
+/// 7 mm for 400–1400 nm; for 1400–4000 nm 1 mm up to 0.35 s, `1.5·t^0.375`
+/// mm for 0.35 s < t < 10 s, 3.5 mm from 10 s. [`Band::aperture_mm`] is its
+/// supremum over `t` (tested over the whole duration range).
+#[must_use]
+pub fn table10_aperture_mm(band: Band, t_s: f64) -> f64 {
+    match band {
+        Band::RetinalNir => APERTURE_RETINAL_MM,
+        Band::Ir1400 | Band::Ir1500 => {
+            if t_s <= 0.35 {
+                1.0
+            } else if t_s < 10.0 {
+                1.5 * t_s.powf(0.375)
+            } else {
+                APERTURE_IR_LONG_MM
+            }
         }
     }
 }
@@ -278,6 +311,36 @@ pub fn table3_j(band: Band, c4: f64, t_s: f64) -> f64 {
     } else {
         rows[3].value_j(t_s)
     }
+}
+
+/// The smallest AEL (Table 3, as [`table3_j`]) over every exposure duration
+/// in `[lo_s, hi_s]` (`hi_s` below `lo_s` is taken as `lo_s`): **the one AEL
+/// infimum** of the model. A window that holds a given set of pulses can be
+/// any length from the pulses' span up to where it must meet more pulses,
+/// and Table 3 is *not* monotone in the duration (it steps down at 5 µs in
+/// 700–1050 nm, at 1 ms in 1400–1500 nm, at 10 s in 700–1050 nm and in
+/// 1500–1800 nm), so every rule compares the pulses a window can hold with
+/// this infimum over every length that holds them, never with the AEL at
+/// their span. Each row is `coef·t^exponent` with `coef > 0`,
+/// `exponent ≥ 0`: nondecreasing within the row, so the infimum over an
+/// interval is at its ends or at a row edge inside it, where [`table3_j`]
+/// takes the smaller of the two rows (the limit of the left row at its end
+/// is never below that). So it is the smallest of the AEL at `lo_s` and at
+/// every row edge in `(lo_s, hi_s]`; the AEL at `hi_s` itself is never
+/// smaller (it is at least its row's value at the row's first edge, or,
+/// with no edge in between, at least the AEL at `lo_s`, in the same row).
+/// Durations below the band's first row take the first row, as
+/// [`table3_j`] does.
+#[must_use]
+pub fn ael_inf_j(band: Band, c4: f64, lo_s: f64, hi_s: f64) -> f64 {
+    let mut v = table3_j(band, c4, lo_s);
+    for row in rows(band, c4) {
+        let e = row.t_hi_s;
+        if e > lo_s && e <= hi_s {
+            v = v.min(table3_j(band, c4, e));
+        }
+    }
+    v
 }
 
 #[cfg(test)]

@@ -698,7 +698,6 @@ impl Greedy<'_> {
 mod derive {
     use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
     use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
-    use crate::eye_safety::bound::Laser;
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
     use crate::eye_safety::EyeSafetyError;
     use crate::firmware::FirmwareTable;
@@ -747,21 +746,6 @@ mod derive {
         let c = x.ceil();
         let c = if c == x && residual > 0.0 { c + 1.0 } else { c };
         Some(c as u64)
-    }
-
-    /// `AEL_inf(t) = inf AEL` over `[t, 100 s]`: each Table 3 row grows with
-    /// `t`, so it is the AEL at `t` or at a row edge after it (the table steps
-    /// down at 5 µs in 700–1050 nm).
-    fn ael_inf(laser: &Laser, t_s: f64) -> f64 {
-        let mut v = laser.ael_j(t_s);
-        for row in laser.rows() {
-            for e in [row.t_lo_s, row.t_hi_s] {
-                if e > t_s && e <= TIME_BASE_S {
-                    v = v.min(laser.ael_j(e));
-                }
-            }
-        }
-        v
     }
 
     impl IntEyeLimits {
@@ -829,7 +813,7 @@ mod derive {
                 let t = (k - 1) as f64 / f_p * (1.0 - 1e-12);
                 train.push(TrainLimit {
                     pulses_from: k,
-                    energy_max_quanta: to_quanta(ael_inf(&laser, t)),
+                    energy_max_quanta: to_quanta(laser.ael_inf_j(t, TIME_BASE_S)),
                 });
                 if k >= k_max {
                     break;
@@ -860,7 +844,7 @@ mod derive {
                 if t > TIME_BASE_S {
                     break;
                 }
-                let per_pass = to_quanta(ael_inf(&laser, t)) / (m as u64);
+                let per_pass = to_quanta(laser.ael_inf_j(t, TIME_BASE_S)) / (m as u64);
                 if per_pass < pass_energy_max_quanta {
                     pass_energy_max_quanta = per_pass;
                     pass_energy_rule = if t <= T2_S {

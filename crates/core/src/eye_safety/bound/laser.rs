@@ -49,28 +49,51 @@ impl Laser {
             .filter(move |&t| t > lo && t < hi)
     }
 
-    /// The smallest AEL over `[lo_s, hi_s]`: the AEL grows within each row
-    /// of Table 3 but may fall at a row edge (905 nm at 5 µs, where
-    /// [`Self::ael_j`] takes the smaller row), so the ends and the edges
-    /// between are every candidate.
-    pub(super) fn min_ael_over(&self, lo_s: f64, hi_s: f64) -> f64 {
-        let mut a = self.ael_j(lo_s).min(self.ael_j(hi_s));
-        for t in self.edges_within(lo_s, hi_s) {
-            a = a.min(self.ael_j(t));
-        }
-        a
+    /// The smallest AEL over every exposure duration in `[lo_s, hi_s]`
+    /// (`hi_s` below `lo_s` is `lo_s`), durations clamped as in
+    /// [`Self::ael_j`]: the model's one AEL infimum, [`ael::ael_inf_j`]
+    /// (Table 3 is not monotone in the duration: it steps down at 5 µs and
+    /// 10 s in 700–1050 nm, at 1 ms in 1400–1500 nm and at 10 s in
+    /// 1500–1800 nm). Every rule that bounds the pulses a window can hold
+    /// compares them with this over every window length that holds them
+    /// (`specs/eye_safety.md`, "The AEL infimum"); the firmware checker's
+    /// limits and the optimizer use the same function.
+    #[must_use]
+    pub fn ael_inf_j(&self, lo_s: f64, hi_s: f64) -> f64 {
+        let clamp = |t: f64| {
+            t.max(self.pulse_duration_s)
+                .max(self.band.min_duration_s())
+                .min(ael::T_MAX_TABLE_S)
+        };
+        ael::ael_inf_j(self.band, self.c4, clamp(lo_s), clamp(hi_s))
     }
 
-    /// `sup τ/AEL(τ)` over `0 < τ ≤ tau_hi_s`: on every row of Table 3 the
-    /// AEL is `c·τ^p` with `0 ≤ p ≤ 1`, so `τ/AEL(τ)` is nondecreasing
-    /// within a row (and below the clamp at the pulse duration, where the
-    /// AEL is constant), and the supremum is at `tau_hi_s` or at a row edge
-    /// below it (where [`Self::ael_j`] takes the smaller row). Bounds
-    /// `E/AEL(τ) ≤ (E/τ)·K` for every `τ ≤ tau_hi_s`.
-    pub(super) fn mean_power_factor(&self, tau_hi_s: f64) -> f64 {
-        let mut k = tau_hi_s / self.ael_j(tau_hi_s);
+    /// The longest window that can still meet only one pass, s (capped at
+    /// the time base): windows from `T_f − max(τ_max, Δ)` on can meet two
+    /// and are bounded by the multi-pass rules ([`Self::multi_pass_ratio`],
+    /// which starts there and takes the AEL at every window's own length),
+    /// so a window holding the pulses of one pass and no more is at most
+    /// this long, or is covered there. The within-pass rules take the AEL
+    /// infimum up to it.
+    #[must_use]
+    pub fn one_pass_window_max_s(&self, frame_s: f64, tau_max_s: f64) -> f64 {
+        let delta = 1.0 / self.pulse_rate_hz;
+        (frame_s - tau_max_s.max(delta)).clamp(0.0, ael::TIME_BASE_S)
+    }
+
+    /// `sup τ/AEL_inf(τ)` over `0 < τ ≤ tau_hi_s`, `AEL_inf(τ)` the
+    /// smallest AEL over `[τ, one_pass_s]` ([`Self::ael_inf_j`]): on every
+    /// row of Table 3 the AEL is `c·τ^p` with `0 ≤ p ≤ 1`, so `τ/AEL(τ)` is
+    /// nondecreasing within a row (and below the clamp at the pulse
+    /// duration, where the AEL is constant), and `τ/m` is increasing where
+    /// the infimum is a later edge's value `m` (constant between edges); so
+    /// the supremum is at `tau_hi_s` or at a row edge below it (where the
+    /// table takes the smaller row, below both sides' limits). Bounds
+    /// `E/AEL_inf(τ) ≤ (E/τ)·K` for every `τ ≤ tau_hi_s`.
+    pub(super) fn mean_power_factor(&self, tau_hi_s: f64, one_pass_s: f64) -> f64 {
+        let mut k = tau_hi_s / self.ael_inf_j(tau_hi_s, one_pass_s);
         for t in self.edges_within(0.0, tau_hi_s) {
-            k = k.max(t / self.ael_j(t));
+            k = k.max(t / self.ael_inf_j(t, one_pass_s));
         }
         k
     }
@@ -123,10 +146,19 @@ impl Laser {
         }
     }
 
-    /// The largest ratio `min(cap_j, e0_j + slope_w·(T − t0))/AEL(T)` over
-    /// `T ∈ [t0, t1]`, the energy being linear until it reaches `cap_j`
-    /// and flat after: evaluated at the segment ends, at the cap and at every
-    /// AEL row edge in between (the ratio has no interior maximum).
+    /// The largest ratio `min(cap_j, e0_j + slope_w·(T − t0))/AEL_inf(T)`
+    /// over `T ∈ [t0, t1]`, the energy being linear until it reaches
+    /// `cap_j` and flat after, `AEL_inf(T)` the smallest AEL over
+    /// `[T, one_pass_s]` ([`Self::ael_inf_j`]: the pulses a window of `T`
+    /// holds are held by every longer window up to `one_pass_s` too; pass
+    /// `one_pass_s ≤ t0` for the AEL at `T` itself). Evaluated at the
+    /// segment ends, at the cap, at `one_pass_s` and at every AEL row edge
+    /// in between: between two of these the energy is `α + βT` (`β ≥ 0`)
+    /// and `AEL_inf(T) = min(c·T^p, m)` with `m` constant (the later edges'
+    /// and `one_pass_s`'s values), so the ratio is the larger of
+    /// `(α + βT)/(c·T^p)` (no interior maximum, `0 ≤ p ≤ 1`) and
+    /// `(α + βT)/m` (largest at the right end, where `AEL_inf` is at most
+    /// `m`).
     pub(super) fn linear_capped_max(
         &self,
         t0: f64,
@@ -134,6 +166,7 @@ impl Laser {
         e0_j: f64,
         slope_w: f64,
         cap_j: f64,
+        one_pass_s: f64,
     ) -> (f64, f64) {
         if t1.is_nan() || t0.is_nan() || t1 < t0 {
             return (0.0, t0);
@@ -141,7 +174,7 @@ impl Laser {
         let energy = |t: f64| (e0_j + slope_w * (t - t0)).min(cap_j);
         let mut best = (0.0, t0);
         let mut consider = |t: f64| {
-            let r = energy(t) / self.ael_j(t);
+            let r = energy(t) / self.ael_inf_j(t, one_pass_s);
             if r > best.0 {
                 best = (r, t);
             }
@@ -153,6 +186,9 @@ impl Laser {
             if t_cap > t0 && t_cap < t1 {
                 consider(t_cap);
             }
+        }
+        if one_pass_s > t0 && one_pass_s < t1 {
+            consider(one_pass_s);
         }
         for t in self.edges_within(t0, t1) {
             consider(t);
@@ -181,6 +217,10 @@ impl Laser {
         let delta = 1.0 / self.pulse_rate_hz;
         let tb = ael::TIME_BASE_S;
         let t_start = (frame_s - pass.duration_s.max(delta)).max(0.0);
+        debug_assert_eq!(
+            t_start.min(tb),
+            self.one_pass_window_max_s(frame_s, pass.duration_s)
+        );
         if pass.envelope_j <= 0.0 || pass.pulses_j <= 0.0 || t_start >= tb {
             return (0.0, t_start);
         }
@@ -322,6 +362,8 @@ impl Laser {
             power_w * (self.pulse_duration_s + delta),
             power_w,
             f64::INFINITY,
+            // Every window length is evaluated: the AEL at its own.
+            0.0,
         );
         if single >= train {
             (single, Rule::SinglePulse)

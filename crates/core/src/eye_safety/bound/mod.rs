@@ -143,6 +143,11 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
     // Rule 2 within one revolution: the whole-pass windows, then window
     // walks over envelope breakpoints within one pass.
     let l_max = (best.tau_max + delta).min(frame_s);
+    // Windows up to `one_pass` can meet one pass only: the pulses a
+    // within-pass figure counts are compared with the smallest AEL over
+    // every such length that holds them (longer ones are the multi-pass
+    // rules'), never with the AEL at their span (Table 3 steps down).
+    let one_pass = laser.one_pass_window_max_s(frame_s, best.tau_max);
     let walks = Walks {
         env: &env,
         tl: &tl,
@@ -150,14 +155,15 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
         two_h_deg: 2.0 * half_deg.min(180.0),
         e_pass: best.e_max.0,
         l_max,
+        one_pass_s: one_pass,
     };
     // Windows of a whole pass or more hold at most `E⁺` (not above the
     // whole-pass bound below, a cheap first threshold for the pruning).
     let t0 = best.tau_max;
-    let first = Best(best.e_max.0 / laser.ael_j(t0), t0);
+    let first = Best(best.e_max.0 / laser.ael_inf_j(t0, one_pass), t0);
     let within = walks.search(search, first);
     let Best(pass_ratio, pass_window) =
-        cells.full_pass_max(search, best.e_max.0, best.tau_max, within);
+        cells.full_pass_max(search, best.e_max.0, best.tau_max, one_pass, within);
     // Rule 2 over several passes, up to the time base.
     let pass = PassFigures {
         envelope_j: best.e_env_max,

@@ -27,11 +27,17 @@ pub(super) struct Walks<'a> {
     pub(super) e_pass: f64,
     /// Longest window a walk follows: a pass plus one pulse spacing, s.
     pub(super) l_max: f64,
+    /// The longest window that meets only one pass
+    /// ([`Laser::one_pass_window_max_s`]): a walk's window of `T` is
+    /// compared with the smallest AEL over `[T, one_pass_s]`, the lengths of
+    /// every window that holds its pulses and no other pass's.
+    pub(super) one_pass_s: f64,
 }
 
 impl Walks<'_> {
-    /// The supremum of `min(E⁺, ∫ P̄ over J)/AEL(T)` over the windows that
-    /// fit in one pass, after `best` (the whole-pass windows,
+    /// The supremum of `min(E⁺, ∫ P̄ over J)/AEL_inf(T)` over the windows that
+    /// fit in one pass (`AEL_inf(T)`: the smallest AEL over `[T, one_pass_s]`,
+    /// every length of a window holding the same pulses), after `best` (the whole-pass windows,
     /// [`Cells::full_pass`]).
     ///
     /// A window `W` of duration `T` meets the pass `I_φ = [a, a + τ(φ)]` of
@@ -39,7 +45,9 @@ impl Walks<'_> {
     /// `J = (W ⊕ [0, Δ]) ∩ (I_φ ⊕ [0, Δ]) = [u, u + ℓ]`, `ℓ ≤ T + Δ`; the
     /// head is at `θ(u) ≥ φ − h` at `u`, so the pass ends by
     /// `t(θ(u) + 2h)` and `ℓ ≤ R(u) = t(θ(u) + 2h) + Δ − u`. The ratio is at
-    /// most `g(u, ℓ) = min(E⁺, ∫_J P̄)/AEL(ℓ − Δ)` over `0 < ℓ ≤ R(u)`. For a
+    /// most `g(u, ℓ) = min(E⁺, ∫_J P̄)/AEL_inf(ℓ − Δ)` over `0 < ℓ ≤ R(u)`
+    /// (`T ≥ ℓ − Δ`, and `T < one_pass_s` or the window is the multi-pass
+    /// rules'; not `AEL(ℓ − Δ)`: Table 3 is not monotone). For a
     /// fixed `ℓ`, `∫_J P̄` is piecewise linear in `u` and its maxima over
     /// each interval of feasible `u` lie where `u` is an up-step of `P̄` or
     /// `u + ℓ` a down-step (the walks: forward from up-steps up to `R(u)`,
@@ -49,7 +57,7 @@ impl Walks<'_> {
     ///
     /// Pruned: a walk's windows hold at most `min(E⁺, p·L)` with `p` the
     /// highest `P̄` it can reach, so its ratio is at most
-    /// `G(p) = sup_T min(E⁺, p·(T + Δ))/AEL(T)` (over `T` up to `l_max`),
+    /// `G(p) = sup_T min(E⁺, p·(T + Δ))/AEL_inf(T)` (over `T` up to `l_max`),
     /// nondecreasing in `p`; walks are followed in decreasing `p` until
     /// `G(p)` falls below the best.
     pub(super) fn search(&self, search: Search, mut best: Best) -> Best {
@@ -81,6 +89,7 @@ impl Walks<'_> {
                             w.p_span * delta,
                             w.p_span,
                             self.e_pass,
+                            self.one_pass_s,
                         );
                         g = (w.p_span, r * (1.0 + PRUNE_SLACK));
                     }
@@ -188,6 +197,7 @@ impl Walks<'_> {
                     e0,
                     piece_p,
                     e_pass,
+                    self.one_pass_s,
                 ));
             }
             e += piece_p * (seg_end - l);
@@ -200,7 +210,14 @@ impl Walks<'_> {
                 } else {
                     (l - delta).max(0.0)
                 };
-                best.take(laser.linear_capped_max(t_c, t_reach.max(t_c), e_pass, 0.0, e_pass));
+                best.take(laser.linear_capped_max(
+                    t_c,
+                    t_reach.max(t_c),
+                    e_pass,
+                    0.0,
+                    e_pass,
+                    self.one_pass_s,
+                ));
                 return;
             }
             if l >= reach {
@@ -211,7 +228,14 @@ impl Walks<'_> {
         // Truncated: longer windows gain at most `p_span` per second.
         let l0 = l.max(delta);
         let e0 = e + w.p_span * (l0 - l);
-        best.take(laser.linear_capped_max(l0 - delta, t_reach, e0, w.p_span, e_pass));
+        best.take(laser.linear_capped_max(
+            l0 - delta,
+            t_reach,
+            e0,
+            w.p_span,
+            e_pass,
+            self.one_pass_s,
+        ));
     }
 }
 

@@ -1,5 +1,5 @@
 //! Rule 2 over the windows that hold one whole pass (the boundary of the
-//! walks' reach): `min(E(φ), E⁺)/AEL(τ(φ))` per cell, and its pruned
+//! walks' reach): `min(E(φ), E⁺)/AEL_inf(τ(φ))` per cell, and its pruned
 //! maximum over the cells (`specs/eye_safety.md`, "Whole-pass windows").
 
 use super::cells::Cells;
@@ -10,7 +10,7 @@ use super::Search;
 impl Cells<'_> {
     /// Rule 2 over the windows that hold one whole pass (the boundary of
     /// the walks' reach, see [`Walks::search`]): an upper bound of
-    /// `min(E(φ), E⁺)/AEL(τ(φ))` over the azimuths `φ` of cell `c`, with the
+    /// `min(E(φ), E⁺)/AEL_inf(τ(φ))` over the azimuths `φ` of cell `c`, with the
     /// `τ` where it is taken. Off the curved cells `E` and `τ` are affine in
     /// `φ` (both pass edges in bins of constant spin, the envelope pieces
     /// fixed), so on each row of Table 3 `E/AEL(τ) = (e₀ + e₁x)/(c·(τ₀ +
@@ -24,17 +24,25 @@ impl Cells<'_> {
     /// `E` (capped) over the smallest AEL between its smallest and largest
     /// `τ` (all exact, see [`Self::exact`]; the AEL may fall at a row
     /// edge).
-    fn full_pass(&self, c: usize, e_cap: f64) -> (f64, f64) {
+    ///
+    /// The AEL is the smallest over every length of a window holding the
+    /// pass and no other, `AEL_inf(τ) = min AEL over [τ, one_pass_s]`
+    /// ([`Laser::ael_inf_j`]): `E/AEL_inf(τ) = max(E/AEL(τ), E/m)` with `m`
+    /// the later edges' (and `one_pass_s`'s) smallest value, constant
+    /// between the points where `τ` meets a row edge, so `E/m` (`E` affine)
+    /// is largest at the same candidates, where `AEL_inf` is at most `m`.
+    fn full_pass(&self, c: usize, e_cap: f64, one_pass_s: f64) -> (f64, f64) {
         let laser = self.laser;
         if self.rows[c].curved {
             let x = self.exact(c);
-            let r = x.e_env.min(e_cap) / laser.min_ael_over(x.tau_min_s, x.tau_s);
+            let r = x.e_env.min(e_cap) / laser.ael_inf_j(x.tau_min_s, x.tau_s.max(one_pass_s));
             return (r, x.tau_min_s);
         }
         let (tu, tv) = (self.tau_pt[c], self.tau_pt[c + 1]);
         let (eu, ev) = (self.e_pt[c], self.e_pt[c + 1]);
         let mut best = Best(0.0, 0.0);
-        let mut take = |e: f64, t: f64| best.take((e.min(e_cap) / laser.ael_j(t), t));
+        let mut take =
+            |e: f64, t: f64| best.take((e.min(e_cap) / laser.ael_inf_j(t, one_pass_s), t));
         take(eu, tu);
         take(ev, tv);
         // Along the cell `E` is affine in `τ`. Interpolations are widened by
@@ -65,24 +73,25 @@ impl Cells<'_> {
     /// The largest [`Self::full_pass`] over the cells and `best`. Pruned: a cell is
     /// evaluated only if `min(E_ub, E⁺)/τ_lb · K` ([`Laser::mean_power_factor`]
     /// up to the longest pass), then `min(E_ub, E⁺)` over the smallest AEL
-    /// between `τ_lb` and `τ_ub`, both upper bounds of its value, can reach
+    /// between `τ_lb` and `max(τ_ub, one_pass_s)`, both upper bounds of its value, can reach
     /// the best so far.
     pub(super) fn full_pass_max(
         &self,
         search: Search,
         e_cap: f64,
         tau_max: f64,
+        one_pass_s: f64,
         mut best: Best,
     ) -> Best {
         match search {
             Search::Exhaustive => {
                 for c in 0..self.len() {
-                    best.take(self.full_pass(c, e_cap));
+                    best.take(self.full_pass(c, e_cap, one_pass_s));
                 }
             }
             Search::Pruned => {
                 let laser = self.laser;
-                let k = laser.mean_power_factor(tau_max) * (1.0 + PRUNE_SLACK);
+                let k = laser.mean_power_factor(tau_max, one_pass_s) * (1.0 + PRUNE_SLACK);
                 for (c, row) in self.rows.iter().enumerate() {
                     // (A NaN bound never prunes; a bound `τ_lb ≤ 0` only
                     // through the AEL, which clamps it.)
@@ -90,11 +99,11 @@ impl Cells<'_> {
                     if row.tau_lb > 0.0 && e / row.tau_lb * k < best.0 {
                         continue;
                     }
-                    let ael = laser.min_ael_over(row.tau_lb, row.tau_ub);
+                    let ael = laser.ael_inf_j(row.tau_lb, row.tau_ub.max(one_pass_s));
                     if e / ael * (1.0 + PRUNE_SLACK) < best.0 {
                         continue;
                     }
-                    best.take(self.full_pass(c, e_cap));
+                    best.take(self.full_pass(c, e_cap, one_pass_s));
                 }
             }
         }

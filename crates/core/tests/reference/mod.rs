@@ -1,7 +1,7 @@
 //! Brute-force reference evaluator for the Class 1 eye-safety rules of a
 //! scanned, pulsed beam (DESIGN.md §2 "Spin with finite acceleration", §5).
 //!
-//! Written independently of `gaze_lidar::eye_safety`: it shares no code with
+//! Written independently of `gaze_lidar_core::eye_safety`: it shares no code with
 //! the crate (own kinematics, own AEL table, own pulse clock). It is slow and
 //! plain on purpose.
 //!
@@ -150,7 +150,7 @@ pub struct Scan {
 
 impl Scan {
     /// A profile's bins and laser as plain numbers (public fields only).
-    pub fn of_profile(p: &gaze_lidar::profile::Profile) -> Self {
+    pub fn of_profile(p: &gaze_lidar_core::profile::Profile) -> Self {
         let es = p.limits.eye_safety.as_ref().expect("eye_safety params");
         Scan {
             bins: p
