@@ -8,16 +8,7 @@ pub use gaze_lidar_core::text::{Limit, Num};
 /// when toml knows it — never toml's multi-line snippet with a caret.
 #[must_use]
 pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
-    // Without the input, toml's rendering is the message and the key path.
-    let mut bare = e.clone();
-    bare.set_input(None);
-    let message = bare
-        .to_string()
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect::<Vec<_>>()
-        .join(" ");
+    let message = toml_message(e);
     match e.span() {
         Some(span) => {
             let (line, column) = line_column(text, span.start);
@@ -25,6 +16,20 @@ pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
         }
         None => message,
     }
+}
+
+/// toml's error as one line: the message and the key path (without the
+/// input, toml's rendering has no snippet).
+#[must_use]
+pub fn toml_message(e: &toml::de::Error) -> String {
+    let mut bare = e.clone();
+    bare.set_input(None);
+    bare.to_string()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// 1-based line and column (in characters) of byte `offset` in `text`

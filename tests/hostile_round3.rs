@@ -839,9 +839,11 @@ fn kind_15_numbers_in_messages_are_compact() {
     p["limits"]["power_w_max"] = serde_json::json!(1e300);
     let prof = d.file("huge.json", p.to_string());
     cases.push(v(&["check", s(&prof)]));
-    // A sensor file whose limit is 1e300: "looser than the sensor's …".
+    // A sensor file whose limit is tiny: "looser than the sensor's …" (a
+    // valid sensor file: its lower power limit 1e-300 W, above the
+    // profile's 0).
     let mut lidar = gaze_lidar::model::presets::paper().lidar;
-    lidar.limits.power_w_min = 1e300;
+    lidar.limits.power_w_min = 1e-300;
     // (TOML has no null: every limit given.)
     lidar.limits.spin_accel_rad_s2_max = Some(1e300);
     lidar.limits.power_slew_w_per_deg_max = Some(1e-300);
@@ -859,7 +861,7 @@ fn kind_15_numbers_in_messages_are_compact() {
     expect(&o, 2, &["--pulse-duration-s", "1e300"], "ael 1e300");
     let o = run(&["check", s(&good_file), "--sensor", s(&sensor)], None);
     assert!(
-        stdout(&o).contains("looser than the sensor's 1e300"),
+        stdout(&o).contains("looser than the sensor's 1e-300"),
         "{}{}",
         stderr(&o),
         stdout(&o)

@@ -142,24 +142,18 @@ struct SensorFile {
     limits: FileLimits,
 }
 
-/// Line and column (1-based) of a byte offset.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
-}
-
 /// Reads a sensor file: the schema (exactly a preset's `lidar`), then every
 /// number through [`LidarSpec::validate`]. `origin` names the file.
 pub fn from_toml(text: &str, origin: &str) -> Result<LidarSpec, SensorError> {
     let file: SensorFile = toml::from_str(text).map_err(|e| {
-        let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
+        let (line, column) = e
+            .span()
+            .map_or((1, 1), |s| crate::text::line_column(text, s.start));
         SensorError::Toml {
             origin: origin.to_owned(),
             line,
             column,
-            message: e.message().replace('\n', " ").trim().to_owned(),
+            message: crate::text::toml_message(&e),
         }
     })?;
     let l = file.limits;

@@ -94,7 +94,10 @@ impl LinearProgram {
         self.integer.iter().any(|&b| b)
     }
 
-    fn highs_model(&self, relax: bool) -> highs::Model {
+    /// The program as a HiGHS model; HiGHS refusing it (a coefficient or a
+    /// bound it cannot take, e.g. from limits of no physical size) is a
+    /// solver error, never a panic.
+    fn highs_model(&self, relax: bool, what: &str) -> Result<highs::Model, OptError> {
         let mut pb = highs::RowProblem::default();
         let cols: Vec<highs::Col> = (0..self.cost.len())
             .map(|j| {
@@ -108,13 +111,15 @@ impl LinearProgram {
         for r in &self.rows {
             pb.add_row(r.lo..=r.hi, r.coefs.iter().map(|&(j, a)| (cols[j], a)));
         }
-        let mut m = pb.optimise(highs::Sense::Maximise);
+        let mut m = pb.try_optimise(highs::Sense::Maximise).map_err(|e| {
+            OptError::Solver(format!("{what} step: HiGHS refused the program ({e:?})"))
+        })?;
         // Pinned for determinism (one thread, fixed seed); MILPs to optimality.
         m.set_option("threads", 1);
         m.set_option("random_seed", 0);
         m.set_option("mip_rel_gap", 0.0);
         m.set_option("mip_abs_gap", 1e-12);
-        m
+        Ok(m)
     }
 
     /// Solves with HiGHS; for a MILP also solves the LP relaxation for the
@@ -122,7 +127,7 @@ impl LinearProgram {
     pub fn solve(&self, what: &str) -> Result<Solved, OptError> {
         let run = |relax: bool| -> Result<highs::SolvedModel, OptError> {
             let solved = self
-                .highs_model(relax)
+                .highs_model(relax, what)?
                 .try_solve()
                 .map_err(|e| OptError::Solver(format!("{what} step: {e:?}")))?;
             match solved.status() {
