@@ -66,7 +66,8 @@
 use super::super::trial::mix64;
 
 /// How the LiDAR is sampled in the `carla` geometry.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Sampling {
     /// CARLA's fixed tick: `round(rate · dt)` points per laser per tick,
