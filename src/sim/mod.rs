@@ -739,63 +739,9 @@ fn run_planar<'s>(
         .into_par_iter()
         .map(|trial| {
             let d = draw(config.seed, trial, &config.scenario);
-            struct Plan {
-                model: ModelKind,
-                variant: Variant,
-                profile: CertifiedProfile,
-                rof_keep: f64,
-                regions: crate::model::acuity::Regions,
-                models: Vec<(FogLevel, ReturnModel)>,
-            }
-            let mut plans = Vec::new();
-            for &model in &config.models {
-                for &variant in &config.variants {
-                    let sensor = sensor_of(variant);
-                    let (profile, rof_keep) = plan_variant(
-                        &config.sensor,
-                        model,
-                        variant,
-                        d.gaze_deg,
-                        config.bins,
-                        table,
-                    )?;
-                    let models = fogs
-                        .iter()
-                        .map(|&fog| {
-                            (
-                                fog,
-                                ReturnModel::new(
-                                    model,
-                                    fog,
-                                    sensor.lidar.rated_range_m,
-                                    sensor.lidar.reference_reflectivity,
-                                ),
-                            )
-                        })
-                        .collect();
-                    plans.push(Plan {
-                        model,
-                        variant,
-                        profile,
-                        rof_keep,
-                        regions: sensor.focus.regions(d.gaze_deg),
-                        models,
-                    });
-                }
-            }
+            let plans = plan_trial(config, fogs, table, sensor_of, d.gaze_deg)?;
             // Group the plans by timeline and regions (first-seen order).
-            let mut groups: Vec<Vec<usize>> = Vec::new();
-            for (i, plan) in plans.iter().enumerate() {
-                let same = groups.iter_mut().find(|g| {
-                    let first = &plans[g[0]];
-                    carla::same_timeline(first.profile.profile(), plan.profile.profile())
-                        && first.regions == plan.regions
-                });
-                match same {
-                    Some(g) => g.push(i),
-                    None => groups.push(vec![i]),
-                }
-            }
+            let groups = group_plans(&plans, |a, b| a.regions == b.regions);
             let mut out = Vec::new();
             for g in &groups {
                 let mut cells = Vec::new();
@@ -925,6 +871,77 @@ fn run_planar_per_cell<'s>(
         .collect()
 }
 
+/// One (model, variant) plan of a trial: its certified profile and one
+/// return model per fog level.
+struct Plan {
+    model: ModelKind,
+    variant: Variant,
+    profile: CertifiedProfile,
+    rof_keep: f64,
+    regions: crate::model::acuity::Regions,
+    models: Vec<(FogLevel, ReturnModel)>,
+}
+
+/// Every (model, variant) plan of a trial whose driver looks at `gaze_deg`,
+/// in the configuration's order (shared by the planar and carla geometries).
+fn plan_trial<'s>(
+    config: &SimConfig,
+    fogs: &[FogLevel],
+    table: Option<&OptTable>,
+    sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
+    gaze_deg: f64,
+) -> Result<Vec<Plan>, SimError> {
+    let mut plans = Vec::new();
+    for &model in &config.models {
+        for &variant in &config.variants {
+            let sensor = sensor_of(variant);
+            let (profile, rof_keep) =
+                plan_variant(&config.sensor, model, variant, gaze_deg, config.bins, table)?;
+            let models = fogs
+                .iter()
+                .map(|&fog| {
+                    (
+                        fog,
+                        ReturnModel::new(
+                            model,
+                            fog,
+                            sensor.lidar.rated_range_m,
+                            sensor.lidar.reference_reflectivity,
+                        ),
+                    )
+                })
+                .collect();
+            plans.push(Plan {
+                model,
+                variant,
+                profile,
+                rof_keep,
+                regions: sensor.focus.regions(gaze_deg),
+                models,
+            });
+        }
+    }
+    Ok(plans)
+}
+
+/// The plans grouped by one timeline (and whatever else `also` requires),
+/// in first-seen order: the indices of each group.
+fn group_plans(plans: &[Plan], also: impl Fn(&Plan, &Plan) -> bool) -> Vec<Vec<usize>> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, plan) in plans.iter().enumerate() {
+        let same = groups.iter_mut().find(|g| {
+            let first = &plans[g[0]];
+            carla::same_timeline(first.profile.profile(), plan.profile.profile())
+                && also(first, plan)
+        });
+        match same {
+            Some(g) => g.push(i),
+            None => groups.push(vec![i]),
+        }
+    }
+    groups
+}
+
 /// The `carla` geometry: per trial, every cell planned, cells sharing a
 /// timeline cast together ([`carla::run_group`]); records in the planar order.
 fn run_carla<'s>(
@@ -939,62 +956,9 @@ fn run_carla<'s>(
         .into_par_iter()
         .map(|trial| {
             let d = draw(config.seed, trial, &config.scenario);
-            // (model, variant) plans, then one cell per fog level.
-            struct Plan {
-                model: ModelKind,
-                variant: Variant,
-                profile: CertifiedProfile,
-                rof_keep: f64,
-                regions: crate::model::acuity::Regions,
-                models: Vec<(FogLevel, ReturnModel)>,
-            }
-            let mut plans = Vec::new();
-            for &model in &config.models {
-                for &variant in &config.variants {
-                    let sensor = sensor_of(variant);
-                    let (profile, rof_keep) = plan_variant(
-                        &config.sensor,
-                        model,
-                        variant,
-                        d.gaze_deg,
-                        config.bins,
-                        table,
-                    )?;
-                    let models = fogs
-                        .iter()
-                        .map(|&fog| {
-                            (
-                                fog,
-                                ReturnModel::new(
-                                    model,
-                                    fog,
-                                    sensor.lidar.rated_range_m,
-                                    sensor.lidar.reference_reflectivity,
-                                ),
-                            )
-                        })
-                        .collect();
-                    plans.push(Plan {
-                        model,
-                        variant,
-                        profile,
-                        rof_keep,
-                        regions: sensor.focus.regions(d.gaze_deg),
-                        models,
-                    });
-                }
-            }
+            let plans = plan_trial(config, fogs, table, sensor_of, d.gaze_deg)?;
             // Group the plans by timeline (first-seen order).
-            let mut groups: Vec<Vec<usize>> = Vec::new();
-            for (i, plan) in plans.iter().enumerate() {
-                let same = groups.iter_mut().find(|g| {
-                    carla::same_timeline(plans[g[0]].profile.profile(), plan.profile.profile())
-                });
-                match same {
-                    Some(g) => g.push(i),
-                    None => groups.push(vec![i]),
-                }
-            }
+            let groups = group_plans(&plans, |_, _| true);
             let mut out = Vec::new();
             let mut rays = carla::TrialRays::default();
             for g in &groups {
