@@ -789,15 +789,7 @@ fn run_planar<'s>(
             Ok(out)
         })
         .collect();
-    let rank = |r: &TrialRecord| {
-        let m = config.models.iter().position(|&x| x == r.model);
-        let v = config.variants.iter().position(|x| x.name() == r.variant);
-        let f = config.fog_pcts.iter().position(|&x| x == r.fog_pct);
-        (m, v, f, r.trial)
-    };
-    let mut records: Vec<TrialRecord> = per_trial?.into_iter().flatten().collect();
-    records.sort_by_key(rank);
-    Ok(records)
+    in_planar_order(config, per_trial)
 }
 
 /// The planar geometry one job per (model, variant, fog, trial), each cast
@@ -1003,7 +995,14 @@ fn run_carla<'s>(
             Ok(out)
         })
         .collect();
-    // The planar order: model, variant, fog, trial.
+    in_planar_order(config, per_trial)
+}
+
+/// The records of every trial in the planar order: model, variant, fog, trial.
+fn in_planar_order(
+    config: &SimConfig,
+    per_trial: Result<Vec<Vec<TrialRecord>>, SimError>,
+) -> Result<Vec<TrialRecord>, SimError> {
     let rank = |r: &TrialRecord| {
         let m = config.models.iter().position(|&x| x == r.model);
         let v = config.variants.iter().position(|x| x.name() == r.variant);
