@@ -18,10 +18,10 @@ use good_lp::{
 use std::f64::consts::TAU;
 
 use super::{OptError, Problem};
-use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
-use crate::eye_safety::bound::{max_pulses_in, passes_in_window, Laser, PassFigures};
-use crate::eye_safety::exposure;
-use crate::model::angle::{next_index, wrap_deg, Arc, Binning, CircularSet};
+use crate::eye_safety::bound::{Laser, Seg, RATIO_MARGIN};
+use crate::eye_safety::cuts::{cuts, Cut};
+use crate::eye_safety::{exposure, EyeSafetyParams};
+use crate::model::angle::{next_index, wrap_deg, Arc, Binning};
 use crate::model::lidar::PowerAccounting;
 use crate::planner::Mode;
 use crate::profile::{Bin, Profile, Region, PROFILE_FORMAT};
@@ -41,12 +41,25 @@ const TIE_BREAK: f64 = 1e-3;
 const TRUST: f64 = 0.3;
 /// Share of the acceleration limit the linearised constraint may use.
 const ACCEL_SHARE: f64 = 0.8;
-/// Relative margin on eye-safety power caps (covers spin variation within a
-/// bin once the continuous spin profile is rebuilt).
-const CAP_MARGIN: f64 = 1e-3;
-/// Relative margin below `K/f_p` for a dwell that holds at most `K` pulses
-/// (well above the model's count margin, `bound::COUNT_MARGIN`).
-const DWELL_COUNT_MARGIN: f64 = 1e-6;
+/// Relative margin every eye-safety cut keeps below its limit: HiGHS's
+/// feasibility tolerance (1e-7 on rows normalised to 1) beyond the
+/// head-room and the bound's own rounding margin (`RATIO_MARGIN`).
+const CUT_MARGIN: f64 = 2e-7;
+/// Head-room the power step leaves under the Class 1 limit of the bound, so
+/// that a rotated copy of its answer (the fast path) still certifies.
+pub(super) const EYE_SAFETY_HEADROOM: f64 = 1e-6;
+/// Right-hand side of a cut row normalised to its limit: a power vector
+/// that meets it with equality is at `1 − headroom` of the bound's figure
+/// for that cut once the bound's rounding margin is applied.
+fn cut_rhs() -> f64 {
+    (1.0 - EYE_SAFETY_HEADROOM) / (1.0 + RATIO_MARGIN) * (1.0 - CUT_MARGIN)
+}
+
+/// Rounds of the cutting-plane loop of one power step.
+const CUT_ROUNDS: usize = 60;
+/// Cuts at or above this ratio of the current iterate are binding: the
+/// dwell step linearises them.
+const BINDING: f64 = 1.0 - 1e-3;
 /// Dwell-step iterations when the acceleration limit is finite.
 const SLP_ROUNDS: usize = 5;
 
@@ -117,22 +130,19 @@ fn sqrt_chords(lo: f64, hi: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Eye-safety windows for the LP: for every bin edge, the pass window
-/// starting and ending there, as (bin, covered fraction) lists, with the
-/// limits taken from the one eye-safety model ([`Laser`]): the LP's linear
-/// constraints are that model's rules inverted at fixed counts, and the
-/// solved profile is then fitted to the model's sound bound
-/// (`fit_to_eye_safety_bound`) and certified by the checker.
+/// The one eye-safety model as the optimizer asks it: the core's sound
+/// bound decides (the verdict `check` gives), and its concrete exposures
+/// ([`crate::eye_safety::cuts`]) are the linear cuts the programs carry
+/// (`specs/optimizer.md`, "Eye safety as cuts"). No eye-safety formula
+/// lives here.
 struct Eye {
-    windows: Vec<Vec<(usize, f64)>>,
+    params: EyeSafetyParams,
     laser: Laser,
-    frame_s: f64,
-    /// Largest energy per pass the multi-pass rules (T2 train and time
-    /// base) allow with every pass at that energy, J.
-    pass_energy_max_j: f64,
+    half_deg: f64,
+    pulse_rate_hz: f64,
 }
 
-fn eye(problem: &Problem, g: &Grid) -> Result<Option<Eye>, OptError> {
+fn eye(problem: &Problem) -> Result<Option<Eye>, OptError> {
     let Some(params) = &problem.lidar.limits.eye_safety else {
         return Ok(None);
     };
@@ -141,120 +151,38 @@ fn eye(problem: &Problem, g: &Grid) -> Result<Option<Eye>, OptError> {
             field: "limits.eye_safety".into(),
             reason: e.to_string(),
         })?;
-    let pass_deg = exposure::pass_angle_deg(params, &laser);
-    let frame_s = 1.0 / problem.lidar.frame_rate_hz;
-    // Energy is linear in the pass energy, and no pass delivers more than
-    // its energy whatever the power: the model's ratio at 1 J per pass with
-    // an unbounded peak power inverts to the cap. The longest pass is the
-    // pass arc at the slowest allowed spin.
-    let slowest_pass_s = pass_deg.to_radians() / problem.lidar.limits.spin_rad_s_min;
-    let pass = PassFigures {
-        envelope_j: 1.0,
-        pulses_j: 1.0,
-        duration_s: if slowest_pass_s.is_finite() {
-            slowest_pass_s.min(frame_s)
-        } else {
-            frame_s
-        },
-    };
-    let (ratio_per_j, _) = laser.multi_pass_ratio(frame_s, pass, f64::MAX);
-    let pass_energy_max_j = if ratio_per_j > 0.0 {
-        1.0 / ratio_per_j
-    } else {
-        f64::INFINITY
-    };
-    let mut windows = Vec::with_capacity(2 * g.n);
-    for &e in &g.start_deg {
-        for start in [e, e - pass_deg] {
-            let set = CircularSet::from_arcs([Arc {
-                start_deg: wrap_deg(start),
-                width_deg: pass_deg,
-            }]);
-            // Bins touched at an edge are in the window too (covered fraction
-            // 0): their power counts for the single-pulse rule, as in the checker.
-            let snap = crate::model::angle::EDGE_SNAP_DEG;
-            let reach = CircularSet::from_arcs([Arc {
-                start_deg: wrap_deg(start - snap),
-                width_deg: (pass_deg + 2.0 * snap).min(360.0),
-            }]);
-            let w: Vec<(usize, f64)> = (0..g.n)
-                .filter_map(|j| {
-                    let lo = g.start_deg[j];
-                    let touches = reach.overlap_deg(lo, lo + g.width_deg[j]) > 0.0;
-                    let cover = set.overlap_deg(lo, lo + g.width_deg[j]) / g.width_deg[j];
-                    touches.then_some((j, cover.clamp(0.0, 1.0)))
-                })
-                .collect();
-            windows.push(w);
-        }
-    }
     Ok(Some(Eye {
-        windows,
+        params: params.clone(),
+        half_deg: 0.5 * exposure::pass_angle_deg(params, &laser),
         laser,
-        frame_s,
-        pass_energy_max_j,
+        pulse_rate_hz: problem.lidar.pulse_rate_hz,
     }))
 }
 
+/// The bins as the eye-safety model sees them.
+fn segs(g: &Grid, spins: &[(f64, f64)], p: &[f64]) -> Vec<Seg> {
+    (0..g.n)
+        .map(|i| Seg {
+            start_deg: g.start_deg[i],
+            width_deg: g.width_deg[i],
+            power_w: p[i],
+            spin_start_rad_s: spins[i].0,
+            spin_end_rad_s: spins[i].1,
+        })
+        .collect()
+}
+
 impl Eye {
-    /// The model's single-pulse ratio per watt for a pass of dwell `t_w`:
-    /// the most pulses such a pass holds, and the most passes meeting a
-    /// T2 window ([`passes_in_window`]).
-    fn single_ratio_per_w(&self, t_w: f64) -> f64 {
-        let f_p = self.laser.pulse_rate_hz;
-        self.laser.single_pulse_ratio(
-            1.0 / f_p,
-            max_pulses_in(t_w, f_p),
-            passes_in_window(T2_S.min(TIME_BASE_S), t_w, self.frame_s),
-        )
+    /// The bound's worst ratio and the azimuth where it binds.
+    fn verdict(&self, segs: &[Seg]) -> Result<(f64, f64), OptError> {
+        exposure::evaluate_segments(segs, &self.params, self.pulse_rate_hz)
+            .map(|r| (r.worst_ratio, r.worst_azimuth_deg))
+            .map_err(|e| OptError::Infeasible(format!("eye safety: {e}")))
     }
 
-    /// Per-bin power caps from the single-pulse rule at the given dwells, W.
-    fn power_caps(&self, t: &[f64]) -> Vec<f64> {
-        let mut cap = vec![f64::INFINITY; t.len()];
-        for w in &self.windows {
-            let t_w: f64 = w.iter().map(|&(j, f)| f * t[j]).sum();
-            let allowed = (1.0 - CAP_MARGIN) / self.single_ratio_per_w(t_w);
-            for &(j, _) in w {
-                cap[j] = cap[j].min(allowed);
-            }
-        }
-        cap
-    }
-
-    /// Largest window dwell at which the single-pulse rule holds for powers
-    /// `p`, s: the most pulses per pass `K` the model allows at the window's
-    /// highest power (the ratio grows with `K`: C5 falls and the T2 window
-    /// meets more passes), found by bisection, as a dwell that cannot hold
-    /// more than `K` pulses (`⌊t·f_p⌋ + 1 ≤ K` for `t < K/f_p`, less the
-    /// model's count margin). Counts and passes are those
-    /// [`Self::power_caps`] uses, so a dwell that met the caps meets this.
-    fn window_dwell_max(&self, w: &[(usize, f64)], p: &[f64]) -> Result<f64, OptError> {
-        let f_p = self.laser.pulse_rate_hz;
-        let p_max = w.iter().map(|&(j, _)| p[j]).fold(0.0, f64::max);
-        let dwell_of = |k: f64| k / f_p * (1.0 - DWELL_COUNT_MARGIN);
-        let ratio = |k: f64| p_max * self.single_ratio_per_w(dwell_of(k));
-        if ratio(1.0) > 1.0 {
-            return Err(OptError::Infeasible(format!(
-                "eye safety: {:.4e} W gives {:.3e} J per pulse, above the single-pulse limit at any spin",
-                p_max,
-                p_max / f_p,
-            )));
-        }
-        let k_turn = max_pulses_in(self.frame_s, f_p);
-        if ratio(k_turn) <= 1.0 {
-            return Ok(f64::INFINITY);
-        }
-        let (mut lo, mut hi) = (1.0_f64, k_turn); // ratio(lo) ≤ 1 < ratio(hi)
-        while hi - lo > 1.0 {
-            let mid = ((lo + hi) / 2.0).floor();
-            if ratio(mid) <= 1.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Ok(dwell_of(lo))
+    /// The concrete exposures at or above `threshold` for these bins.
+    fn cuts(&self, segs: &[Seg], witness_deg: &[f64], threshold: f64) -> Vec<Cut> {
+        cuts(segs, self.half_deg, &self.laser, witness_deg, threshold)
     }
 }
 
@@ -290,18 +218,21 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
         });
     }
     if let Some(e) = eye {
-        // The most lenient single-pulse cap: the fastest spin everywhere.
-        let t_fast: Vec<f64> = vec![TAU / l.spin_rad_s_max / problem.bins as f64; problem.bins];
-        let cap = e
-            .power_caps(&t_fast)
-            .into_iter()
-            .fold(f64::INFINITY, f64::min);
-        if cap < l.power_w_min {
-            let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
-            return Err(OptError::Infeasible(format!(
-                "eye-safety cap {cap:.4e} W at {wl} nm (even at spin_rad_s_max) is below power_w_min {:.4e} W",
-                l.power_w_min
-            )));
+        // With the spin fixed (range mode: the mean spin everywhere), the
+        // floor alone must be Class 1; more power never lowers the bound.
+        if l.power_w_min > 0.0 && !problem.objective.mode.controls_resolution() {
+            let g = grid(problem, 0.0)?;
+            let w = lid.mean_spin_rad_s();
+            let (ratio, at) =
+                e.verdict(&segs(&g, &vec![(w, w); g.n], &vec![l.power_w_min; g.n]))?;
+            if ratio > 1.0 {
+                return Err(OptError::Infeasible(format!(
+                    "eye safety: power_w_min {:.4e} W everywhere at the mean spin is {:.1} % of the Class 1 limit (worst at {at:.3}°) at {} nm",
+                    l.power_w_min,
+                    100.0 * ratio,
+                    e.params.wavelength_nm
+                )));
+            }
         }
     }
     if !problem.levels.spin_rad_s.is_empty()
@@ -369,132 +300,216 @@ fn chosen(sol: &impl Solution, group: &[(f64, Variable)]) -> f64 {
         .map_or(0.0, |&(level, _)| level)
 }
 
-/// Power step: dwell `t` fixed.
+/// Dwell of each bin under `spins` (constant acceleration within a bin), s.
+fn dwell_of(g: &Grid, spins: &[(f64, f64)]) -> Vec<f64> {
+    spins
+        .iter()
+        .zip(&g.theta)
+        .map(|(w, th)| 2.0 * th / (w.0 + w.1))
+        .collect()
+}
+
+/// Power step: the spin fixed (`spins`, rad/s at each bin's two edges).
+/// Without eye safety one LP. With it, a cutting-plane loop
+/// (`specs/optimizer.md`, "Eye safety as cuts"): solve, ask the core bound,
+/// add the concrete exposures the answer breaks (valid for every power
+/// vector), repeat until the bound certifies. `pool` holds the cuts of
+/// these spins (empty for new spins) and keeps the ones added.
 fn power_step(
     problem: &Problem,
     g: &Grid,
     eye: Option<&Eye>,
-    t: &[f64],
+    spins: &[(f64, f64)],
+    pool: &mut Vec<Cut>,
 ) -> Result<(Vec<f64>, PowerLp), OptError> {
+    let t = &dwell_of(g, spins)[..];
     let lid = &problem.lidar;
     let l = &lid.limits;
     let p_mean = lid.average_power_w;
     let period: f64 = t.iter().sum();
-    let caps = eye.map_or_else(|| vec![f64::INFINITY; g.n], |e| e.power_caps(t));
-    let lam = problem.objective.range_weight;
-    let levels = &problem.levels.power_w;
-    let mut lp = LinearProgram::default();
-    // x_i = p_i / P̄ as a linear form (a continuous column or Σ levels·z).
-    let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
-    let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
-    for i in 0..g.n {
-        let hi = l.power_w_max.min(caps[i]);
-        if levels.is_empty() {
-            let lo_x = l.power_w_min / p_mean;
-            let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
-            let xi = lp.add_col(lo_x, hi_x, 0.0, false);
-            // The utility's column is boxed (so the certificate's bound is
-            // finite); the box never binds: at an optimum u is the chords'
-            // minimum, within [√lo_x, √hi_x].
-            let u_hi = 2.0 * hi_x.sqrt() + 1.0;
-            let u = lp.add_col(0.0, u_hi, lam * g.theta[i] * g.weight[i], false);
-            let chords = sqrt_chords(lo_x, hi_x);
-            for &(a, b) in &chords {
-                lp.add_row(&[(u, 1.0), (xi, -a)], f64::NEG_INFINITY, b);
+    let mut round = 0;
+    loop {
+        // A cut on one bin's power alone is that bin's column bound (the
+        // utility's chords then span the reachable powers only).
+        let mut caps = vec![f64::INFINITY; g.n];
+        if let Some(e) = eye {
+            for c in pool.iter() {
+                if let [(b, n)] = c.pulses[..] {
+                    caps[b] = caps[b].min(cut_rhs() * c.limit_j * e.pulse_rate_hz / n);
+                }
             }
-            x.push(vec![(xi, 1.0)]);
-            bins.push(PowerBin::Continuous { x: xi, u, chords });
-        } else {
-            let allowed: Vec<f64> = levels
-                .iter()
-                .copied()
-                .filter(|&lv| lv >= l.power_w_min && lv <= hi)
-                .collect();
-            if allowed.is_empty() {
-                return Err(OptError::Infeasible(format!(
-                    "no power level lies within [power_w_min, min(power_w_max, eye-safety cap)] = [{:.4e}, {:.4e}] W in bin {i}",
-                    l.power_w_min, hi
-                )));
-            }
-            let zs: Vec<(f64, usize)> = allowed
-                .iter()
-                .map(|&lv| {
-                    let cost = lam * g.theta[i] * g.weight[i] * (lv / p_mean).sqrt();
-                    (lv, lp.add_col(0.0, 1.0, cost, true))
-                })
-                .collect();
-            let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
-            lp.add_row(&one, 1.0, 1.0);
-            x.push(zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect());
-            bins.push(PowerBin::Levels(zs));
         }
-    }
-    let scaled = |k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>| {
-        out.extend(form.iter().map(|&(j, a)| (j, k * a)));
-    };
-    // Budget.
-    // Levels: the budget exactly, plus [`LEVEL_BUDGET_SLACK`] (far inside
-    // the checker's REL_TOL) so that a level choice that meets it in
-    // floating point (the closed form's does, to the last bit) also meets
-    // it in the exact arithmetic of the certificate.
-    let budget_margin = if levels.is_empty() {
-        1.0 - MARGIN
-    } else {
-        1.0 + LEVEL_BUDGET_SLACK
-    };
-    let mut spend = Vec::new();
-    let budget = match lid.power_accounting {
-        PowerAccounting::Angle => {
-            for i in 0..g.n {
-                scaled(g.theta[i], &x[i], &mut spend);
-            }
-            TAU * budget_margin
-        }
-        PowerAccounting::Time => {
-            for i in 0..g.n {
-                scaled(t[i] / period, &x[i], &mut spend);
-            }
-            budget_margin
-        }
-    };
-    lp.add_row(&spend, f64::NEG_INFINITY, budget);
-    // Slew.
-    if let Some(s) = l.power_slew_w_per_deg_max {
+        let lam = problem.objective.range_weight;
+        let levels = &problem.levels.power_w;
+        let mut lp = LinearProgram::default();
+        // x_i = p_i / P̄ as a linear form (a continuous column or Σ levels·z).
+        let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
+        let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
         for i in 0..g.n {
-            let j = next_index(i, g.n);
-            let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - MARGIN);
-            let mut d = Vec::new();
-            scaled(1.0, &x[j], &mut d);
-            scaled(-1.0, &x[i], &mut d);
-            lp.add_row(&d, -lim, lim);
-        }
-    }
-    // Eye safety: energy per pass (T2 and time base).
-    if let Some(e) = eye {
-        for w in &e.windows {
-            let mut en = Vec::new();
-            for &(j, f) in w {
-                scaled(f * t[j] * p_mean, &x[j], &mut en);
+            let hi = l.power_w_max.min(caps[i]);
+            if levels.is_empty() {
+                let lo_x = l.power_w_min / p_mean;
+                let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
+                let xi = lp.add_col(lo_x, hi_x, 0.0, false);
+                // The utility's column is boxed (so the certificate's bound is
+                // finite); the box never binds: at an optimum u is the chords'
+                // minimum, within [√lo_x, √hi_x].
+                let u_hi = 2.0 * hi_x.sqrt() + 1.0;
+                let u = lp.add_col(0.0, u_hi, lam * g.theta[i] * g.weight[i], false);
+                let chords = sqrt_chords(lo_x, hi_x);
+                for &(a, b) in &chords {
+                    lp.add_row(&[(u, 1.0), (xi, -a)], f64::NEG_INFINITY, b);
+                }
+                x.push(vec![(xi, 1.0)]);
+                bins.push(PowerBin::Continuous { x: xi, u, chords });
+            } else {
+                let allowed: Vec<f64> = levels
+                    .iter()
+                    .copied()
+                    .filter(|&lv| lv >= l.power_w_min && lv <= hi)
+                    .collect();
+                if allowed.is_empty() {
+                    return Err(OptError::Infeasible(format!(
+                            "no power level lies within [power_w_min, min(power_w_max, the bin's eye-safety cut)] = [{:.4e}, {:.4e}] W in bin {i}",
+                            l.power_w_min, hi
+                        )));
+                }
+                let zs: Vec<(f64, usize)> = allowed
+                    .iter()
+                    .map(|&lv| {
+                        let cost = lam * g.theta[i] * g.weight[i] * (lv / p_mean).sqrt();
+                        (lv, lp.add_col(0.0, 1.0, cost, true))
+                    })
+                    .collect();
+                let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
+                lp.add_row(&one, 1.0, 1.0);
+                x.push(zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect());
+                bins.push(PowerBin::Levels(zs));
             }
-            lp.add_row(&en, f64::NEG_INFINITY, e.pass_energy_max_j * (1.0 - MARGIN));
         }
+        let scaled = |k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>| {
+            out.extend(form.iter().map(|&(j, a)| (j, k * a)));
+        };
+        // Budget.
+        // Levels: the budget exactly, plus [`LEVEL_BUDGET_SLACK`] (far inside
+        // the checker's REL_TOL) so that a level choice that meets it in
+        // floating point (the closed form's does, to the last bit) also meets
+        // it in the exact arithmetic of the certificate.
+        let budget_margin = if levels.is_empty() {
+            1.0 - MARGIN
+        } else {
+            1.0 + LEVEL_BUDGET_SLACK
+        };
+        let mut spend = Vec::new();
+        let budget = match lid.power_accounting {
+            PowerAccounting::Angle => {
+                for i in 0..g.n {
+                    scaled(g.theta[i], &x[i], &mut spend);
+                }
+                TAU * budget_margin
+            }
+            PowerAccounting::Time => {
+                for i in 0..g.n {
+                    scaled(t[i] / period, &x[i], &mut spend);
+                }
+                budget_margin
+            }
+        };
+        lp.add_row(&spend, f64::NEG_INFINITY, budget);
+        // Slew.
+        if let Some(s) = l.power_slew_w_per_deg_max {
+            for i in 0..g.n {
+                let j = next_index(i, g.n);
+                let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - MARGIN);
+                let mut d = Vec::new();
+                scaled(1.0, &x[j], &mut d);
+                scaled(-1.0, &x[i], &mut d);
+                lp.add_row(&d, -lim, lim);
+            }
+        }
+
+        if let Some(e) = eye {
+            for c in pool.iter().filter(|c| c.pulses.len() > 1) {
+                let mut row = Vec::new();
+                for &(b, n) in &c.pulses {
+                    scaled(n * p_mean / (e.pulse_rate_hz * c.limit_j), &x[b], &mut row);
+                }
+                lp.add_row(&row, f64::NEG_INFINITY, cut_rhs());
+            }
+        }
+        let solved = lp.solve("power").map_err(|err| match (err, eye) {
+            (OptError::Infeasible(_), Some(_)) => OptError::Infeasible(format!(
+                "the power step has no solution within the limits: {} eye-safety cuts (concrete exposures at the Class 1 limit) leave no powers within power_w_min/max, the budget and the slew limit",
+                pool.len()
+            )),
+            (other, _) => other,
+        })?;
+        let p = powers(problem, g, t, &bins, &x, &solved.x);
+        if let Some(e) = eye {
+            let s = segs(g, spins, &p);
+            let (ratio, witness) = e.verdict(&s)?;
+            if ratio > 1.0 - EYE_SAFETY_HEADROOM {
+                round += 1;
+                let fresh: Vec<Cut> = e
+                    .cuts(&s, &[witness], cut_rhs())
+                    .into_iter()
+                    .filter(|c| !pool.contains(c))
+                    .collect();
+                if fresh.is_empty() || round > CUT_ROUNDS {
+                    return Err(OptError::Solver(format!(
+                        "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° and no concrete exposure there is over its limit ({} cuts)",
+                        pool.len()
+                    )));
+                }
+                pool.extend(fresh);
+                continue;
+            }
+        }
+        return Ok((
+            p,
+            PowerLp {
+                lp,
+                bins,
+                p_mean,
+                floor_w: l.power_w_min,
+                y: solved.y,
+                solver_dual_bound: solved.solver_dual_bound,
+            },
+        ));
     }
-    let solved = lp.solve("power")?;
-    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * solved.x[j]).sum::<f64>();
+}
+
+/// The powers (W) of a solved power step: levels as chosen, continuous
+/// powers clamped into their bounds and trimmed to the budget exactly
+/// (lower powers never break a cut: every cut has nonnegative
+/// coefficients).
+fn powers(
+    problem: &Problem,
+    g: &Grid,
+    t: &[f64],
+    bins: &[PowerBin],
+    x: &[Vec<(usize, f64)>],
+    sol: &[f64],
+) -> Vec<f64> {
+    let lid = &problem.lidar;
+    let l = &lid.limits;
+    let p_mean = lid.average_power_w;
+    let period: f64 = t.iter().sum();
+    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * sol[j]).sum::<f64>();
     let mut p: Vec<f64> = bins
         .iter()
-        .zip(&x)
+        .zip(x)
         .map(|(b, form)| match b {
             PowerBin::Continuous { .. } => eval(form) * p_mean,
             PowerBin::Levels(zs) => zs
                 .iter()
-                .max_by(|a, b| solved.x[a.1].total_cmp(&solved.x[b.1]))
+                .max_by(|a, b| sol[a.1].total_cmp(&sol[b.1]))
                 .map_or(0.0, |&(level, _)| level),
         })
         .collect();
-    if levels.is_empty() {
-        for (i, pi) in p.iter_mut().enumerate() {
-            *pi = pi.clamp(l.power_w_min, l.power_w_max.min(caps[i]));
+    if problem.levels.power_w.is_empty() {
+        for pi in &mut p {
+            *pi = pi.clamp(l.power_w_min, l.power_w_max);
         }
         // Exact budget: HiGHS meets it to 1e-7 absolute; trim the excess.
         let spent = match lid.power_accounting {
@@ -508,17 +523,7 @@ fn power_step(
             }
         }
     }
-    Ok((
-        p,
-        PowerLp {
-            lp,
-            bins,
-            p_mean,
-            floor_w: l.power_w_min,
-            y: solved.y,
-            solver_dual_bound: solved.solver_dual_bound,
-        },
-    ))
+    p
 }
 
 /// How a bin's power enters the power step's program.
@@ -607,13 +612,29 @@ impl PowerLp {
 }
 
 /// Dwell step: power `p` fixed; `current` is the iterate for linearisation.
+///
+/// Eye safety: the cuts `binding` at `(p, current)` (concrete exposures at
+/// their limit, found by the power step before) linearised in dwell — the
+/// pulses a cut counts from bin `b` scaled by `t_b/t_b⁰` (a pass over `b`
+/// holds pulses in proportion to its time there), the limits held at the
+/// iterate's — inside a trust region of ±[`TRUST`] on the bins they touch.
+/// Exact at the iterate, first order around it; the bound decides after
+/// (the power step that follows restores certified powers; without one the
+/// move is shortened until the bound certifies, see [`solve`]).
 fn dwell_step(
     problem: &Problem,
     g: &Grid,
-    eye: Option<&Eye>,
+    binding: &[Cut],
+    pulse_rate_hz: f64,
     p: &[f64],
     current: &[f64],
 ) -> Result<Vec<f64>, OptError> {
+    let mut touched = vec![false; g.n];
+    for c in binding {
+        for &(b, _) in &c.pulses {
+            touched[b] = true;
+        }
+    }
     let lid = &problem.lidar;
     let l = &lid.limits;
     let period = 1.0 / lid.frame_rate_hz;
@@ -636,7 +657,7 @@ fn dwell_step(
                 1e9
             };
             let (mut lo, mut hi) = (lo, hi.max(lo));
-            if l.spin_accel_rad_s2_max.is_some() {
+            if l.spin_accel_rad_s2_max.is_some() || touched[i] {
                 lo = lo.max(current[i] / unit * (1.0 - TRUST));
                 hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
             }
@@ -710,20 +731,13 @@ fn dwell_step(
             cons.push(constraint!(ki * tau[i].clone() - kj * tau[j].clone() <= ds));
         }
     }
-    if let Some(e) = eye {
-        for w in &e.windows {
-            let t_max = e.window_dwell_max(w, p)?;
-            let mut dwell = Expression::from(0.0);
-            let mut en = Expression::from(0.0);
-            for &(j, f) in w {
-                dwell += (f * unit) * tau[j].clone();
-                en += (f * unit * p[j]) * tau[j].clone();
-            }
-            if t_max.is_finite() {
-                cons.push(constraint!(dwell <= t_max * (1.0 - MARGIN)));
-            }
-            cons.push(constraint!(en <= e.pass_energy_max_j * (1.0 - MARGIN)));
+    for c in binding {
+        let mut en = Expression::from(0.0);
+        for &(b, n) in &c.pulses {
+            let tau0 = current[b] / unit;
+            en += (n * p[b] / (pulse_rate_hz * c.limit_j) / tau0) * tau[b].clone();
         }
+        cons.push(constraint!(en <= cut_rhs()));
     }
     let model = configured(vars.maximise(objective).using(highs), cons);
     let sol = solve_model(model, "dwell")?;
@@ -746,6 +760,30 @@ fn dwell_step(
     Ok(t)
 }
 
+/// The spin of dwell `t`: one spin per bin (steps) when `smooth` is
+/// false, else continuous node spins (the harmonic mean of the
+/// neighbours' slowness) rescaled so the frame period is exact.
+fn spins_of(g: &Grid, t: &[f64], smooth: bool, frame_rate_hz: f64) -> Vec<(f64, f64)> {
+    if !smooth {
+        return t
+            .iter()
+            .zip(&g.theta)
+            .map(|(t, th)| (th / t, th / t))
+            .collect();
+    }
+    let s: Vec<f64> = t.iter().zip(&g.theta).map(|(t, th)| t / th).collect();
+    let node: Vec<f64> = (0..g.n)
+        .map(|i| 2.0 / (s[(i + g.n - 1) % g.n] + s[i]))
+        .collect();
+    let dwell: f64 = (0..g.n)
+        .map(|i| 2.0 * g.theta[i] / (node[i] + node[next_index(i, g.n)]))
+        .sum();
+    let c = dwell * frame_rate_hz;
+    (0..g.n)
+        .map(|i| (node[i] * c, node[next_index(i, g.n)] * c))
+        .collect()
+}
+
 /// Solves and builds the (uncertified) profile, with the final power
 /// step's program (none when the power does not move).
 pub(super) fn solve(
@@ -754,10 +792,11 @@ pub(super) fn solve(
 ) -> Result<(Profile, Option<PowerLp>), OptError> {
     let g = grid(problem, gaze_deg)?;
     let lid = &problem.lidar;
-    let eye = eye(problem, &g)?;
+    let eye = eye(problem)?;
     prechecks(problem, eye.as_ref())?;
     let w_mean = lid.mean_spin_rad_s();
-    let mut t: Vec<f64> = g.theta.iter().map(|th| th / w_mean).collect();
+    let t_base: Vec<f64> = g.theta.iter().map(|th| th / w_mean).collect();
+    let mut t = t_base.clone();
     let p_start = lid
         .average_power_w
         .clamp(lid.limits.power_w_min, lid.limits.power_w_max);
@@ -766,58 +805,71 @@ pub(super) fn solve(
     let mut last: Option<PowerLp> = None;
     let smooth_spin = lid.limits.spin_accel_rad_s2_max.is_some();
     let spin_rounds = if smooth_spin { SLP_ROUNDS } else { 1 };
+    let f_p = lid.pulse_rate_hz;
+    // The cuts of new spins, found at the powers before the step (a warm
+    // start: valid whatever the powers).
+    let warm = |spins: &[(f64, f64)], p: &[f64]| -> Vec<Cut> {
+        eye.as_ref()
+            .map_or_else(Vec::new, |e| e.cuts(&segs(&g, spins, p), &[], BINDING))
+    };
+    let steps = |t: &[f64]| spins_of(&g, t, false, lid.frame_rate_hz);
+    let mut binding: Vec<Cut> = Vec::new();
     match mode {
         Mode::Baseline => {}
         Mode::Range => {
-            let (pp, plp) = power_step(problem, &g, eye.as_ref(), &t)?;
+            let sp = steps(&t);
+            let mut pool = warm(&sp, &p);
+            let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
             p = pp;
             last = Some(plp);
         }
         Mode::Resolution => {
             for _ in 0..spin_rounds {
-                t = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
+                t = dwell_step(problem, &g, &[], f_p, &p, &t)?;
             }
         }
         Mode::Joint => {
             for _ in 0..spin_rounds.max(2) {
-                t = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
-                let (pp, plp) = power_step(problem, &g, eye.as_ref(), &t)?;
+                t = dwell_step(problem, &g, &binding, f_p, &p, &t)?;
+                let sp = steps(&t);
+                let mut pool = warm(&sp, &p);
+                let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
                 p = pp;
                 last = Some(plp);
+                binding = pool
+                    .into_iter()
+                    .filter(|c| c.ratio(&p, f_p) >= BINDING)
+                    .collect();
             }
         }
     }
-    // Spin: steps when unlimited, else continuous node spins rescaled to the period.
-    let spins: Vec<(f64, f64)> = if smooth_spin && mode.controls_resolution() {
-        let s: Vec<f64> = t.iter().zip(&g.theta).map(|(t, th)| t / th).collect();
-        let node: Vec<f64> = (0..g.n)
-            .map(|i| 2.0 / (s[(i + g.n - 1) % g.n] + s[i]))
-            .collect();
-        let dwell: f64 = (0..g.n)
-            .map(|i| 2.0 * g.theta[i] / (node[i] + node[next_index(i, g.n)]))
-            .sum();
-        let c = dwell * lid.frame_rate_hz;
-        let spins: Vec<(f64, f64)> = (0..g.n)
-            .map(|i| (node[i] * c, node[next_index(i, g.n)] * c))
-            .collect();
-        if mode.controls_range() {
-            // Final power step on the exact dwell of the rebuilt spin.
-            let exact: Vec<f64> = spins
+    let smooth = smooth_spin && mode.controls_resolution();
+    let mut spins = spins_of(&g, &t, smooth, lid.frame_rate_hz);
+    if smooth && mode.controls_range() {
+        // Final power step on the exact spin of the rebuilt profile.
+        let mut pool = warm(&spins, &p);
+        let (pp, plp) = power_step(problem, &g, eye.as_ref(), &spins, &mut pool)?;
+        p = pp;
+        last = Some(plp);
+    }
+    if let (Some(e), Mode::Resolution) = (eye.as_ref(), mode) {
+        // No power step follows the dwell steps: shorten the move from the
+        // uniform spin until the bound certifies (the uniform spin itself
+        // is the last resort, and the checker has the last word).
+        let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
+            Ok(e.verdict(&segs(&g, sp, &p))?.0 <= 1.0 - EYE_SAFETY_HEADROOM)
+        };
+        let mut alpha = 1.0;
+        while !safe(&spins)? && alpha > 0.0 {
+            alpha = if alpha > 1.0 / 64.0 { alpha / 2.0 } else { 0.0 };
+            let ta: Vec<f64> = t_base
                 .iter()
-                .zip(&g.theta)
-                .map(|(w, th)| 2.0 * th / (w.0 + w.1))
+                .zip(&t)
+                .map(|(b, x)| b + alpha * (x - b))
                 .collect();
-            let (pp, plp) = power_step(problem, &g, eye.as_ref(), &exact)?;
-            p = pp;
-            last = Some(plp);
+            spins = spins_of(&g, &ta, smooth, lid.frame_rate_hz);
         }
-        spins
-    } else {
-        t.iter()
-            .zip(&g.theta)
-            .map(|(t, th)| (th / t, th / t))
-            .collect()
-    };
+    }
     let bins = (0..g.n)
         .map(|i| Bin {
             start_deg: g.start_deg[i],

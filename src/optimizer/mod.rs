@@ -56,7 +56,7 @@ use crate::planner::Mode;
 pub use config::OptimizerConfig;
 
 /// Chords of the piecewise-linear utilities.
-pub const UTILITY_SEGMENTS: usize = 8;
+pub const UTILITY_SEGMENTS: usize = 16;
 
 /// A static prior: extra weight on a sector (e.g. cross-traffic directions).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -234,8 +234,7 @@ pub(crate) fn optimize_unrated(
         field: "gaze-deg".into(),
         reason: e.to_string(),
     })?;
-    let (mut profile, _) = lp::solve(problem, gaze_deg)?;
-    fit_to_eye_safety_bound(&mut profile);
+    let (profile, _) = lp::solve(problem, gaze_deg)?;
     Ok(certify(profile)?)
 }
 
@@ -251,7 +250,6 @@ pub fn optimize_with_certificate(
         reason: e.to_string(),
     })?;
     let (mut profile, power_lp) = lp::solve(problem, gaze_deg)?;
-    fit_to_eye_safety_bound(&mut profile);
     let cert = match power_lp {
         None => Err("this mode has no power step to certify (the power does not move)".into()),
         Some(plp) => {
@@ -274,40 +272,43 @@ pub fn optimize_with_certificate(
     Ok((certify(profile)?, cert))
 }
 
-/// Relative head-room left under the Class 1 limit after fitting, so that a
-/// rotated copy of a fitted profile (the fast path) still certifies.
-const EYE_SAFETY_HEADROOM: f64 = 1e-6;
-
-/// The LP's eye-safety rows are a linear surrogate (per-window energy and
-/// pulse caps); the verdict belongs to the one eye-safety model of the core.
-/// Every rule of that model is linear in power, so when the solved profile
-/// exceeds it, scaling every bin's power by `(1 − headroom)/ratio` brings it
-/// just under the limit (a lower power never breaks the budget or the slew
-/// limit; a power floor may make it infeasible, which the checker reports).
-pub(crate) fn fit_to_eye_safety_bound(profile: &mut crate::profile::Profile) {
-    let Some(params) = profile.limits.eye_safety.clone() else {
-        return;
-    };
-    let Ok(report) = crate::eye_safety::evaluate_profile(profile, &params) else {
-        return;
-    };
-    let target = 1.0 - EYE_SAFETY_HEADROOM;
-    let floor = profile.limits.power_w_min.max(0.0);
-    let mut ratio = report.worst_ratio;
-    // Scale the power above the floor; a few rounds settle it (the floor's
-    // own share does not scale).
-    for _ in 0..8 {
-        if ratio <= target {
-            break;
-        }
-        let scale = target / ratio;
-        for b in &mut profile.bins {
-            b.power_w = floor + (b.power_w - floor).max(0.0) * scale;
-        }
-        profile.summary = None;
-        match crate::eye_safety::evaluate_profile(profile, &params) {
-            Ok(r) => ratio = r.worst_ratio,
-            Err(_) => return,
-        }
+/// The objective with the exact utilities (√ of the power and density
+/// ratios, not the programs' chords) of `profile` for `problem` at
+/// `gaze_deg`: what the chords approximate from below, comparable across
+/// programs whose chords differ.
+pub fn exact_objective(
+    problem: &Problem,
+    gaze_deg: f64,
+    profile: &crate::profile::Profile,
+) -> Result<f64, OptError> {
+    let g = lp::grid(problem, gaze_deg)?;
+    if profile.bins.len() != g.n {
+        return Err(OptError::Invalid {
+            field: "bins".into(),
+            reason: format!("{} bins, the problem has {}", profile.bins.len(), g.n),
+        });
     }
+    let o = &problem.objective;
+    let p_mean = problem.lidar.average_power_w;
+    let period = 1.0 / problem.lidar.frame_rate_hz;
+    Ok(profile
+        .bins
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let dwell = 2.0 * g.theta[i] / (b.spin_start_rad_s + b.spin_end_rad_s);
+            let density = dwell * std::f64::consts::TAU / (g.theta[i] * period);
+            let range = if o.mode.controls_range() {
+                o.range_weight * (b.power_w / p_mean).sqrt()
+            } else {
+                0.0
+            };
+            let res = if o.mode.controls_resolution() {
+                o.resolution_weight * density.sqrt()
+            } else {
+                0.0
+            };
+            g.theta[i] * g.weight[i] * (range + res)
+        })
+        .sum())
 }

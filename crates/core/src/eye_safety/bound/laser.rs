@@ -109,6 +109,18 @@ impl Laser {
         }
     }
 
+    /// C5 for `n_pulses` effective pulses within `T_max = min(T2, time
+    /// base)` ([`ael::c5`]); 1 for pulses longer than `T_i` (2014
+    /// small-source rule). Nonincreasing in `n_pulses`.
+    #[must_use]
+    pub fn c5(&self, n_pulses: f64) -> f64 {
+        if self.pulse_duration_s > self.band.t_i_s() {
+            1.0
+        } else {
+            ael::c5(self.band, n_pulses, ael::T2_S.min(ael::TIME_BASE_S))
+        }
+    }
+
     /// Rule 1 ratio for pulses (or groups) of at most `pulse_energy_j` each
     /// (one pulse; the group is applied here), with at most `per_pass`
     /// pulses in any pass and `passes_t2` passes meeting any T2 window:
@@ -124,16 +136,8 @@ impl Laser {
     /// groups grows.
     #[must_use]
     pub fn single_pulse_ratio_per_j(&self, per_pass: f64, passes_t2: f64) -> f64 {
-        let t_max = ael::T2_S.min(ael::TIME_BASE_S);
         let g = self.group(per_pass);
-        // C5 = 1 for pulses longer than T_i (2014 small-source rule).
-        let c5_of = |n: f64| {
-            if self.pulse_duration_s > self.band.t_i_s() {
-                1.0
-            } else {
-                ael::c5(self.band, n, t_max)
-            }
-        };
+        let c5_of = |n: f64| self.c5(n);
         let n_pulses = per_pass * passes_t2;
         let single = 1.0 / (c5_of(n_pulses) * self.ael_j(self.pulse_duration_s));
         if g > 1.0 {

@@ -1,0 +1,367 @@
+//! Linear cuts for the optimizer: **concrete exposures**, each linear in the
+//! bin powers (`specs/optimizer.md`, "Eye safety as cuts").
+//!
+//! Fix the spin profile. Take one aperture azimuth `φ`, one pulse clock
+//! locked to the rotation (its phase chosen), and one window. Which pulses
+//! the aperture receives in the window — so how many come from each bin,
+//! `n_b` — depends on the spin alone; their energy is `Σ_b n_b·p_b/f_p`,
+//! linear in the powers `p`. The window's limit `L` depends on the spin
+//! alone too: the smallest AEL over the window lengths that hold exactly
+//! those pulses (each such length is a window of its own), times C5 of the
+//! exposure's own effective pulse count for Rule 1. So
+//!
+//! `Σ_b n_b·p_b/f_p ≤ L`
+//!
+//! is the statement "this one exposure is within its limit". The true
+//! worst ratio over every aperture, clock and window is at least this
+//! exposure's, and the sound bound ([`super::bound`]) is at least the true
+//! worst ratio: **every power vector the bound certifies meets every cut**,
+//! whatever powers the cut was found at. A cut never removes a certifiable
+//! profile; a program with cuts in place of the bound is a relaxation of
+//! "the bound certifies", and its optimum an upper bound of the best
+//! certifiable objective.
+//!
+//! Nothing here decides that a profile is safe: the cuts are lower bounds of
+//! the true ratio (samples of it), the bound's opposite. Their use is to
+//! *separate* — to tell a program which linear constraint the current
+//! powers break. [`cuts`] finds, for the powers a set of bins carries, the
+//! concrete exposures at or above a threshold ratio: at every bin edge
+//! `± h` (where pass edges meet bin edges, the bound's cells) and at any
+//! extra azimuths asked for (the bound's witness), three clock phases
+//! (pulses pushed to the start, the middle and the end of the pass's
+//! slack), and the windows: every single pulse (Rule 1), every run of
+//! consecutive pulses of one pass (Rule 2 within a pass; runs from the first
+//! and to the last pulse only when a pass holds more than
+//! [`ALL_RUNS_MAX_PULSES`]), and `q` whole passes up to the time base (the
+//! multi-pass rules), `q` at the ends of every Table 3 row.
+//!
+//! Counts are taken inside by a relative margin [`COUNT_INSIDE`] (a pass
+//! that holds `x·f_p` on an integer gets the smaller count), and window
+//! lengths are kept strictly between the pulses' span and the next pulse:
+//! a cut is then a concrete exposure with room to spare, never one that
+//! exists only up to rounding.
+
+use super::ael::{T2_S, TIME_BASE_S};
+use super::bound::{max_pulses_in, passes_in_window, Laser, Rule, Seg};
+use crate::profile::kinematics::{split_periods, Timeline};
+
+/// Pulses of one pass up to which every run of consecutive pulses is a
+/// window; beyond, the runs from the first pulse and to the last.
+pub const ALL_RUNS_MAX_PULSES: usize = 32;
+
+/// Relative margin by which counts and window lengths stay inside.
+pub const COUNT_INSIDE: f64 = 1e-9;
+
+/// A concrete exposure: the pulses one aperture receives from each bin in
+/// one window, and the limit they are held to. Valid for every power
+/// vector of the same spin profile (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cut {
+    /// The rule whose limit this is.
+    pub rule: Rule,
+    /// Aperture azimuth, deg.
+    pub azimuth_deg: f64,
+    /// The window lengths that hold exactly these pulses, s: the limit is
+    /// the smallest AEL over them ([`Laser::ael_inf_j`], the model's one AEL
+    /// infimum; every one of them is a concrete window).
+    pub window_s: (f64, f64),
+    /// (bin, pulses received from it), bins ascending, counts ≥ 1.
+    pub pulses: Vec<(usize, f64)>,
+    /// The limit, J.
+    pub limit_j: f64,
+}
+
+impl Cut {
+    /// Energy received with bin powers `power_w`, J.
+    #[must_use]
+    pub fn energy_j(&self, power_w: &[f64], pulse_rate_hz: f64) -> f64 {
+        self.pulses
+            .iter()
+            .map(|&(b, n)| n * power_w[b])
+            .sum::<f64>()
+            / pulse_rate_hz
+    }
+
+    /// Energy over the limit with bin powers `power_w`.
+    #[must_use]
+    pub fn ratio(&self, power_w: &[f64], pulse_rate_hz: f64) -> f64 {
+        self.energy_j(power_w, pulse_rate_hz) / self.limit_j
+    }
+}
+
+/// The received pulses of one pass, one clock.
+struct Pass {
+    azimuth_deg: f64,
+    /// The pass's duration, s.
+    tau_s: f64,
+    /// Every bin the closed pass arc meets.
+    met: Vec<usize>,
+    /// Pulse times from the first pulse, s.
+    t_s: Vec<f64>,
+    /// Bin of each pulse.
+    bin: Vec<usize>,
+}
+
+/// The concrete exposures of the bins `segs` (validated: they cover
+/// `[0, 360)` in order, spins positive) at a ratio of at least `threshold`
+/// for their own powers, strongest first: at most one Rule 1 cut per bin
+/// (its smallest limit), and no two cuts with the same pulses and limit.
+/// `half_deg` is half the pass angle, `extra_azimuths_deg` apertures to try
+/// besides every bin edge `± half_deg`.
+#[must_use]
+pub fn cuts(
+    segs: &[Seg],
+    half_deg: f64,
+    laser: &Laser,
+    extra_azimuths_deg: &[f64],
+    threshold: f64,
+) -> Vec<Cut> {
+    let tl = Timeline::from_bins(segs);
+    let h = half_deg.min(180.0);
+    let mut found: Vec<Cut> = Vec::new();
+    let mut single: Vec<Option<Cut>> = vec![None; segs.len()];
+    let azimuths = segs
+        .iter()
+        .flat_map(|s| [s.start_deg - h, s.start_deg + h])
+        .chain(extra_azimuths_deg.iter().copied());
+    for phi in azimuths {
+        for phase in [1e-3, 0.5, 1.0 - 1e-3] {
+            let Some(pass) = received(&tl, laser, phi, h, phase) else {
+                continue;
+            };
+            exposures(&pass, segs, &tl, laser, threshold, &mut single, &mut found);
+        }
+    }
+    found.extend(single.into_iter().flatten());
+    let f_p = laser.pulse_rate_hz;
+    let p: Vec<f64> = segs.iter().map(|s| s.power_w).collect();
+    found.sort_by(|a, b| {
+        b.ratio(&p, f_p)
+            .total_cmp(&a.ratio(&p, f_p))
+            .then_with(|| a.limit_j.total_cmp(&b.limit_j))
+            .then_with(|| {
+                a.pulses
+                    .partial_cmp(&b.pulses)
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+    });
+    found.dedup_by(|a, b| a.pulses == b.pulses && a.limit_j == b.limit_j);
+    found
+}
+
+/// The pulses the aperture at `phi` receives in one pass under a clock
+/// locked to the rotation whose first pulse sits `phase` of the way through
+/// the pass's slack (the time the pass has beyond its pulses' span).
+fn received(tl: &Timeline<'_, Seg>, laser: &Laser, phi: f64, h: f64, phase: f64) -> Option<Pass> {
+    let f_p = laser.pulse_rate_hz;
+    let delta = 1.0 / f_p;
+    let t_a = tl.time_at_unwrapped_s(phi - h);
+    let t_b = tl.time_at_unwrapped_s(phi + h);
+    let tau = (t_b - t_a).min(tl.period_s());
+    if !(tau > 0.0) {
+        return None;
+    }
+    // Pulses strictly inside the pass, with room: (K − 1)·Δ < τ.
+    let k = (tau * f_p * (1.0 - COUNT_INSIDE)).floor() + 1.0;
+    let slack = tau - (k - 1.0) * delta;
+    if !(slack > 0.0) || k > 1e6 {
+        return None;
+    }
+    let t0 = t_a + phase * slack;
+    let period = tl.period_s();
+    let n = k as usize;
+    let mut t_s = Vec::with_capacity(n);
+    let mut bin = Vec::with_capacity(n);
+    for j in 0..n {
+        let dt = j as f64 * delta;
+        let (_, t) = split_periods(t0 + dt, period);
+        t_s.push(dt);
+        bin.push(tl.azimuth_at(t).1);
+    }
+    Some(Pass {
+        azimuth_deg: crate::model::angle::wrap_deg(phi),
+        tau_s: tau,
+        met: tl.bins_touching(phi - h, 2.0 * h),
+        t_s,
+        bin,
+    })
+}
+
+/// Pulses of `pass[i..=k]`, per bin, times `q`.
+fn tally(pass: &Pass, i: usize, k: usize, q: f64) -> Vec<(usize, f64)> {
+    let mut v: Vec<(usize, f64)> = pass.bin[i..=k].iter().map(|&b| (b, q)).collect();
+    v.sort_by_key(|e| e.0);
+    let mut out: Vec<(usize, f64)> = Vec::with_capacity(v.len());
+    for (b, c) in v {
+        match out.last_mut() {
+            Some(last) if last.0 == b => last.1 += c,
+            _ => out.push((b, c)),
+        }
+    }
+    out
+}
+
+#[allow(clippy::too_many_arguments)]
+fn exposures(
+    pass: &Pass,
+    segs: &[Seg],
+    tl: &Timeline<'_, Seg>,
+    laser: &Laser,
+    threshold: f64,
+    single: &mut [Option<Cut>],
+    found: &mut Vec<Cut>,
+) {
+    let f_p = laser.pulse_rate_hz;
+    let frame_s = tl.period_s();
+    let k_n = pass.t_s.len();
+    let span = pass.t_s[k_n - 1];
+    let energy_of = |j: usize| segs[pass.bin[j]].power_w / f_p;
+    let mut prefix = Vec::with_capacity(k_n + 1);
+    prefix.push(0.0);
+    for j in 0..k_n {
+        prefix.push(prefix[j] + energy_of(j));
+    }
+    let e_pass = prefix[k_n];
+    let inside = 1.0 + COUNT_INSIDE;
+    let below = 1.0 - COUNT_INSIDE;
+
+    // Rule 1, the bound's own figure at this aperture: every bin the pass
+    // meets, at the counts of this pass's duration (`max_pulses_in`,
+    // `passes_in_window`, rounded up as the bound rounds them). The bound's
+    // Rule 1 figure is at least this for every aperture (each cell takes
+    // its bins' largest power at counts of its largest duration), so the
+    // cut holds wherever the bound certifies; it is not a concrete exposure
+    // (the counts are the bound's, which no one clock need reach).
+    let tau = pass.tau_s;
+    let per_j = laser.single_pulse_ratio_per_j(
+        max_pulses_in(tau, f_p),
+        passes_in_window(T2_S.min(TIME_BASE_S), tau, frame_s),
+    );
+    let limit1 = 1.0 / per_j;
+    for &b in &pass.met {
+        if segs[b].power_w / f_p / limit1 >= threshold
+            && single[b].as_ref().is_none_or(|c| limit1 < c.limit_j)
+        {
+            single[b] = Some(Cut {
+                rule: Rule::SinglePulse,
+                azimuth_deg: pass.azimuth_deg,
+                window_s: (laser.pulse_duration_s, laser.pulse_duration_s),
+                pulses: vec![(b, 1.0)],
+                limit_j: limit1,
+            });
+        }
+    }
+    // The effective pulses of the concrete clock in [t_0, t_0 + T_max),
+    // the passes repeating every frame (locked clock); pulses within T_i
+    // one group (700–1050 nm) by the greedy cover, the fewest groups any
+    // grouping gives, so the largest C5 of any reading.
+    let t_i = laser.band.t_i_s();
+    let grouped = laser.group(k_n as f64) > 1.0;
+    let t_max = T2_S.min(TIME_BASE_S);
+    let starts: Vec<usize> = if grouped {
+        let mut g = Vec::new();
+        let mut open = f64::NEG_INFINITY;
+        for (j, &t) in pass.t_s.iter().enumerate() {
+            if t >= open {
+                g.push(j);
+                open = t + t_i;
+            }
+        }
+        g
+    } else {
+        Vec::new()
+    };
+    let mut n_eff = 0.0;
+    let mut m = 0.0;
+    while grouped && m * frame_s < t_max * below {
+        n_eff += starts
+            .iter()
+            .filter(|&&j| m * frame_s + pass.t_s[j] < t_max * below)
+            .count() as f64;
+        m += 1.0;
+    }
+    let c5 = laser.c5(n_eff);
+    if grouped {
+        // The pulses of one T_i window against C5·AEL(T_i).
+        let limit_g = c5 * laser.ael_j(t_i);
+        for (i, &t) in pass.t_s.iter().enumerate() {
+            let k = pass.t_s.partition_point(|&u| u < t + t_i * below) - 1;
+            if k > i && (prefix[k + 1] - prefix[i]) / limit_g >= threshold {
+                found.push(Cut {
+                    rule: Rule::SinglePulse,
+                    azimuth_deg: pass.azimuth_deg,
+                    window_s: (t_i, t_i),
+                    pulses: tally(pass, i, k, 1.0),
+                    limit_j: limit_g,
+                });
+            }
+        }
+    }
+
+    // Rule 2 within a pass: runs i..=k of consecutive pulses, every window
+    // length from just over their span to just under the next pulse.
+    let next_after = |k: usize| {
+        if k + 1 < k_n {
+            pass.t_s[k + 1]
+        } else {
+            frame_s
+        }
+    };
+    let runs: Vec<(usize, usize)> = if k_n <= ALL_RUNS_MAX_PULSES {
+        (0..k_n)
+            .flat_map(|i| (i..k_n).map(move |k| (i, k)))
+            .collect()
+    } else {
+        (0..k_n)
+            .map(|k| (0, k))
+            .chain((1..k_n).map(|i| (i, k_n - 1)))
+            .collect()
+    };
+    for (i, k) in runs {
+        let e = prefix[k + 1] - prefix[i];
+        let lo = ((pass.t_s[k] - pass.t_s[i]) * inside).max(laser.pulse_duration_s);
+        let hi = ((next_after(k) - pass.t_s[i]) * below).min(TIME_BASE_S);
+        let limit = laser.ael_inf_j(lo, hi);
+        if e / limit >= threshold {
+            found.push(Cut {
+                rule: Rule::for_duration(lo, frame_s),
+                azimuth_deg: pass.azimuth_deg,
+                window_s: (lo, hi.max(lo)),
+                pulses: tally(pass, i, k, 1.0),
+                limit_j: limit,
+            });
+        }
+    }
+
+    // Several passes: q whole passes, every length from just over
+    // (q − 1)·T_f + span to just under q·T_f (the next pass's first pulse),
+    // up to the time base; q at the ends of every Table 3 row.
+    let q_max = ((TIME_BASE_S / inside - span) / frame_s).floor() + 1.0;
+    let mut qs: Vec<f64> = vec![2.0, 3.0, q_max - 1.0, q_max];
+    for row in laser.rows() {
+        for t in [row.t_lo_s, row.t_hi_s] {
+            let q = ((t - span) / frame_s).floor() + 1.0;
+            qs.extend([q - 1.0, q, q + 1.0, q + 2.0]);
+        }
+    }
+    qs.retain(|&q| q >= 2.0 && q <= q_max);
+    qs.sort_by(f64::total_cmp);
+    qs.dedup();
+    for q in qs {
+        let lo = ((q - 1.0) * frame_s + span) * inside;
+        let hi = (q * frame_s * below).min(TIME_BASE_S);
+        if lo > hi {
+            continue;
+        }
+        let limit = laser.ael_inf_j(lo, hi);
+        if q * e_pass / limit >= threshold {
+            found.push(Cut {
+                rule: Rule::for_duration(lo, frame_s),
+                azimuth_deg: pass.azimuth_deg,
+                window_s: (lo, hi),
+                pulses: tally(pass, 0, k_n - 1, q),
+                limit_j: limit,
+            });
+        }
+    }
+}
