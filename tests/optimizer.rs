@@ -7,7 +7,7 @@ mod independent;
 use common::{assert_bad_input, run, stderr, stdout};
 use gaze_lidar::model::presets;
 use gaze_lidar::optimizer::fast::FastPlanner;
-use gaze_lidar::optimizer::{optimize, OptError, OptimizerConfig, Problem};
+use gaze_lidar::optimizer::{exact_objective, optimize, OptError, OptimizerConfig, Problem};
 use gaze_lidar::planner::Mode;
 use gaze_lidar::profile::Profile;
 
@@ -189,10 +189,24 @@ fn fast_path_equals_a_fresh_solve() {
             assert!((gaze_lidar::model::angle::diff_deg(q, gaze)).abs() <= 0.5 / 64.0 + 1e-12);
             let a = fast.plan(gaze).unwrap();
             let b = optimize(&problem, q).unwrap();
+            // Equal powers bin for bin — or, for a MILP (hardware levels),
+            // an equally good choice: the two solves carry different pools
+            // of eye-safety cuts (the cutting-plane loop's path differs), so
+            // a near-tie of two level choices within HiGHS's tolerances
+            // (multi_level at 47.5°: 3.6e-8 of 5.93) may fall either way.
+            let (oa, ob) = (
+                exact_objective(&problem, q, a.profile()).unwrap(),
+                exact_objective(&problem, q, b.profile()).unwrap(),
+            );
+            let milp = !problem.levels.power_w.is_empty();
+            assert!(
+                (oa - ob).abs() <= 1e-7 * ob,
+                "gaze {gaze}: objective {oa} vs {ob}"
+            );
             for (x, y) in a.profile().bins.iter().zip(&b.profile().bins) {
                 assert_eq!(x.start_deg, y.start_deg);
                 assert!(
-                    (x.power_w - y.power_w).abs() <= 1e-9 * y.power_w.max(1e-12),
+                    milp || (x.power_w - y.power_w).abs() <= 1e-9 * y.power_w.max(1e-12),
                     "gaze {gaze}: {} vs {}",
                     x.power_w,
                     y.power_w

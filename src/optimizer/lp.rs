@@ -346,6 +346,13 @@ fn power_step(
         let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
         let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
         for i in 0..g.n {
+            if caps[i] < l.power_w_min {
+                let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
+                return Err(OptError::Infeasible(format!(
+                    "eye-safety cap {:.4e} W at {wl} nm in bin {i} (the single-pulse limit at this spin) is below power_w_min {:.4e} W",
+                    caps[i], l.power_w_min
+                )));
+            }
             let hi = l.power_w_max.min(caps[i]);
             if levels.is_empty() {
                 let lo_x = l.power_w_min / p_mean;
@@ -450,11 +457,19 @@ fn power_step(
             let (ratio, witness) = e.verdict(&s)?;
             if ratio > 1.0 - EYE_SAFETY_HEADROOM {
                 round += 1;
-                let fresh: Vec<Cut> = e
-                    .cuts(&s, &[witness], cut_rhs())
-                    .into_iter()
-                    .filter(|c| !pool.contains(c))
-                    .collect();
+                // Every bin edge ± h first (rotation-equivariant: a rotated
+                // problem gets the rotated cuts); the bound's witness only
+                // when those hold.
+                let new_cuts = |extra: &[f64]| -> Vec<Cut> {
+                    e.cuts(&s, extra, cut_rhs())
+                        .into_iter()
+                        .filter(|c| !pool.contains(c))
+                        .collect()
+                };
+                let mut fresh = new_cuts(&[]);
+                if fresh.is_empty() {
+                    fresh = new_cuts(&[witness]);
+                }
                 if fresh.is_empty() || round > CUT_ROUNDS {
                     return Err(OptError::Solver(format!(
                         "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° and no concrete exposure there is over its limit ({} cuts)",
@@ -836,10 +851,9 @@ pub(super) fn solve(
                 let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
                 p = pp;
                 last = Some(plp);
-                binding = pool
-                    .into_iter()
-                    .filter(|c| c.ratio(&p, f_p) >= BINDING)
-                    .collect();
+                // The binding cuts of the new iterate, found afresh (a
+                // function of the iterate alone, not of the loop's path).
+                binding = warm(&sp, &p);
             }
         }
     }
