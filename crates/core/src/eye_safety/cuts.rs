@@ -1,45 +1,54 @@
-//! Linear cuts for the optimizer: **concrete exposures**, each linear in the
-//! bin powers (`specs/optimizer.md`, "Eye safety as cuts").
+//! Linear cuts for the optimizer: constraints linear in the bin powers
+//! that every power vector the sound bound certifies meets
+//! (`specs/optimizer.md`, "Eye safety as cuts").
 //!
-//! Fix the spin profile. Take one aperture azimuth `φ`, one pulse clock
-//! locked to the rotation (its phase chosen), and one window. Which pulses
-//! the aperture receives in the window — so how many come from each bin,
-//! `n_b` — depends on the spin alone; their energy is `Σ_b n_b·p_b/f_p`,
-//! linear in the powers `p`. The window's limit `L` depends on the spin
-//! alone too: the smallest AEL over the window lengths that hold exactly
-//! those pulses (each such length is a window of its own), times C5 of the
-//! exposure's own effective pulse count for Rule 1. So
+//! Fix the spin profile. Two kinds of cut, both `Σ_b n_b·p_b/f_p ≤ L` with
+//! `n_b` and `L` functions of the spin alone:
 //!
-//! `Σ_b n_b·p_b/f_p ≤ L`
+//! - **Concrete exposures** (Rule 2 within a pass, and over several passes
+//!   up to the time base; the `T_i` groups of Rule 1). One aperture azimuth
+//!   `φ`, one pulse clock locked to the rotation (its phase chosen), one
+//!   window: the pulses the aperture receives in it, `n_b` from bin `b`,
+//!   carry `Σ n_b·p_b/f_p` J, against `L`, the smallest AEL over the
+//!   window lengths that hold exactly those pulses (each is a window of its
+//!   own; [`Laser::ael_inf_j`], the model's one AEL infimum). The true
+//!   worst ratio is at least this exposure's, and the bound at least the
+//!   true worst ratio.
+//! - **The bound's Rule 1 figure at one aperture.** For every bin the
+//!   closed pass arc at `φ` meets, one pulse (`n_b = 1`) against
+//!   `1/`[`Laser::single_pulse_ratio_per_j`] at the counts of that pass's
+//!   duration (`max_pulses_in`, `passes_in_window`, rounded up as the bound
+//!   rounds them). The bound's Rule 1 figure is at least this at every
+//!   aperture (each cell takes the largest power of the bins its passes
+//!   meet, at the counts of its longest pass), so the cut holds wherever
+//!   the bound certifies. It is the bound's own figure, not a concrete
+//!   exposure: no one clock need reach its counts, which is what makes it
+//!   tight where Rule 1 binds.
 //!
-//! is the statement "this one exposure is within its limit". The true
-//! worst ratio over every aperture, clock and window is at least this
-//! exposure's, and the sound bound ([`super::bound`]) is at least the true
-//! worst ratio: **every power vector the bound certifies meets every cut**,
-//! whatever powers the cut was found at. A cut never removes a certifiable
-//! profile; a program with cuts in place of the bound is a relaxation of
+//! So a cut never removes a certifiable profile, whatever powers it was
+//! found at: a program with cuts in place of the bound is a relaxation of
 //! "the bound certifies", and its optimum an upper bound of the best
-//! certifiable objective.
+//! certifiable objective. `tests/cuts.rs` checks every cut against the
+//! bound on random profiles of every band.
 //!
-//! Nothing here decides that a profile is safe: the cuts are lower bounds of
-//! the true ratio (samples of it), the bound's opposite. Their use is to
-//! *separate* — to tell a program which linear constraint the current
-//! powers break. [`cuts`] finds, for the powers a set of bins carries, the
-//! concrete exposures at or above a threshold ratio: at every bin edge
-//! `± h` (where pass edges meet bin edges, the bound's cells) and at any
-//! extra azimuths asked for (the bound's witness), three clock phases
-//! (pulses pushed to the start, the middle and the end of the pass's
-//! slack), and the windows: every single pulse (Rule 1), every run of
-//! consecutive pulses of one pass (Rule 2 within a pass; runs from the first
-//! and to the last pulse only when a pass holds more than
-//! [`ALL_RUNS_MAX_PULSES`]), and `q` whole passes up to the time base (the
-//! multi-pass rules), `q` at the ends of every Table 3 row.
+//! Nothing here decides that a profile is safe: a cut is a lower bound of
+//! the bound's figure (a sample of it), the bound's opposite. Cuts
+//! *separate*: they tell a program which linear constraint its current
+//! powers break. [`cuts`] finds the ones at or above a threshold ratio for
+//! the powers the bins carry: apertures at every bin edge `± h` (where pass
+//! edges meet bin edges, the bound's cells) and at any extra azimuths asked
+//! for (the bound's witness); three clock phases (the pulses pushed to the
+//! start, the middle and the end of the pass's slack); and the windows:
+//! every run of consecutive pulses of one pass (when a pass holds more than
+//! [`ALL_RUNS_MAX_PULSES`], the runs from its first pulse to the last pulse
+//! of each bin, and from the first pulse of each bin to its last), and `q`
+//! whole passes up to the time base, `q` at the ends of every Table 3 row.
 //!
-//! Counts are taken inside by a relative margin [`COUNT_INSIDE`] (a pass
-//! that holds `x·f_p` on an integer gets the smaller count), and window
-//! lengths are kept strictly between the pulses' span and the next pulse:
-//! a cut is then a concrete exposure with room to spare, never one that
-//! exists only up to rounding.
+//! Concrete counts are taken inside by a relative margin [`COUNT_INSIDE`]
+//! (a pass that holds `x·f_p` on an integer gets the smaller count), and
+//! window lengths are kept strictly between the pulses' span and the next
+//! pulse: a concrete exposure with room to spare, never one that exists only
+//! up to rounding.
 
 use super::ael::{T2_S, TIME_BASE_S};
 use super::bound::{max_pulses_in, passes_in_window, Laser, Rule, Seg};
@@ -187,18 +196,25 @@ fn received(tl: &Timeline<'_, Seg>, laser: &Laser, phi: f64, h: f64, phase: f64)
     })
 }
 
-/// Pulses of `pass[i..=k]`, per bin, times `q`.
+/// Pulses of `pass[i..=k]`, per bin, times `q` (bins ascending).
 fn tally(pass: &Pass, i: usize, k: usize, q: f64) -> Vec<(usize, f64)> {
-    let mut v: Vec<(usize, f64)> = pass.bin[i..=k].iter().map(|&b| (b, q)).collect();
-    v.sort_by_key(|e| e.0);
-    let mut out: Vec<(usize, f64)> = Vec::with_capacity(v.len());
-    for (b, c) in v {
+    // The pulses meet the bins in runs (the head moves on): count the runs.
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for &b in &pass.bin[i..=k] {
         match out.last_mut() {
-            Some(last) if last.0 == b => last.1 += c,
-            _ => out.push((b, c)),
+            Some(last) if last.0 == b => last.1 += q,
+            _ => out.push((b, q)),
         }
     }
-    out
+    out.sort_by_key(|e| e.0);
+    let mut merged: Vec<(usize, f64)> = Vec::with_capacity(out.len());
+    for (b, c) in out {
+        match merged.last_mut() {
+            Some(last) if last.0 == b => last.1 += c,
+            _ => merged.push((b, c)),
+        }
+    }
+    merged
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -312,9 +328,13 @@ fn exposures(
             .flat_map(|i| (i..k_n).map(move |k| (i, k)))
             .collect()
     } else {
-        (0..k_n)
+        // From the first pulse to the last of each bin's run of pulses,
+        // and from the first of each run to the last pulse.
+        let firsts = (0..k_n).filter(|&j| j == 0 || pass.bin[j] != pass.bin[j - 1]);
+        let lasts = (0..k_n).filter(|&j| j + 1 == k_n || pass.bin[j] != pass.bin[j + 1]);
+        lasts
             .map(|k| (0, k))
-            .chain((1..k_n).map(|i| (i, k_n - 1)))
+            .chain(firsts.filter(|&i| i > 0).map(|i| (i, k_n - 1)))
             .collect()
     };
     for (i, k) in runs {
@@ -336,6 +356,7 @@ fn exposures(
     // Several passes: q whole passes, every length from just over
     // (q − 1)·T_f + span to just under q·T_f (the next pass's first pulse),
     // up to the time base; q at the ends of every Table 3 row.
+    let whole = tally(pass, 0, k_n - 1, 1.0);
     let q_max = ((TIME_BASE_S / inside - span) / frame_s).floor() + 1.0;
     let mut qs: Vec<f64> = vec![2.0, 3.0, q_max - 1.0, q_max];
     for row in laser.rows() {
@@ -359,7 +380,7 @@ fn exposures(
                 rule: Rule::for_duration(lo, frame_s),
                 azimuth_deg: pass.azimuth_deg,
                 window_s: (lo, hi),
-                pulses: tally(pass, 0, k_n - 1, q),
+                pulses: whole.iter().map(|&(b, n)| (b, n * q)).collect(),
                 limit_j: limit,
             });
         }
