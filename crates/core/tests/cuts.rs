@@ -75,6 +75,35 @@ proptest! {
         }
     }
 
+    /// The search's pruning skips only what cannot reach the threshold:
+    /// with a threshold, the cuts are exactly those at or above it among
+    /// all of them (`threshold` drawn around the strongest cut's ratio).
+    #[test]
+    fn a_threshold_drops_only_the_cuts_below_it(
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 2.0f64..80.0, any::<bool>()), 1..12),
+        band in prop_oneof![Just(Band::RetinalNir), Just(Band::Ir1400), Just(Band::Ir1500)],
+        f_p in 1e3f64..1e5,
+        half_deg in 0.05f64..5.0,
+        share in 0.0f64..1.2,
+    ) {
+        let segs = profile(&bins);
+        let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+        let p = powers(&segs);
+        let all = cuts(&segs, half_deg, &laser, &[], 0.0);
+        let top = all.iter().map(|c| c.ratio(&p, f_p)).fold(0.0, f64::max);
+        prop_assume!(top > 0.0);
+        let t = top * share;
+        let mut want: Vec<_> = all.into_iter().filter(|c| c.ratio(&p, f_p) >= t).collect();
+        let mut got = cuts(&segs, half_deg, &laser, &[], t);
+        let key = |c: &gaze_lidar_core::eye_safety::cuts::Cut| (c.pulses.clone(), c.limit_j.to_bits());
+        want.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+        got.sort_by(|a, b| key(a).partial_cmp(&key(b)).unwrap());
+        prop_assert_eq!(got.len(), want.len());
+        for (a, b) in got.iter().zip(&want) {
+            prop_assert_eq!(key(a), key(b));
+        }
+    }
+
     /// Tightness where Rule 1 decides: at a constant spin the largest
     /// single-bin cut equals the bound's Rule 1 figure (to the bound's
     /// rounding margin), so the cutting-plane loop stops on the limit.

@@ -133,12 +133,22 @@ pub fn cuts(
         .iter()
         .flat_map(|s| [s.start_deg - h, s.start_deg + h])
         .chain(extra_azimuths_deg.iter().copied());
+    let mut prune = Prune::new(laser, tl.period_s());
     for phi in azimuths {
         for phase in [1e-3, 0.5, 1.0 - 1e-3] {
             let Some(pass) = received(&tl, laser, phi, h, phase) else {
                 continue;
             };
-            exposures(&pass, segs, &tl, laser, threshold, &mut single, &mut found);
+            exposures(
+                &pass,
+                segs,
+                &tl,
+                laser,
+                threshold,
+                &mut prune,
+                &mut single,
+                &mut found,
+            );
         }
     }
     found.extend(single.into_iter().flatten());
@@ -217,6 +227,64 @@ fn tally(pass: &Pass, i: usize, k: usize, q: f64) -> Vec<(usize, f64)> {
     merged
 }
 
+/// Upper bounds of the window cuts' ratios per joule, so that apertures
+/// whose windows cannot reach the threshold skip them (a cut skipped is
+/// only a cut not offered: the loop asks again if the bound still
+/// rejects).
+struct Prune {
+    /// `g[ℓ − 1]` = the largest `ℓ'/AEL_inf` over runs of `ℓ' ≤ ℓ` pulses:
+    /// a run of `ℓ'` pulses spans `(ℓ' − 1)·Δ` and ends within the frame,
+    /// so its limit is at least the smallest AEL over
+    /// `[(ℓ' − 1)·Δ, T_f]` (a wider range, a smaller infimum).
+    runs: Vec<f64>,
+    /// The largest `q/AEL_inf` over `q` whole passes: each spans at least
+    /// `(q − 1)·T_f` and less than `q·T_f`; infinite when there are more
+    /// than [`Prune::MAX_PASSES`] candidates (no pruning).
+    passes: f64,
+    laser: Laser,
+    frame_s: f64,
+}
+
+impl Prune {
+    const MAX_PASSES: f64 = 4096.0;
+
+    fn new(laser: &Laser, frame_s: f64) -> Self {
+        let low = 1.0 - 1e-12;
+        let q_max = (TIME_BASE_S / frame_s).floor() + 1.0;
+        let passes = if q_max > Self::MAX_PASSES {
+            f64::INFINITY
+        } else {
+            let mut best: f64 = 0.0;
+            let mut q = 2.0;
+            while q <= q_max {
+                let lo = ((q - 1.0) * frame_s * low).max(laser.pulse_duration_s);
+                best = best.max(q / laser.ael_inf_j(lo, (q * frame_s).max(lo)));
+                q += 1.0;
+            }
+            best
+        };
+        Self {
+            runs: Vec::new(),
+            passes,
+            laser: *laser,
+            frame_s,
+        }
+    }
+
+    /// The largest `ℓ/AEL_inf` over runs of at most `len` pulses.
+    fn runs_up_to(&mut self, len: usize) -> f64 {
+        let delta = 1.0 / self.laser.pulse_rate_hz;
+        while self.runs.len() < len {
+            let l = self.runs.len() + 1;
+            let lo = ((l as f64 - 1.0) * delta * (1.0 - 1e-12)).max(self.laser.pulse_duration_s);
+            let g = l as f64 / self.laser.ael_inf_j(lo, self.frame_s.max(lo));
+            let prev = self.runs.last().copied().unwrap_or(0.0);
+            self.runs.push(prev.max(g));
+        }
+        self.runs[len - 1]
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn exposures(
     pass: &Pass,
@@ -224,6 +292,7 @@ fn exposures(
     tl: &Timeline<'_, Seg>,
     laser: &Laser,
     threshold: f64,
+    prune: &mut Prune,
     single: &mut [Option<Cut>],
     found: &mut Vec<Cut>,
 ) {
@@ -323,7 +392,15 @@ fn exposures(
             frame_s
         }
     };
-    let runs: Vec<(usize, usize)> = if k_n <= ALL_RUNS_MAX_PULSES {
+    let p_max = pass
+        .bin
+        .iter()
+        .map(|&b| segs[b].power_w)
+        .fold(0.0, f64::max);
+    let reachable = threshold <= 0.0 || p_max / f_p * prune.runs_up_to(k_n) >= threshold;
+    let runs: Vec<(usize, usize)> = if !reachable {
+        Vec::new()
+    } else if k_n <= ALL_RUNS_MAX_PULSES {
         (0..k_n)
             .flat_map(|i| (i..k_n).map(move |k| (i, k)))
             .collect()
@@ -356,6 +433,9 @@ fn exposures(
     // Several passes: q whole passes, every length from just over
     // (q − 1)·T_f + span to just under q·T_f (the next pass's first pulse),
     // up to the time base; q at the ends of every Table 3 row.
+    if threshold > 0.0 && e_pass * prune.passes < threshold {
+        return;
+    }
     let whole = tally(pass, 0, k_n - 1, 1.0);
     let q_max = ((TIME_BASE_S / inside - span) / frame_s).floor() + 1.0;
     let mut qs: Vec<f64> = vec![2.0, 3.0, q_max - 1.0, q_max];
