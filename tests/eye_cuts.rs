@@ -153,3 +153,63 @@ fn brute_force_finds_nothing_better_than_the_power_step() {
         "{better_and_safe:?} beat {o_best}"
     );
 }
+
+/// Every mode that moves the spin ends certified where eye safety binds:
+/// `joint` (its last power step runs the exact loop at the final spin) and
+/// `resolution` (no power step: the move from the uniform spin is shortened
+/// until the bound certifies), on `vls128_eye` with a faster-spinning
+/// periphery allowed.
+#[test]
+fn joint_and_resolution_modes_certify_where_eye_safety_binds() {
+    use gaze_lidar::planner::Mode;
+    for mode in [Mode::Joint, Mode::Resolution] {
+        let mut problem = shipped("vls128_eye");
+        problem.objective.mode = mode;
+        let c = optimize(&problem, 90.0).unwrap_or_else(|e| panic!("{mode:?}: {e}"));
+        let p = c.profile();
+        let r = exposure::evaluate_profile(p, p.limits.eye_safety.as_ref().unwrap()).unwrap();
+        assert!(r.worst_ratio <= 1.0 - 1e-6, "{mode:?}: {}", r.worst_ratio);
+        let spins: Vec<f64> = p.bins.iter().map(|b| b.spin_start_rad_s).collect();
+        let (lo, hi) = spins
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(a, b), &w| (a.min(w), b.max(w)));
+        assert!(hi > 1.5 * lo, "{mode:?}: the spin moved ({lo}..{hi})");
+        if mode == Mode::Joint {
+            // The power step binds eye safety at the final spin.
+            assert!(r.worst_ratio > 1.0 - 1e-5, "{}", r.worst_ratio);
+        }
+    }
+}
+
+/// `resolution` mode at a power where slowing the spin anywhere crosses the
+/// limit (uniform 2.2 mW is 98 % of the Rule 1 limit at the mean spin: more
+/// pulses per pass lower C5): the shortened move still certifies.
+#[test]
+fn resolution_mode_shortens_a_move_the_bound_rejects() {
+    use gaze_lidar::planner::Mode;
+    let mut problem = shipped("vls128_eye");
+    problem.objective.mode = Mode::Resolution;
+    problem.lidar.average_power_w = 2.2e-3;
+    let c = optimize(&problem, 90.0).expect("the uniform spin at least");
+    let p = c.profile();
+    let r = exposure::evaluate_profile(p, p.limits.eye_safety.as_ref().unwrap()).unwrap();
+    assert!(r.worst_ratio <= 1.0 - 1e-6, "{}", r.worst_ratio);
+    // Where eye safety does not bind the same move goes further: it was
+    // shortened.
+    let spread = |prof: &Profile| {
+        let w: Vec<f64> = prof.bins.iter().map(|b| b.spin_start_rad_s).collect();
+        w.iter().fold(0.0f64, |a, &x| a.max(x)) / w.iter().fold(f64::MAX, |a, &x| a.min(x))
+    };
+    let mut free = problem.clone();
+    // 1550 nm: limits thousands of times higher, never binding here.
+    if let Some(e) = free.lidar.limits.eye_safety.as_mut() {
+        e.wavelength_nm = 1550.0;
+    }
+    let f = optimize(&free, 90.0).unwrap();
+    assert!(
+        spread(p) < spread(f.profile()) * (1.0 - 1e-3),
+        "{} vs {}",
+        spread(p),
+        spread(f.profile())
+    );
+}
