@@ -44,6 +44,7 @@ pub mod config;
 pub mod fast;
 pub mod global;
 mod lp;
+mod utility;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
