@@ -119,6 +119,13 @@ impl LinearProgram {
         m.set_option("random_seed", 0);
         m.set_option("mip_rel_gap", 0.0);
         m.set_option("mip_abs_gap", 1e-12);
+        if relax || !self.is_mip() {
+            // Measured on the shipped configs' power steps and global bound
+            // (360 bins): HiGHS's presolve costs more than it saves on these
+            // programs (boxed segment columns, few rows): 1.9× (power) to
+            // 3× (global bound) faster without it; MILPs keep it.
+            m.set_option("presolve", "off");
+        }
         Ok(m)
     }
 
