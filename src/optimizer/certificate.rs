@@ -145,16 +145,47 @@ impl LinearProgram {
                 s => Err(OptError::Solver(format!("{what} step: HiGHS status {s:?}"))),
             }
         };
-        let main = run(false)?;
-        let sol = main.get_solution();
-        let x = sol.columns().to_vec();
-        let solver_objective = main.objective_value();
-        let (y, solver_dual_bound) = if self.is_mip() {
-            let bound = main.double_info_value(c"mip_dual_bound").ok();
-            let relaxed = run(true)?;
-            (relaxed.get_solution().dual_rows().to_vec(), bound)
+        if !self.is_mip() {
+            let main = run(false)?;
+            let sol = main.get_solution();
+            return Ok(Solved {
+                x: sol.columns().to_vec(),
+                y: sol.dual_rows().to_vec(),
+                solver_objective: main.objective_value(),
+                solver_dual_bound: None,
+            });
+        }
+        // A MILP: its LP relaxation first (its row duals are the
+        // certificate's multipliers anyway). When the relaxation's optimum
+        // is integral (within 1e-9; HiGHS's own MIP tolerance is 1e-6), it
+        // is the MILP's optimum (the relaxation
+        // bounds the MILP and this point is a MILP point), so the branch
+        // and bound is skipped; the point is still checked exactly by the
+        // certificate. Otherwise HiGHS's MIP solver runs as before.
+        let relaxed = run(true)?;
+        let rsol = relaxed.get_solution();
+        let y = rsol.dual_rows().to_vec();
+        let integral = rsol
+            .columns()
+            .iter()
+            .zip(&self.integer)
+            .all(|(v, &int)| !int || (v - v.round()).abs() <= RELAXATION_INTEGRALITY_TOL);
+        let (x, solver_objective, solver_dual_bound) = if integral {
+            let x = rsol
+                .columns()
+                .iter()
+                .zip(&self.integer)
+                .map(|(&v, &int)| if int { v.round() } else { v })
+                .collect();
+            let obj = relaxed.objective_value();
+            (x, obj, Some(obj))
         } else {
-            (sol.dual_rows().to_vec(), None)
+            let main = run(false)?;
+            (
+                main.get_solution().columns().to_vec(),
+                main.objective_value(),
+                main.double_info_value(c"mip_dual_bound").ok(),
+            )
         };
         Ok(Solved {
             x,
@@ -250,6 +281,10 @@ impl LinearProgram {
     }
 }
 
+/// Distance from an integer within which a relaxation's value counts as
+/// integral (HiGHS's own `mip_feasibility_tolerance` is 1e-6).
+pub(super) const RELAXATION_INTEGRALITY_TOL: f64 = 1e-9;
+
 /// HiGHS's floating-point answer (untrusted).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Solved {
@@ -260,7 +295,9 @@ pub struct Solved {
     pub y: Vec<f64>,
     /// HiGHS's objective value.
     pub solver_objective: f64,
-    /// HiGHS's MIP dual bound (a MILP only; a float, not checked).
+    /// HiGHS's MIP dual bound (a MILP only; a float, not checked): the
+    /// relaxation's optimum when that was integral and no branch and bound
+    /// ran.
     pub solver_dual_bound: Option<f64>,
 }
 

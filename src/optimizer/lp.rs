@@ -346,6 +346,37 @@ fn solve_model<M: SolverModel<Error = good_lp::ResolutionError>>(
     })
 }
 
+/// Solves the dwell step's program; with set-points (a MILP: the
+/// binaries in `groups`) its LP relaxation first, whose optimum, when
+/// integral, is the MILP's (the relaxation bounds it and contains this
+/// point), so HiGHS's branch and bound runs only when it is not.
+fn solve_relaxation_first(
+    vars: ProblemVariables,
+    objective: Expression,
+    cons: Vec<good_lp::Constraint>,
+    groups: &[Vec<(f64, Variable)>],
+) -> Result<good_lp::solvers::highs::HighsSolution, OptError> {
+    if !groups.is_empty() {
+        let relaxed = configured(
+            vars.clone().maximise(objective.clone()).using(highs),
+            cons.clone(),
+        )
+        .set_option("solve_relaxation", true);
+        let sol = solve_model(relaxed, "dwell")?;
+        let integral = groups.iter().flatten().all(|&(_, y)| {
+            let v = sol.value(y);
+            (v - v.round()).abs() <= super::certificate::RELAXATION_INTEGRALITY_TOL
+        });
+        if integral {
+            return Ok(sol);
+        }
+    }
+    solve_model(
+        configured(vars.maximise(objective).using(highs), cons),
+        "dwell",
+    )
+}
+
 /// The level a solved one-hot group of binaries picked.
 fn chosen(sol: &impl Solution, group: &[(f64, Variable)]) -> f64 {
     group
@@ -730,8 +761,7 @@ fn dwell_step(
             cons.push(constraint!(en <= e.pass_energy_max_j * (1.0 - MARGIN)));
         }
     }
-    let model = configured(vars.maximise(objective).using(highs), cons);
-    let sol = solve_model(model, "dwell")?;
+    let sol = solve_relaxation_first(vars, objective, cons, &sp_vars)?;
     let mut t: Vec<f64> = if setpoints.is_empty() {
         tau.iter().map(|te| sol.eval(te) * unit).collect()
     } else {
@@ -785,7 +815,13 @@ pub(super) fn solve(
         }
         Mode::Joint => {
             for _ in 0..spin_rounds.max(2) {
-                t = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
+                let next = dwell_step(problem, &g, eye.as_ref(), &p, &t)?;
+                if last.is_some() && next == t {
+                    // A fixed point: both steps are deterministic functions
+                    // of (p, t), so every further round repeats this one.
+                    break;
+                }
+                t = next;
                 let (pp, plp) = power_step(problem, &g, eye.as_ref(), &t)?;
                 p = pp;
                 last = Some(plp);
