@@ -41,6 +41,7 @@
 
 pub mod certificate;
 pub mod config;
+mod exact;
 pub mod fast;
 pub mod global;
 mod lp;
