@@ -8,8 +8,13 @@
 //! Model objective (the one the steps approximate from below with chords):
 //! `J = λ_R Σ θ_i w_i √x_i + λ_ρ Σ θ_i w_i √r_i`, `x_i = p_i/P̄`, density
 //! ratio `r_i = t_i·2π/(θ_i T)`. With `τ_i = t_i N/T`:
-//! - `√` is concave, so every tangent lies above it: `u_i ≤ tangent_k(x_i)`
-//!   and `v_i ≤ tangent_k(r_i)` over-estimate the utilities;
+//! - `√` is concave, so every tangent lies above it; the minimum of the
+//!   tangents over-estimates each utility. It enters the LP as segments
+//!   (boxed columns, one fill row per utility, [`tangent_segments`]: the
+//!   breakpoints at or after the tangents' intersections, so the segments
+//!   stay above every tangent they follow) rather than one row per
+//!   tangent: 3× fewer rows; with HiGHS's presolve off the LP solves ≈10×
+//!   faster on `smooth` (measured; the bound moves by < 1e-12 relative);
 //! - `x_i` lies in `[min, max]` of the allowed powers (levels or limits),
 //!   `τ_i` in the spin limits' (set-points') box; a block the mode does not
 //!   move is fixed at its start value;
@@ -59,6 +64,67 @@ fn tangents(k: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
             (s > 0.0).then(|| (-next_down(-(k / (2.0 * s))), s / 2.0))
         })
         .collect()
+}
+
+/// The lower envelope of the [`tangents`] lines (each above `√(k·v)` for
+/// `v ≥ 0`) on `[lo, hi]` as segments: `(g0, [(slope, length)])` with
+/// `g(v) = g0 + Σ_j slope_j·clip_j(v − lo)` (segments filled in order).
+/// Sound by construction, whatever the rounding: `g0 ≥ L_0(lo)`; segment
+/// `j` follows line `L_j` from its start `E_j` (where `g(E_j) ≥ L_j(E_j)`),
+/// so `g ≥ L_j ≥ √` on it; the next segment starts at or after the
+/// intersection of `L_j` and `L_{j+1}`, where `L_j ≥ L_{j+1}` (smaller
+/// slope after), so `g(E_{j+1}) ≥ L_{j+1}(E_{j+1})`; the lengths sum to at
+/// least `hi − lo`. Each intersection `(b₁ − b₀)/(a₀ − a₁)` of two exact
+/// doubles' lines is computed with three correctly rounded operations
+/// (relative error ≤ 3ε) and moved later by a relative 1e-12; each length
+/// is rounded up, so the exact partial sums of the lengths (what the
+/// program adds up) reach every computed start. Lines whose slope does not
+/// fall are dropped (fewer lines: a higher minimum, still above `√`).
+fn tangent_segments(k: f64, lo: f64, hi: f64) -> (f64, Vec<(f64, f64)>) {
+    let up = |v: f64| -next_down(-v);
+    let later = |v: f64| up(v + v.abs() * 1e-12);
+    let mut lines: Vec<(f64, f64)> = Vec::new();
+    for (a, b) in tangents(k, lo, hi) {
+        if lines.last().is_none_or(|&(a0, _)| a < a0) {
+            lines.push((a, b));
+        }
+    }
+    let Some(&(a0, b0)) = lines.first() else {
+        return (up(up((k * hi).max(0.0).sqrt())), Vec::new());
+    };
+    let g0 = later(b0 + a0 * lo);
+    let mut start = lo;
+    let mut segments = Vec::with_capacity(lines.len());
+    for (j, &(a, b)) in lines.iter().enumerate() {
+        let end = match lines.get(j + 1) {
+            Some(&(a1, b1)) => later((b1 - b) / (a - a1)).max(start),
+            None => hi,
+        };
+        if end >= hi || j + 1 == lines.len() {
+            segments.push((a, up(hi - start).max(0.0)));
+            break;
+        }
+        segments.push((a, up(end - start)));
+        start = end;
+    }
+    (g0, segments)
+}
+
+/// Adds `√(k·v)`'s over-estimator on column `v ∈ [lo, hi]` with weight
+/// `c ≥ 0`: segment columns (cost `c·slope` rounded up) and the row
+/// `Σ δ − v ≤ −lo`; returns `c·g0` (rounded up), the caller's constant.
+fn add_concave_bound(lp: &mut LinearProgram, v: usize, k: f64, lo: f64, hi: f64, c: f64) -> f64 {
+    let up = |x: f64| -next_down(-x);
+    let (g0, segments) = tangent_segments(k, lo, hi);
+    let mut row: Vec<(usize, f64)> = segments
+        .iter()
+        .map(|&(a, len)| (lp.add_col(0.0, len, up(c * a), false), 1.0))
+        .collect();
+    if !row.is_empty() {
+        row.push((v, -1.0));
+        lp.add_row(&row, f64::NEG_INFINITY, -lo);
+    }
+    up(c * g0)
 }
 
 /// One separable term `c·√(s·v)` with `v ∈ [lo, hi]` and weight `a` in
@@ -288,6 +354,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let mut lp = LinearProgram::default();
     let mut xs = Vec::with_capacity(g.n);
     let mut taus = Vec::with_capacity(g.n);
+    let mut constant = 0.0;
     for i in 0..g.n {
         let t_lo = g.theta[i] / w_hi / unit;
         let t_hi = if w_lo > 0.0 {
@@ -302,25 +369,25 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         // (√ rounded up by a relative 1e-15, above the true root).
         let up = |v: f64| v.sqrt() * (1.0 + 1e-15);
         if x_lo < x_hi {
-            let u = lp.add_col(0.0, x_hi.sqrt(), o.range_weight * cw, false);
-            for (a, b) in tangents(1.0, x_lo, x_hi) {
-                lp.add_row(&[(u, 1.0), (x, -a)], f64::NEG_INFINITY, b);
-            }
+            constant += add_concave_bound(&mut lp, x, 1.0, x_lo, x_hi, o.range_weight * cw);
         } else {
             lp.add_col(0.0, up(x_hi), o.range_weight * cw, false);
         }
         // r = k·τ, k = unit·2π/(θ·T).
         let k = unit * TAU / (g.theta[i] * period);
         if t_lo < t_hi {
-            let v = lp.add_col(0.0, (k * t_hi).sqrt(), o.resolution_weight * cw, false);
-            for (a, b) in tangents(k, t_lo, t_hi) {
-                lp.add_row(&[(v, 1.0), (tau, -a)], f64::NEG_INFINITY, b);
-            }
+            constant += add_concave_bound(&mut lp, tau, k, t_lo, t_hi, o.resolution_weight * cw);
         } else {
             lp.add_col(0.0, up(k * t_hi), o.resolution_weight * cw, false);
         }
         xs.push((x, x_lo, x_hi));
         taus.push((tau, t_lo, t_hi));
+    }
+    // The over-estimators' constants on one column fixed at 1: a sum of
+    // at most 2N non-negative doubles, each rounded up, raised by a
+    // relative 1e-12 (far above the 2N·ε its rounding can lose).
+    if constant > 0.0 {
+        lp.add_col(1.0, 1.0, constant * (1.0 + 1e-12), false);
     }
     let frame: Vec<(usize, f64)> = taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
     lp.add_row(&frame, n * (1.0 - WIDEN), n * (1.0 + WIDEN));
@@ -358,4 +425,80 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     // Raised by OBJECTIVE_MARGIN: covers the float evaluation of the model's
     // constants (k, √ of a fixed block) the rows were built from.
     Ok(to_f64_up(&ub) * (1.0 + OBJECTIVE_MARGIN))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_rational::BigRational;
+
+    fn q(v: f64) -> BigRational {
+        BigRational::from_float(v).unwrap()
+    }
+
+    /// `g(v)` of the segments, exactly: `g0 + Σ slope·clip(v − E_j)` with
+    /// the exact partial sums `E_j` of the lengths (what the program adds).
+    fn g_exact(g0: f64, segments: &[(f64, f64)], lo: f64, v: &BigRational) -> BigRational {
+        let zero = q(0.0);
+        let mut start = q(lo);
+        let mut g = q(g0);
+        for &(a, len) in segments {
+            let room = (v - &start).max(zero.clone()).min(q(len));
+            g += q(a) * room;
+            start += q(len);
+        }
+        g
+    }
+
+    #[test]
+    fn tangent_segments_stay_above_the_root_exactly_and_follow_the_tangents() {
+        let cases = [
+            (1.0, 0.0, 1.3),
+            (1.0, 0.2, 4.5),
+            (1.0, 0.153_846_153_846, 1.230_769_230_769),
+            (0.45, 0.5, 1.111),
+            (3.3e-3, 1e-2, 7.5e2),
+            (1.0, 0.999_999_9, 1.0),
+        ];
+        for (k, lo, hi) in cases {
+            let (g0, segments) = tangent_segments(k, lo, hi);
+            let total = segments.iter().fold(q(0.0), |acc, s| acc + q(s.1));
+            assert!(
+                q(lo) + total >= q(hi),
+                "{k} {lo} {hi}: the segments reach hi"
+            );
+            let lines = tangents(k, lo, hi);
+            // Dense grid plus both sides of every segment start.
+            let mut vs: Vec<f64> = (0..=400)
+                .map(|j| lo + (hi - lo) * f64::from(j) / 400.0)
+                .collect();
+            // The tangent points, where the lines touch the root.
+            vs.extend(lines.iter().map(|&(_, b)| (2.0 * b).powi(2) / k));
+            let mut e = lo;
+            for &(_, len) in &segments {
+                e += len;
+                vs.extend([next_down(e), e, -next_down(-e)]);
+            }
+            for v in vs.into_iter().filter(|v| (lo..=hi).contains(v)) {
+                let g = g_exact(g0, &segments, lo, &q(v));
+                assert!(&g * &g >= q(k) * q(v), "{k} {lo} {hi}: g({v}) below √(k·v)");
+                // Not looser than the tangent rows it replaces, beyond the
+                // stated 1e-12 margins.
+                let m = lines
+                    .iter()
+                    .map(|&(a, b)| b + a * v)
+                    .fold(f64::INFINITY, f64::min);
+                let gf = rat(&g);
+                assert!(
+                    gf <= m * (1.0 + 1e-10) + 1e-14,
+                    "{k} {lo} {hi} {v}: {gf} vs {m}"
+                );
+            }
+        }
+    }
+
+    fn rat(v: &BigRational) -> f64 {
+        use num_traits::ToPrimitive;
+        v.to_f64().unwrap()
+    }
 }

@@ -10,7 +10,8 @@
 // variables); indices read like the formulation.
 #![allow(clippy::needless_range_loop)]
 
-use super::certificate::{next_down, Certified, LinearProgram};
+use super::certificate::{Certified, LinearProgram};
+use super::utility::{sqrt_segments, SqrtSegments};
 use good_lp::solvers::highs::highs;
 use good_lp::{
     constraint, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
@@ -112,22 +113,6 @@ pub(super) fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
         weight,
         in_rof,
     })
-}
-
-/// Chords of √x on `[lo, hi]`: (slope, intercept) pairs.
-fn sqrt_chords(lo: f64, hi: f64) -> Vec<(f64, f64)> {
-    let (a, b) = (lo.max(0.0).sqrt(), hi.max(lo).sqrt());
-    let k = super::UTILITY_SEGMENTS;
-    (0..k)
-        .filter_map(|j| {
-            let x0 = (a + (b - a) * j as f64 / k as f64).powi(2);
-            let x1 = (a + (b - a) * (j + 1) as f64 / k as f64).powi(2);
-            (x1 > x0).then(|| {
-                let slope = (x1.sqrt() - x0.sqrt()) / (x1 - x0);
-                (slope, x0.sqrt() - slope * x0)
-            })
-        })
-        .collect()
 }
 
 /// The one eye-safety model as the optimizer asks it: the core's sound
@@ -292,6 +277,37 @@ fn solve_model<M: SolverModel<Error = good_lp::ResolutionError>>(
     })
 }
 
+/// Solves the dwell step's program; with set-points (a MILP: the
+/// binaries in `groups`) its LP relaxation first, whose optimum, when
+/// integral, is the MILP's (the relaxation bounds it and contains this
+/// point), so HiGHS's branch and bound runs only when it is not.
+fn solve_relaxation_first(
+    vars: ProblemVariables,
+    objective: Expression,
+    cons: Vec<good_lp::Constraint>,
+    groups: &[Vec<(f64, Variable)>],
+) -> Result<good_lp::solvers::highs::HighsSolution, OptError> {
+    if !groups.is_empty() {
+        let relaxed = configured(
+            vars.clone().maximise(objective.clone()).using(highs),
+            cons.clone(),
+        )
+        .set_option("solve_relaxation", true);
+        let sol = solve_model(relaxed, "dwell")?;
+        let integral = groups.iter().flatten().all(|&(_, y)| {
+            let v = sol.value(y);
+            (v - v.round()).abs() <= super::certificate::RELAXATION_INTEGRALITY_TOL
+        });
+        if integral {
+            return Ok(sol);
+        }
+    }
+    solve_model(
+        configured(vars.maximise(objective).using(highs), cons),
+        "dwell",
+    )
+}
+
 /// The level a solved one-hot group of binaries picked.
 fn chosen(sol: &impl Solution, group: &[(f64, Variable)]) -> f64 {
     group
@@ -345,6 +361,7 @@ fn power_step(
         // x_i = p_i / P̄ as a linear form (a continuous column or Σ levels·z).
         let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
         let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
+        let mut utility_constant = 0.0;
         for i in 0..g.n {
             if caps[i] < l.power_w_min {
                 let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
@@ -358,17 +375,18 @@ fn power_step(
                 let lo_x = l.power_w_min / p_mean;
                 let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
                 let xi = lp.add_col(lo_x, hi_x, 0.0, false);
-                // The utility's column is boxed (so the certificate's bound is
-                // finite); the box never binds: at an optimum u is the chords'
-                // minimum, within [√lo_x, √hi_x].
-                let u_hi = 2.0 * hi_x.sqrt() + 1.0;
-                let u = lp.add_col(0.0, u_hi, lam * g.theta[i] * g.weight[i], false);
-                let chords = sqrt_chords(lo_x, hi_x);
-                for &(a, b) in &chords {
-                    lp.add_row(&[(u, 1.0), (xi, -a)], f64::NEG_INFINITY, b);
-                }
+                // The utility as boxed segment columns (see `utility`).
+                let c = lam * g.theta[i] * g.weight[i];
+                let shape = sqrt_segments(lo_x, hi_x);
+                let deltas = shape.add_to(&mut lp, xi, lo_x, c);
+                utility_constant += c * shape.base;
                 x.push(vec![(xi, 1.0)]);
-                bins.push(PowerBin::Continuous { x: xi, u, chords });
+                bins.push(PowerBin::Continuous {
+                    x: xi,
+                    lo: lo_x,
+                    deltas,
+                    shape,
+                });
             } else {
                 let allowed: Vec<f64> = levels
                     .iter()
@@ -394,6 +412,8 @@ fn power_step(
                 bins.push(PowerBin::Levels(zs));
             }
         }
+        // The utilities' constants Σ c·√lo as one column fixed at 1.
+        let one = (utility_constant != 0.0).then(|| lp.add_col(1.0, 1.0, utility_constant, false));
         let scaled = |k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>| {
             out.extend(form.iter().map(|&(j, a)| (j, k * a)));
         };
@@ -485,6 +505,7 @@ fn power_step(
             PowerLp {
                 lp,
                 bins,
+                one,
                 p_mean,
                 floor_w: l.power_w_min,
                 y: solved.y,
@@ -543,11 +564,13 @@ fn powers(
 
 /// How a bin's power enters the power step's program.
 enum PowerBin {
-    /// `x = p/P̄` column, utility column `u ≤ a·x + b` per chord.
+    /// `x = p/P̄` column (lower bound `lo`), the utility's segment
+    /// columns (see `utility`).
     Continuous {
         x: usize,
-        u: usize,
-        chords: Vec<(f64, f64)>,
+        lo: f64,
+        deltas: Vec<usize>,
+        shape: SqrtSegments,
     },
     /// One binary per allowed level (W, column).
     Levels(Vec<(f64, usize)>),
@@ -558,6 +581,8 @@ enum PowerBin {
 pub(super) struct PowerLp {
     lp: LinearProgram,
     bins: Vec<PowerBin>,
+    /// The column fixed at 1 that carries the utilities' constants.
+    one: Option<usize>,
     p_mean: f64,
     floor_w: f64,
     y: Vec<f64>,
@@ -569,21 +594,27 @@ pub(super) struct PowerLp {
 const REPAIR_TRIES: usize = 40;
 
 impl PowerLp {
-    /// The program's point for powers `p` (W): `x = p/P̄`, `u` the chords'
-    /// minimum rounded down; `None` when a power is not an allowed level.
+    /// The program's point for powers `p` (W): `x = p/P̄`, the segments
+    /// filled greedily (a few ulps short, so the row holds exactly); `None`
+    /// when a power is not an allowed level.
     fn point(&self, p: &[f64]) -> Option<Vec<f64>> {
         let mut v = vec![0.0; self.lp.cost.len()];
+        if let Some(one) = self.one {
+            v[one] = 1.0;
+        }
         for (b, &pi) in self.bins.iter().zip(p) {
             match b {
-                PowerBin::Continuous { x, u, chords } => {
+                PowerBin::Continuous {
+                    x,
+                    lo,
+                    deltas,
+                    shape,
+                } => {
                     let xi = (pi / self.p_mean).clamp(self.lp.col_lo[*x], self.lp.col_hi[*x]);
                     v[*x] = xi;
-                    let m = chords
-                        .iter()
-                        .map(|&(a, c)| a * xi + c)
-                        .fold(f64::INFINITY, f64::min);
-                    // Rounded down twice over: the exact check decides.
-                    v[*u] = next_down(next_down(m)).clamp(0.0, self.lp.col_hi[*u]);
+                    for (&d, f) in deltas.iter().zip(shape.fill(*lo, xi)) {
+                        v[d] = f;
+                    }
                 }
                 PowerBin::Levels(zs) => {
                     let k = zs.iter().position(|&(lv, _)| lv == pi)?;
@@ -677,7 +708,6 @@ fn dwell_step(
                 hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
             }
             let ti = vars.add(variable().min(lo).max(hi));
-            let v = vars.add(variable());
             // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
             let k = unit * TAU / (th * period);
             let (r_lo, r_hi) = (
@@ -688,10 +718,16 @@ fn dwell_step(
                     1e3
                 },
             );
-            for (a, b) in sqrt_chords(r_lo, r_hi) {
-                cons.push(constraint!(v <= a * k * ti + b));
+            // The utility as boxed segment columns, Σ δ ≤ r − r_lo (see
+            // `utility`; its constant does not move the optimum).
+            let c = lam * th * g.weight[i];
+            let mut fill = Expression::from(0.0);
+            for &(a, len) in &sqrt_segments(r_lo, r_hi).segments {
+                let d = vars.add(variable().min(0.0).max(len));
+                objective.add_mul(c * a, d);
+                fill.add_mul(1.0, d);
             }
-            objective.add_mul(lam * th * g.weight[i], v);
+            cons.push(constraint!(fill <= k * ti - r_lo));
             tau.push(Expression::from(ti));
         } else {
             let allowed: Vec<f64> = setpoints
@@ -754,8 +790,7 @@ fn dwell_step(
         }
         cons.push(constraint!(en <= cut_rhs()));
     }
-    let model = configured(vars.maximise(objective).using(highs), cons);
-    let sol = solve_model(model, "dwell")?;
+    let sol = solve_relaxation_first(vars, objective, cons, &sp_vars)?;
     let mut t: Vec<f64> = if setpoints.is_empty() {
         tau.iter().map(|te| sol.eval(te) * unit).collect()
     } else {

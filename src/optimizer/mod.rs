@@ -41,9 +41,11 @@
 
 pub mod certificate;
 pub mod config;
+mod exact;
 pub mod fast;
 pub mod global;
 mod lp;
+mod utility;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Whole-process timing of `gaze-lidar profile --config C --gaze-deg 90
+# --format json` for the shipped optimizer configs, as ratios against a
+# baseline binary measured in the same run (old and new runs alternate, so
+# load from other processes falls on both alike).
+#
+#   scripts/bench-profile.sh [BASE_REV] [RUNS]
+#
+# BASE_REV (default `main`) is checked out in a temporary git worktree and
+# built with this repository's target directory (only the workspace crates
+# rebuild; HiGHS is reused), its binary kept as target/bench/gaze-lidar-base;
+# then the working tree is built again as target/bench/gaze-lidar-new.
+# OLD=path / NEW=path skip the builds. RUNS (default 21) runs per binary and
+# config; the table gives the median and the minimum wall time in ms.
+# Outputs of both binaries are compared byte for byte (reported, not
+# required: a new formulation may move the last bits).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BASE_REV="${1:-main}"
+RUNS="${2:-21}"
+CONFIGS="${CONFIGS:-paper multi_level vls128_eye smooth}"
+mkdir -p target/bench
+if [[ -z "${OLD:-}" ]]; then
+    wt="$(mktemp -d)"
+    trap 'git worktree remove --force "$wt" >/dev/null 2>&1 || true' EXIT
+    git worktree add --detach "$wt" "$BASE_REV" >/dev/null
+    (cd "$wt" && cargo build --release --bin gaze-lidar --target-dir "$OLDPWD/target" >&2)
+    cp target/release/gaze-lidar target/bench/gaze-lidar-base
+    OLD=target/bench/gaze-lidar-base
+fi
+if [[ -z "${NEW:-}" ]]; then
+    cargo build --release --bin gaze-lidar >&2
+    cp target/release/gaze-lidar target/bench/gaze-lidar-new
+    NEW=target/bench/gaze-lidar-new
+fi
+python3 - "$OLD" "$NEW" "$RUNS" $CONFIGS <<'EOF'
+import statistics, subprocess, sys, time
+old, new, runs, configs = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
+def once(binary, config):
+    args = [binary, "profile", "--config", f"examples/configs/{config}.toml",
+            "--gaze-deg", "90", "--format", "json"]
+    t0 = time.perf_counter()
+    out = subprocess.run(args, capture_output=True, check=True).stdout
+    return time.perf_counter() - t0, out
+print(f"baseline {old}, new {new}, {runs} runs each, alternated")
+print(f"{'config':<12} {'base med':>9} {'new med':>9} {'base min':>9} {'new min':>9} {'ratio':>7}  outputs")
+for c in configs:
+    ts = {old: [], new: []}
+    outs = {}
+    for _ in range(runs):
+        for b in (old, new):
+            dt, out = once(b, c)
+            ts[b].append(dt * 1e3)
+            outs[b] = out
+    mo, mn = statistics.median(ts[old]), statistics.median(ts[new])
+    same = "identical" if outs[old] == outs[new] else "differ"
+    print(f"{c:<12} {mo:9.1f} {mn:9.1f} {min(ts[old]):9.1f} {min(ts[new]):9.1f} {mo / mn:6.2f}×  {same}")
+EOF

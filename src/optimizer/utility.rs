@@ -1,0 +1,161 @@
+//! The concave piecewise-linear utilities of the steps, as *segments*.
+//!
+//! `√v` on `[lo, hi]` is approximated from below by its chords between
+//! [`super::UTILITY_SEGMENTS`] + 1 nodes spread evenly in `√` (`sqrt_chords`
+//! in `lp.rs` lists the same chords as lines). A concave piecewise-linear
+//! function `h` with nodes `v_0 = lo < v_1 < … < v_K = hi` and decreasing
+//! slopes `a_k` is, for every `v ∈ [lo, hi]`,
+//!
+//! `h(v) = √lo + max { Σ_k a_k δ_k : 0 ≤ δ_k ≤ v_{k+1} − v_k, Σ_k δ_k ≤ v − lo }`
+//!
+//! (the maximum fills the steepest segments first, which is `h`; any other
+//! fill is below it). So instead of one epigraph row `u ≤ a_k v + b_k` per
+//! chord (`K` rows per bin), a program carries `K` boxed columns `δ_k`
+//! (cost `c·a_k`) and **one** row `Σ δ_k − v ≤ −lo` per bin, plus the
+//! constant `c·√lo`: the same optimum over `v`, with `K − 1` fewer rows per
+//! bin (HiGHS's dual simplex handles boxed columns by bound flips, rows by
+//! pivots; the rows were most of the power and dwell steps' programs).
+//! Every slope is positive (√ grows), which is what makes the fill greedy.
+
+use super::certificate::LinearProgram;
+
+/// `√v` on `[lo, hi]` as segments: the value at `lo` and `(slope, length)`
+/// per segment, slopes decreasing.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct SqrtSegments {
+    /// `√lo`.
+    pub(super) base: f64,
+    /// `(slope, length)` of each segment, in order from `lo`.
+    pub(super) segments: Vec<(f64, f64)>,
+}
+
+/// The chords of `√v` on `[lo, hi]` (nodes evenly spaced in `√`) as
+/// segments. Empty when `hi <= lo`.
+pub(super) fn sqrt_segments(lo: f64, hi: f64) -> SqrtSegments {
+    let (a, b) = (lo.max(0.0).sqrt(), hi.max(lo).sqrt());
+    let k = super::UTILITY_SEGMENTS;
+    let node = |j: usize| (a + (b - a) * j as f64 / k as f64).powi(2);
+    let segments = (0..k)
+        .filter_map(|j| {
+            let (x0, x1) = (node(j), node(j + 1));
+            (x1 > x0).then(|| ((x1.sqrt() - x0.sqrt()) / (x1 - x0), x1 - x0))
+        })
+        .collect();
+    SqrtSegments { base: a, segments }
+}
+
+/// Relative shortfall left when a fill is computed in floating point, so
+/// that `Σ δ_k ≤ v − lo` holds *exactly* for the doubles handed to the
+/// exact check: at most `K` roundings of a subtraction (half an ulp each)
+/// and one of `v − lo` stay far inside `64·ε`.
+const FILL_SHORTFALL: f64 = 64.0 * f64::EPSILON;
+
+impl SqrtSegments {
+    /// Adds the segment columns (cost `c·slope`, boxed by the lengths) and
+    /// the row `Σ δ_k − v ≤ −lo` on column `v`; returns the columns. The
+    /// constant `c·√lo` is the caller's.
+    pub(super) fn add_to(&self, lp: &mut LinearProgram, v: usize, lo: f64, c: f64) -> Vec<usize> {
+        let deltas: Vec<usize> = self
+            .segments
+            .iter()
+            .map(|&(a, len)| lp.add_col(0.0, len, c * a, false))
+            .collect();
+        if !deltas.is_empty() {
+            let mut row: Vec<(usize, f64)> = deltas.iter().map(|&d| (d, 1.0)).collect();
+            row.push((v, -1.0));
+            lp.add_row(&row, f64::NEG_INFINITY, -lo);
+        }
+        deltas
+    }
+
+    /// The greedy fill for `v` (the maximiser above, shortened by a
+    /// relative [`FILL_SHORTFALL`] so that it is exactly feasible).
+    pub(super) fn fill(&self, lo: f64, v: f64) -> Vec<f64> {
+        let mut rem = ((v - lo) * (1.0 - FILL_SHORTFALL)).max(0.0);
+        self.segments
+            .iter()
+            .map(|&(_, len)| {
+                let d = len.min(rem);
+                rem = (rem - d).max(0.0);
+                d
+            })
+            .collect()
+    }
+
+    /// `h(v)` by the fill (floating point).
+    #[cfg(test)]
+    fn value(&self, lo: f64, v: f64) -> f64 {
+        self.base
+            + self
+                .fill(lo, v)
+                .iter()
+                .zip(&self.segments)
+                .map(|(d, (a, _))| d * a)
+                .sum::<f64>()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The chords as lines, written independently of the segments: the
+    /// minimum of the lines through consecutive nodes.
+    fn chord_min(lo: f64, hi: f64, v: f64) -> f64 {
+        let (a, b) = (lo.sqrt(), hi.sqrt());
+        let k = crate::optimizer::UTILITY_SEGMENTS;
+        (0..k)
+            .map(|j| {
+                let x0 = (a + (b - a) * j as f64 / k as f64).powi(2);
+                let x1 = (a + (b - a) * (j + 1) as f64 / k as f64).powi(2);
+                let s = (x1.sqrt() - x0.sqrt()) / (x1 - x0);
+                x0.sqrt() + s * (v - x0)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn segments_are_the_chords_and_lie_below_the_root() {
+        for &(lo, hi) in &[
+            (0.0, 1.0),
+            (0.2, 4.5),
+            (0.05, 1.3),
+            (0.4, 0.400001),
+            (3.0, 3.0),
+        ] {
+            let s = sqrt_segments(lo, hi);
+            for w in s.segments.windows(2) {
+                assert!(w[0].0 > w[1].0, "slopes decrease");
+            }
+            let total: f64 = s.segments.iter().map(|x| x.1).sum();
+            assert!((total - (hi - lo)).abs() <= 1e-12 * hi.max(1.0));
+            for k in 0..=200 {
+                let v = lo + (hi - lo) * f64::from(k) / 200.0;
+                let h = s.value(lo, v);
+                assert!(h <= v.sqrt() + 1e-12, "{lo} {hi} {v}: {h} above √");
+                if hi > lo {
+                    let c = chord_min(lo, hi, v);
+                    assert!((h - c).abs() <= 1e-12, "{lo} {hi} {v}: {h} vs chords {c}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_fill_never_exceeds_the_room_exactly() {
+        use num_rational::BigRational;
+        let q = |v: f64| BigRational::from_float(v).unwrap();
+        for &(lo, hi) in &[(0.0, 1.0), (0.2, 4.5), (0.153_846, 1.3), (1e-3, 1e3)] {
+            let s = sqrt_segments(lo, hi);
+            for k in 0..=500 {
+                let v = lo + (hi - lo) * f64::from(k) / 500.0;
+                let d = s.fill(lo, v);
+                let sum = d.iter().fold(q(0.0), |acc, &x| acc + q(x));
+                assert!(sum <= q(v) - q(lo), "{lo} {hi} {v}");
+                for (x, &(_, len)) in d.iter().zip(&s.segments) {
+                    assert!(*x >= 0.0 && *x <= len);
+                }
+            }
+        }
+    }
+}
