@@ -880,7 +880,14 @@ pub(super) fn solve(
         }
         Mode::Joint => {
             for _ in 0..spin_rounds.max(2) {
-                t = dwell_step(problem, &g, &binding, f_p, &p, &t)?;
+                let next = dwell_step(problem, &g, &binding, f_p, &p, &t)?;
+                if last.is_some() && next == t {
+                    // A fixed point: both steps are deterministic functions
+                    // of (p, t) (the binding cuts are found afresh from
+                    // them), so every further round repeats this one.
+                    break;
+                }
+                t = next;
                 let sp = steps(&t);
                 let mut pool = warm(&sp, &p);
                 let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
