@@ -571,6 +571,7 @@ impl Certified {
             gap: to_f64_up(&gap),
             exact: gap.is_zero(),
             global: None,
+            figures: None,
         }
     }
 

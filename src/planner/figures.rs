@@ -1,0 +1,230 @@
+//! A profile in units people use: the range (m) and the point density
+//! (points per degree) inside the driver's region of focus and outside it,
+//! next to the paper's closed form's for the same gaze.
+//!
+//! What each figure is and how a per-bin figure aggregates over a region
+//! is stated once, on [`UnitFigures`] (profile@1's `optimality.figures`)
+//! and in `specs/optimizer.md`. The range comes from the one range
+//! equation ([`crate::model::range`]); the dwell from the core's
+//! kinematics ([`crate::profile::Bin::dwell_time_s`]).
+
+use crate::checker::CertifiedProfile;
+use crate::model::acuity::FocusModel;
+use crate::model::angle::CircularSet;
+use crate::model::lidar::LidarSpec;
+use crate::model::presets::Preset;
+use crate::model::range::RangeEquation;
+use crate::planner::{closed_form, Mode};
+use crate::profile::{Aggregate, Bin, Profile, RegionFigure, RegionFigures, UnitFigures};
+
+/// The sensor's range at `power_w` on its reference reflectivity in clear
+/// air, m (the range equation calibrated so `average_power_w` reaches
+/// `rated_range_m`).
+#[must_use]
+pub fn range_m(lidar: &LidarSpec, power_w: f64) -> f64 {
+    RangeEquation::rated(lidar.rated_range_m, lidar.reference_reflectivity)
+        .rated_conditions_range_m(power_w / lidar.average_power_w)
+}
+
+/// Points per degree per channel and revolution in `bin`:
+/// `pulse_rate_hz · dwell / width` (the pulse rate over the bin's mean
+/// spin in deg/s).
+#[must_use]
+pub fn points_per_deg(pulse_rate_hz: f64, bin: &Bin) -> f64 {
+    pulse_rate_hz * bin.dwell_time_s() / bin.width_deg
+}
+
+/// Running angle-weighted mean, min and max.
+#[derive(Default)]
+struct Acc {
+    width_deg: f64,
+    range: (f64, f64, f64),
+    density: (f64, f64, f64),
+}
+
+fn push(acc: &mut (f64, f64, f64), width_deg: f64, v: f64, first: bool) {
+    acc.0 += width_deg * v;
+    if first {
+        (acc.1, acc.2) = (v, v);
+    } else {
+        acc.1 = acc.1.min(v);
+        acc.2 = acc.2.max(v);
+    }
+}
+
+impl Acc {
+    fn add(&mut self, width_deg: f64, range_m: f64, points_per_deg: f64) {
+        let first = self.width_deg == 0.0;
+        push(&mut self.range, width_deg, range_m, first);
+        push(&mut self.density, width_deg, points_per_deg, first);
+        self.width_deg += width_deg;
+    }
+
+    fn finish(self) -> Option<RegionFigure> {
+        let agg = |(sum, min, max): (f64, f64, f64)| Aggregate {
+            mean: sum / self.width_deg,
+            min,
+            max,
+        };
+        (self.width_deg > 0.0).then(|| RegionFigure {
+            width_deg: self.width_deg,
+            range_m: agg(self.range),
+            points_per_deg: agg(self.density),
+        })
+    }
+}
+
+/// `profile`'s figures on `lidar` with the region of focus of `focus` at
+/// the profile's gaze (none for a gaze-free profile: every bin is in the
+/// region of interest). A bin belongs to the region containing its centre.
+#[must_use]
+pub fn region_figures(profile: &Profile, lidar: &LidarSpec, focus: &FocusModel) -> RegionFigures {
+    let rof = profile
+        .gaze_deg
+        .map_or_else(CircularSet::empty, |g| focus.regions(g).rof);
+    let (mut inside, mut outside) = (Acc::default(), Acc::default());
+    for b in &profile.bins {
+        let acc = if rof.contains(b.center_deg()) {
+            &mut inside
+        } else {
+            &mut outside
+        };
+        acc.add(
+            b.width_deg,
+            range_m(lidar, b.power_w),
+            points_per_deg(profile.pulse_rate_hz, b),
+        );
+    }
+    RegionFigures {
+        rof: inside.finish(),
+        roi: outside.finish(),
+    }
+}
+
+/// `profile`'s figures on `preset`'s sensor and driver model, next to
+/// those of the paper's closed form `mode` (with `preset`'s levels) for
+/// the profile's gaze on `bins` bins.
+#[must_use]
+pub fn unit_figures(profile: &Profile, preset: &Preset, mode: Mode, bins: usize) -> UnitFigures {
+    let own = region_figures(profile, &preset.lidar, &preset.focus);
+    let (closed, rejected) = match closed_form(preset, mode, profile.gaze_deg, bins) {
+        Ok(c) => (
+            Some(region_figures(c.profile(), &preset.lidar, &preset.focus)),
+            None,
+        ),
+        Err(e) => (None, Some(format!("closed-form {}: {e}", mode.name()))),
+    };
+    UnitFigures {
+        profile: own,
+        closed_form: closed,
+        closed_form_rejected: rejected,
+    }
+}
+
+/// Writes [`unit_figures`] into `certified`'s `optimality` block (a
+/// profile without one is returned unchanged); the block is informational,
+/// so the certificate stands.
+#[must_use]
+pub fn attach(
+    mut certified: CertifiedProfile,
+    preset: &Preset,
+    mode: Mode,
+    bins: usize,
+) -> CertifiedProfile {
+    if let Some(mut opt) = certified.profile().optimality.clone() {
+        opt.figures = Some(unit_figures(certified.profile(), preset, mode, bins));
+        certified.set_optimality(Some(opt));
+    }
+    certified
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets::{paper, vls128};
+    use crate::profile::Region;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn hand_worked_bin_figures() {
+        let p = paper();
+        // Paper preset: 7,812.5 pulses/s per channel. A 1° bin at a steady
+        // 20 Hz (7,200 °/s): 7812.5 / 7200 = 1.0850694 points/deg.
+        let bin = Bin {
+            start_deg: 0.0,
+            width_deg: 1.0,
+            power_w: 1.1e-3,
+            spin_start_rad_s: 40.0 * std::f64::consts::PI,
+            spin_end_rad_s: 40.0 * std::f64::consts::PI,
+            region: None,
+            dwell_s: None,
+        };
+        assert_relative_eq!(
+            points_per_deg(p.lidar.pulse_rate_hz, &bin),
+            1.085_069_444,
+            epsilon = 1e-9
+        );
+        // Ramping 10 → 30 Hz over 2°: dwell 2·2°/(3600 + 10800 °/s)
+        // = 2.7778e-4 s, so 7812.5 · 2.7778e-4 / 2 = 1.0850694: the same
+        // density as a steady 20 Hz (the time-mean spin is 20 Hz).
+        let ramp = Bin {
+            width_deg: 2.0,
+            spin_start_rad_s: 20.0 * std::f64::consts::PI,
+            spin_end_rad_s: 60.0 * std::f64::consts::PI,
+            ..bin.clone()
+        };
+        assert_relative_eq!(
+            points_per_deg(p.lidar.pulse_rate_hz, &ramp),
+            1.085_069_444,
+            epsilon = 1e-9
+        );
+        // Range at 1.1 P̄ on the paper's 100 m rating, clear air: 104.8054 m
+        // (worked in `model::range`'s tests); at P̄ the rated 100 m; VLS-128
+        // (245 m at 1.5 mW) at 0.75 mW: 245·√0.5 = 173.24 m, and clear air
+        // (α₀ = 1.498e-4 /m) lengthens it: R = 173.2412·e^(−α₀(R − 245)):
+        // e^(α₀·71.759) = 1.010808 → 175.113; e^(α₀·69.887) = 1.010524 →
+        // 175.064; e^(α₀·69.936) = 1.010532 → 175.066 m.
+        assert_relative_eq!(range_m(&p.lidar, 1.1e-3), 104.8054, epsilon = 1e-3);
+        assert_eq!(range_m(&p.lidar, 1.0e-3), 100.0);
+        assert_relative_eq!(range_m(&vls128().lidar, 0.75e-3), 175.066, epsilon = 2e-3);
+    }
+
+    #[test]
+    fn closed_form_split_matches_its_levels_and_labels() {
+        let preset = paper();
+        for mode in [Mode::Range, Mode::Resolution, Mode::Joint] {
+            let c = closed_form(&preset, mode, Some(90.0), 360).unwrap();
+            let f = region_figures(c.profile(), &preset.lidar, &preset.focus);
+            let (rof, roi) = (f.rof.unwrap(), f.roi.unwrap());
+            // The paper's 60° box about 90°: [60°, 120°).
+            assert_eq!((rof.width_deg, roi.width_deg), (60.0, 300.0));
+            for b in &c.profile().bins {
+                let inside = (60.0..120.0).contains(&b.center_deg());
+                assert_eq!(b.region == Some(Region::Rof), inside, "{b:?}");
+            }
+            let lv = crate::planner::closed_form::levels(&preset, mode, 60.0, 300.0).unwrap();
+            for (r, k) in [(&rof, 0), (&roi, 1)] {
+                let range = range_m(&preset.lidar, lv.power_w[k]);
+                let density = preset.lidar.pulse_rate_hz / lv.spin_rad_s[k].to_degrees();
+                for a in [r.range_m, r.points_per_deg] {
+                    assert!(a.min <= a.mean * (1.0 + 1e-12) && a.mean <= a.max * (1.0 + 1e-12));
+                }
+                assert_relative_eq!(r.range_m.min, range, max_relative = 1e-12);
+                assert_relative_eq!(r.range_m.max, range, max_relative = 1e-12);
+                assert_relative_eq!(r.range_m.mean, range, max_relative = 1e-12);
+                assert_relative_eq!(r.points_per_deg.mean, density, max_relative = 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn gaze_free_profile_is_all_roi() {
+        let preset = paper();
+        let c = closed_form(&preset, Mode::Baseline, None, 360).unwrap();
+        let f = region_figures(c.profile(), &preset.lidar, &preset.focus);
+        assert!(f.rof.is_none());
+        let roi = f.roi.unwrap();
+        assert_eq!(roi.width_deg, 360.0);
+        assert_eq!(roi.range_m.mean, 100.0);
+    }
+}
