@@ -206,10 +206,8 @@ fn shipped_configs_report_range_and_density_per_region_next_to_the_closed_form()
     }
 }
 
-#[test]
-fn the_paper_problem_reads_as_its_closed_form() {
-    // paper.toml's optimum is the closed form (its comment): so are its
-    // figures — 0.5 P̄ and ω_high in the RoF, 1.1 P̄ and ω_low outside.
+/// `profile --config examples/configs/paper.toml --gaze-deg 90`'s JSON.
+fn paper_optimum_json() -> String {
     let o = run(
         &[
             "profile",
@@ -221,7 +219,14 @@ fn the_paper_problem_reads_as_its_closed_form() {
         None,
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    let p = Profile::from_json(&stdout(&o), "paper").unwrap();
+    stdout(&o)
+}
+
+#[test]
+fn the_paper_problem_reads_as_its_closed_form() {
+    // paper.toml's optimum is the closed form (its comment): so are its
+    // figures — 0.5 P̄ and ω_high in the RoF, 1.1 P̄ and ω_low outside.
+    let p = Profile::from_json(&paper_optimum_json(), "paper").unwrap();
     let fig = p.optimality.unwrap().figures.unwrap();
     let cf = fig.closed_form.unwrap();
     for (a, b, what) in [
@@ -252,18 +257,7 @@ fn the_paper_problem_reads_as_its_closed_form() {
 
 #[test]
 fn profile_files_with_and_without_figures_read_back() {
-    let o = run(
-        &[
-            "profile",
-            "--config",
-            &config_path("paper"),
-            "--gaze-deg",
-            "90",
-        ],
-        None,
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = stdout(&o);
+    let text = paper_optimum_json();
     let p = Profile::from_json(&text, "new").unwrap();
     assert_eq!(p.to_json().unwrap(), text, "round trip");
     // An older file: no `figures` in its optimality block.

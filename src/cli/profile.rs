@@ -293,18 +293,13 @@ fn optimized(
         }
     };
     let (c, cert) = optimize_with_certificate(&problem, gaze).map_err(err)?;
-    // The paper's closed form on the same sensor and driver model.
+    let c = figures::attach_to_optimum(c, &problem, named.levels.clone());
     let basis = Basis {
-        preset: Preset {
-            lidar: problem.lidar.clone(),
-            focus: problem.focus.clone(),
-            levels: named.levels,
-        },
+        preset: figures::closed_form_basis(&problem, named.levels),
         mode: problem.objective.mode,
         bins: problem.bins,
         optimized: true,
     };
-    let c = figures::attach(c, &basis.preset, basis.mode, basis.bins);
     Ok((c, cert, basis))
 }
 
