@@ -34,39 +34,56 @@ pub fn points_per_deg(pulse_rate_hz: f64, bin: &Bin) -> f64 {
     pulse_rate_hz * bin.dwell_time_s() / bin.width_deg
 }
 
-/// Running angle-weighted mean, min and max.
-#[derive(Default)]
-struct Acc {
-    width_deg: f64,
-    range: (f64, f64, f64),
-    density: (f64, f64, f64),
+/// Running angle-weighted sum, min and max of one figure.
+#[derive(Clone, Copy)]
+struct Running {
+    sum: f64,
+    min: f64,
+    max: f64,
 }
 
-fn push(acc: &mut (f64, f64, f64), width_deg: f64, v: f64, first: bool) {
-    acc.0 += width_deg * v;
-    if first {
-        (acc.1, acc.2) = (v, v);
-    } else {
-        acc.1 = acc.1.min(v);
-        acc.2 = acc.2.max(v);
+impl Default for Running {
+    fn default() -> Self {
+        Self {
+            sum: 0.0,
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+        }
     }
+}
+
+impl Running {
+    fn push(&mut self, width_deg: f64, v: f64) {
+        self.sum += width_deg * v;
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+    }
+}
+
+/// One region's running figures.
+#[derive(Default)]
+struct Acc {
+    bins: usize,
+    width_deg: f64,
+    range: Running,
+    density: Running,
 }
 
 impl Acc {
     fn add(&mut self, width_deg: f64, range_m: f64, points_per_deg: f64) {
-        let first = self.width_deg == 0.0;
-        push(&mut self.range, width_deg, range_m, first);
-        push(&mut self.density, width_deg, points_per_deg, first);
+        self.bins += 1;
         self.width_deg += width_deg;
+        self.range.push(width_deg, range_m);
+        self.density.push(width_deg, points_per_deg);
     }
 
     fn finish(self) -> Option<RegionFigure> {
-        let agg = |(sum, min, max): (f64, f64, f64)| Aggregate {
-            mean: sum / self.width_deg,
-            min,
-            max,
+        let agg = |r: Running| Aggregate {
+            mean: r.sum / self.width_deg,
+            min: r.min,
+            max: r.max,
         };
-        (self.width_deg > 0.0).then(|| RegionFigure {
+        (self.bins > 0).then(|| RegionFigure {
             width_deg: self.width_deg,
             range_m: agg(self.range),
             points_per_deg: agg(self.density),
@@ -248,6 +265,55 @@ mod tests {
                 assert_relative_eq!(r.points_per_deg.mean, density, max_relative = 1e-9);
             }
         }
+    }
+
+    #[test]
+    fn unequal_bins_aggregate_by_angle() {
+        // Gaze 90°: the paper's RoF is [60°, 120°). RoI bins: [0, 60) at P̄
+        // (100 m) spinning 40 Hz (14,400 °/s: 7812.5/14400 = 0.5425 points/deg),
+        // [120, 350) at 0 W (0 m) and [350, 360) at P̄ (100 m), both 20 Hz
+        // (1.0851 points/deg). Angle-weighted over 300°:
+        // range (60·100 + 230·0 + 10·100)/300 = 23.333 m (unweighted: 66.7);
+        // density 7812.5·(60/14400 + 240/7200)/300 = 0.9765625 (the RoI's
+        // points per turn over its degrees; unweighted: 0.9494).
+        let preset = paper();
+        let mut profile = closed_form(&preset, Mode::Range, Some(90.0), 360)
+            .unwrap()
+            .into_inner();
+        let hz = |f: f64| f * std::f64::consts::TAU;
+        let bin = |start_deg: f64, end_deg: f64, power_w: f64, spin_rad_s: f64| Bin {
+            start_deg,
+            width_deg: end_deg - start_deg,
+            power_w,
+            spin_start_rad_s: spin_rad_s,
+            spin_end_rad_s: spin_rad_s,
+            region: None,
+            dwell_s: None,
+        };
+        profile.bins = vec![
+            bin(0.0, 60.0, 1e-3, hz(40.0)),
+            bin(60.0, 120.0, 0.0, hz(20.0)),
+            bin(120.0, 350.0, 0.0, hz(20.0)),
+            bin(350.0, 360.0, 1e-3, hz(20.0)),
+        ];
+        let f = region_figures(&profile, &preset.lidar, &preset.focus);
+        let (rof, roi) = (f.rof.unwrap(), f.roi.unwrap());
+        assert_eq!(rof.width_deg, 60.0);
+        assert_eq!((rof.range_m.min, rof.range_m.max), (0.0, 0.0));
+        assert_eq!(roi.width_deg, 300.0);
+        assert_relative_eq!(roi.range_m.mean, 70.0 / 3.0, max_relative = 1e-12);
+        assert_eq!((roi.range_m.min, roi.range_m.max), (0.0, 100.0));
+        assert_relative_eq!(roi.points_per_deg.mean, 0.976_562_5, max_relative = 1e-12);
+        assert_relative_eq!(
+            roi.points_per_deg.min,
+            7812.5 / 14400.0,
+            max_relative = 1e-12
+        );
+        assert_relative_eq!(
+            roi.points_per_deg.max,
+            7812.5 / 7200.0,
+            max_relative = 1e-12
+        );
     }
 
     #[test]
