@@ -305,4 +305,31 @@ fn text_format_shows_both_regions_next_to_the_closed_form() {
     }
     // The closed form's RoF line: 0.5 P̄ on the 245 m rating is 175.07 m.
     assert!(t.contains("range 175.07 m [175.07, 175.07]"), "{t}");
+    // A closed-form profile reads its own figures, with nothing to compare.
+    let o = run(
+        &[
+            "profile",
+            "--mode",
+            "range",
+            "--gaze-deg",
+            "90",
+            "--format",
+            "text",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = stdout(&o);
+    assert!(
+        t.contains("this profile           range 71.02 m [71.02, 71.02]"),
+        "{t}"
+    );
+    assert!(
+        t.contains("this profile           range 104.81 m [104.81, 104.81]"),
+        "{t}"
+    );
+    assert!(
+        !t.contains("optimality") && !t.contains("closed-form range "),
+        "{t}"
+    );
 }

@@ -414,7 +414,7 @@ fn text_summary(c: &CertifiedProfile, basis: &Basis) -> String {
         let width = pick(&units.profile).map_or(0.0, |f| f.width_deg);
         let _ = writeln!(out, "  {name} ({width}°):");
         for (label, r) in &rows {
-            let _ = writeln!(out, "    {label:<20} {}", cell(pick(r).as_ref()));
+            let _ = writeln!(out, "    {label:<22} {}", cell(pick(r).as_ref()));
         }
     }
     if let Some(why) = &units.closed_form_rejected {
