@@ -113,6 +113,11 @@ def optimize(config: ConfigSource, gaze_deg: float) -> Profile:
     `config`: a dict of the same keys, a path to a ``.toml`` (or ``.json``)
     file, or TOML text (a ``str`` that names no existing file). Raises
     ValueError for a bad key (named), Infeasible naming the limit.
+
+    The profile's ``optimality`` dict holds the exact gap of the final power
+    step and, in ``figures`` (also ``Profile.figures``), the range in metres
+    and the points per degree inside and outside the region of focus next to
+    the paper's closed form's for the same gaze.
     """
     if isinstance(config, Mapping):
         return _native.optimize(json.dumps(config), gaze_deg, json=True)

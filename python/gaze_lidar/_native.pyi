@@ -121,6 +121,20 @@ class Profile:
         """The checker's figures: average_power_angle_w, average_power_time_w,
         energy_per_frame_j, frame_period_s, max_spin_accel_rad_s2 (None for a
         spin step), rof_width_deg, power_w_range, spin_rad_s_range."""
+    @property
+    def optimality(self) -> dict[str, Any] | None:
+        """The optimizer's figures (profile@1 `optimality`): objective,
+        upper_bound, gap, exact, global, figures; None for the closed forms."""
+    @property
+    def figures(self) -> dict[str, Any] | None:
+        """Range and point density in units people use (profile@1
+        `optimality.figures`): {"profile": {"rof", "roi"}, "closed_form":
+        {"rof", "roi"} or absent, "closed_form_rejected": reason or absent};
+        each region {"width_deg", "range_m", "points_per_deg"}, each figure
+        {"mean" (angle-weighted over the region's bins), "min", "max"}. Range
+        on the reference reflectivity in clear air from the range equation at
+        the sensor's rated range; points per degree per channel and
+        revolution. None where the profile has none (the closed forms)."""
     def to_json(self) -> str:
         """The profile as `gaze-lidar/profile@1` JSON (what `gaze-lidar check` reads)."""
     @staticmethod

@@ -327,6 +327,38 @@ impl PyProfile {
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         guard(|| to_py_json(py, self.inner.summary()))
     }
+    /// The optimizer's figures (profile@1 `optimality`: objective,
+    /// upper_bound, gap, exact, global, figures), as a dict; None for a
+    /// profile without them (the closed forms).
+    #[getter]
+    fn optimality<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        guard(|| {
+            self.inner
+                .profile()
+                .optimality
+                .as_ref()
+                .map(|o| to_py_json(py, o))
+                .transpose()
+        })
+    }
+    /// The range (m) and points per degree inside the region of focus
+    /// ("rof") and outside it ("roi"), each {"mean", "min", "max"} over the
+    /// region's bins (angle-weighted mean), and the closed form's for the
+    /// same gaze ("closed_form", or "closed_form_rejected" saying why
+    /// there is none): profile@1 `optimality.figures`, as a dict; None
+    /// where the profile has none.
+    #[getter]
+    fn figures<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        guard(|| {
+            self.inner
+                .profile()
+                .optimality
+                .as_ref()
+                .and_then(|o| o.figures.as_ref())
+                .map(|f| to_py_json(py, f))
+                .transpose()
+        })
+    }
     /// The profile as `gaze-lidar/profile@1` JSON.
     fn to_json(&self) -> PyResult<String> {
         guard(|| {
@@ -554,12 +586,15 @@ fn optimize(py: Python<'_>, config_text: &str, gaze_deg: f64, json: bool) -> PyR
         } else {
             OptimizerConfig::from_toml(config_text, "config")
         };
-        let problem = config
-            .and_then(|c| c.problem())
+        let (problem, named) = config
+            .and_then(|c| Ok((c.problem()?, c.preset()?)))
             .map_err(|e| opt_error(py, e))?;
-        detached(py, || gaze_lidar::optimizer::optimize(&problem, gaze_deg))?
-            .map(|inner| PyProfile { inner })
-            .map_err(|e| opt_error(py, e))
+        detached(py, || {
+            gaze_lidar::optimizer::optimize(&problem, gaze_deg)
+                .map(|c| gaze_lidar::planner::figures::attach_to_optimum(c, &problem, named.levels))
+        })?
+        .map(|inner| PyProfile { inner })
+        .map_err(|e| opt_error(py, e))
     })
 }
 

@@ -150,3 +150,38 @@ def test_optimizer_from_a_toml_config(repo: pathlib.Path) -> None:
     infeasible = cfg.replace("[levels]", "[limits]\nspin_rad_s_max = 100.0\n\n[levels]")
     with pytest.raises(gl.Infeasible, match="spin_rad_s_max"):
         gl.optimize(infeasible, 90.0)
+
+
+def test_optimized_profile_reports_range_and_density_per_region(repo: pathlib.Path) -> None:
+    # examples/configs/paper.toml: the optimum is the paper's closed form,
+    # so its figures are the closed form's. By hand: the paper's 100 m
+    # rating at P̄ = 1 mW, clear air (α₀ = 2.996/20 km): 1.1 P̄ reaches
+    # R = 100·√1.1·e^(−α₀(R − 100)) = 104.805 m, 0.5 P̄ 71.018 m; the spin
+    # outside is ω_low = 2π·20·(60/5.4 + 300)/360 rad/s = 6222.2 °/s, so
+    # 7812.5 / 6222.2 = 1.25558 points per degree, 5.4 times fewer inside.
+    p = gl.optimize((repo / "examples/configs/paper.toml").read_text(), 90.0)
+    opt = p.optimality
+    assert opt is not None and opt["figures"] == p.figures
+    f = p.figures
+    assert f is not None
+    rof, roi = f["profile"]["rof"], f["profile"]["roi"]
+    assert (rof["width_deg"], roi["width_deg"]) == (60.0, 300.0)
+    assert rof["range_m"]["mean"] == pytest.approx(71.018, abs=1e-3)
+    assert roi["range_m"]["mean"] == pytest.approx(104.805, abs=1e-3)
+    assert roi["points_per_deg"]["mean"] == pytest.approx(1.25558, abs=1e-4)
+    assert rof["points_per_deg"]["mean"] == pytest.approx(1.25558 / 5.4, abs=1e-4)
+    for region in ("rof", "roi"):
+        for key in ("range_m", "points_per_deg"):
+            a = f["profile"][region][key]
+            assert a["min"] <= a["mean"] * (1 + 1e-12) and a["mean"] <= a["max"] * (1 + 1e-12)
+            assert a == pytest.approx(f["closed_form"][region][key], rel=1e-9)
+    # The per-bin arrays give the same region split and density.
+    inside = p.in_rof
+    dens = p.pulse_rate_hz * p.dwell_s / p.width_deg
+    w = p.width_deg
+    assert float(np.sum(w[inside] * dens[inside]) / np.sum(w[inside])) == pytest.approx(
+        rof["points_per_deg"]["mean"], rel=1e-12
+    )
+    # The closed forms carry no optimality block; JSON keeps the figures.
+    assert gl.profile(mode="joint", gaze_deg=90.0).figures is None
+    assert gl.Profile.from_json(p.to_json()).figures == f

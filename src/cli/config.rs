@@ -44,6 +44,22 @@ pub fn optimizer_problem(
     path: &Path,
     overrides: &Overrides<'_>,
 ) -> Result<gaze_lidar::optimizer::Problem, CliError> {
+    optimizer_problem_and_preset(path, overrides).map(|(p, _)| p)
+}
+
+/// [`optimizer_problem`] and the preset the file (or `--preset`) names,
+/// before the file's overrides (its closed forms' levels).
+#[cfg(feature = "solver")]
+pub fn optimizer_problem_and_preset(
+    path: &Path,
+    overrides: &Overrides<'_>,
+) -> Result<
+    (
+        gaze_lidar::optimizer::Problem,
+        gaze_lidar::model::presets::Preset,
+    ),
+    CliError,
+> {
     use gaze_lidar::optimizer::{OptError, OptimizerConfig};
     let err = |e: OptError| {
         if e.is_input_error() {
@@ -80,7 +96,8 @@ pub fn optimizer_problem(
         }
         problem.objective.mode = m;
     }
-    Ok(problem)
+    let preset = config.preset().map_err(err)?;
+    Ok((problem, preset))
 }
 
 /// Without the solver there is no optimizer configuration.

@@ -9,7 +9,11 @@ use gaze_lidar::planner::{closed_form, Mode};
 
 use gaze_lidar::firmware::{binary, FirmwareConfig, FirmwareError, FirmwareTable};
 
+use gaze_lidar::checker::CertifiedProfile;
 use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
+use gaze_lidar::model::presets::Preset;
+use gaze_lidar::planner::figures;
+use gaze_lidar::profile::{RegionFigure, RegionFigures};
 
 use super::args::{finite_positive, int_in};
 use super::config::Overrides;
@@ -27,6 +31,10 @@ pub enum Format {
     Firmware,
     /// The firmware table's fixed-size binary encoding (needs --out).
     FirmwareBin,
+    /// A readable summary: power, frame period, the optimizer's optimality
+    /// figures, and the range (m) and points per degree inside and outside
+    /// the region of focus (an optimized profile's next to the closed form's).
+    Text,
 }
 
 /// Accounting override.
@@ -158,6 +166,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         ));
     }
     let mut extra = Vec::new();
+    // The sensor, driver model and closed-form levels the figures use.
+    let mut basis = Basis {
+        preset: preset.clone(),
+        mode,
+        bins: bins.unwrap_or(360),
+        optimized: false,
+    };
     let certified = if a.optimize || a.config.is_some() {
         let overrides = Overrides {
             preset: a.preset.as_deref(),
@@ -165,7 +180,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             accounting,
             mode: a.mode,
         };
-        let (c, cert) = optimized(a, &preset, gaze, &overrides)?;
+        let (c, cert, b) = optimized(a, &preset, gaze, &overrides)?;
+        basis = b;
         if let Some(dir) = &a.certificate {
             extra = certificate_files(dir, cert)?;
         }
@@ -196,6 +212,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             .map_err(|e| CliError::input(e.to_string()))?
             .into_bytes(),
         Format::FirmwareBin => binary::encode(&firmware()?),
+        Format::Text => text_summary(&certified, &basis).into_bytes(),
     };
     for (path, b) in extra {
         outputs.set(&path, b);
@@ -244,8 +261,9 @@ fn optimized(
     overrides: &Overrides<'_>,
 ) -> Result<
     (
-        gaze_lidar::checker::CertifiedProfile,
+        CertifiedProfile,
         Result<gaze_lidar::optimizer::certificate::Certified, String>,
+        Basis,
     ),
     CliError,
 > {
@@ -262,8 +280,8 @@ fn optimized(
             "--optimize needs --gaze-deg (the baseline has nothing to optimize)",
         ));
     };
-    let problem = match &a.config {
-        Some(path) => super::config::optimizer_problem(path, overrides)?,
+    let (problem, named) = match &a.config {
+        Some(path) => super::config::optimizer_problem_and_preset(path, overrides)?,
         None => {
             let bins = super::config::optimizer_bins(overrides.bins.unwrap_or(360))?;
             let mut p = Problem::paper_equivalent(preset, a.mode.unwrap_or(Mode::Range), bins)
@@ -271,10 +289,18 @@ fn optimized(
             if let Some(m) = a.mode {
                 p.objective.mode = m;
             }
-            p
+            (p, preset.clone())
         }
     };
-    optimize_with_certificate(&problem, gaze).map_err(err)
+    let (c, cert) = optimize_with_certificate(&problem, gaze).map_err(err)?;
+    let c = figures::attach_to_optimum(c, &problem, named.levels.clone());
+    let basis = Basis {
+        preset: figures::closed_form_basis(&problem, named.levels),
+        mode: problem.objective.mode,
+        bins: problem.bins,
+        optimized: true,
+    };
+    Ok((c, cert, basis))
 }
 
 #[cfg(not(feature = "solver"))]
@@ -283,6 +309,116 @@ fn optimized(
     _preset: &gaze_lidar::model::presets::Preset,
     _gaze: Option<f64>,
     _overrides: &Overrides<'_>,
-) -> Result<(gaze_lidar::checker::CertifiedProfile, Result<(), String>), CliError> {
+) -> Result<(CertifiedProfile, Result<(), String>, Basis), CliError> {
     Err(super::config::no_solver("--optimize/--config"))
+}
+
+/// What a profile's figures are computed on: the sensor and driver model
+/// (and the closed forms' levels) of `preset`, the controller `mode` and
+/// the bin count; `optimized` profiles are compared with the closed form.
+struct Basis {
+    preset: Preset,
+    mode: Mode,
+    bins: usize,
+    optimized: bool,
+}
+
+/// `--format text`: the checker's figures, the optimizer's optimality
+/// figures and the range and point density per region (`planner::figures`).
+fn text_summary(c: &CertifiedProfile, basis: &Basis) -> String {
+    use std::fmt::Write as _;
+    let p = c.profile();
+    let s = c.summary();
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{}: {} bins, gaze {}; average power {:.6e} W (angle) / {:.6e} W (time) of budget {:.6e} W ({}); frame period {:.9} s",
+        p.mode.as_deref().unwrap_or("profile"),
+        p.bins.len(),
+        p.gaze_deg.map_or("none".to_owned(), |g| format!("{g}°")),
+        s.average_power_angle_w,
+        s.average_power_time_w,
+        p.average_power_w,
+        p.power_accounting,
+        s.frame_period_s,
+    );
+    if let Some(o) = &p.optimality {
+        let _ = write!(
+            out,
+            "optimality (final power step): objective {:.9} ≤ upper bound {:.9}, gap {:.3e}{}",
+            o.objective,
+            o.upper_bound,
+            o.gap,
+            if o.exact { " (proven optimal)" } else { "" }
+        );
+        if let Some(g) = &o.global {
+            let _ = write!(
+                out,
+                "; global: objective {:.9} ≤ upper bound {:.9}, gap {:.3e}",
+                g.objective, g.upper_bound, g.gap
+            );
+        }
+        out.push('\n');
+    }
+    let lidar = &basis.preset.lidar;
+    let _ = writeln!(
+        out,
+        "range on {} % reflectivity in clear air (rated {} m at {:e} W) and points per degree per channel and turn; each the angle-weighted mean [min, max] over the region's bins:",
+        100.0 * lidar.reference_reflectivity,
+        lidar.rated_range_m,
+        lidar.average_power_w,
+    );
+    let units = if basis.optimized {
+        p.optimality
+            .as_ref()
+            .and_then(|o| o.figures.clone())
+            .unwrap_or_else(|| figures::unit_figures(p, &basis.preset, basis.mode, basis.bins))
+    } else {
+        gaze_lidar::profile::UnitFigures {
+            profile: figures::region_figures(p, lidar, &basis.preset.focus),
+            closed_form: None,
+            closed_form_rejected: None,
+        }
+    };
+    let mut rows: Vec<(&str, &RegionFigures)> = vec![(
+        if basis.optimized {
+            "optimized"
+        } else {
+            "this profile"
+        },
+        &units.profile,
+    )];
+    let closed_name = format!("closed-form {}", basis.mode.name());
+    if let Some(cf) = &units.closed_form {
+        rows.push((closed_name.as_str(), cf));
+    }
+    let cell = |f: Option<&RegionFigure>| match f {
+        None => "(empty)".to_owned(),
+        Some(f) => format!(
+            "range {:.2} m [{:.2}, {:.2}]  {:.4} points/deg [{:.4}, {:.4}]",
+            f.range_m.mean,
+            f.range_m.min,
+            f.range_m.max,
+            f.points_per_deg.mean,
+            f.points_per_deg.min,
+            f.points_per_deg.max
+        ),
+    };
+    for (name, pick) in [
+        (
+            "RoF",
+            (|r: &RegionFigures| r.rof.clone()) as fn(&RegionFigures) -> Option<RegionFigure>,
+        ),
+        ("RoI", |r: &RegionFigures| r.roi.clone()),
+    ] {
+        let width = pick(&units.profile).map_or(0.0, |f| f.width_deg);
+        let _ = writeln!(out, "  {name} ({width}°):");
+        for (label, r) in &rows {
+            let _ = writeln!(out, "    {label:<22} {}", cell(pick(r).as_ref()));
+        }
+    }
+    if let Some(why) = &units.closed_form_rejected {
+        let _ = writeln!(out, "  no closed form to compare with: {why}");
+    }
+    out
 }

@@ -555,6 +555,7 @@ impl Certified {
             gap: to_f64_up(&gap),
             exact: gap.is_zero(),
             global: None,
+            figures: None,
         }
     }
 

@@ -161,13 +161,20 @@ impl OptimizerConfig {
         Self::from_toml(&text, &path.display().to_string())
     }
 
-    /// Builds and validates the problem.
-    pub fn problem(&self) -> Result<Problem, OptError> {
+    /// The preset the file names (`[lidar] preset`, default `paper`),
+    /// before the file's overrides: its `levels` are the closed forms' that
+    /// `planner::figures` compares the optimum with.
+    pub fn preset(&self) -> Result<presets::Preset, OptError> {
         let name = self.lidar.preset.as_deref().unwrap_or("paper");
-        let mut preset = presets::preset(name).map_err(|e| OptError::Invalid {
+        presets::preset(name).map_err(|e| OptError::Invalid {
             field: "lidar.preset".into(),
             reason: e.to_string(),
-        })?;
+        })
+    }
+
+    /// Builds and validates the problem.
+    pub fn problem(&self) -> Result<Problem, OptError> {
+        let mut preset = self.preset()?;
         let lid = &mut preset.lidar;
         if let Some(v) = self.lidar.frame_rate_hz {
             lid.frame_rate_hz = positive("lidar.frame_rate_hz", v)?;

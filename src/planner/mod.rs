@@ -2,6 +2,7 @@
 //! the paper's two-level controllers (eq. 3–6).
 
 pub mod closed_form;
+pub mod figures;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

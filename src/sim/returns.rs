@@ -8,7 +8,8 @@
 //!   range control multiplies intensity by the profile's `P(β)/P̄`
 //!   (0.5 in the RoF, 1.1 outside, as the code's `adjust_intensity`).
 //! - [`ReturnModel::Physical`]: extended Lambertian target,
-//!   `A ∝ P·ρ·cos θ·e^(−2αR)/R²`, detection probability
+//!   `A ∝ P·ρ·cos θ·e^(−2αR)/R²` (the range equation of
+//!   [`crate::model::range`], the one model of it), detection probability
 //!   `P_D = ½·erfc((T − A)/(σ√2))`, calibrated so the baseline detects its
 //!   reference reflectivity at its rated range in clear air with `P_D = ½`.
 //!
@@ -22,6 +23,8 @@
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
+
+use crate::model::range::{self, RangeEquation};
 
 /// The two return models.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -68,7 +71,7 @@ impl FogLevel {
     /// The documented mapping (module docs).
     pub fn of(fog_pct: u32) -> Result<Self, BadFog> {
         let (argus_code_fog, mor_m) = match fog_pct {
-            0 => (0.0, 20_000.0),
+            0 => (0.0, range::CLEAR_AIR_MOR_M),
             25 => (50.0, 200.0),
             50 => (100.0, 100.0),
             other => return Err(BadFog(other)),
@@ -83,7 +86,7 @@ impl FogLevel {
     /// Extinction coefficient α = 2.996 / MOR, 1/m.
     #[must_use]
     pub fn extinction_per_m(&self) -> f64 {
-        2.996 / self.mor_m
+        range::extinction_per_m(self.mor_m)
     }
 }
 
@@ -106,6 +109,18 @@ pub struct PhysicalParams {
     pub reference_reflectivity: f64,
     /// Clear-air extinction used in the calibration, 1/m.
     pub clear_extinction_per_m: f64,
+}
+
+impl PhysicalParams {
+    /// The range equation these constants calibrate.
+    #[must_use]
+    pub fn equation(&self) -> RangeEquation {
+        RangeEquation {
+            rated_range_m: self.rated_range_m,
+            reference_reflectivity: self.reference_reflectivity,
+            clear_extinction_per_m: self.clear_extinction_per_m,
+        }
+    }
 }
 
 /// A return model for one fog level.
@@ -212,9 +227,9 @@ impl ReturnModel {
             Self::Physical {
                 params,
                 extinction_per_m,
-            } => (-2.0 * extinction_per_m * range_m
-                + 2.0 * params.clear_extinction_per_m * params.rated_range_m)
-                .exp(),
+            } => params
+                .equation()
+                .extinction_factor(extinction_per_m, range_m),
         }
     }
 
@@ -307,16 +322,14 @@ impl ReturnModel {
     ) -> f64 {
         match *self {
             Self::Argus { .. } => 0.0,
-            Self::Physical { params, .. } => {
-                let r0 = params.rated_range_m;
-                let geometric = (r0 / range_m).powi(2);
-                params.threshold_sigma
-                    * power_ratio
-                    * (reflectivity / params.reference_reflectivity)
-                    * cos_incidence
-                    * geometric
-                    * extinction
-            }
+            Self::Physical { params, .. } => params.equation().signal(
+                params.threshold_sigma,
+                power_ratio,
+                reflectivity,
+                cos_incidence,
+                range_m,
+                extinction,
+            ),
         }
     }
 
@@ -381,17 +394,21 @@ impl Saturation {
             return None;
         }
         let buckets = (range_m / RANGE_BUCKET_M).ceil() as usize + 1;
-        let r0 = params.rated_range_m;
+        let eq = params.equation();
         let rows = reflectivity.map(|rho| {
             (0..buckets)
                 .map(|i| {
                     let r_hi = (i + 1) as f64 * RANGE_BUCKET_M;
-                    let bound = params.threshold_sigma
-                        * (rho / params.reference_reflectivity)
-                        * (r0 / r_hi).powi(2)
-                        * (-2.0 * extinction_per_m * r_hi
-                            + 2.0 * params.clear_extinction_per_m * r0)
-                            .exp();
+                    // `T·S` at power ratio 1 and normal incidence (the
+                    // factors of 1 are exact: the same bits as `P·cos` = 1).
+                    let bound = eq.signal(
+                        params.threshold_sigma,
+                        1.0,
+                        rho,
+                        1.0,
+                        r_hi,
+                        eq.extinction_factor(extinction_per_m, r_hi),
+                    );
                     bound * (1.0 - 1e-12)
                 })
                 .collect()

@@ -437,6 +437,12 @@ impl CertifiedProfile {
         self.eye_safety.as_ref()
     }
 
+    /// Replaces the informational `optimality` block: the checker neither
+    /// reads nor checks it, so the certificate stands.
+    pub fn set_optimality(&mut self, optimality: Option<crate::profile::Optimality>) {
+        self.profile.optimality = optimality;
+    }
+
     /// Gives the profile back (it stays certified only as long as unchanged).
     #[must_use]
     pub fn into_inner(self) -> Profile {

@@ -142,6 +142,74 @@ pub struct Optimality {
     /// McCormick relaxation; `specs/optimizer.md`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub global: Option<GlobalOptimality>,
+    /// The answer in units people use — range (m) and point density
+    /// (points per degree) inside and outside the region of focus — next
+    /// to the paper's closed form's for the same gaze.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub figures: Option<UnitFigures>,
+}
+
+/// A profile's figures in units people use, next to the paper's closed
+/// form's (same sensor, driver model, mode, gaze and bin count).
+///
+/// Per bin: **range** `range_m` on the sensor's reference reflectivity in
+/// clear air, from the range equation calibrated at its rated range (`P̄`
+/// reaches `rated_range_m`; `gaze_lidar::model::range`); **point density**
+/// `points_per_deg = pulse_rate_hz · dwell_s / width_deg`, per channel and
+/// revolution (the pulse rate over the bin's mean spin in deg/s).
+///
+/// Per region: a bin belongs to the region of focus when its centre lies
+/// in it (the rule both planners label bins `rof` with), else to the
+/// region of interest. Each figure aggregates over the region's bins as
+/// an **angle-weighted mean** `Σ Δθ_i f_i / Σ Δθ_i` (for the density that
+/// is the region's points over its degrees) with the **min** and **max**
+/// over its bins.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnitFigures {
+    /// This profile's.
+    pub profile: RegionFigures,
+    /// The closed form's; absent when the closed form cannot be certified
+    /// on this sensor (`closed_form_rejected` says why).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_form: Option<RegionFigures>,
+    /// Why there is no closed form to compare with (one line).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_form_rejected: Option<String>,
+}
+
+/// Figures inside the driver's region of focus and outside it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionFigures {
+    /// Region of focus (`null` when no bin's centre lies in it).
+    pub rof: Option<RegionFigure>,
+    /// Region of interest, the rest (`null` when empty).
+    pub roi: Option<RegionFigure>,
+}
+
+/// One region's figures ([`UnitFigures`] says how they aggregate).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionFigure {
+    /// Total width of the region's bins, degrees.
+    pub width_deg: f64,
+    /// Range on the reference reflectivity in clear air, m.
+    pub range_m: Aggregate,
+    /// Points per degree per channel and revolution.
+    pub points_per_deg: Aggregate,
+}
+
+/// A per-bin figure over a region: angle-weighted mean, min and max.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Aggregate {
+    /// `Σ Δθ_i f_i / Σ Δθ_i` over the region's bins.
+    pub mean: f64,
+    /// Smallest over the region's bins.
+    pub min: f64,
+    /// Largest over the region's bins.
+    pub max: f64,
 }
 
 /// Global figures: `objective` of the answer under the model objective
