@@ -177,13 +177,13 @@ fn received(tl: &Timeline<'_, Seg>, laser: &Laser, phi: f64, h: f64, phase: f64)
     let t_a = tl.time_at_unwrapped_s(phi - h);
     let t_b = tl.time_at_unwrapped_s(phi + h);
     let tau = (t_b - t_a).min(tl.period_s());
-    if !(tau > 0.0) {
+    if tau.is_nan() || tau <= 0.0 {
         return None;
     }
     // Pulses strictly inside the pass, with room: (K − 1)·Δ < τ.
     let k = (tau * f_p * (1.0 - COUNT_INSIDE)).floor() + 1.0;
     let slack = tau - (k - 1.0) * delta;
-    if !(slack > 0.0) || k > 1e6 {
+    if slack.is_nan() || slack <= 0.0 || k > 1e6 {
         return None;
     }
     let t0 = t_a + phase * slack;
