@@ -705,6 +705,15 @@ mod derive {
     /// Relative head-room every limit loses before it is rounded down, so
     /// float rounding in the AEL and the quotient can never raise it.
     pub const LIMIT_MARGIN: f64 = 1e-9;
+
+    /// Relative widening of every float the derivation rounds towards
+    /// safety (far above the few ulps of one product or quotient): the pass
+    /// arc is widened before it is rounded up to whole millidegrees, and the
+    /// shortest durations that can hold `k` pulses or `m` passes are
+    /// shortened before the AEL infimum is taken over them, so a rounding
+    /// in `pass_angle_deg` or in a tick-to-seconds quotient can never narrow
+    /// the arc or lengthen a window (which could raise its smallest AEL).
+    pub const WIDEN: f64 = 1e-12;
     /// Within-pass buckets hold one pulse count each up to this count, then
     /// grow by `1/EXACT_PULSE_BUCKETS` of their start (≤ 0.4 % looser).
     pub const EXACT_PULSE_BUCKETS: u64 = 256;
@@ -762,7 +771,7 @@ mod derive {
                 field: "pulse_rate_hz",
                 reason: "must be finite and > 0",
             })?;
-            let arc = (pass_angle_deg(params, &laser) * 1000.0 * (1.0 + 1e-12)).ceil();
+            let arc = (pass_angle_deg(params, &laser) * 1000.0 * (1.0 + WIDEN)).ceil();
             if !(arc >= 1.0 && arc < f64::from(u32::MAX)) {
                 return Err(DeriveError::Range {
                     field: "pass arc",
@@ -810,7 +819,7 @@ mod derive {
             let mut train = Vec::new();
             let mut k: u64 = 1;
             loop {
-                let t = (k - 1) as f64 / f_p * (1.0 - 1e-12);
+                let t = (k - 1) as f64 / f_p * (1.0 - WIDEN);
                 train.push(TrainLimit {
                     pulses_from: k,
                     energy_max_quanta: to_quanta(laser.ael_inf_j(t, TIME_BASE_S)),
@@ -840,7 +849,7 @@ mod derive {
             let mut pass_energy_rule = IntRule::TimeBase;
             for m in 2..=m_last {
                 let span = ((m - 1) * frame).saturating_sub(tau);
-                let t = span as f64 / tick_hz * (1.0 - 1e-12);
+                let t = span as f64 / tick_hz * (1.0 - WIDEN);
                 if t > TIME_BASE_S {
                     break;
                 }
