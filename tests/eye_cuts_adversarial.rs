@@ -219,3 +219,136 @@ fn the_loop_closes_where_a_one_pulse_window_binds() {
         assert!(r.is_ok(), "{pulse_s} s at {f_p} Hz: {}", r.err().unwrap());
     }
 }
+
+/// Every level assignment of `problem` (n bins, the given levels) that
+/// meets the budget, beats the optimizer's exact objective and certifies.
+fn brute_force(mut problem: Problem, levels: &[f64], gaze: f64) -> (usize, Vec<f64>) {
+    use gaze_lidar::checker::certify;
+    problem.levels = gaze_lidar::optimizer::Levels {
+        power_w: levels.to_vec(),
+        spin_rad_s: Vec::new(),
+    };
+    let best = optimize(&problem, gaze).expect("solves");
+    let o_best = exact_objective(&problem, gaze, best.profile()).unwrap();
+    let n = problem.bins;
+    let k = levels.len();
+    let mut base = best.profile().clone();
+    let util: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            levels
+                .iter()
+                .map(|&lv| {
+                    let mut q = base.clone();
+                    q.bins[i].power_w = lv;
+                    let mut r = base.clone();
+                    r.bins[i].power_w = 0.0;
+                    exact_objective(&problem, gaze, &q).unwrap()
+                        - exact_objective(&problem, gaze, &r).unwrap()
+                })
+                .collect()
+        })
+        .collect();
+    // Budget as the problem accounts it (time: dwell-weighted).
+    let dwell: Vec<f64> = base.bins.iter().map(|b| b.dwell_s.unwrap()).collect();
+    let period: f64 = dwell.iter().sum();
+    let time = matches!(
+        problem.lidar.power_accounting,
+        gaze_lidar::model::PowerAccounting::Time
+    );
+    let share: Vec<f64> = (0..n)
+        .map(|i| {
+            if time {
+                dwell[i] / period
+            } else {
+                base.bins[i].width_deg / 360.0
+            }
+        })
+        .collect();
+    let budget = problem.lidar.average_power_w * (1.0 + 1e-12);
+    let mut better = Vec::new();
+    let mut checked = 0;
+    for code in 0..k.pow(n as u32) {
+        let (mut c, mut obj, mut spend) = (code, 0.0, 0.0);
+        let mut pick = vec![0usize; n];
+        for (i, slot) in pick.iter_mut().enumerate() {
+            *slot = c % k;
+            c /= k;
+            obj += util[i][*slot];
+            spend += share[i] * levels[*slot];
+        }
+        if spend > budget || obj <= o_best * (1.0 + 1e-12) {
+            continue;
+        }
+        for (i, &j) in pick.iter().enumerate() {
+            base.bins[i].power_w = levels[j];
+        }
+        base.summary = None;
+        checked += 1;
+        if certify(base.clone()).is_ok() {
+            better.push(obj / o_best);
+        }
+    }
+    (checked, better)
+}
+
+/// Optimality by brute force on the `paper` laser (905 nm, 5 ns,
+/// 7,812.5 Hz, 20 Hz; Rule 1 with C5 ≈ 0.74 binds near 1.15 mW) at 9
+/// bins, angle accounting, levels 0.4, 0.9, 1.1 and 1.3 × the budget (the
+/// last over the limit): no assignment that beats the power step
+/// certifies.
+#[test]
+fn brute_force_on_the_paper_laser_finds_nothing_better() {
+    let mut p = shipped("paper");
+    p.bins = 9;
+    p.lidar.limits.power_w_min = 0.0;
+    p.lidar.limits.power_w_max = 2.0 * p.lidar.average_power_w;
+    p.objective.mode = Mode::Range;
+    let m = p.lidar.average_power_w;
+    let (checked, better) = brute_force(p, &[0.4 * m, 0.9 * m, 1.1 * m, 1.3 * m], 90.0);
+    eprintln!("paper brute force: {checked} better within budget put to the checker");
+    assert!(better.is_empty(), "{better:?}");
+}
+
+/// BREAKS (optimality, by the stated margin): a hardware level a hair
+/// under the Rule 1 limit (bound 0.9999995 with every bin there) is never
+/// chosen — the Rule 1 cut's column bound is `cut_rhs()` ≈ 1 − 1.2e-6 of
+/// its limit — so with levels {0.4, 0.9999995·L/P̄} × P̄ the power step puts
+/// every bin at 0.4 P̄ while assignments with most bins at the high level
+/// meet the budget and certify. "Optimal for limits lowered by 1.3e-6"
+/// is what `specs/optimizer.md` states; with discrete levels that margin
+/// costs a whole level step of objective, not 1e-6 of it.
+#[test]
+#[ignore = "finding: levels within the head-room of the limit are excluded; brute force beats the power step"]
+fn a_level_just_under_the_limit_is_used() {
+    let mut p = shipped("paper");
+    p.bins = 9;
+    p.lidar.limits.power_w_min = 0.0;
+    p.lidar.limits.power_w_max = 2.0 * p.lidar.average_power_w;
+    p.objective.mode = Mode::Range;
+    let m = p.lidar.average_power_w;
+    let params = p.lidar.limits.eye_safety.clone().unwrap();
+    let w = p.lidar.mean_spin_rad_s();
+    let ratio = |p_w: f64| {
+        let segs: Vec<gaze_lidar::eye_safety::bound::Seg> = (0..9)
+            .map(|i| gaze_lidar::eye_safety::bound::Seg {
+                start_deg: 40.0 * f64::from(i),
+                width_deg: 40.0,
+                power_w: p_w,
+                spin_start_rad_s: w,
+                spin_end_rad_s: w,
+            })
+            .collect();
+        exposure::evaluate_segments(&segs, &params, p.lidar.pulse_rate_hz)
+            .unwrap()
+            .worst_ratio
+    };
+    let high = m / ratio(m) * (1.0 - 5e-7);
+    assert!(high > m && ratio(high) <= 1.0, "{high} {}", ratio(high));
+    let (checked, better) = brute_force(p, &[0.4 * m, high], 90.0);
+    let best = better.iter().copied().fold(1.0, f64::max);
+    assert!(
+        better.is_empty(),
+        "{} of {checked} better assignments certify, the best {best}× the power step's objective",
+        better.len()
+    );
+}
