@@ -372,3 +372,52 @@ fn resolution_mode_over_the_limit_is_infeasible() {
         r.map(|_| ()).map_err(|e| e.to_string())
     );
 }
+
+/// Exploration: slew limits, levels and gazes at the wrap with eye safety
+/// binding (prints).
+#[test]
+#[ignore = "exploration harness (prints)"]
+fn explore_slew_levels_wrap() {
+    for slew in [None, Some(1e-5), Some(1e-6)] {
+        for levels in [vec![], vec![0.5e-3, 1e-3, 2e-3, 2.3e-3, 4e-3]] {
+            for mode in [Mode::Range, Mode::Joint] {
+                for gaze in [0.0, 359.999, 123.4] {
+                    let mut prob = variant(903.0, 3e-9, 18_761.0, 1.5e-3, 3.0, mode, 90);
+                    prob.lidar.limits.power_slew_w_per_deg_max = slew;
+                    prob.levels.power_w = levels.clone();
+                    let t0 = std::time::Instant::now();
+                    let r = optimize(&prob, gaze);
+                    let dt = t0.elapsed().as_secs_f64();
+                    match r {
+                        Ok(c) => {
+                            let params = c.profile().limits.eye_safety.clone().unwrap();
+                            let b = exposure::evaluate_profile(c.profile(), &params).unwrap();
+                            eprintln!("slew {slew:?} levels {} {mode:?} gaze {gaze}: ok {dt:.2}s ratio {:.7}", levels.len(), b.worst_ratio);
+                        }
+                        Err(e) => eprintln!(
+                            "slew {slew:?} levels {} {mode:?} gaze {gaze}: ERR {dt:.2}s {e}",
+                            levels.len()
+                        ),
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Timing: joint mode with five hardware levels at 90 bins, gaze 0°, with
+/// and without eye safety (prints).
+#[test]
+#[ignore = "timing (prints)"]
+fn timing_joint_levels_with_and_without_eye_safety() {
+    for eye in [true, false] {
+        let mut prob = variant(903.0, 3e-9, 18_761.0, 1.5e-3, 3.0, Mode::Joint, 90);
+        prob.levels.power_w = vec![0.5e-3, 1e-3, 2e-3, 2.3e-3, 4e-3];
+        if !eye {
+            prob.lidar.limits.eye_safety = None;
+        }
+        let t0 = std::time::Instant::now();
+        let r = optimize(&prob, 0.0).map(|_| ()).map_err(|e| e.to_string());
+        eprintln!("eye {eye}: {:.2} s {r:?}", t0.elapsed().as_secs_f64());
+    }
+}

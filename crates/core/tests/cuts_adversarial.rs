@@ -37,7 +37,7 @@ fn cases() -> u32 {
     std::env::var("GAZE_LIDAR_CUTS_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(24)
+        .unwrap_or(12)
 }
 
 fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
