@@ -145,14 +145,17 @@ proptest! {
         off in prop_oneof![1e-6f64..0.9, Just(0.5)],
         k in 1.0f64..300.0,
         frame_s in log_uniform(1e-3, 1.0),
-        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4), 1..6),
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 0.5f64..2.0, any::<bool>()), 1..6),
+        pulse_frac in prop_oneof![Just(1e-4), 1e-4f64..0.9],
     ) {
         let f_p = (f64::from(n) + off) / 5e-6;
         let spin = std::f64::consts::TAU / frame_s;
         let half_deg = 0.5 * (spin * k / f_p).to_degrees();
-        let b: Vec<(f64, f64, f64, bool)> = bins.iter().map(|&(w, p)| (w, p, spin, false)).collect();
+        let b: Vec<(f64, f64, f64, bool)> =
+            bins.iter().map(|&(w, p, s, a)| (w, p, spin * s, a)).collect();
         let segs = profile(&b);
-        let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: 1e-9, pulse_rate_hz: f_p };
+        let pulse_s = pulse_frac / f_p;
+        let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: pulse_s, pulse_rate_hz: f_p };
         let (r, what) = worst_excess(&segs, half_deg, &laser, &[]);
         prop_assert!(r <= 1.0, "cut over the bound by {r}: {what}");
     }
