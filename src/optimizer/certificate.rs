@@ -556,6 +556,7 @@ impl Certified {
             exact: gap.is_zero(),
             global: None,
             figures: None,
+            eye_safety_tightening: None,
         }
     }
 

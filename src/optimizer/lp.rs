@@ -19,7 +19,7 @@ use good_lp::{
 use std::f64::consts::TAU;
 
 use super::{OptError, Problem};
-use crate::eye_safety::bound::{Laser, Seg, RATIO_MARGIN};
+use crate::eye_safety::bound::{Laser, Rule, Seg, RATIO_MARGIN};
 use crate::eye_safety::cuts::{cuts, Cut};
 use crate::eye_safety::{exposure, EyeSafetyParams};
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning};
@@ -48,12 +48,19 @@ const ACCEL_SHARE: f64 = 0.8;
 const CUT_MARGIN: f64 = 2e-7;
 /// Head-room the power step leaves under the Class 1 limit of the bound, so
 /// that a rotated copy of its answer (the fast path) still certifies.
-pub(super) const EYE_SAFETY_HEADROOM: f64 = 1e-6;
+pub(super) const EYE_SAFETY_HEADROOM: f64 = 1e-9;
 /// Right-hand side of a cut row normalised to its limit: a power vector
 /// that meets it with equality is at `1 − headroom` of the bound's figure
 /// for that cut once the bound's rounding margin is applied.
 fn cut_rhs() -> f64 {
-    (1.0 - EYE_SAFETY_HEADROOM) / (1.0 + RATIO_MARGIN) * (1.0 - CUT_MARGIN)
+    level_rhs() * (1.0 - CUT_MARGIN)
+}
+
+/// As [`cut_rhs`] for a cut on one bin when the power takes hardware
+/// levels: the levels are exact (no solver tolerance enters), so only the
+/// head-room and the bound's rounding margin.
+fn level_rhs() -> f64 {
+    (1.0 - EYE_SAFETY_HEADROOM) / (1.0 + RATIO_MARGIN)
 }
 
 /// Rounds of the cutting-plane loop of one power step.
@@ -160,8 +167,13 @@ fn segs(g: &Grid, spins: &[(f64, f64)], p: &[f64]) -> Vec<Seg> {
 impl Eye {
     /// The bound's worst ratio and the azimuth where it binds.
     fn verdict(&self, segs: &[Seg]) -> Result<(f64, f64), OptError> {
-        exposure::evaluate_segments(segs, &self.params, self.pulse_rate_hz)
+        self.report(segs)
             .map(|r| (r.worst_ratio, r.worst_azimuth_deg))
+    }
+
+    /// The bound's whole report.
+    fn report(&self, segs: &[Seg]) -> Result<exposure::ExposureReport, OptError> {
+        exposure::evaluate_segments(segs, &self.params, self.pulse_rate_hz)
             .map_err(|e| OptError::Infeasible(format!("eye safety: {e}")))
     }
 
@@ -343,34 +355,48 @@ fn power_step(
     let l = &lid.limits;
     let p_mean = lid.average_power_w;
     let period: f64 = t.iter().sum();
+    let lam = problem.objective.range_weight;
+    let levels = &problem.levels.power_w;
     let mut round = 0;
+    // Where no valid cut separates (see below), the limits of one class of
+    // cuts — Rule 1's (0) or the windows' (1) — are divided by a factor.
+    let mut factor = [1.0f64; 2];
+    let class = |c: &Cut| usize::from(c.rule != Rule::SinglePulse);
     loop {
         // A cut on one bin's power alone is that bin's column bound (the
         // utility's chords then span the reachable powers only).
+        let rhs = if levels.is_empty() {
+            cut_rhs()
+        } else {
+            level_rhs()
+        };
         let mut caps = vec![f64::INFINITY; g.n];
+        // The same without margins: a floor between the two is kept (the
+        // bound decides), one above the bare limit is infeasible.
+        let mut bare = vec![f64::INFINITY; g.n];
         if let Some(e) = eye {
             for c in pool.iter() {
                 if let [(b, n)] = c.pulses[..] {
-                    caps[b] = caps[b].min(cut_rhs() * c.limit_j * e.pulse_rate_hz / n);
+                    caps[b] = caps[b].min(rhs * c.limit_j / factor[class(c)] * e.pulse_rate_hz / n);
+                    bare[b] = bare[b].min(c.limit_j * e.pulse_rate_hz / n);
                 }
             }
         }
-        let lam = problem.objective.range_weight;
-        let levels = &problem.levels.power_w;
         let mut lp = LinearProgram::default();
         // x_i = p_i / P̄ as a linear form (a continuous column or Σ levels·z).
         let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
         let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
         let mut utility_constant = 0.0;
         for i in 0..g.n {
-            if caps[i] < l.power_w_min {
+            if bare[i] < l.power_w_min {
                 let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
                 return Err(OptError::Infeasible(format!(
                     "eye-safety cap {:.4e} W at {wl} nm in bin {i} (the single-pulse limit at this spin) is below power_w_min {:.4e} W",
-                    caps[i], l.power_w_min
+                    bare[i], l.power_w_min
                 )));
             }
-            let hi = l.power_w_max.min(caps[i]);
+            let caps_i = caps[i].max(l.power_w_min);
+            let hi = l.power_w_max.min(caps_i);
             if levels.is_empty() {
                 let lo_x = l.power_w_min / p_mean;
                 let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
@@ -442,7 +468,11 @@ fn power_step(
                 budget_margin
             }
         };
-        lp.add_row(&spend, f64::NEG_INFINITY, budget);
+        // A floor that spends the whole budget (power_w_min = P̄) keeps its
+        // own spend: the margin must not make the all-floor answer
+        // infeasible.
+        let floor_spend: f64 = spend.iter().map(|&(j, a)| a * lp.col_lo[j]).sum();
+        lp.add_row(&spend, f64::NEG_INFINITY, budget.max(floor_spend));
         // Slew.
         if let Some(s) = l.power_slew_w_per_deg_max {
             for i in 0..g.n {
@@ -458,10 +488,29 @@ fn power_step(
         if let Some(e) = eye {
             for c in pool.iter().filter(|c| c.pulses.len() > 1) {
                 let mut row = Vec::new();
+                let limit = c.limit_j / factor[class(c)];
                 for &(b, n) in &c.pulses {
-                    scaled(n * p_mean / (e.pulse_rate_hz * c.limit_j), &x[b], &mut row);
+                    scaled(n * p_mean / (e.pulse_rate_hz * limit), &x[b], &mut row);
                 }
-                lp.add_row(&row, f64::NEG_INFINITY, cut_rhs());
+                // A floor alone at more than the row's side (but within the
+                // bare limit: checked below) keeps its own value.
+                let at_floor: f64 = c.pulses.iter().map(|&(_, n)| n).sum::<f64>() * l.power_w_min
+                    / (e.pulse_rate_hz * limit);
+                if at_floor > factor[class(c)] {
+                    let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
+                    return Err(OptError::Infeasible(format!(
+                        "eye safety at {wl} nm: power_w_min {:.4e} W in every bin is {:.4} of the limit of a window at {:.3}° ({:?})",
+                        l.power_w_min,
+                        at_floor / factor[class(c)],
+                        c.azimuth_deg,
+                        c.rule
+                    )));
+                }
+                lp.add_row(
+                    &row,
+                    f64::NEG_INFINITY,
+                    cut_rhs().max(at_floor * (1.0 + 1e-12)),
+                );
             }
         }
         let solved = lp.solve("power").map_err(|err| match (err, eye) {
@@ -474,7 +523,8 @@ fn power_step(
         let p = powers(problem, g, t, &bins, &x, &solved.x);
         if let Some(e) = eye {
             let s = segs(g, spins, &p);
-            let (ratio, witness) = e.verdict(&s)?;
+            let report = e.report(&s)?;
+            let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
             if ratio > 1.0 - EYE_SAFETY_HEADROOM {
                 round += 1;
                 // Every bin edge ± h first (rotation-equivariant: a rotated
@@ -490,11 +540,45 @@ fn power_step(
                 if fresh.is_empty() {
                     fresh = new_cuts(&[witness]);
                 }
-                if fresh.is_empty() || round > CUT_ROUNDS {
+                if round > CUT_ROUNDS {
                     return Err(OptError::Solver(format!(
-                        "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° and no concrete exposure there is over its limit ({} cuts)",
-                        pool.len()
+                        "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° ({} cuts, limits divided by {factor:?})",
+                        pool.len(),
                     )));
+                }
+                if fresh.is_empty() {
+                    // The bound exceeds every valid cut here (its
+                    // conservatism in the rule that binds): divide the
+                    // limits of that rule's class of cuts by the bound's
+                    // excess over the strongest of them, so the next answer
+                    // meets them where the bound would.
+                    let k = usize::from(report.binding_rule != Rule::SinglePulse);
+                    let near: Vec<Cut> = e
+                        .cuts(&s, &[witness], 0.0)
+                        .into_iter()
+                        .filter(|c| class(c) == k)
+                        .collect();
+                    let top = near
+                        .iter()
+                        .map(|c| c.ratio(&p, e.pulse_rate_hz))
+                        .fold(0.0, f64::max);
+                    if top <= 0.0 {
+                        return Err(OptError::Solver(format!(
+                            "eye-safety cuts: the bound gives {ratio:.6} at {witness:.3}° ({:?}) and no cut of that rule has any exposure there",
+                            report.binding_rule
+                        )));
+                    }
+                    factor[k] = (factor[k] * ratio / (1.0 - EYE_SAFETY_HEADROOM)).max(ratio / top)
+                        * (1.0 + 1e-9);
+                    let top_cuts: Vec<Cut> = near
+                        .into_iter()
+                        .filter(|c| {
+                            c.ratio(&p, e.pulse_rate_hz) * factor[k] >= cut_rhs()
+                                && !pool.contains(c)
+                        })
+                        .collect();
+                    pool.extend(top_cuts);
+                    continue;
                 }
                 pool.extend(fresh);
                 continue;
@@ -506,6 +590,7 @@ fn power_step(
                 lp,
                 bins,
                 one,
+                tightening: (factor[0].max(factor[1]) > 1.0).then_some(factor[0].max(factor[1])),
                 p_mean,
                 floor_w: l.power_w_min,
                 y: solved.y,
@@ -581,6 +666,8 @@ enum PowerBin {
 pub(super) struct PowerLp {
     lp: LinearProgram,
     bins: Vec<PowerBin>,
+    /// The largest factor an eye-safety cut was tightened by, if any.
+    pub(super) tightening: Option<f64>,
     /// The column fixed at 1 that carries the utilities' constants.
     one: Option<usize>,
     p_mean: f64,
@@ -924,6 +1011,14 @@ pub(super) fn solve(
                 .map(|(b, x)| b + alpha * (x - b))
                 .collect();
             spins = spins_of(&g, &ta, smooth, lid.frame_rate_hz);
+        }
+        let (ratio, at) = e.verdict(&segs(&g, &spins, &p))?;
+        if ratio > 1.0 - EYE_SAFETY_HEADROOM {
+            return Err(OptError::Infeasible(format!(
+                "eye safety: the power ({:.4e} W in every bin; resolution mode does not move it) is {:.1} % of the Class 1 limit at {at:.3}° even at the uniform spin",
+                p[0],
+                100.0 * ratio
+            )));
         }
     }
     let bins = (0..g.n)

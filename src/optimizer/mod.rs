@@ -260,7 +260,9 @@ pub fn optimize_with_certificate(
                 for (b, qi) in profile.bins.iter_mut().zip(q) {
                     b.power_w = qi;
                 }
-                profile.optimality = Some(c.optimality());
+                let mut o = c.optimality();
+                o.eye_safety_tightening = plp.tightening;
+                profile.optimality = Some(o);
                 c
             })
         }

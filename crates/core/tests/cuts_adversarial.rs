@@ -198,9 +198,10 @@ fn t_i_edge(n: f64, frame_s: f64) -> (Vec<Seg>, f64, Laser) {
 /// term is the bound's Rule 1 figure (at `N = 6` the single-pulse term
 /// wins and nothing shows). A certifiable profile (the bound ≤ 1 after
 /// scaling the powers up by up to 13 %) is cut off, so the optimizer's
-/// "optimal among certifiable" fails there.
+/// "optimal among certifiable" fails there. Fixed: the group cuts now take
+/// `g` = `Laser::group` consecutive pulses (the bound's closed `T_i`
+/// window) at the bound's group count.
 #[test]
-#[ignore = "finding: T_i group cut above the bound at T_i·f_p integer"]
 fn t_i_group_cut_is_at_most_the_bound_at_an_integer_t_i_f_p() {
     for (n, frame_s) in [(20.0, 0.01), (20.0, 0.1), (12.0, 0.01)] {
         let (segs, half_deg, laser) = t_i_edge(n, frame_s);

@@ -6,7 +6,7 @@
 //! `n_b` and `L` functions of the spin alone:
 //!
 //! - **Concrete exposures** (Rule 2 within a pass, and over several passes
-//!   up to the time base; the `T_i` groups of Rule 1). One aperture azimuth
+//!   up to the time base). One aperture azimuth
 //!   `φ`, one pulse clock locked to the rotation (its phase chosen), one
 //!   window: the pulses the aperture receives in it, `n_b` from bin `b`,
 //!   carry `Σ n_b·p_b/f_p` J, against `L`, the smallest AEL over the
@@ -23,7 +23,9 @@
 //!   meet, at the counts of its longest pass), so the cut holds wherever
 //!   the bound certifies. It is the bound's own figure, not a concrete
 //!   exposure: no one clock need reach its counts, which is what makes it
-//!   tight where Rule 1 binds.
+//!   tight where Rule 1 binds. Likewise Rule 1's `T_i` groups (700–1050
+//!   nm): any `g` = [`Laser::group`] consecutive pulses against
+//!   `C5(⌈K/g⌉·passes)·AEL(T_i)` at the bound's counts.
 //!
 //! So a cut never removes a certifiable profile, whatever powers it was
 //! found at: a program with cuts in place of the bound is a relaxation of
@@ -336,46 +338,26 @@ fn exposures(
             });
         }
     }
-    // The effective pulses of the concrete clock in [t_0, t_0 + T_max),
-    // the passes repeating every frame (locked clock); pulses within T_i
-    // one group (700–1050 nm) by the greedy cover, the fewest groups any
-    // grouping gives, so the largest C5 of any reading.
-    let t_i = laser.band.t_i_s();
-    let grouped = laser.group(k_n as f64) > 1.0;
-    let t_max = T2_S.min(TIME_BASE_S);
-    let starts: Vec<usize> = if grouped {
-        let mut g = Vec::new();
-        let mut open = f64::NEG_INFINITY;
-        for (j, &t) in pass.t_s.iter().enumerate() {
-            if t >= open {
-                g.push(j);
-                open = t + t_i;
-            }
-        }
-        g
-    } else {
-        Vec::new()
-    };
-    let mut n_eff = 0.0;
-    let mut m = 0.0;
-    while grouped && m * frame_s < t_max * below {
-        n_eff += starts
-            .iter()
-            .filter(|&&j| m * frame_s + pass.t_s[j] < t_max * below)
-            .count() as f64;
-        m += 1.0;
-    }
-    let c5 = laser.c5(n_eff);
-    if grouped {
-        // The pulses of one T_i window against C5·AEL(T_i).
-        let limit_g = c5 * laser.ael_j(t_i);
-        for (i, &t) in pass.t_s.iter().enumerate() {
-            let k = pass.t_s.partition_point(|&u| u < t + t_i * below) - 1;
+    // Rule 1's T_i groups (700–1050 nm), as the bound counts them: at most
+    // g = `Laser::group` pulses (a closed T_i window) in one group, ⌈K/g⌉
+    // groups a pass at the bound's counts K and passes, against
+    // C5(groups)·AEL(T_i). Any g consecutive pulses of this pass carry at
+    // most g times the hottest met bin's pulse, which the bound's group
+    // figure charges at these counts or larger ones: a cut under the bound.
+    let per_pass = max_pulses_in(tau, f_p);
+    let g = laser.group(per_pass);
+    if g > 1.0 {
+        let passes = passes_in_window(T2_S.min(TIME_BASE_S), tau, frame_s);
+        let n_groups = (per_pass / g).ceil() * passes;
+        let limit_g = laser.c5(n_groups) * laser.ael_j(laser.band.t_i_s());
+        let len = (g as usize).min(k_n);
+        for i in 0..=(k_n - len) {
+            let k = i + len - 1;
             if k > i && (prefix[k + 1] - prefix[i]) / limit_g >= threshold {
                 found.push(Cut {
                     rule: Rule::SinglePulse,
                     azimuth_deg: pass.azimuth_deg,
-                    window_s: (t_i, t_i),
+                    window_s: (laser.band.t_i_s(), laser.band.t_i_s()),
                     pulses: tally(pass, i, k, 1.0),
                     limit_j: limit_g,
                 });

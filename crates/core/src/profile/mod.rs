@@ -147,6 +147,15 @@ pub struct Optimality {
     /// to the paper's closed form's for the same gaze.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub figures: Option<UnitFigures>,
+    /// Where the eye-safety bound exceeds every valid cut (its conservatism
+    /// in the multi-pass or window rules), the power step tightens the
+    /// cuts that bind there until the bound certifies: the largest factor
+    /// a limit was divided by (> 1). `objective`/`upper_bound` are then
+    /// for the tightened program, and the answer may be below the best
+    /// certifiable one by up to that factor's share (`specs/optimizer.md`,
+    /// "Eye safety as cuts"). Absent when every cut is valid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eye_safety_tightening: Option<f64>,
 }
 
 /// A profile's figures in units people use, next to the paper's closed
