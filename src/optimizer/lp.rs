@@ -361,7 +361,8 @@ fn solve_relaxation_first(
             vars.clone().maximise(objective.clone()).using(highs),
             cons.clone(),
         )
-        .set_option("solve_relaxation", true);
+        .set_option("solve_relaxation", true)
+        .set_option("presolve", "off");
         let sol = solve_model(relaxed, "dwell")?;
         let integral = groups.iter().flatten().all(|&(_, y)| {
             let v = sol.value(y);
