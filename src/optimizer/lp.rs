@@ -672,7 +672,7 @@ fn dwell_step(
                 lo = lo.max(current[i] / unit * (1.0 - TRUST));
                 hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
             }
-            let t0 = (current[i] / unit).clamp(lo, hi);
+            let t0 = (current[i] / unit).max(lo).min(hi);
             let ti = vars.add(variable().min(lo).max(hi).initial(t0));
             // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
             let k = unit * TAU / (th * period);
