@@ -9,7 +9,8 @@
 # BASE_REV (default `main`) is checked out in a temporary git worktree and
 # built with this repository's target directory (only the workspace crates
 # rebuild; HiGHS is reused), its binary kept as target/bench/gaze-lidar-base;
-# then the working tree is built again as target/bench/gaze-lidar-new.
+# then the working tree is rebuilt (its sources touched, see below, so
+# target/ holds this tree's build afterwards) as target/bench/gaze-lidar-new.
 # OLD=path / NEW=path skip the builds. RUNS (default 21) runs per binary and
 # config; the table gives the median and the minimum wall time in ms.
 # Outputs of both binaries are compared byte for byte (reported, not
@@ -29,6 +30,11 @@ if [[ -z "${OLD:-}" ]]; then
     OLD=target/bench/gaze-lidar-base
 fi
 if [[ -z "${NEW:-}" ]]; then
+    # The worktree's build wrote its own gaze-lidar and gaze-lidar-core
+    # artifacts under the same names (cargo hashes path packages relative
+    # to the workspace root), and this tree's older sources would read as
+    # fresh: touch them so cargo rebuilds both crates from this tree.
+    find src crates/core/src -name '*.rs' -exec touch {} +
     cargo build --release --bin gaze-lidar >&2
     cp target/release/gaze-lidar target/bench/gaze-lidar-new
     NEW=target/bench/gaze-lidar-new

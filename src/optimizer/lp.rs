@@ -304,7 +304,8 @@ fn solve_relaxation_first(
             vars.clone().maximise(objective.clone()).using(highs),
             cons.clone(),
         )
-        .set_option("solve_relaxation", true);
+        .set_option("solve_relaxation", true)
+        .set_option("presolve", "off");
         let sol = solve_model(relaxed, "dwell")?;
         let integral = groups.iter().flatten().all(|&(_, y)| {
             let v = sol.value(y);
@@ -794,7 +795,8 @@ fn dwell_step(
                 lo = lo.max(current[i] / unit * (1.0 - TRUST));
                 hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
             }
-            let ti = vars.add(variable().min(lo).max(hi));
+            let t0 = (current[i] / unit).max(lo).min(hi);
+            let ti = vars.add(variable().min(lo).max(hi).initial(t0));
             // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
             let k = unit * TAU / (th * period);
             let (r_lo, r_hi) = (
@@ -809,8 +811,10 @@ fn dwell_step(
             // `utility`; its constant does not move the optimum).
             let c = lam * th * g.weight[i];
             let mut fill = Expression::from(0.0);
-            for &(a, len) in &sqrt_segments(r_lo, r_hi).segments {
-                let d = vars.add(variable().min(0.0).max(len));
+            let shape = sqrt_segments(r_lo, r_hi);
+            let f0 = shape.fill(r_lo, k * t0);
+            for (&(a, len), &d0) in shape.segments.iter().zip(&f0) {
+                let d = vars.add(variable().min(0.0).max(len).initial(d0));
                 objective.add_mul(c * a, d);
                 fill.add_mul(1.0, d);
             }
