@@ -91,8 +91,8 @@ fn explore() {
 /// know (its envelope / pass-count conservatism), no cut separates, and
 /// there is no fallback (the loop neither rescales nor lowers the powers).
 /// 1450 nm at 0.5 W fails the same way (bound 1.009 after one round).
+/// Fixed: where no valid cut separates, the limits of the binding rule's class of cuts are divided by the bound's excess (`optimality.eye_safety_tightening`).
 #[test]
-#[ignore = "finding: the cutting-plane loop cannot close where a multi-pass rule binds (1550/1450 nm)"]
 fn the_loop_closes_where_a_multi_pass_rule_binds() {
     for (wl, mode) in [
         (1550.0, Mode::Range),
@@ -167,8 +167,8 @@ fn rotated_answers_certify_and_match_fresh_solves() {
 /// the budget (= the floor) and certifies, so "infeasible" (exit 1) is
 /// wrong; the stated margins make it "optimal for limits lowered by
 /// 1.3e-6", but here they turn a feasible request into a rejection.
+/// Fixed: a floor within the bare limit keeps its column (the bound decides), and the budget row keeps the floor's own spend.
 #[test]
-#[ignore = "finding: a floor within the head-room of the limit is called infeasible"]
 fn a_floor_just_under_the_limit_is_feasible() {
     let mut prob = variant(903.0, 3e-9, 18_761.0, 1.5e-3, 3.0, Mode::Range, 12);
     let params = prob.lidar.limits.eye_safety.clone().unwrap();
@@ -208,8 +208,8 @@ fn a_floor_just_under_the_limit_is_feasible() {
 /// with the bound at 1.1876 and no cut over its limit. The bound charges a
 /// one-pulse window `P·(t_p + Δ)` (`1 + t_p·f_p` pulses); see the core's
 /// `the_best_cut_reaches_the_bound_with_long_pulses`.
+/// Fixed: as the multi-pass case (the window cuts' limits divided by the bound's excess).
 #[test]
-#[ignore = "finding: the loop cannot close where a one-pulse window binds (903 nm, 10 µs; 3 ns at 1 kHz)"]
 fn the_loop_closes_where_a_one_pulse_window_binds() {
     // And 3 ns pulses at 1 kHz (C5 = 1): the bound's worst window is the
     // 5 µs row edge, charged `P·(5 µs + Δ)`, 1.005 pulses.
@@ -317,8 +317,8 @@ fn brute_force_on_the_paper_laser_finds_nothing_better() {
 /// meet the budget and certify. "Optimal for limits lowered by 1.3e-6"
 /// is what `specs/optimizer.md` states; with discrete levels that margin
 /// costs a whole level step of objective, not 1e-6 of it.
+/// Fixed: level caps carry the head-room (now 1e-9) and the bound's rounding margin only, not the LP tolerance margin.
 #[test]
-#[ignore = "finding: levels within the head-room of the limit are excluded; brute force beats the power step"]
 fn a_level_just_under_the_limit_is_used() {
     let mut p = shipped("paper");
     p.bins = 9;
@@ -360,8 +360,8 @@ fn a_level_just_under_the_limit_is_used() {
 /// failed the checker) after the halving fallback reaches the uniform
 /// spin, instead of a plain `Infeasible` naming the power and the limit
 /// (the prechecks skip eye safety in the modes that move the spin).
+/// Fixed: resolution mode reports the uniform spin over the limit as infeasible.
 #[test]
-#[ignore = "finding: resolution mode over the limit is reported as a rejected solution, not infeasible"]
 fn resolution_mode_over_the_limit_is_infeasible() {
     use gaze_lidar::optimizer::OptError;
     let prob = variant(903.0, 3e-9, 18_761.0, 3e-3, 3.0, Mode::Resolution, 12);
