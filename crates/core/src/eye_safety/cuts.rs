@@ -105,8 +105,6 @@ struct Pass {
     azimuth_deg: f64,
     /// The pass's duration, s.
     tau_s: f64,
-    /// Every bin the closed pass arc meets.
-    met: Vec<usize>,
     /// Pulse times from the first pulse, s.
     t_s: Vec<f64>,
     /// Bin of each pulse.
@@ -136,21 +134,53 @@ pub fn cuts(
         .flat_map(|s| [s.start_deg - h, s.start_deg + h])
         .chain(extra_azimuths_deg.iter().copied());
     let mut prune = Prune::new(laser, tl.period_s());
+    let f_p = laser.pulse_rate_hz;
+    let frame_s = tl.period_s();
     for phi in azimuths {
+        let Some(ap) = aperture(&tl, laser, phi, h) else {
+            continue;
+        };
+        let p_max = ap.met.iter().map(|&b| segs[b].power_w).fold(0.0, f64::max);
+        // Rule 1, the bound's own figure at this aperture: every bin the
+        // pass meets, at the counts of this pass's duration
+        // (`max_pulses_in`, `passes_in_window`, rounded up as the bound
+        // rounds them). The bound's Rule 1 figure is at least this for
+        // every aperture (each cell takes its bins' largest power at counts
+        // of its largest duration), so the cut holds wherever the bound
+        // certifies; it is not a concrete exposure (the counts are the
+        // bound's, which no one clock need reach).
+        let per_pass = max_pulses_in(ap.tau_s, f_p);
+        let passes = passes_in_window(T2_S.min(TIME_BASE_S), ap.tau_s, frame_s);
+        let limit1 = 1.0 / laser.single_pulse_ratio_per_j(per_pass, passes);
+        for &b in &ap.met {
+            if segs[b].power_w / f_p / limit1 >= threshold
+                && single[b].as_ref().is_none_or(|c| limit1 < c.limit_j)
+            {
+                single[b] = Some(Cut {
+                    rule: Rule::SinglePulse,
+                    azimuth_deg: ap.azimuth_deg,
+                    window_s: (laser.pulse_duration_s, laser.pulse_duration_s),
+                    pulses: vec![(b, 1.0)],
+                    limit_j: limit1,
+                });
+            }
+        }
+        // The windows and groups need the pulses; skip them where even the
+        // hottest met bin in every pulse cannot reach the threshold.
+        let k = ap.pulses as usize;
+        let g = laser.group(per_pass);
+        let limit_g = laser.c5((per_pass / g).ceil() * passes) * laser.ael_j(laser.band.t_i_s());
+        let per_pulse = p_max / f_p;
+        let reachable = threshold <= 0.0
+            || per_pulse * prune.runs_up_to(k) >= threshold
+            || per_pulse * ap.pulses * prune.passes >= threshold
+            || (g > 1.0 && g * per_pulse / limit_g >= threshold);
+        if !reachable {
+            continue;
+        }
         for phase in [1e-3, 0.5, 1.0 - 1e-3] {
-            let Some(pass) = received(&tl, laser, phi, h, phase) else {
-                continue;
-            };
-            exposures(
-                &pass,
-                segs,
-                &tl,
-                laser,
-                threshold,
-                &mut prune,
-                &mut single,
-                &mut found,
-            );
+            let pass = received(&tl, laser, &ap, phase);
+            exposures(&pass, segs, &tl, laser, threshold, &mut prune, &mut found);
         }
     }
     found.extend(single.into_iter().flatten());
@@ -170,27 +200,51 @@ pub fn cuts(
     found
 }
 
-/// The pulses the aperture at `phi` receives in one pass under a clock
-/// locked to the rotation whose first pulse sits `phase` of the way through
-/// the pass's slack (the time the pass has beyond its pulses' span).
-fn received(tl: &Timeline<'_, Seg>, laser: &Laser, phi: f64, h: f64, phase: f64) -> Option<Pass> {
+/// One aperture's pass: its azimuth, when it starts (unwrapped), how long
+/// it lasts, how many pulses fit strictly inside it, and the bins it meets.
+struct Aperture {
+    azimuth_deg: f64,
+    t_a_s: f64,
+    tau_s: f64,
+    /// Pulses strictly inside the pass, with room: `(K − 1)·Δ < τ`.
+    pulses: f64,
+    /// Every bin the closed pass arc meets.
+    met: Vec<usize>,
+}
+
+/// The pass of the aperture at `phi` (half pass angle `h`); `None` for an
+/// empty pass or more than 10⁶ pulses in it.
+fn aperture(tl: &Timeline<'_, Seg>, laser: &Laser, phi: f64, h: f64) -> Option<Aperture> {
     let f_p = laser.pulse_rate_hz;
-    let delta = 1.0 / f_p;
     let t_a = tl.time_at_unwrapped_s(phi - h);
     let t_b = tl.time_at_unwrapped_s(phi + h);
     let tau = (t_b - t_a).min(tl.period_s());
     if tau.is_nan() || tau <= 0.0 {
         return None;
     }
-    // Pulses strictly inside the pass, with room: (K − 1)·Δ < τ.
     let k = (tau * f_p * (1.0 - COUNT_INSIDE)).floor() + 1.0;
-    let slack = tau - (k - 1.0) * delta;
+    let slack = tau - (k - 1.0) / f_p;
     if slack.is_nan() || slack <= 0.0 || k > 1e6 {
         return None;
     }
-    let t0 = t_a + phase * slack;
+    Some(Aperture {
+        azimuth_deg: crate::model::angle::wrap_deg(phi),
+        t_a_s: t_a,
+        tau_s: tau,
+        pulses: k,
+        met: tl.bins_touching(phi - h, 2.0 * h),
+    })
+}
+
+/// The pulses the aperture receives in one pass under a clock locked to the
+/// rotation whose first pulse sits `phase` of the way through the pass's
+/// slack (the time the pass has beyond its pulses' span).
+fn received(tl: &Timeline<'_, Seg>, laser: &Laser, ap: &Aperture, phase: f64) -> Pass {
+    let delta = 1.0 / laser.pulse_rate_hz;
+    let slack = ap.tau_s - (ap.pulses - 1.0) * delta;
+    let t0 = ap.t_a_s + phase * slack;
     let period = tl.period_s();
-    let n = k as usize;
+    let n = ap.pulses as usize;
     let mut t_s = Vec::with_capacity(n);
     let mut bin = Vec::with_capacity(n);
     for j in 0..n {
@@ -199,13 +253,12 @@ fn received(tl: &Timeline<'_, Seg>, laser: &Laser, phi: f64, h: f64, phase: f64)
         t_s.push(dt);
         bin.push(tl.azimuth_at(t).1);
     }
-    Some(Pass {
-        azimuth_deg: crate::model::angle::wrap_deg(phi),
-        tau_s: tau,
-        met: tl.bins_touching(phi - h, 2.0 * h),
+    Pass {
+        azimuth_deg: ap.azimuth_deg,
+        tau_s: ap.tau_s,
         t_s,
         bin,
-    })
+    }
 }
 
 /// Pulses of `pass[i..=k]`, per bin, times `q` (bins ascending).
@@ -295,7 +348,6 @@ fn exposures(
     laser: &Laser,
     threshold: f64,
     prune: &mut Prune,
-    single: &mut [Option<Cut>],
     found: &mut Vec<Cut>,
 ) {
     let f_p = laser.pulse_rate_hz;
@@ -312,32 +364,7 @@ fn exposures(
     let inside = 1.0 + COUNT_INSIDE;
     let below = 1.0 - COUNT_INSIDE;
 
-    // Rule 1, the bound's own figure at this aperture: every bin the pass
-    // meets, at the counts of this pass's duration (`max_pulses_in`,
-    // `passes_in_window`, rounded up as the bound rounds them). The bound's
-    // Rule 1 figure is at least this for every aperture (each cell takes
-    // its bins' largest power at counts of its largest duration), so the
-    // cut holds wherever the bound certifies; it is not a concrete exposure
-    // (the counts are the bound's, which no one clock need reach).
     let tau = pass.tau_s;
-    let per_j = laser.single_pulse_ratio_per_j(
-        max_pulses_in(tau, f_p),
-        passes_in_window(T2_S.min(TIME_BASE_S), tau, frame_s),
-    );
-    let limit1 = 1.0 / per_j;
-    for &b in &pass.met {
-        if segs[b].power_w / f_p / limit1 >= threshold
-            && single[b].as_ref().is_none_or(|c| limit1 < c.limit_j)
-        {
-            single[b] = Some(Cut {
-                rule: Rule::SinglePulse,
-                azimuth_deg: pass.azimuth_deg,
-                window_s: (laser.pulse_duration_s, laser.pulse_duration_s),
-                pulses: vec![(b, 1.0)],
-                limit_j: limit1,
-            });
-        }
-    }
     // Rule 1's T_i groups (700–1050 nm), as the bound counts them: at most
     // g = `Laser::group` pulses (a closed T_i window) in one group, ⌈K/g⌉
     // groups a pass at the bound's counts K and passes, against
