@@ -20,7 +20,7 @@ use std::f64::consts::TAU;
 
 use super::{OptError, Problem};
 use crate::eye_safety::bound::{Laser, Rule, Seg, RATIO_MARGIN};
-use crate::eye_safety::cuts::{cuts, Cut};
+use crate::eye_safety::cuts::{cuts_with, Cut};
 use crate::eye_safety::{exposure, EyeSafetyParams};
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning};
 use crate::model::lidar::PowerAccounting;
@@ -178,8 +178,16 @@ impl Eye {
     }
 
     /// The concrete exposures at or above `threshold` for these bins.
+    /// Every Rule 1 cut on one bin comes too (a column bound, free).
     fn cuts(&self, segs: &[Seg], witness_deg: &[f64], threshold: f64) -> Vec<Cut> {
-        cuts(segs, self.half_deg, &self.laser, witness_deg, threshold)
+        cuts_with(
+            segs,
+            self.half_deg,
+            &self.laser,
+            witness_deg,
+            threshold,
+            0.0,
+        )
     }
 }
 
@@ -986,7 +994,10 @@ pub(super) fn solve(
                 last = Some(plp);
                 // The binding cuts of the new iterate, found afresh (a
                 // function of the iterate alone, not of the loop's path).
-                binding = warm(&sp, &p);
+                binding = warm(&sp, &p)
+                    .into_iter()
+                    .filter(|c| c.ratio(&p, f_p) >= BINDING)
+                    .collect();
             }
         }
     }

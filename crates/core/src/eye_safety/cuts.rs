@@ -125,6 +125,28 @@ pub fn cuts(
     extra_azimuths_deg: &[f64],
     threshold: f64,
 ) -> Vec<Cut> {
+    cuts_with(
+        segs,
+        half_deg,
+        laser,
+        extra_azimuths_deg,
+        threshold,
+        threshold,
+    )
+}
+
+/// [`cuts`] with its own threshold for the Rule 1 cuts on one bin (a
+/// program takes those as column bounds, which cost it nothing: the
+/// optimizer asks for all of them).
+#[must_use]
+pub fn cuts_with(
+    segs: &[Seg],
+    half_deg: f64,
+    laser: &Laser,
+    extra_azimuths_deg: &[f64],
+    threshold: f64,
+    rule_one_threshold: f64,
+) -> Vec<Cut> {
     let tl = Timeline::from_bins(segs);
     let h = half_deg.min(180.0);
     let mut found: Vec<Cut> = Vec::new();
@@ -153,7 +175,7 @@ pub fn cuts(
         let passes = passes_in_window(T2_S.min(TIME_BASE_S), ap.tau_s, frame_s);
         let limit1 = 1.0 / laser.single_pulse_ratio_per_j(per_pass, passes);
         for &b in &ap.met {
-            if segs[b].power_w / f_p / limit1 >= threshold
+            if segs[b].power_w / f_p / limit1 >= rule_one_threshold
                 && single[b].as_ref().is_none_or(|c| limit1 < c.limit_j)
             {
                 single[b] = Some(Cut {
