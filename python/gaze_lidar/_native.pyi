@@ -124,7 +124,9 @@ class Profile:
     @property
     def optimality(self) -> dict[str, Any] | None:
         """The optimizer's figures (profile@1 `optimality`): objective,
-        upper_bound, gap, exact, global, figures; None for the closed forms."""
+        upper_bound, gap, exact, global, figures, and eye_safety_tightening
+        when the power step had to tighten its eye-safety cuts; None for the
+        closed forms."""
     @property
     def figures(self) -> dict[str, Any] | None:
         """Range and point density in units people use (profile@1
