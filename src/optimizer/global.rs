@@ -296,6 +296,24 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     if !(x_lo <= x_hi && w_lo <= w_hi && w_hi > 0.0) {
         return Err(OptError::Infeasible("empty power or spin box".into()));
     }
+    // Eye safety: no bin of a certifiable profile carries more than the
+    // bound's Rule 1 cap at the fastest spin the box allows (the core's
+    // `rule_one_cap_w`, valid for every spin profile in the box).
+    let x_hi = match &l.eye_safety {
+        Some(params) if mode.controls_range() => {
+            let laser =
+                crate::eye_safety::exposure::laser(params, lid.pulse_rate_hz).map_err(|e| {
+                    OptError::Invalid {
+                        field: "limits.eye_safety".into(),
+                        reason: e.to_string(),
+                    }
+                })?;
+            let half = 0.5 * crate::eye_safety::exposure::pass_angle_deg(params, &laser);
+            let cap = crate::eye_safety::cuts::rule_one_cap_w(&laser, half, w_hi, period);
+            x_hi.min(cap / p_mean).max(x_lo)
+        }
+        _ => x_hi,
+    };
     let o = &problem.objective;
     let slew_moves = mode.controls_range() && l.power_slew_w_per_deg_max.is_some();
     let coupled = lid.power_accounting == PowerAccounting::Time

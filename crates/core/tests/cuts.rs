@@ -105,6 +105,31 @@ proptest! {
         }
     }
 
+    /// The cap for every spin no faster than a limit: on random profiles
+    /// whose spins stay at or below it, the bound's Rule 1 ratio is at
+    /// least the hottest bin's power over the cap.
+    #[test]
+    fn the_rule_one_cap_holds_at_every_spin_below_the_limit(
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 2.0f64..80.0, any::<bool>()), 1..16),
+        band in prop_oneof![Just(Band::RetinalNir), Just(Band::Ir1400), Just(Band::Ir1500)],
+        f_p in 1e3f64..3e5,
+        half_deg in 0.05f64..5.0,
+        above in 1.0f64..3.0,
+    ) {
+        let segs = profile(&bins);
+        let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+        let w_max = segs
+            .iter()
+            .map(|s| s.spin_start_rad_s.max(s.spin_end_rad_s))
+            .fold(0.0, f64::max)
+            * above;
+        let frame_s = gaze_lidar_core::profile::kinematics::Timeline::from_bins(&segs).period_s();
+        let cap = gaze_lidar_core::eye_safety::cuts::rule_one_cap_w(&laser, half_deg, w_max, frame_s);
+        let p_max = segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
+        let b = evaluate(&segs, half_deg, &laser);
+        prop_assert!(p_max / cap <= b.ratios[0], "{} > {}", p_max / cap, b.ratios[0]);
+    }
+
     /// Tightness where Rule 1 decides: at a constant spin the largest
     /// single-bin cut equals the bound's Rule 1 figure (to the bound's
     /// rounding margin), so the cutting-plane loop stops on the limit.

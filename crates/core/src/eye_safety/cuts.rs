@@ -497,3 +497,24 @@ fn exposures(
         }
     }
 }
+
+/// The largest power any bin can carry in a profile the bound certifies,
+/// over every spin profile that never turns faster than `spin_max_rad_s`
+/// with frame period `frame_s`: Rule 1 at the counts of the shortest pass
+/// such a profile can have. Every aperture's pass lasts at least
+/// `2h/spin_max` (capped at the frame), the bound's Rule 1 figure charges
+/// every bin a pass meets at the counts of that pass or larger ones, and
+/// its ratio per joule never falls as the counts grow: so a bin above this
+/// power makes the bound exceed 1 whatever the spin. A column bound for
+/// programs whose spin moves (the global relaxation), W.
+#[must_use]
+pub fn rule_one_cap_w(laser: &Laser, half_deg: f64, spin_max_rad_s: f64, frame_s: f64) -> f64 {
+    let tau_min = (2.0 * half_deg.min(180.0)).to_radians() / spin_max_rad_s;
+    let tau_min = tau_min.min(frame_s);
+    let f_p = laser.pulse_rate_hz;
+    let per_j = laser.single_pulse_ratio_per_j(
+        max_pulses_in(tau_min, f_p),
+        passes_in_window(T2_S.min(TIME_BASE_S), tau_min, frame_s),
+    );
+    f_p / per_j
+}
