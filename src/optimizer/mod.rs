@@ -300,7 +300,7 @@ pub fn exact_objective(
         .iter()
         .enumerate()
         .map(|(i, b)| {
-            let dwell = 2.0 * g.theta[i] / (b.spin_start_rad_s + b.spin_end_rad_s);
+            let dwell = crate::profile::kinematics::BinMotion::dwell_s(b);
             let density = dwell * std::f64::consts::TAU / (g.theta[i] * period);
             let range = if o.mode.controls_range() {
                 o.range_weight * (b.power_w / p_mean).sqrt()

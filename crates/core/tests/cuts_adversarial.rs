@@ -11,27 +11,8 @@ use gaze_lidar_core::eye_safety::bound::{evaluate, Laser, Seg};
 use gaze_lidar_core::eye_safety::cuts::cuts;
 use proptest::prelude::*;
 
-fn profile(bins: &[(f64, f64, f64, bool)]) -> Vec<Seg> {
-    let total: f64 = bins.iter().map(|b| b.0).sum();
-    let n = bins.len();
-    let mut start = 0.0;
-    (0..n)
-        .map(|i| {
-            let (w, p, w0, accel) = bins[i];
-            let width = 360.0 * w / total;
-            let w1 = if accel { bins[(i + 1) % n].2 } else { w0 };
-            let s = Seg {
-                start_deg: start,
-                width_deg: width,
-                power_w: p,
-                spin_start_rad_s: w0,
-                spin_end_rad_s: w1,
-            };
-            start += width;
-            s
-        })
-        .collect()
-}
+mod common;
+use common::profile;
 
 fn cases() -> u32 {
     std::env::var("GAZE_LIDAR_CUTS_CASES")

@@ -6,6 +6,7 @@ use gaze_lidar_core::model::PowerAccounting;
 
 /// A time-accounted table of `(width_mdeg, dwell_ticks, code)` bins at
 /// 1 mW per code, with open limits and unconstrained bins; frame = Σ dwell.
+#[allow(dead_code)]
 pub fn open_table(
     tick_hz: u64,
     pulse_rate_hz: f64,
@@ -40,4 +41,29 @@ pub fn open_table(
             })
             .collect(),
     }
+}
+
+/// Bins from `(share of the turn, power W, spin rad/s, accelerate into the
+/// next bin's spin)`: the random profiles of the cut tests.
+#[allow(dead_code)]
+pub fn profile(bins: &[(f64, f64, f64, bool)]) -> Vec<gaze_lidar_core::eye_safety::bound::Seg> {
+    let total: f64 = bins.iter().map(|b| b.0).sum();
+    let n = bins.len();
+    let mut start = 0.0;
+    (0..n)
+        .map(|i| {
+            let (w, p, w0, accel) = bins[i];
+            let width = 360.0 * w / total;
+            let w1 = if accel { bins[(i + 1) % n].2 } else { w0 };
+            let s = gaze_lidar_core::eye_safety::bound::Seg {
+                start_deg: start,
+                width_deg: width,
+                power_w: p,
+                spin_start_rad_s: w0,
+                spin_end_rad_s: w1,
+            };
+            start += width;
+            s
+        })
+        .collect()
 }
