@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what building gaze-lidar needs on a fresh Debian machine, only
 # when missing: cmake and libclang (HiGHS is compiled from source by
-# good_lp's `highs` feature; its bindgen step loads libclang.so, which only
+# the `highs` crate (highs-sys); its bindgen step loads libclang.so, which only
 # the libclang-dev package provides: the image's libclang-cpp.so is a
 # different library and does not count) and a C++ compiler.
 # Idempotent and quiet when everything is there.

@@ -1,4 +1,4 @@
-//! Issue 4 acceptance: the optimizer (good_lp + HiGHS).
+//! Issue 4 acceptance: the optimizer (HiGHS).
 #![cfg(feature = "solver")]
 
 mod common;

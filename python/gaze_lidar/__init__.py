@@ -105,7 +105,7 @@ def check(
 
 
 def optimize(config: ConfigSource, gaze_deg: float) -> Profile:
-    """The optimizer's certified profile (good_lp + HiGHS) for a
+    """The optimizer's certified profile (HiGHS) for a
     configuration as ``gaze-lidar profile --config`` reads it (see
     examples/configs/), for a driver looking at `gaze_deg` (degrees, ISO
     8855). Releases the GIL while solving.

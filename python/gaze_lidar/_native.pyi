@@ -124,9 +124,10 @@ class Profile:
     @property
     def optimality(self) -> dict[str, Any] | None:
         """The optimizer's figures (profile@1 `optimality`): objective,
-        upper_bound, gap, exact, global, figures, and eye_safety_tightening
-        when the power step had to tighten its eye-safety cuts; None for the
-        closed forms."""
+        upper_bound, gap, exact, global, figures, dwell_step (the dwell
+        steps' programs: the last one's exact figures and how many ran), and
+        eye_safety_tightening when the power step had to tighten its
+        eye-safety cuts; None for the closed forms."""
     @property
     def figures(self) -> dict[str, Any] | None:
         """Range and point density in units people use (profile@1
@@ -180,7 +181,7 @@ def profile(
     """
 
 def optimize(config_text: str, gaze_deg: float, json: bool = False) -> Profile:
-    """The optimizer's certified profile (good_lp + HiGHS) for a TOML
+    """The optimizer's certified profile (HiGHS) for a TOML
     configuration as `gaze-lidar profile --config` reads it (see
     examples/configs/). Releases the GIL while solving.
     Raises ValueError for a bad key (named), Infeasible naming the limit."""

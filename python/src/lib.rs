@@ -566,7 +566,7 @@ fn profile(
     })
 }
 
-/// The optimizer's certified profile (good_lp + HiGHS) for a configuration
+/// The optimizer's certified profile (HiGHS) for a configuration
 /// as `gaze-lidar profile --config` reads it (see examples/configs/):
 /// TOML text, or with json=True the same keys as JSON text.
 /// Releases the GIL while solving. Raises ValueError for a bad key (named),

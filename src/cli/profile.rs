@@ -240,7 +240,7 @@ fn certificate_files(
     let json = serde_json::to_string_pretty(&cert.file())
         .map_err(|e| CliError::output(format!("certificate.json: {e}")))?;
     Ok(vec![
-        (dir.join("problem.mps"), cert.lp.to_mps().into_bytes()),
+        (dir.join("problem.mps"), cert.mps().into_bytes()),
         (dir.join("certificate.json"), (json + "\n").into_bytes()),
     ])
 }

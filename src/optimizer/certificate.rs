@@ -97,7 +97,12 @@ impl LinearProgram {
     /// The program as a HiGHS model; HiGHS refusing it (a coefficient or a
     /// bound it cannot take, e.g. from limits of no physical size) is a
     /// solver error, never a panic.
-    fn highs_model(&self, relax: bool, what: &str) -> Result<highs::Model, OptError> {
+    fn highs_model(
+        &self,
+        relax: bool,
+        what: &str,
+        opts: &SolveOptions<'_>,
+    ) -> Result<highs::Model, OptError> {
         let mut pb = highs::RowProblem::default();
         let cols: Vec<highs::Col> = (0..self.cost.len())
             .map(|j| {
@@ -124,6 +129,9 @@ impl LinearProgram {
             // zero): measured, it costs more than it saves on the power
             // steps' multiple-choice programs.
             m.set_option("mip_heuristic_run_feasibility_jump", false);
+            // A deterministic work limit (nodes, not seconds): see
+            // [`MIP_MAX_NODES`].
+            m.set_option("mip_max_nodes", MIP_MAX_NODES);
         }
         // Measured on the shipped configs' power steps and global bound
         // (360 bins): HiGHS's presolve costs more than it saves on these
@@ -133,19 +141,82 @@ impl LinearProgram {
         // 1.45× whole process, same answers (the search still closes the
         // gap to zero).
         m.set_option("presolve", "off");
+        m.set_option(
+            "primal_feasibility_tolerance",
+            opts.primal_feasibility_tolerance,
+        );
+        if let Some(x0) = opts.initial {
+            // A hot start (HiGHS's `setSolution`): a wrong length is the
+            // caller's bug, refused by HiGHS, and only costs the hot start.
+            let _ = m.try_set_solution(Some(x0), None, None, None);
+        }
         Ok(m)
+    }
+
+    /// This program with every finite row side moved outwards by
+    /// `tol·(1 + Σ_j |a_j|)`: what a point HiGHS returns at primal
+    /// feasibility tolerance `tol` (on rows and column bounds), with its
+    /// columns then clamped into their bounds, meets exactly when HiGHS
+    /// kept its tolerance (a row is off by at most `tol`, and the clamp
+    /// moves it by at most `tol·Σ|a_j|`). A relaxation of this program, so
+    /// an upper bound of it bounds this program too. Integral columns are
+    /// not covered (the caller rounds them; their rows must hold as they
+    /// are).
+    #[must_use]
+    pub fn widened(&self, tol: f64) -> Self {
+        let mut out = self.clone();
+        for r in &mut out.rows {
+            let w = tol * (1.0 + r.coefs.iter().map(|(_, a)| a.abs()).sum::<f64>());
+            // Rounded outwards (the sum and product above are floats).
+            let w = w * (1.0 + 1e-12);
+            if r.lo.is_finite() {
+                r.lo = -widen_up(-r.lo, w);
+            }
+            if r.hi.is_finite() {
+                r.hi = widen_up(r.hi, w);
+            }
+        }
+        out
+    }
+
+    /// `x` clamped into the column bounds, integral columns rounded.
+    #[must_use]
+    pub fn clamped(&self, x: &[f64]) -> Vec<f64> {
+        x.iter()
+            .enumerate()
+            .map(|(j, &v)| {
+                let v = if self.integer[j] { v.round() } else { v };
+                v.clamp(self.col_lo[j], self.col_hi[j])
+            })
+            .collect()
     }
 
     /// Solves with HiGHS; for a MILP also solves the LP relaxation for the
     /// row multipliers of the certificate.
     pub fn solve(&self, what: &str) -> Result<Solved, OptError> {
+        self.solve_with(what, &SolveOptions::default())
+    }
+
+    /// [`Self::solve`] with options (a hot start, a feasibility tolerance).
+    pub fn solve_with(&self, what: &str, opts: &SolveOptions<'_>) -> Result<Solved, OptError> {
         let run = |relax: bool| -> Result<highs::SolvedModel, OptError> {
             let solved = self
-                .highs_model(relax, what)?
+                .highs_model(relax, what, opts)?
                 .try_solve()
                 .map_err(|e| OptError::Solver(format!("{what} step: {e:?}")))?;
             match solved.status() {
                 highs::HighsModelStatus::Optimal => Ok(solved),
+                // The node limit of a MILP's branch and bound, with an
+                // incumbent: a feasible point (checked exactly like any
+                // other); its gap is stated, not assumed zero.
+                highs::HighsModelStatus::ReachedSolutionLimit
+                    if !relax
+                        && self.is_mip()
+                        && solved.primal_solution_status()
+                            == highs::HighsSolutionStatus::Feasible =>
+                {
+                    Ok(solved)
+                }
                 highs::HighsModelStatus::Infeasible => Err(OptError::Infeasible(format!(
                     "the {what} step has no solution within the limits (power_w_min/max, the budget, spin limits, slew, acceleration and eye safety together)"
                 ))),
@@ -207,9 +278,15 @@ impl LinearProgram {
     /// `OBJSENSE MAX`.
     #[must_use]
     pub fn to_mps(&self) -> String {
+        self.to_mps_named("gaze_lidar_power_step")
+    }
+
+    /// [`Self::to_mps`] under the MPS `NAME` given.
+    #[must_use]
+    pub fn to_mps_named(&self, name: &str) -> String {
         use std::fmt::Write as _;
         let mut s = String::new();
-        let _ = writeln!(s, "NAME gaze_lidar_power_step");
+        let _ = writeln!(s, "NAME {name}");
         let _ = writeln!(s, "OBJSENSE\n    MAX");
         let _ = writeln!(s, "ROWS\n N obj");
         for (i, r) in self.rows.iter().enumerate() {
@@ -287,6 +364,39 @@ impl LinearProgram {
         s
     }
 }
+
+/// `v + w` rounded up (`v` finite, `w ≥ 0`): at least the exact sum.
+fn widen_up(v: f64, w: f64) -> f64 {
+    let s = v + w;
+    -next_down(-s)
+}
+
+/// How HiGHS is run on a program.
+#[derive(Debug, Clone, Copy)]
+pub struct SolveOptions<'a> {
+    /// A starting point (one value per column), passed as a hot start.
+    pub initial: Option<&'a [f64]>,
+    /// HiGHS's `primal_feasibility_tolerance` (its default is 1e-7).
+    pub primal_feasibility_tolerance: f64,
+}
+
+impl Default for SolveOptions<'_> {
+    fn default() -> Self {
+        Self {
+            initial: None,
+            primal_feasibility_tolerance: 1e-7,
+        }
+    }
+}
+
+/// Branch-and-bound nodes a MILP may use before its best incumbent is
+/// taken. Multiple-choice knapsacks with unequal weights (hardware power
+/// levels under time accounting once the dwell moves, `joint` mode) take
+/// HiGHS minutes to close to a zero gap at 90 bins (measured: 66–82 s) for
+/// an answer the certificate cannot tell apart: its bound comes from the
+/// LP relaxation's duals, not from the search. A node count, unlike a
+/// time limit, keeps answers deterministic; the exact gap is reported.
+pub(super) const MIP_MAX_NODES: i32 = 100;
 
 /// Distance from an integer within which a relaxation's value counts as
 /// integral (HiGHS's own `mip_feasibility_tolerance` is 1e-6).
@@ -507,9 +617,31 @@ pub struct CertificateFile {
     pub y: Vec<f64>,
 }
 
+/// Which step of the block-coordinate ascent a program belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Step {
+    /// The power step (dwell fixed).
+    Power,
+    /// The dwell step (power fixed).
+    Dwell,
+}
+
+impl Step {
+    /// `power` / `dwell`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Power => "power",
+            Self::Dwell => "dwell",
+        }
+    }
+}
+
 /// The certified answer of one LP (or MILP).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Certified {
+    /// Whose program.
+    pub step: Step,
     /// The program.
     pub lp: LinearProgram,
     /// The primal point (exactly feasible).
@@ -526,6 +658,7 @@ impl Certified {
     /// Checks `x`, `y` exactly; an error if `x` is not exactly feasible or
     /// the bound is infinite (neither happens for the optimizer's programs).
     pub fn new(
+        step: Step,
         lp: LinearProgram,
         x: Vec<f64>,
         y: Vec<f64>,
@@ -543,12 +676,33 @@ impl Certified {
             ));
         }
         Ok(Self {
+            step,
             lp,
             x,
             y,
             exact,
             solver_dual_bound,
         })
+    }
+
+    /// The program in free MPS, named after its step.
+    #[must_use]
+    pub fn mps(&self) -> String {
+        self.lp
+            .to_mps_named(&format!("gaze_lidar_{}_step", self.step.name()))
+    }
+
+    /// The step's figures (objective rounded down, bound and gap up).
+    #[must_use]
+    pub fn step_figures(&self, programs: usize) -> crate::profile::StepOptimality {
+        let o = self.optimality();
+        crate::profile::StepOptimality {
+            objective: o.objective,
+            upper_bound: o.upper_bound,
+            gap: o.gap,
+            exact: o.exact,
+            programs,
+        }
     }
 
     /// The `optimality` figures (objective rounded down, bound and gap up).
@@ -564,6 +718,7 @@ impl Certified {
             global: None,
             figures: None,
             eye_safety_tightening: None,
+            dwell_step: None,
         }
     }
 
@@ -574,10 +729,11 @@ impl Certified {
         let gap = self.exact.gap().unwrap_or_default();
         CertificateFile {
             format: "gaze-lidar/certificate@1".into(),
-            problem: if self.lp.is_mip() {
-                "the final power step (a MILP over hardware power levels); y are the row duals of its LP relaxation, so upper_bound bounds the MILP too".into()
-            } else {
-                "the final power step (an LP)".into()
+            problem: match (self.step, self.lp.is_mip()) {
+                (Step::Power, true) => "the final power step (a MILP over hardware power levels); y are the row duals of its LP relaxation, so upper_bound bounds the MILP too".into(),
+                (Step::Power, false) => "the final power step (an LP)".into(),
+                (Step::Dwell, true) => "the final dwell step (a MILP over spin set-points; rows widened by HiGHS's feasibility tolerance, specs/optimizer.md); y are the row duals of its LP relaxation, so upper_bound bounds the MILP too".into(),
+                (Step::Dwell, false) => "the final dwell step (an LP; rows widened by HiGHS's feasibility tolerance, specs/optimizer.md)".into(),
             },
             sense: "maximise".into(),
             dual_sign_convention: "HiGHS's: reduced costs d = c - A^T y; for every feasible x, c^T x <= sum_r max(y_r*lo_r, y_r*hi_r) + sum_j max(d_j*lo_j, d_j*hi_j) = upper_bound (a multiplier whose side has an infinite bound counts as 0)".into(),
@@ -691,8 +847,60 @@ mod tests {
         }
     }
 
+    prop_compose! {
+        /// A program, a point HiGHS might return at tolerance `tol` (each
+        /// column within `tol` of its box, each row within `tol` of its
+        /// sides), and `tol`.
+        fn near_feasible()(n in 1usize..6, m in 1usize..6, e in -12i32..-3)(
+            boxes in proptest::collection::vec((-1e3f64..1e3, 0.0f64..1e3), n),
+            coefs in proptest::collection::vec(
+                proptest::collection::vec((0..n, value()), 1..5), m),
+            at in proptest::collection::vec(0.0f64..=1.0, n),
+            out in proptest::collection::vec(-1.0f64..=1.0, n),
+            sides in proptest::collection::vec((-1.0f64..=1.0, 0.0f64..10.0, any::<bool>()), m),
+            tol in Just(10f64.powi(e)),
+        ) -> (LinearProgram, Vec<f64>, f64) {
+            let mut lp = LinearProgram::default();
+            let mut x = Vec::with_capacity(boxes.len());
+            for (j, &(lo, w)) in boxes.iter().enumerate() {
+                lp.add_col(lo, lo + w, 0.0, false);
+                // Inside the box, or past a bound by at most tol.
+                let v = lo + w * at[j];
+                x.push(if out[j] > 0.5 { lo + w + tol * out[j] } else if out[j] < -0.5 { lo + tol * out[j] } else { v });
+            }
+            for (c, &(off, w, eq)) in coefs.iter().zip(&sides) {
+                lp.add_row(c, 0.0, 0.0);
+                let r = lp.rows.last_mut().unwrap();
+                let ax: f64 = r.coefs.iter().map(|&(j, a)| a * x[j]).sum();
+                // The point is off the row by at most tol·|off| (< tol,
+                // less a float's rounding of `ax`, covered below).
+                let lo = ax + 0.9 * tol * off;
+                r.lo = lo;
+                r.hi = if eq { lo } else { lo + w };
+            }
+            (lp, x, tol)
+        }
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(500))]
+
+        /// `widened`'s claim: a point within `tol` of every row and bound,
+        /// clamped, meets the program widened by `tol` exactly; and the
+        /// widened program contains the original.
+        #[test]
+        fn a_near_feasible_point_clamped_meets_the_widened_program_exactly(
+            (lp, x, tol) in near_feasible()
+        ) {
+            let wide = lp.widened(tol);
+            for (r, w) in lp.rows.iter().zip(&wide.rows) {
+                prop_assert!(w.lo <= r.lo && w.hi >= r.hi);
+                let need = q(tol) * (q(1.0) + r.coefs.iter().map(|&(_, a)| q(a.abs())).sum::<BigRational>());
+                prop_assert!(q(r.lo) - q(w.lo) >= need && q(w.hi) - q(r.hi) >= need);
+            }
+            let e = check(&wide, &lp.clamped(&x), &vec![0.0; lp.rows.len()]);
+            prop_assert!(e.primal_feasible, "{:?}", e.violation);
+        }
 
         #[test]
         fn check_agrees_with_plain_rationals((lp, x, y) in program()) {

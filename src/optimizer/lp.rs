@@ -10,12 +10,8 @@
 // variables); indices read like the formulation.
 #![allow(clippy::needless_range_loop)]
 
-use super::certificate::{Certified, LinearProgram};
+use super::certificate::{Certified, LinearProgram, SolveOptions, Step};
 use super::utility::{sqrt_segments, SqrtSegments};
-use good_lp::solvers::highs::highs;
-use good_lp::{
-    constraint, variable, Expression, ProblemVariables, Solution, SolverModel, Variable,
-};
 use std::f64::consts::TAU;
 
 use super::{OptError, Problem};
@@ -268,75 +264,6 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
     Ok(())
 }
 
-/// HiGHS pinned for determinism (one thread, fixed seed), MILPs solved to
-/// optimality (zero gap) so equal problems give equal answers.
-fn configured(
-    model: good_lp::solvers::highs::HighsProblem,
-    cons: Vec<good_lp::Constraint>,
-) -> good_lp::solvers::highs::HighsProblem {
-    let mut m = model
-        .set_threads(1)
-        .set_option("random_seed", 0)
-        .set_option("mip_rel_gap", 0.0)
-        .set_option("mip_abs_gap", 1e-12);
-    for c in cons {
-        m = m.with(c);
-    }
-    m
-}
-
-fn solve_model<M: SolverModel<Error = good_lp::ResolutionError>>(
-    model: M,
-    what: &str,
-) -> Result<M::Solution, OptError> {
-    model.solve().map_err(|e| match e {
-        good_lp::ResolutionError::Infeasible => OptError::Infeasible(format!(
-            "the {what} step has no solution within the limits (power_w_min/max, the budget, spin limits, slew, acceleration and eye safety together)"
-        )),
-        other => OptError::Solver(format!("{what} step: {other}")),
-    })
-}
-
-/// Solves the dwell step's program; with set-points (a MILP: the
-/// binaries in `groups`) its LP relaxation first, whose optimum, when
-/// integral, is the MILP's (the relaxation bounds it and contains this
-/// point), so HiGHS's branch and bound runs only when it is not.
-fn solve_relaxation_first(
-    vars: ProblemVariables,
-    objective: Expression,
-    cons: Vec<good_lp::Constraint>,
-    groups: &[Vec<(f64, Variable)>],
-) -> Result<good_lp::solvers::highs::HighsSolution, OptError> {
-    if !groups.is_empty() {
-        let relaxed = configured(
-            vars.clone().maximise(objective.clone()).using(highs),
-            cons.clone(),
-        )
-        .set_option("solve_relaxation", true)
-        .set_option("presolve", "off");
-        let sol = solve_model(relaxed, "dwell")?;
-        let integral = groups.iter().flatten().all(|&(_, y)| {
-            let v = sol.value(y);
-            (v - v.round()).abs() <= super::certificate::RELAXATION_INTEGRALITY_TOL
-        });
-        if integral {
-            return Ok(sol);
-        }
-    }
-    solve_model(
-        configured(vars.maximise(objective).using(highs), cons),
-        "dwell",
-    )
-}
-
-/// The level a solved one-hot group of binaries picked.
-fn chosen(sol: &impl Solution, group: &[(f64, Variable)]) -> f64 {
-    group
-        .iter()
-        .max_by(|a, b| sol.value(a.1).total_cmp(&sol.value(b.1)))
-        .map_or(0.0, |&(level, _)| level)
-}
-
 /// Dwell of each bin under `spins` (constant acceleration within a bin), s.
 fn dwell_of(g: &Grid, spins: &[(f64, f64)]) -> Vec<f64> {
     spins
@@ -413,7 +340,7 @@ fn power_step(
                 // The utility as boxed segment columns (see `utility`).
                 let c = lam * g.theta[i] * g.weight[i];
                 let shape = sqrt_segments(lo_x, hi_x);
-                let deltas = shape.add_to(&mut lp, xi, lo_x, c);
+                let deltas = shape.add_to(&mut lp, xi, 1.0, lo_x, c);
                 utility_constant += c * shape.base;
                 x.push(vec![(xi, 1.0)]);
                 bins.push(PowerBin::Continuous {
@@ -734,7 +661,13 @@ impl PowerLp {
                 "a power is not one of the hardware levels (the eye-safety fit scaled it)"
                     .to_owned()
             })?;
-            match Certified::new(self.lp.clone(), v, self.y.clone(), self.solver_dual_bound) {
+            match Certified::new(
+                Step::Power,
+                self.lp.clone(),
+                v,
+                self.y.clone(),
+                self.solver_dual_bound,
+            ) {
                 Ok(c) => return Ok((c, q)),
                 Err(e)
                     if k + 1 == REPAIR_TRIES
@@ -753,6 +686,18 @@ impl PowerLp {
     }
 }
 
+/// HiGHS's primal feasibility tolerance on the dwell step's program (its
+/// default is 1e-7): the certified program's rows are widened by
+/// `2·DWELL_FEASIBILITY_TOL·(1 + Σ|a|)` ([`LinearProgram::widened`]).
+const DWELL_FEASIBILITY_TOL: f64 = 1e-9;
+
+/// A dwell step's answer: the dwell (s), and its program's exact
+/// certificate or why there is none.
+pub(super) struct DwellStep {
+    t: Vec<f64>,
+    cert: Result<Certified, String>,
+}
+
 /// Dwell step: power `p` fixed; `current` is the iterate for linearisation.
 ///
 /// Eye safety: the cuts `binding` at `(p, current)` (concrete exposures at
@@ -763,6 +708,15 @@ impl PowerLp {
 /// Exact at the iterate, first order around it; the bound decides after
 /// (the power step that follows restores certified powers; without one the
 /// move is shortened until the bound certifies, see [`solve`]).
+///
+/// Certificate (`specs/optimizer.md`, "The dwell step's certificate"):
+/// HiGHS solves the program at [`DWELL_FEASIBILITY_TOL`]; its point, with
+/// the columns clamped into their bounds and the binaries rounded, is
+/// checked exactly against the program with every row widened by twice
+/// that tolerance (the frame equality `Σ τ = N` becomes a range of width
+/// `4·10⁻⁹·(1 + N)`), with the relaxation's row duals as multipliers. The
+/// dwell handed on is that point's, rescaled to the exact frame period (a
+/// relative move of at most `2·10⁻⁹·(1 + 1/N)`).
 fn dwell_step(
     problem: &Problem,
     g: &Grid,
@@ -770,7 +724,7 @@ fn dwell_step(
     pulse_rate_hz: f64,
     p: &[f64],
     current: &[f64],
-) -> Result<Vec<f64>, OptError> {
+) -> Result<DwellStep, OptError> {
     let mut touched = vec![false; g.n];
     for c in binding {
         for &(b, _) in &c.pulses {
@@ -784,11 +738,22 @@ fn dwell_step(
     let w_mean = lid.mean_spin_rad_s();
     let lam = problem.objective.resolution_weight;
     let setpoints = &problem.levels.spin_rad_s;
-    let mut vars = ProblemVariables::new();
-    let mut objective = Expression::from(0.0);
-    let mut cons = Vec::new();
-    let mut tau: Vec<Expression> = Vec::with_capacity(g.n);
-    let mut sp_vars: Vec<Vec<(f64, Variable)>> = Vec::new();
+    let mut lp = LinearProgram::default();
+    // τ_i as a linear form over the columns.
+    let mut tau: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
+    // Per bin with set-points, (spin, binary column) per set-point.
+    let mut sp_cols: Vec<Vec<(f64, usize)>> = Vec::new();
+    let mut start: Vec<f64> = Vec::new();
+    let allowed: Vec<f64> = setpoints
+        .iter()
+        .copied()
+        .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
+        .collect();
+    if !setpoints.is_empty() && allowed.is_empty() {
+        return Err(OptError::Infeasible(
+            "no spin set-point lies within [spin_rad_s_min, spin_rad_s_max]".into(),
+        ));
+    }
     for i in 0..g.n {
         let th = g.theta[i];
         if setpoints.is_empty() {
@@ -804,7 +769,8 @@ fn dwell_step(
                 hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
             }
             let t0 = (current[i] / unit).max(lo).min(hi);
-            let ti = vars.add(variable().min(lo).max(hi).initial(t0));
+            let ti = lp.add_col(lo, hi, 0.0, false);
+            start.push(t0);
             // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
             let k = unit * TAU / (th * period);
             let (r_lo, r_hi) = (
@@ -815,59 +781,41 @@ fn dwell_step(
                     1e3
                 },
             );
-            // The utility as boxed segment columns, Σ δ ≤ r − r_lo (see
+            // The utility as boxed segment columns, Σ δ ≤ k·τ − r_lo (see
             // `utility`; its constant does not move the optimum).
-            let c = lam * th * g.weight[i];
-            let mut fill = Expression::from(0.0);
             let shape = sqrt_segments(r_lo, r_hi);
-            let f0 = shape.fill(r_lo, k * t0);
-            for (&(a, len), &d0) in shape.segments.iter().zip(&f0) {
-                let d = vars.add(variable().min(0.0).max(len).initial(d0));
-                objective.add_mul(c * a, d);
-                fill.add_mul(1.0, d);
-            }
-            cons.push(constraint!(fill <= k * ti - r_lo));
-            tau.push(Expression::from(ti));
+            shape.add_to(&mut lp, ti, k, r_lo, lam * th * g.weight[i]);
+            start.extend(shape.fill(r_lo, k * t0));
+            tau.push(vec![(ti, 1.0)]);
         } else {
-            let allowed: Vec<f64> = setpoints
+            let ys: Vec<(f64, usize)> = allowed
                 .iter()
-                .copied()
-                .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
+                .map(|&w| {
+                    let cost = lam * th * g.weight[i] * (w_mean / w).sqrt();
+                    start.push(0.0);
+                    (w, lp.add_col(0.0, 1.0, cost, true))
+                })
                 .collect();
-            if allowed.is_empty() {
-                return Err(OptError::Infeasible(
-                    "no spin set-point lies within [spin_rad_s_min, spin_rad_s_max]".into(),
-                ));
-            }
-            let ys: Vec<(f64, Variable)> = allowed
-                .iter()
-                .map(|&w| (w, vars.add(variable().binary())))
-                .collect();
-            let mut te = Expression::from(0.0);
-            let mut one = Expression::from(0.0);
-            for &(w, y) in &ys {
-                te.add_mul(th / w / unit, y);
-                one.add_mul(1.0, y);
-                objective.add_mul(lam * th * g.weight[i] * (w_mean / w).sqrt(), y);
-            }
-            cons.push(constraint!(one == 1.0));
-            tau.push(te);
-            sp_vars.push(ys);
+            let one: Vec<(usize, f64)> = ys.iter().map(|&(_, y)| (y, 1.0)).collect();
+            lp.add_row(&one, 1.0, 1.0);
+            tau.push(ys.iter().map(|&(w, y)| (y, th / w / unit)).collect());
+            sp_cols.push(ys);
         }
     }
-    let mut frame = Expression::from(0.0);
-    for te in &tau {
-        frame += te.clone();
-    }
-    cons.push(constraint!(frame == g.n as f64));
+    let n = g.n as f64;
+    lp.add_row(&tau.concat(), n, n);
     if lid.power_accounting == PowerAccounting::Time {
-        let mut spend = Expression::from(0.0);
-        for i in 0..g.n {
-            spend += (p[i] / lid.average_power_w) * tau[i].clone();
-        }
         // No margin here: with uniform P̄ the budget is exactly tight. The
         // power step that ends every joint solve trims the budget exactly.
-        cons.push(constraint!(spend <= g.n as f64));
+        let spend: Vec<(usize, f64)> = tau
+            .iter()
+            .zip(p)
+            .flat_map(|(form, &pi)| {
+                form.iter()
+                    .map(move |&(j, a)| (j, a * pi / lid.average_power_w))
+            })
+            .collect();
+        lp.add_row(&spend, f64::NEG_INFINITY, n);
     }
     if let Some(a_max) = l.spin_accel_rad_s2_max {
         for i in 0..g.n {
@@ -877,26 +825,44 @@ fn dwell_step(
             let ds = ACCEL_SHARE * a_max * dtheta * (1.0 - TRUST).powi(3) / w_cur.powi(3);
             // s = t/θ = τ·unit/θ.
             let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
-            cons.push(constraint!(kj * tau[j].clone() - ki * tau[i].clone() <= ds));
-            cons.push(constraint!(ki * tau[i].clone() - kj * tau[j].clone() <= ds));
+            let scaled = |form: &[(usize, f64)], k: f64| -> Vec<(usize, f64)> {
+                form.iter().map(|&(c, a)| (c, a * k)).collect()
+            };
+            let diff = [scaled(&tau[j], kj), scaled(&tau[i], -ki)].concat();
+            lp.add_row(&diff, -ds, ds);
         }
     }
     for c in binding {
-        let mut en = Expression::from(0.0);
-        for &(b, n) in &c.pulses {
+        let mut en: Vec<(usize, f64)> = Vec::new();
+        for &(b, cnt) in &c.pulses {
             let tau0 = current[b] / unit;
-            en += (n * p[b] / (pulse_rate_hz * c.limit_j) / tau0) * tau[b].clone();
+            let k = cnt * p[b] / (pulse_rate_hz * c.limit_j) / tau0;
+            en.extend(tau[b].iter().map(|&(col, a)| (col, a * k)));
         }
-        cons.push(constraint!(en <= cut_rhs()));
+        lp.add_row(&en, f64::NEG_INFINITY, cut_rhs());
     }
-    let sol = solve_relaxation_first(vars, objective, cons, &sp_vars)?;
+    let solved = lp.solve_with(
+        "dwell",
+        &SolveOptions {
+            initial: Some(&start),
+            primal_feasibility_tolerance: DWELL_FEASIBILITY_TOL,
+        },
+    )?;
+    let x = lp.clamped(&solved.x);
+    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * x[j]).sum::<f64>();
     let mut t: Vec<f64> = if setpoints.is_empty() {
-        tau.iter().map(|te| sol.eval(te) * unit).collect()
+        tau.iter().map(|form| eval(form) * unit).collect()
     } else {
-        sp_vars
+        sp_cols
             .iter()
             .zip(&g.theta)
-            .map(|(ys, th)| th / chosen(&sol, ys))
+            .map(|(ys, th)| {
+                let w = ys
+                    .iter()
+                    .max_by(|a, b| x[a.1].total_cmp(&x[b.1]))
+                    .map_or(0.0, |&(w, _)| w);
+                th / w
+            })
             .collect()
     };
     if setpoints.is_empty() {
@@ -906,7 +872,15 @@ fn dwell_step(
             *ti *= period / s;
         }
     }
-    Ok(t)
+    let cert = Certified::new(
+        Step::Dwell,
+        lp.widened(2.0 * DWELL_FEASIBILITY_TOL),
+        x,
+        solved.y,
+        solved.solver_dual_bound,
+    )
+    .map_err(|e| format!("the dwell step's answer could not be certified exactly: {e}"));
+    Ok(DwellStep { t, cert })
 }
 
 /// The spin of dwell `t`: one spin per bin (steps) when `smooth` is
@@ -933,12 +907,44 @@ fn spins_of(g: &Grid, t: &[f64], smooth: bool, frame_rate_hz: f64) -> Vec<(f64, 
         .collect()
 }
 
-/// Solves and builds the (uncertified) profile, with the final power
-/// step's program (none when the power does not move).
-pub(super) fn solve(
-    problem: &Problem,
-    gaze_deg: f64,
-) -> Result<(Profile, Option<PowerLp>), OptError> {
+/// What [`solve`] hands out: the (uncertified) profile, the final power
+/// step's program (none when the power does not move) and the dwell
+/// steps' certificates.
+pub(super) struct Solution {
+    pub(super) profile: Profile,
+    pub(super) power: Option<PowerLp>,
+    pub(super) dwell: Option<DwellCertificates>,
+}
+
+/// The dwell steps' certificates.
+pub(super) struct DwellCertificates {
+    /// The last program's certificate, or the first failure.
+    pub(super) last: Result<Certified, String>,
+    /// Programs solved.
+    pub(super) programs: usize,
+    /// Whether the profile's dwell is the last program's point (rescaled
+    /// to the exact period): `resolution` mode with spin steps, the move
+    /// not shortened for eye safety. Its certificate is then the answer's.
+    pub(super) is_answer: bool,
+}
+
+impl DwellCertificates {
+    fn push(this: &mut Option<Self>, step: DwellStep) -> Vec<f64> {
+        let d = this.get_or_insert(Self {
+            last: Err(String::new()),
+            programs: 0,
+            is_answer: false,
+        });
+        if d.programs == 0 || d.last.is_ok() {
+            d.last = step.cert;
+        }
+        d.programs += 1;
+        step.t
+    }
+}
+
+/// Solves and builds the (uncertified) profile, with the programs' certificates.
+pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptError> {
     let g = grid(problem, gaze_deg)?;
     let lid = &problem.lidar;
     let eye = eye(problem)?;
@@ -963,6 +969,7 @@ pub(super) fn solve(
     };
     let steps = |t: &[f64]| spins_of(&g, t, false, lid.frame_rate_hz);
     let mut binding: Vec<Cut> = Vec::new();
+    let mut dwell: Option<DwellCertificates> = None;
     match mode {
         Mode::Baseline => {}
         Mode::Range => {
@@ -974,12 +981,14 @@ pub(super) fn solve(
         }
         Mode::Resolution => {
             for _ in 0..spin_rounds {
-                t = dwell_step(problem, &g, &[], f_p, &p, &t)?;
+                let step = dwell_step(problem, &g, &[], f_p, &p, &t)?;
+                t = DwellCertificates::push(&mut dwell, step);
             }
         }
         Mode::Joint => {
             for _ in 0..spin_rounds.max(2) {
-                let next = dwell_step(problem, &g, &binding, f_p, &p, &t)?;
+                let step = dwell_step(problem, &g, &binding, f_p, &p, &t)?;
+                let next = DwellCertificates::push(&mut dwell, step);
                 if last.is_some() && next == t {
                     // A fixed point: both steps are deterministic functions
                     // of (p, t) (the binding cuts are found afresh from
@@ -1010,6 +1019,7 @@ pub(super) fn solve(
         p = pp;
         last = Some(plp);
     }
+    let mut shortened = false;
     if let (Some(e), Mode::Resolution) = (eye.as_ref(), mode) {
         // No power step follows the dwell steps: shorten the move from the
         // uniform spin until the bound certifies (the uniform spin itself
@@ -1019,6 +1029,7 @@ pub(super) fn solve(
         };
         let mut alpha = 1.0;
         while !safe(&spins)? && alpha > 0.0 {
+            shortened = true;
             alpha = if alpha > 1.0 / 64.0 { alpha / 2.0 } else { 0.0 };
             let ta: Vec<f64> = t_base
                 .iter()
@@ -1064,5 +1075,12 @@ pub(super) fn solve(
         summary: None,
         optimality: None,
     };
-    Ok((profile, last))
+    if let Some(d) = dwell.as_mut() {
+        d.is_answer = mode == Mode::Resolution && !smooth && !shortened;
+    }
+    Ok(Solution {
+        profile,
+        power: last,
+        dwell,
+    })
 }

@@ -1,5 +1,5 @@
 //! The optimizer: power and spin profiles derived from the driver's acuity
-//! function, with good_lp + HiGHS.
+//! function, with HiGHS (every program's answer certified exactly).
 //!
 //! # Formulation
 //!
@@ -18,19 +18,21 @@
 //! Constraints: frame period `Σ t_i = T`; budget `Σ θ_i p_i <= 2π P̄`
 //! (angle) or `Σ t_i p_i <= P̄ T` (time); `p_i ∈ [P_min, P_max]`;
 //! `t_i ∈ [θ_i/ω_max, θ_i/ω_min]`; slew `|p_{i+1} − p_i| <= s·(Δ_i+Δ_{i+1})/2`;
-//! acceleration (linearised, see below); eye safety per aperture window
-//! (single-pulse rule with C5 from the window's dwell; energy over T2 and
-//! the 100 s time base), windows aligned with every bin edge, bins counted
-//! by their exact covered fraction.
+//! acceleration (linearised, see below); eye safety as cuts from the core's
+//! sound bound (`gaze_lidar_core::eye_safety::cuts`): the power step adds
+//! the concrete exposures its answer breaks until the bound certifies
+//! (`specs/optimizer.md`, "Eye safety as cuts").
 //!
 //! Power × dwell is bilinear under time accounting and in the eye-safety
 //! rules, so the problem is solved by **block-coordinate ascent**: a power
 //! step (dwell fixed: an LP, or a MILP with `K` hardware power levels) and a
 //! dwell step (power fixed: an LP, or a MILP with spin set-points), starting
-//! from the uniform baseline and ending with a power step. Under `angle`
-//! accounting without binding eye-safety coupling the two blocks separate
-//! and one round is exact; in general the result is a good feasible point,
-//! not a certified global optimum.
+//! from the uniform baseline and ending with a power step. Every program's
+//! answer carries a certificate checked in exact rational arithmetic
+//! ([`certificate`]; `optimality` and `optimality.dwell_step` in the
+//! profile), and [`global`] bounds the joint problem's optimum from a
+//! relaxation (`optimality.global`): block-coordinate ascent stops at a
+//! stationary point, and the global gap says how far it can be.
 //!
 //! Acceleration: with a finite motor limit the dwell step bounds the change
 //! of slowness `s = t/θ` between neighbours, `|Δs| <= a·Δθ·(1−ρ)³/ω̃³`
@@ -236,13 +238,12 @@ pub(crate) fn optimize_unrated(
         field: "gaze-deg".into(),
         reason: e.to_string(),
     })?;
-    let (profile, _) = lp::solve(problem, gaze_deg)?;
-    Ok(certify(profile)?)
+    Ok(certify(lp::solve(problem, gaze_deg)?.profile)?)
 }
 
-/// [`optimize`], also handing out the final power step's program and its
-/// exact certificate, or why there is none (the power does not move, or
-/// the answer is not exactly feasible for the program).
+/// [`optimize`], also handing out the final step's program and its exact
+/// certificate (the power step's; in `resolution` mode with spin steps the
+/// dwell step's), or why there is none.
 pub fn optimize_with_certificate(
     problem: &Problem,
     gaze_deg: f64,
@@ -251,9 +252,27 @@ pub fn optimize_with_certificate(
         field: "gaze-deg".into(),
         reason: e.to_string(),
     })?;
-    let (mut profile, power_lp) = lp::solve(problem, gaze_deg)?;
-    let cert = match power_lp {
-        None => Err("this mode has no power step to certify (the power does not move)".into()),
+    let lp::Solution {
+        mut profile,
+        power,
+        dwell,
+    } = lp::solve(problem, gaze_deg)?;
+    let dwell_figures = dwell
+        .as_ref()
+        .and_then(|d| d.last.as_ref().ok().map(|c| c.step_figures(d.programs)));
+    let cert = match power {
+        None => match dwell {
+            Some(lp::DwellCertificates {
+                last: Ok(c),
+                is_answer: true,
+                ..
+            }) => {
+                profile.optimality = Some(c.optimality());
+                Ok(c)
+            }
+            Some(lp::DwellCertificates { last: Err(e), .. }) => Err(e),
+            _ => Err("this mode has no power step, and the profile's dwell is not the dwell step's answer (smoothed spin, or the move shortened for eye safety)".into()),
+        },
         Some(plp) => {
             let p: Vec<f64> = profile.bins.iter().map(|b| b.power_w).collect();
             plp.certify(&p).map(|(c, q)| {
@@ -267,6 +286,9 @@ pub fn optimize_with_certificate(
             })
         }
     };
+    if let Some(o) = profile.optimality.as_mut() {
+        o.dwell_step = dwell_figures;
+    }
     if profile.optimality.is_some() {
         let global = global::bound(problem, gaze_deg, &profile).ok();
         if let Some(opt) = profile.optimality.as_mut() {

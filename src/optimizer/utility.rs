@@ -52,9 +52,16 @@ const FILL_SHORTFALL: f64 = 64.0 * f64::EPSILON;
 
 impl SqrtSegments {
     /// Adds the segment columns (cost `c·slope`, boxed by the lengths) and
-    /// the row `Σ δ_k − v ≤ −lo` on column `v`; returns the columns. The
-    /// constant `c·√lo` is the caller's.
-    pub(super) fn add_to(&self, lp: &mut LinearProgram, v: usize, lo: f64, c: f64) -> Vec<usize> {
+    /// the row `Σ δ_k − k·v ≤ −lo` on column `v` (the utility of `k·v`);
+    /// returns the columns. The constant `c·√lo` is the caller's.
+    pub(super) fn add_to(
+        &self,
+        lp: &mut LinearProgram,
+        v: usize,
+        k: f64,
+        lo: f64,
+        c: f64,
+    ) -> Vec<usize> {
         let deltas: Vec<usize> = self
             .segments
             .iter()
@@ -62,7 +69,7 @@ impl SqrtSegments {
             .collect();
         if !deltas.is_empty() {
             let mut row: Vec<(usize, f64)> = deltas.iter().map(|&d| (d, 1.0)).collect();
-            row.push((v, -1.0));
+            row.push((v, -k));
             lp.add_row(&row, f64::NEG_INFINITY, -lo);
         }
         deltas

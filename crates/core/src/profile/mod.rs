@@ -123,8 +123,9 @@ pub struct Profile {
 }
 
 /// The optimizer's optimality figures for the LP (or MILP) of its final
-/// power step, in the objective's units: `objective` of the profile's
-/// powers and an `upper_bound` of that program's optimum, both checked in
+/// step — the power step's, or in `resolution` mode (no power step) the
+/// dwell step's — in the objective's units: `objective` of the profile's
+/// point and an `upper_bound` of that program's optimum, both checked in
 /// exact rational arithmetic (`objective` rounded down, `upper_bound` and
 /// `gap` rounded up to doubles).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -156,6 +157,28 @@ pub struct Optimality {
     /// "Eye safety as cuts"). Absent when every cut is valid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eye_safety_tightening: Option<f64>,
+    /// The dwell steps' programs (`joint` and `resolution` modes): every
+    /// one was certified exactly, and these are the last one's figures.
+    /// Absent when no dwell step ran or one could not be certified.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dwell_step: Option<StepOptimality>,
+}
+
+/// One step's program's exact figures (as [`Optimality`]'s), and how many
+/// programs of that step the solve certified.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepOptimality {
+    /// Objective of the program's point (exact, rounded down).
+    pub objective: f64,
+    /// Proven upper bound of the program's optimum (rounded up).
+    pub upper_bound: f64,
+    /// `upper_bound − objective` (exact difference, rounded up).
+    pub gap: f64,
+    /// Whether the exact gap is 0.
+    pub exact: bool,
+    /// Programs of this step solved and certified in this solve.
+    pub programs: usize,
 }
 
 /// A profile's figures in units people use, next to the paper's closed
