@@ -202,6 +202,12 @@ fn highs_objective_of_file(path: &Path) -> f64 {
         highs_sys::Highs_setBoolOptionValue(h, quiet.as_ptr(), 0);
         let threads = CString::new("threads").unwrap();
         highs_sys::Highs_setIntOptionValue(h, threads.as_ptr(), 1);
+        // Tight tolerances: a point 1e-7 outside a row (HiGHS's default)
+        // can score above the exact optimum by that much times a dual.
+        for name in ["primal_feasibility_tolerance", "dual_feasibility_tolerance"] {
+            let key = CString::new(name).unwrap();
+            highs_sys::Highs_setDoubleOptionValue(h, key.as_ptr(), 1e-10);
+        }
         let st = highs_sys::Highs_readModel(h, file.as_ptr());
         assert_eq!(st, 0, "HiGHS read {}", path.display());
         let st = highs_sys::Highs_run(h);

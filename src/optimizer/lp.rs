@@ -11,7 +11,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::certificate::{Certified, LinearProgram, SolveOptions, Step};
-use super::utility::{sqrt_segments, SqrtSegments};
+use super::utility::{sqrt_segments, sqrt_segments_n, SqrtSegments};
 use std::f64::consts::TAU;
 
 use super::{OptError, Problem};
@@ -64,8 +64,32 @@ const CUT_ROUNDS: usize = 60;
 /// Cuts at or above this ratio of the current iterate are binding: the
 /// dwell step linearises them.
 const BINDING: f64 = 1.0 - 1e-3;
-/// Dwell-step iterations when the acceleration limit is finite.
+/// Chords of the density utility on a dwell column inside a trust region
+/// (±[`TRUST`] around the iterate: a sequential LP's first-order model,
+/// where the acceleration rows allow far smaller moves still). Measured on
+/// `smooth` (360 bins, joint): 16 chords → 4 makes the whole solve 1.8×
+/// faster (99 → 55 ms) and moves the answer's exact objective by 2e-14
+/// relative (`optimality.global.objective` 8.864885452179 either way).
+/// Columns without a trust region keep [`super::UTILITY_SEGMENTS`].
+const TRUST_REGION_SEGMENTS: usize = 4;
+
+/// Dwell-step iterations when the acceleration limit is finite (at most).
 const SLP_ROUNDS: usize = 5;
+/// The sequential LP stops once a dwell step moves no bin's dwell by more
+/// than this (relative). On `smooth` (360 bins, joint) the five rounds'
+/// moves were 2.7e-2, 7.6e-4, 2.4e-5, 3.2e-6, 3.7e-6; stopping after the
+/// second changes the answer's exact objective by −1.4e-7 relative
+/// (8.864885070 with five rounds, 8.864884199 with two; the global gap is
+/// 2.4e-2) and makes the whole process 1.24× faster than stopping after the
+/// third (1e-4).
+const SLP_SETTLED: f64 = 1e-3;
+
+/// Whether the dwell `next` is within [`SLP_SETTLED`] of `t` in every bin.
+fn settled(next: &[f64], t: &[f64]) -> bool {
+    next.iter()
+        .zip(t)
+        .all(|(a, b)| (a - b).abs() <= SLP_SETTLED * b.abs())
+}
 
 pub(super) struct Grid {
     pub(super) n: usize,
@@ -764,7 +788,8 @@ fn dwell_step(
                 1e9
             };
             let (mut lo, mut hi) = (lo, hi.max(lo));
-            if l.spin_accel_rad_s2_max.is_some() || touched[i] {
+            let trust = l.spin_accel_rad_s2_max.is_some() || touched[i];
+            if trust {
                 lo = lo.max(current[i] / unit * (1.0 - TRUST));
                 hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
             }
@@ -781,11 +806,19 @@ fn dwell_step(
                     1e3
                 },
             );
-            // The utility as boxed segment columns, Σ δ ≤ k·τ − r_lo (see
-            // `utility`; its constant does not move the optimum).
-            let shape = sqrt_segments(r_lo, r_hi);
-            shape.add_to(&mut lp, ti, k, r_lo, lam * th * g.weight[i]);
-            start.extend(shape.fill(r_lo, k * t0));
+            // The utility as boxed segment columns on the densities this
+            // column reaches (its box: the spin limits, and the trust region
+            // where it applies), Σ δ ≤ k·τ − r_0 (see `utility`; its
+            // constant does not move the optimum).
+            let r_0 = r_lo.max(k * lo);
+            let chords = if trust {
+                TRUST_REGION_SEGMENTS
+            } else {
+                super::UTILITY_SEGMENTS
+            };
+            let shape = sqrt_segments_n(r_0, r_hi.min(k * hi).max(r_0), chords);
+            shape.add_to(&mut lp, ti, k, r_0, lam * th * g.weight[i]);
+            start.extend(shape.fill(r_0, k * t0));
             tau.push(vec![(ti, 1.0)]);
         } else {
             let ys: Vec<(f64, usize)> = allowed
@@ -982,11 +1015,17 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
         Mode::Resolution => {
             for _ in 0..spin_rounds {
                 let step = dwell_step(problem, &g, &[], f_p, &p, &t)?;
-                t = DwellCertificates::push(&mut dwell, step);
+                let next = DwellCertificates::push(&mut dwell, step);
+                let settled = settled(&next, &t);
+                t = next;
+                if settled {
+                    break;
+                }
             }
         }
         Mode::Joint => {
-            for _ in 0..spin_rounds.max(2) {
+            let rounds = spin_rounds.max(2);
+            for round in 0..rounds {
                 let step = dwell_step(problem, &g, &binding, f_p, &p, &t)?;
                 let next = DwellCertificates::push(&mut dwell, step);
                 if last.is_some() && next == t {
@@ -995,7 +1034,14 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
                     // them), so every further round repeats this one.
                     break;
                 }
+                let settled = smooth_spin && settled(&next, &t);
                 t = next;
+                if smooth_spin && (settled || round + 1 == rounds) {
+                    // The last dwell of a smoothed spin: the final power
+                    // step below, on the rebuilt spin, replaces this
+                    // round's power step on the step spins.
+                    break;
+                }
                 let sp = steps(&t);
                 let mut pool = warm(&sp, &p);
                 let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;

@@ -32,8 +32,12 @@ pub(super) struct SqrtSegments {
 /// The chords of `√v` on `[lo, hi]` (nodes evenly spaced in `√`) as
 /// segments. Empty when `hi <= lo`.
 pub(super) fn sqrt_segments(lo: f64, hi: f64) -> SqrtSegments {
+    sqrt_segments_n(lo, hi, super::UTILITY_SEGMENTS)
+}
+
+/// [`sqrt_segments`] with `k` chords.
+pub(super) fn sqrt_segments_n(lo: f64, hi: f64, k: usize) -> SqrtSegments {
     let (a, b) = (lo.max(0.0).sqrt(), hi.max(lo).sqrt());
-    let k = super::UTILITY_SEGMENTS;
     let node = |j: usize| (a + (b - a) * j as f64 / k as f64).powi(2);
     let segments = (0..k)
         .filter_map(|j| {
