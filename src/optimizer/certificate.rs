@@ -132,6 +132,7 @@ impl LinearProgram {
             // A deterministic work limit (nodes, not seconds): see
             // [`MIP_MAX_NODES`].
             m.set_option("mip_max_nodes", MIP_MAX_NODES);
+            m.set_option("mip_detect_symmetry", false);
         }
         // Measured on the shipped configs' power steps and global bound
         // (360 bins): HiGHS's presolve costs more than it saves on these
