@@ -193,6 +193,108 @@ fn lagrangian_bound(terms: &[Term], b: f64) -> Option<f64> {
     total.is_finite().then_some(total + 1e-12 * magnitude)
 }
 
+/// Bisection between `a`, where `keep(a)` holds, and `b`, where it is
+/// expected not to (either order): returns the last `b`, a point where
+/// `keep` failed unless `b` never moved (callers check it again).
+fn bisect(a: f64, b: f64, keep: impl Fn(f64) -> bool) -> f64 {
+    let (mut a, mut b) = (a, b);
+    for _ in 0..200 {
+        let mid = 0.5 * (a + b);
+        if mid == a || mid == b {
+            break;
+        }
+        if keep(mid) {
+            a = mid;
+        } else {
+            b = mid;
+        }
+    }
+    b
+}
+
+/// The spin box `[ω_lo, ω_hi]` every start and end spin of a profile the
+/// checker accepts lies in, given the acceleration limit `a` and the frame
+/// (module docs, "acceleration"): `lo`/`hi` are the limits' box (already
+/// widened), `n` the bins. Returns `(lo, hi)` unchanged where no bound is
+/// tighter.
+fn accel_spin_box(a: f64, period: f64, n: usize, lo: f64, hi: f64) -> (f64, f64) {
+    // Each pass starts from the previous box (valid for every accepted
+    // profile), so its jump slack and clipping use the tighter spins.
+    let mut b = (lo, hi);
+    for _ in 0..4 {
+        b = accel_spin_box_once(a, period, n, b.0, b.1);
+    }
+    b
+}
+
+/// One pass of [`accel_spin_box`].
+fn accel_spin_box_once(a: f64, period: f64, n: usize, lo: f64, hi: f64) -> (f64, f64) {
+    use std::f64::consts::PI;
+    // ω² changes by at most 2a''·(angle) plus J over the circle (jumps at
+    // edges within the checker's tolerance, and its float rounding).
+    let a2 = a * (1.0 + 1.1e-9);
+    let j_all = n as f64 * (2.2e-9 + 8.0 * f64::EPSILON) * hi.max(1.0).powi(2);
+    // The frame the checker accepts: Σ t within REL_TOL of T, the float
+    // sum's rounding (n·ε ≤ 1.1e-10 for n ≤ 10⁶) inside 1.2e-9.
+    let t_lo = period * (1.0 - 1.2e-9);
+    let t_hi = period * (1.0 + 1.2e-9);
+    if a2 <= 0.0 || !(lo >= 0.0 && hi > lo) {
+        return (lo, hi);
+    }
+    // Slowest profile with ω² = W at some point: ω(d)² ≥ max(W − 2a''d, f²),
+    // its time 2∫₀^π dθ/ω, decreasing in W; F written without cancellation.
+    let f = lo;
+    let time_slowest = |w: f64| -> f64 {
+        if w <= f * f {
+            return TAU / f;
+        }
+        let c = (w - f * f) / (2.0 * a2);
+        if c >= PI {
+            2.0 * TAU / (w.sqrt() + (w - 2.0 * a2 * PI).max(0.0).sqrt())
+        } else {
+            4.0 * c / (w.sqrt() + f) + 2.0 * (PI - c) / f
+        }
+    };
+    // Fastest profile with ω² = w at some point: ω(d)² ≤ min(w + 2a''d, c²).
+    let top = hi;
+    let time_fastest = |w: f64| -> f64 {
+        if w >= top * top {
+            return TAU / top;
+        }
+        let c = (top * top - w) / (2.0 * a2);
+        if c >= PI {
+            2.0 * TAU / ((w + 2.0 * a2 * PI).sqrt() + w.max(0.0).sqrt())
+        } else {
+            4.0 * c / (top + w.max(0.0).sqrt()) + 2.0 * (PI - c) / top
+        }
+    };
+    // Every feasible W − J has true time ≥ t_lo, so computed time ≥
+    // t_lo(1 − 1e-13); the bisection's `hi` end has computed time below
+    // t_lo(1 − 1e-10), so the true time there is below t_lo: every W − J
+    // at or above it is infeasible.
+    let w_cap = bisect(0.0, top * top, |w| time_slowest(w) > t_lo * (1.0 - 1e-10));
+    let new_hi = if time_slowest(w_cap) <= t_lo * (1.0 - 1e-10) {
+        ((w_cap + j_all) * (1.0 + 1e-12)).sqrt() * (1.0 + 4.0 * f64::EPSILON)
+    } else {
+        hi
+    };
+    // Symmetric: feasible w + J has true time ≤ t_hi; the bisection's
+    // `lo` end has computed time above t_hi(1 + 1e-10), so every w + J at
+    // or below it is infeasible.
+    let w_floor = bisect(top * top, 0.0, |w| time_fastest(w) < t_hi * (1.0 + 1e-10));
+    let new_lo = if time_fastest(w_floor) >= t_hi * (1.0 + 1e-10) {
+        ((w_floor - j_all) * (1.0 - 1e-12)).max(0.0).sqrt() * (1.0 - 4.0 * f64::EPSILON)
+    } else {
+        lo
+    };
+    let (l2, h2) = (new_lo.max(lo), new_hi.min(hi));
+    if l2 <= h2 {
+        (l2, h2)
+    } else {
+        (lo, hi)
+    }
+}
+
 /// The model objective `J` of a profile (floating point).
 fn objective_of(problem: &Problem, g: &Grid, profile: &Profile) -> f64 {
     let lid = &problem.lidar;
@@ -296,6 +398,25 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     if !(x_lo <= x_hi && w_lo <= w_hi && w_hi > 0.0) {
         return Err(OptError::Infeasible("empty power or spin box".into()));
     }
+    // Limits (not levels, which are exact) are met to the checker's
+    // tolerance: the boxes widened by it.
+    let (x_lo, x_hi) = if mode.controls_range() && problem.levels.power_w.is_empty() {
+        (x_lo * (1.0 - WIDEN), x_hi * (1.0 + WIDEN))
+    } else {
+        (x_lo, x_hi)
+    };
+    let accel = l
+        .spin_accel_rad_s2_max
+        .filter(|a| mode.controls_resolution() && a.is_finite() && *a >= 0.0);
+    let (w_lo, w_hi) = if mode.controls_resolution() && problem.levels.spin_rad_s.is_empty() {
+        let (lo, hi) = (w_lo * (1.0 - WIDEN), w_hi * (1.0 + WIDEN));
+        match accel {
+            Some(a) => accel_spin_box(a, period, g.n, lo, hi),
+            None => (lo, hi),
+        }
+    } else {
+        (w_lo, w_hi)
+    };
     // Eye safety: no bin of a certifiable profile carries more than the
     // bound's Rule 1 cap at the fastest spin the box allows (the core's
     // `rule_one_cap_w`, valid for every spin profile in the box).
@@ -319,17 +440,20 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let coupled = lid.power_accounting == PowerAccounting::Time
         && mode.controls_range()
         && mode.controls_resolution();
+    // τ = t/unit with t = 2θ/(ω_start + ω_end), both in the spin box;
+    // rounded outward where the spin moves (a few ulps).
+    let tau_box = |i: usize| {
+        let outward = if w_lo < w_hi { 4.0 * f64::EPSILON } else { 0.0 };
+        let t_lo = g.theta[i] / w_hi / unit * (1.0 - outward);
+        let t_hi = if w_lo > 0.0 {
+            (g.theta[i] / w_lo / unit * (1.0 + outward)).min(n)
+        } else {
+            n
+        };
+        (t_lo, t_hi)
+    };
     if !slew_moves && !coupled {
         // Separable: power against one budget row, dwell against the frame.
-        let tau_box = |i: usize| {
-            let t_lo = g.theta[i] / w_hi / unit;
-            let t_hi = if w_lo > 0.0 {
-                (g.theta[i] / w_lo / unit).min(n)
-            } else {
-                n
-            };
-            (t_lo, t_hi)
-        };
         let power: Vec<Term> = (0..g.n)
             .map(|i| Term {
                 c: o.range_weight * g.theta[i] * g.weight[i],
@@ -374,12 +498,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let mut taus = Vec::with_capacity(g.n);
     let mut constant = 0.0;
     for i in 0..g.n {
-        let t_lo = g.theta[i] / w_hi / unit;
-        let t_hi = if w_lo > 0.0 {
-            (g.theta[i] / w_lo / unit).min(n)
-        } else {
-            n
-        };
+        let (t_lo, t_hi) = tau_box(i);
         let x = lp.add_col(x_lo, x_hi, 0.0, false);
         let tau = lp.add_col(t_lo, t_hi, 0.0, false);
         let cw = g.theta[i] * g.weight[i];
@@ -512,6 +631,40 @@ mod tests {
                     "{k} {lo} {hi} {v}: {gf} vs {m}"
                 );
             }
+        }
+    }
+
+    proptest::proptest! {
+        /// The spin box against the closed form of its extreme profile:
+        /// ω² linear in the distance from one point at slope 2a (reachable
+        /// exactly by ramps, so the box cannot be tighter), meeting the
+        /// frame: with q = aT/2, √W_max − √(W_max − 2aπ) = q, i.e.
+        /// ω_max = (2aπ/q + q)/2 and ω_min = (2aπ/q − q)/2. The box holds
+        /// both (sound) and is within its stated slack of them (tight); with limits
+        /// inside, the limits.
+        #[test]
+        fn the_acceleration_box_meets_its_closed_form(
+            a in 1.0f64..1e4,
+            rate in 5.0f64..50.0,
+            n in 1usize..2000,
+        ) {
+            use std::f64::consts::PI;
+            let period = 1.0 / rate;
+            let q = a * period / 2.0;
+            let (hi, lo) = ((2.0 * a * PI / q + q) / 2.0, (2.0 * a * PI / q - q) / 2.0);
+            // The extreme profile above the floor (else it is clipped).
+            proptest::prop_assume!(lo > 1.5);
+            let (b_lo, b_hi) = accel_spin_box(a, period, n, 1.0, 1e5);
+            // Tight up to the stated slack: the checker's edge tolerance
+            // summed over the n edges (n·2.2e-9·ω_max² in ω²) and the
+            // frame's 1.2e-9, relative to the smaller ω².
+            let tight = (1e-7 + n as f64 * 1.5e-9) * (hi / lo).powi(2);
+            proptest::prop_assert!(b_hi >= hi && b_hi <= hi * (1.0 + tight), "{b_hi} vs {hi}");
+            proptest::prop_assert!(b_lo <= lo && b_lo >= lo * (1.0 - tight), "{b_lo} vs {lo}");
+            // Limits inside the extreme profile's range are kept.
+            let mid = 2.0 * PI / period;
+            let (c_lo, c_hi) = accel_spin_box(a, period, n, mid * 0.999, mid * 1.001);
+            proptest::prop_assert!(c_lo >= mid * 0.999 && c_hi <= mid * 1.001);
         }
     }
 
