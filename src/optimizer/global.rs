@@ -17,7 +17,11 @@
 //!   faster on `smooth` (measured; the bound moves by < 1e-12 relative);
 //! - `x_i` lies in `[min, max]` of the allowed powers (levels or limits),
 //!   `τ_i` in the spin limits' (set-points') box; a block the mode does not
-//!   move is fixed at its start value;
+//!   move is fixed at its start value; boxes from limits (not levels, which
+//!   are exact) widened by the checker's tolerance;
+//! - under a finite acceleration limit the spin box is the one the limit
+//!   and the frame leave ([`accel_spin_box`]), below; it bounds `τ`, the
+//!   McCormick rows and the Rule 1 cap's fastest spin;
 //! - frame `Σ τ_i = N`; budget `Σ θ_i x_i ≤ 2π` (angle) or, under time
 //!   accounting, `Σ τ_i x_i ≤ N`, bilinear: each product `w_i = τ_i x_i` is
 //!   replaced by its McCormick under-estimators
@@ -26,8 +30,34 @@
 //! - slew `|x_j − x_i| ≤ s (Δ_i+Δ_j)/2 / P̄`;
 //! - every row is widened by the checker's relative tolerance (1e-9), so
 //!   whatever the checker accepts is inside;
-//! - **dropped** (a relaxation may drop rows): eye safety and the spin
-//!   acceleration limit. Where they bind, the gap includes their price.
+//! - **dropped** (a relaxation may drop rows): eye safety beyond the Rule 1
+//!   cap, and the acceleration limit beyond the spin box. Where they bind,
+//!   the gap includes their price.
+//!
+//! **The acceleration box.** Assumptions (profile@1 and the core checker):
+//! within a bin the acceleration is constant, so `ω²` is linear in the
+//! angle between the bin's start and end spins; the checker accepts
+//! `|ω_e² − ω_s²|/(2θ) ≤ a(1 + 1e-9)` (evaluated in floats: a few ε of
+//! `ω_max²` more), adjacent bins meeting within `1e-9·max(ω, 1)` (so
+//! `|Δω²| ≤ 2.2e-9·ω_max²` at an edge), every start and end spin in the
+//! limits widened by 1e-9, and `Σ t` within 1e-9 of `T` (its float sum
+//! inside 1.2e-9 for `N ≤ 10⁶`). Then if `ω² = W` somewhere, at angular
+//! distance `d` along the circle `ω² ≥ W − 2a''d − J` with
+//! `a'' = a(1 + 1.1e-9)` and `J = N(2.2e-9 + 8ε)ω_max²` (every edge and
+//! rounding on the way), and `ω ≥ ω_min` (the floor, at the ends and so
+//! in between). The frame's time `∫dθ/ω ≥ T(1 − 1.2e-9)` therefore needs
+//! `F(W − J) ≥ T(1 − 1.2e-9)` with `F(W) = 2∫₀^π dθ/√max(W − 2a''θ, ω_min²)`
+//! (closed form, decreasing in `W`); symmetrically the smallest `ω² = w`
+//! needs `G(w + J) ≤ T(1 + 1.2e-9)` with
+//! `G(w) = 2∫₀^π dθ/√min(w + 2a''θ, ω_max²)`. A bisection finds each
+//! threshold, comparing the computed time with `T` moved by a relative
+//! 1e-10 (far above the closed forms' rounding), so the point returned is
+//! proven on the far side; four passes, each from the previous box (the
+//! slack `J` and the clipping then use the tighter spins). The box is tight
+//! up to `J` and the frame's tolerance: the triangle `ω² = W − 2a·d` is a
+//! profile of ramps that meets it (tested against its closed form,
+//! `ω_max,min = (2aπ/q ± q)/2`, `q = aT/2`). On `smooth` it is
+//! `[113.16, 138.16]` rad/s against the limits' `[90, 200]`.
 //!
 //! (Separable problems skip the LP: see `lagrangian_bound`.) The LP's own bound is certified exactly ([`super::certificate::check`]),
 //! so `upper_bound` is proven for the relaxation, hence for the problem.
