@@ -79,6 +79,8 @@ use crate::profile::{GlobalOptimality, Profile};
 const TANGENTS: usize = 12;
 /// The checker's relative tolerance, by which every row is widened.
 const WIDEN: f64 = 1e-9;
+/// τ slices per bin in the coupled Lagrangian's final evaluation.
+const LAGRANGIAN_SLICES: usize = 256;
 /// Relative lowering of the floating-point objective, and raising of the
 /// bound (rounding cover).
 const OBJECTIVE_MARGIN: f64 = 1e-12;
@@ -557,7 +559,9 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         lp.add_col(1.0, 1.0, constant * (1.0 + 1e-12), false);
     }
     let frame: Vec<(usize, f64)> = taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
+    let frame_row = lp.rows.len();
     lp.add_row(&frame, n * (1.0 - WIDEN), n * (1.0 + WIDEN));
+    let mut budget_row = frame_row;
     match lid.power_accounting {
         PowerAccounting::Angle => {
             let spend: Vec<(usize, f64)> = (0..g.n).map(|i| (xs[i].0, g.theta[i])).collect();
@@ -574,13 +578,16 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
                 lp.add_row(&[(w, 1.0), (x, -th), (t, -xh)], -th * xh, f64::INFINITY);
                 spend.push((w, 1.0));
             }
+            budget_row = lp.rows.len();
             lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + WIDEN));
         }
     }
+    let mut slews = Vec::new();
     if let (Some(s), true) = (l.power_slew_w_per_deg_max, mode.controls_range()) {
         for i in 0..g.n {
             let j = next_index(i, g.n);
             let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + WIDEN);
+            slews.push((lp.rows.len(), i, j, lim));
             lp.add_row(&[(xs[j].0, 1.0), (xs[i].0, -1.0)], -lim, lim);
         }
     }
@@ -591,7 +598,163 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         .ok_or_else(|| OptError::Solver("global bound: no finite dual bound".into()))?;
     // Raised by OBJECTIVE_MARGIN: covers the float evaluation of the model's
     // constants (k, √ of a fixed block) the rows were built from.
-    Ok(to_f64_up(&ub) * (1.0 + OBJECTIVE_MARGIN))
+    let lp_bound = to_f64_up(&ub) * (1.0 + OBJECTIVE_MARGIN);
+    if !coupled {
+        return Ok(lp_bound);
+    }
+    let bins: Vec<Bilinear> = (0..g.n)
+        .map(|i| {
+            let cw = g.theta[i] * g.weight[i];
+            Bilinear {
+                cx: o.range_weight * cw,
+                ct: o.resolution_weight * cw,
+                k: unit * TAU / (g.theta[i] * period),
+                x: (xs[i].1, xs[i].2),
+                t: (taus[i].1, taus[i].2),
+            }
+        })
+        .collect();
+    let duals = Duals {
+        frame: (solved.y[frame_row], n * (1.0 - WIDEN), n * (1.0 + WIDEN)),
+        budget: (solved.y[budget_row].max(0.0), n * (1.0 + WIDEN)),
+        slews: slews
+            .iter()
+            .map(|&(r, i, j, lim)| (solved.y[r], i, j, lim))
+            .collect(),
+    };
+    let duals = improve_multipliers(&bins, duals);
+    let lag = coupled_lagrangian(&bins, &duals, LAGRANGIAN_SLICES);
+    // The smaller of two valid bounds (the Lagrangian's constants are the
+    // same floats the rows were built from: OBJECTIVE_MARGIN as above).
+    Ok(lp_bound.min(lag * (1.0 + OBJECTIVE_MARGIN)))
+}
+
+/// Lowers the Lagrangian over the frame's and the budget's multipliers
+/// (convex in them: a sum of maxima of affine functions), by coordinate
+/// golden-section searches on a coarse slicing; any multipliers are valid,
+/// this only tightens.
+fn improve_multipliers(bins: &[Bilinear], mut d: Duals) -> Duals {
+    // Measured on `smooth` (bound 8.91687 at the LP's multipliers): one
+    // round 8.91094 in 4 ms, three 8.91085 in 15 ms.
+    const PIECES: usize = 16;
+    const ROUNDS: usize = 1;
+    let golden = |lo: f64, hi: f64, f: &dyn Fn(f64) -> f64| -> f64 {
+        let r = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut a, mut b) = (lo, hi);
+        let (mut c, mut e) = (b - r * (b - a), a + r * (b - a));
+        let (mut fc, mut fe) = (f(c), f(e));
+        for _ in 0..40 {
+            if fc < fe {
+                b = e;
+                e = c;
+                fe = fc;
+                c = b - r * (b - a);
+                fc = f(c);
+            } else {
+                a = c;
+                c = e;
+                fc = fe;
+                e = a + r * (b - a);
+                fe = f(e);
+            }
+        }
+        0.5 * (a + b)
+    };
+    for _ in 0..ROUNDS {
+        let (mu, nu) = (d.budget.0, d.frame.0);
+        let span = mu.abs() + nu.abs() + 1e-6;
+        d.budget.0 = golden(0.0, mu + span, &|m| {
+            coupled_lagrangian_at(bins, &d, m, nu, PIECES)
+        });
+        let mu = d.budget.0;
+        d.frame.0 = golden(nu - span, nu + span, &|v| {
+            coupled_lagrangian_at(bins, &d, mu, v, PIECES)
+        });
+    }
+    d
+}
+
+/// One bin of the coupled problem: `cx·√x + ct·√(k·τ)` on the box.
+struct Bilinear {
+    cx: f64,
+    ct: f64,
+    k: f64,
+    x: (f64, f64),
+    t: (f64, f64),
+}
+
+/// Multipliers of the coupled problem's rows: frame `(ν, lo, hi)`, budget
+/// `(μ ≥ 0, hi)` of `Σ τ_i x_i ≤ hi`, slew `(y, i, j, lim)` of
+/// `−lim ≤ x_j − x_i ≤ lim`.
+struct Duals {
+    frame: (f64, f64, f64),
+    budget: (f64, f64),
+    slews: Vec<(f64, usize, usize, f64)>,
+}
+
+/// Weak duality for the coupled problem with the **exact** product
+/// `τ_i x_i` (module docs, "coupled Lagrangian"): for the multipliers `d`,
+/// `Σ_rows max(y·lo, y·hi) + Σ_i max_box (J_i − μ τ x − ν τ − σ_i x)`,
+/// each bin's maximum bounded over `pieces` slices of its τ box (on a
+/// slice `μτx ≥ μ·τ_start·x`, so the slice's bound is the x-part at
+/// `τ_start` plus the τ-part's own maximum, both concave closed forms).
+/// Floating point, raised by a relative 1e-12 of the terms' magnitudes.
+fn coupled_lagrangian(bins: &[Bilinear], d: &Duals, pieces: usize) -> f64 {
+    coupled_lagrangian_at(bins, d, d.budget.0, d.frame.0, pieces)
+}
+
+/// [`coupled_lagrangian`] with the budget's multiplier `mu ≥ 0` and the
+/// frame's `nu` in place of `d`'s.
+fn coupled_lagrangian_at(bins: &[Bilinear], d: &Duals, mu: f64, nu: f64, pieces: usize) -> f64 {
+    let (_, f_lo, f_hi) = d.frame;
+    let (_, b_hi) = d.budget;
+    let mut sigma = vec![0.0; bins.len()];
+    let mut total = (nu * f_lo).max(nu * f_hi) + mu * b_hi;
+    let mut magnitude = total.abs();
+    for &(y, i, j, lim) in &d.slews {
+        sigma[j] += y;
+        sigma[i] -= y;
+        total += y.abs() * lim;
+        magnitude += y.abs() * lim;
+    }
+    // max over v ∈ [lo, hi] of c√(s·v) − m·v (c ≥ 0), value and magnitude.
+    let concave = |c: f64, s: f64, m: f64, lo: f64, hi: f64| -> (f64, f64) {
+        let v = if m <= 0.0 || c <= 0.0 {
+            if m <= 0.0 {
+                hi
+            } else {
+                lo
+            }
+        } else {
+            (s * (c / (2.0 * m)).powi(2)).clamp(lo, hi)
+        };
+        let (gain, cost) = (c * (s * v).max(0.0).sqrt(), m * v);
+        (gain - cost, gain.abs() + cost.abs())
+    };
+    for (b, &sg) in bins.iter().zip(&sigma) {
+        let (tl, th) = b.t;
+        let mut best = f64::NEG_INFINITY;
+        let mut best_mag = 0.0;
+        for p in 0..pieces {
+            let a = tl + (th - tl) * p as f64 / pieces as f64;
+            let e = if p + 1 == pieces {
+                th
+            } else {
+                tl + (th - tl) * (p + 1) as f64 / pieces as f64
+            };
+            let (vx, mx) = concave(b.cx, 1.0, mu * a + sg, b.x.0, b.x.1);
+            let (vt, mt) = concave(b.ct, b.k, nu, a, e);
+            if vx + vt > best {
+                best = vx + vt;
+                best_mag = mx + mt;
+            }
+        }
+        total += best;
+        magnitude += best_mag;
+    }
+    // Each term to a few ε, the sum to (terms)·ε of the magnitudes.
+    let terms = (bins.len() + d.slews.len() + 2) as f64;
+    total + (1e-12 + 2.0 * terms * f64::EPSILON) * magnitude
 }
 
 #[cfg(test)]
@@ -695,6 +858,86 @@ mod tests {
             let mid = 2.0 * PI / period;
             let (c_lo, c_hi) = accel_spin_box(a, period, n, mid * 0.999, mid * 1.001);
             proptest::prop_assert!(c_lo >= mid * 0.999 && c_hi <= mid * 1.001);
+        }
+    }
+
+    proptest::proptest! {
+        /// Weak duality of the coupled Lagrangian against plain evaluation:
+        /// for random bins, multipliers (either sign where the row allows)
+        /// and slew rows, at random points of the boxes the Lagrangian
+        /// function `Σ_rows max(y·lo, y·hi) + Σ_i (J_i − μτx − ντ − σ_i x)`
+        /// never exceeds `coupled_lagrangian` (so every feasible point's
+        /// `J` is below it), and a fine grid of one bin's own maximum
+        /// comes within the slicing's stated error of it.
+        #[test]
+        fn the_coupled_lagrangian_bounds_every_point(
+            seed in 0u64..u64::MAX,
+            n in 1usize..7,
+        ) {
+            use rand::{Rng, SeedableRng};
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let bins: Vec<Bilinear> = (0..n)
+                .map(|_| {
+                    let xl = rng.random_range(0.0..1.0);
+                    let tl = rng.random_range(0.1..2.0);
+                    Bilinear {
+                        cx: rng.random_range(0.0..2.0),
+                        ct: rng.random_range(0.0..2.0),
+                        k: rng.random_range(0.1..3.0),
+                        x: (xl, xl + rng.random_range(0.0..2.0)),
+                        t: (tl, tl * rng.random_range(1.0..2.0)),
+                    }
+                })
+                .collect();
+            let slews: Vec<(f64, usize, usize, f64)> = (0..n)
+                .map(|i| (rng.random_range(-1.0..1.0), i, (i + 1) % n, rng.random_range(0.0..0.5)))
+                .collect();
+            let d = Duals {
+                frame: (rng.random_range(-1.0..1.0), n as f64 * 0.9, n as f64 * 1.1),
+                budget: (rng.random_range(0.0..2.0), n as f64),
+                slews,
+            };
+            let bound = coupled_lagrangian(&bins, &d, 64);
+            let (mu, nu) = (d.budget.0, d.frame.0);
+            let rows = (nu * d.frame.1).max(nu * d.frame.2)
+                + mu * d.budget.1
+                + d.slews.iter().map(|s| s.0.abs() * s.3).sum::<f64>();
+            let mut sigma = vec![0.0; n];
+            for &(y, i, j, _) in &d.slews {
+                sigma[j] += y;
+                sigma[i] -= y;
+            }
+            let term = |b: &Bilinear, s: f64, x: f64, t: f64| {
+                b.cx * x.sqrt() + b.ct * (b.k * t).sqrt() - mu * t * x - nu * t - s * x
+            };
+            for _ in 0..200 {
+                let value: f64 = rows
+                    + bins
+                        .iter()
+                        .zip(&sigma)
+                        .map(|(b, &s)| {
+                            let x = rng.random_range(b.x.0..=b.x.1);
+                            let t = rng.random_range(b.t.0..=b.t.1);
+                            term(b, s, x, t)
+                        })
+                        .sum::<f64>();
+                proptest::prop_assert!(value <= bound, "{value} above {bound}");
+            }
+            // Not loose beyond the slicing: one bin, grid maximum.
+            let b = &bins[0];
+            let one = Duals { frame: (nu, 0.0, 0.0), budget: (mu, 0.0), slews: Vec::new() };
+            let bound1 = coupled_lagrangian(std::slice::from_ref(b), &one, 64);
+            let grid = (0..=300)
+                .flat_map(|i| (0..=300).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    let x = b.x.0 + (b.x.1 - b.x.0) * f64::from(i) / 300.0;
+                    let t = b.t.0 + (b.t.1 - b.t.0) * f64::from(j) / 300.0;
+                    term(b, 0.0, x, t)
+                })
+                .fold(f64::NEG_INFINITY, f64::max);
+            let slicing = mu * (b.t.1 - b.t.0) / 64.0 * b.x.1;
+            proptest::prop_assert!(grid <= bound1, "{grid} above {bound1}");
+            proptest::prop_assert!(bound1 <= grid + slicing + 1e-3, "{bound1} vs grid {grid} + {slicing}");
         }
     }
 
