@@ -59,6 +59,24 @@
 //! `ω_max,min = (2aπ/q ± q)/2`, `q = aT/2`). On `smooth` it is
 //! `[113.16, 138.16]` rad/s against the limits' `[90, 200]`.
 //!
+//! **Coupled Lagrangian** (time accounting with both blocks moving: the
+//! bilinear budget). McCormick's rows are the convex hull of one product
+//! on its box, but with the concave utilities kept at the point's own
+//! `(x, τ)` the LP may sit inside the hull and keep the full utility. So
+//! the bound is also computed by weak duality over the frame, budget and
+//! slew rows with the **exact** product and exact `√` per bin
+//! ([`coupled_lagrangian`]): for multipliers `ν` (frame, either sign),
+//! `μ ≥ 0` (budget), `y_r` (slew), every point meeting those rows has
+//! `J ≤ Σ_r max(y_r lo_r, y_r hi_r) + Σ_i max_box(J_i − μτ_i x_i − ντ_i − σ_i x_i)`
+//! (`σ_i` the slew multipliers on `x_i`). Each bin's maximum is bounded on
+//! slices of its τ box (on a slice `μτx ≥ μ·τ_start·x` for `x ≥ 0`, leaving
+//! two concave one-dimensional maxima in closed form). Multipliers: the
+//! LP's duals, then one golden-section pass on `μ` and `ν` (any values are
+//! valid; the function is convex in them). Floating point, raised by a
+//! relative `1e-12 + 2·(terms)·ε` of the terms' magnitudes (as
+//! `lagrangian_bound`). The answer is the smaller of this and the LP's
+//! certified bound, both valid.
+//!
 //! (Separable problems skip the LP: see `lagrangian_bound`.) The LP's own bound is certified exactly ([`super::certificate::check`]),
 //! so `upper_bound` is proven for the relaxation, hence for the problem.
 //! `objective` is `J` of the profile handed out, evaluated in floating
@@ -719,15 +737,14 @@ fn coupled_lagrangian_at(bins: &[Bilinear], d: &Duals, mu: f64, nu: f64, pieces:
     }
     // max over v ∈ [lo, hi] of c√(s·v) − m·v (c ≥ 0), value and magnitude.
     let concave = |c: f64, s: f64, m: f64, lo: f64, hi: f64| -> (f64, f64) {
-        let v = if m <= 0.0 || c <= 0.0 {
-            if m <= 0.0 {
-                hi
-            } else {
-                lo
-            }
-        } else {
-            (s * (c / (2.0 * m)).powi(2)).clamp(lo, hi)
-        };
+        let v = Term {
+            c,
+            s,
+            a: 1.0,
+            lo,
+            hi,
+        }
+        .argmax(m);
         let (gain, cost) = (c * (s * v).max(0.0).sqrt(), m * v);
         (gain - cost, gain.abs() + cost.abs())
     };
