@@ -617,7 +617,8 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     // Raised by OBJECTIVE_MARGIN: covers the float evaluation of the model's
     // constants (k, √ of a fixed block) the rows were built from.
     let lp_bound = to_f64_up(&ub) * (1.0 + OBJECTIVE_MARGIN);
-    if !coupled {
+    // The Lagrangian's slices need x ≥ 0 (powers are never negative).
+    if !coupled || xs.iter().any(|&(_, lo, _)| lo.is_nan() || lo < 0.0) {
         return Ok(lp_bound);
     }
     let bins: Vec<Bilinear> = (0..g.n)
@@ -678,6 +679,7 @@ fn improve_multipliers(bins: &[Bilinear], mut d: Duals) -> Duals {
         }
         0.5 * (a + b)
     };
+    let start = (d.budget.0, d.frame.0, coupled_lagrangian(bins, &d, PIECES));
     for _ in 0..ROUNDS {
         let (mu, nu) = (d.budget.0, d.frame.0);
         let span = mu.abs() + nu.abs() + 1e-6;
@@ -688,6 +690,11 @@ fn improve_multipliers(bins: &[Bilinear], mut d: Duals) -> Duals {
         d.frame.0 = golden(nu - span, nu + span, &|v| {
             coupled_lagrangian_at(bins, &d, mu, v, PIECES)
         });
+    }
+    // Keep the start where the search did not improve on it.
+    let after = coupled_lagrangian(bins, &d, PIECES);
+    if after.is_nan() || after > start.2 {
+        (d.budget.0, d.frame.0) = (start.0, start.1);
     }
     d
 }
