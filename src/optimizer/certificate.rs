@@ -72,12 +72,18 @@ impl LinearProgram {
 
     /// Adds `lo ≤ Σ coefs ≤ hi`; coefficients on the same column are summed.
     pub fn add_row(&mut self, coefs: &[(usize, f64)], lo: f64, hi: f64) {
+        // Merged in order of first appearance; the slot of each column
+        // through a map (a budget row has thousands of entries).
         let mut merged: Vec<(usize, f64)> = Vec::with_capacity(coefs.len());
+        let mut slot: std::collections::HashMap<usize, usize> =
+            std::collections::HashMap::with_capacity(coefs.len());
         for &(j, a) in coefs {
-            if let Some(e) = merged.iter_mut().find(|e| e.0 == j) {
-                e.1 += a;
-            } else {
-                merged.push((j, a));
+            match slot.entry(j) {
+                std::collections::hash_map::Entry::Occupied(e) => merged[*e.get()].1 += a,
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(merged.len());
+                    merged.push((j, a));
+                }
             }
         }
         merged.retain(|e| e.1 != 0.0);
