@@ -170,3 +170,95 @@ fn setpoints_that_cannot_meet_the_frame_are_reported_infeasible() {
         Ok(_) => panic!("no composition of the set-points meets the frame"),
     }
 }
+
+/// A profile@1 of equal bins with the given powers (W) and step spins
+/// (rad/s), the problem's sensor and limits, certified by the checker.
+fn certify_by_hand(
+    problem: &gaze_lidar::optimizer::Problem,
+    power_w: &[f64],
+    spin_rad_s: &[f64],
+) -> Result<gaze_lidar::checker::CertifiedProfile, gaze_lidar::checker::Rejected> {
+    let n = power_w.len();
+    let width = 360.0 / n as f64;
+    let bins: Vec<serde_json::Value> = (0..n)
+        .map(|i| {
+            serde_json::json!({
+                "start_deg": i as f64 * width, "width_deg": width, "power_w": power_w[i],
+                "spin_start_rad_s": spin_rad_s[i], "spin_end_rad_s": spin_rad_s[i],
+            })
+        })
+        .collect();
+    let doc = serde_json::json!({
+        "format": "gaze-lidar/profile@1",
+        "frame_rate_hz": problem.lidar.frame_rate_hz,
+        "pulse_rate_hz": problem.lidar.pulse_rate_hz,
+        "average_power_w": problem.lidar.average_power_w,
+        "power_accounting": serde_json::to_value(problem.lidar.power_accounting).unwrap(),
+        "gaze_deg": null,
+        "limits": serde_json::to_value(&problem.lidar.limits).unwrap(),
+        "bins": bins,
+    });
+    let profile = gaze_lidar::profile::Profile::from_json(&doc.to_string(), "by hand").unwrap();
+    gaze_lidar::checker::certify(profile)
+}
+
+/// Claim 3/4 ("a node-limited answer is a feasible incumbent checked
+/// exactly"; "the answers pass check"): the power step's MILP accepts
+/// HiGHS's level choice at HiGHS's own tolerance (its MIP feasibility
+/// tolerance is 1e-6, the budget row's slack 1e-12 relative), and nothing
+/// repairs a level choice. Two levels, 0.5·P̄ and 1.5·P̄·(1 + 3.3e-8):
+/// six high bins of twelve overspend the budget by 5e-8 relative; HiGHS
+/// takes them, the exact check fails (no `optimality`), and the checker
+/// rejects the profile: exit 1 "the optimized profile violates its
+/// limits: average_power_w …" although five high bins (or all low ones,
+/// certified below) are an answer.
+#[test]
+#[ignore = "finding: power-level MILP answer overspends the budget within HiGHS's MIP tolerance; the checker rejects it (error instead of answer)"]
+fn hardware_levels_a_hair_over_the_budget_still_give_an_answer() {
+    for mode in ["range", "joint"] {
+        let text = format!(
+            "bins = 12\n[lidar]\npreset = \"paper\"\npower_accounting = \"angle\"\naverage_power_w = 0.0005\n[limits]\npower_w_max = 0.001\n[levels]\npower_w = [0.00025, 0.00075000005]\n[objective]\nmode = \"{mode}\"\n"
+        );
+        let problem = problem_from_toml(&text);
+        let w = problem.lidar.mean_spin_rad_s();
+        certify_by_hand(&problem, &[0.00025; 12], &[w; 12]).expect("all low levels certify");
+        let mut five_high = [0.00025; 12];
+        five_high[..5].fill(0.00075000005);
+        certify_by_hand(&problem, &five_high, &[w; 12]).expect("five high levels certify");
+        match optimize_with_certificate(&problem, 90.0) {
+            Ok((c, cert)) => {
+                assert!(cert.is_ok(), "{mode}: the power step certified");
+                assert!(c.profile().optimality.is_some(), "{mode}");
+            }
+            Err(e) => panic!("{mode}: {e}"),
+        }
+    }
+}
+
+/// The dwell step's twin: three set-points, ω̄/1.5, ω̄/(1 + 2.5e-8) and
+/// ω̄/0.75. Four bins at ω̄/1.5 and eight at ω̄/0.75 meet the frame exactly (certified
+/// below); the dwell MILP instead takes a choice that misses the frame by
+/// ~1e-8 relative (inside HiGHS's MIP tolerance, outside the widened frame
+/// row `4e-9·(1 + Σ|a|)` and the checker's 1e-9): no certificate, and the
+/// checker rejects the profile (exit 1, "frame period: the bins' dwell
+/// times sum to 0.0500000009375 s").
+#[test]
+#[ignore = "finding: set-point MILP answer misses the frame within HiGHS's MIP tolerance; the checker rejects it (error instead of answer)"]
+fn setpoints_a_hair_off_the_frame_still_give_an_answer() {
+    let w_mean = 2.0 * std::f64::consts::PI * 20.0;
+    let sp = [w_mean / 1.5, w_mean / (1.0 + 2.5e-8), w_mean / 0.75];
+    let text = setpoint_config(&sp, "resolution").replace("bins = 360", "bins = 12");
+    let text = text.replace("spin_rad_s_min = 20.0\nspin_rad_s_max = 600.0\n", "");
+    let problem = problem_from_toml(&text);
+    let p = problem.lidar.average_power_w;
+    let mut spins = [sp[2]; 12];
+    spins[..4].fill(sp[0]);
+    certify_by_hand(&problem, &[p; 12], &spins).expect("4 slow + 8 fast meet the frame");
+    match optimize_with_certificate(&problem, 90.0) {
+        Ok((c, cert)) => {
+            assert!(cert.is_ok());
+            assert!(c.profile().optimality.is_some());
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
