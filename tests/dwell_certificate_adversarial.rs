@@ -286,3 +286,45 @@ fn a_generous_acceleration_limit_is_not_infeasible_in_joint_mode() {
         panic!("{e}");
     }
 }
+
+/// Claim 4 ("infeasible exit 1"): a spin fixed by its limits
+/// (`spin_rad_s_min = spin_rad_s_max` = the mean spin the frame needs,
+/// which the prechecks accept) is feasible — the uniform spin certifies —
+/// but the dwell step's box keeps a relative `MARGIN` (1e-6) inside both
+/// limits, so its lower side exceeds its upper one, the column is fixed at
+/// `1 + 1e-6` and the frame row cannot hold: `infeasible: the dwell step
+/// has no solution within the limits` in `resolution` and `joint` modes.
+#[test]
+#[ignore = "finding: spin_rad_s_min = spin_rad_s_max = the mean spin is reported infeasible (the dwell box's MARGIN)"]
+fn a_spin_fixed_by_its_limits_is_not_infeasible() {
+    for mode in ["resolution", "joint"] {
+        let w = 2.0 * std::f64::consts::PI * 20.0;
+        let text = format!(
+            "bins = 24\n[lidar]\npreset = \"paper\"\n[limits]\nspin_rad_s_min = {w:?}\nspin_rad_s_max = {w:?}\n[objective]\nmode = \"{mode}\"\n"
+        );
+        let problem = problem_from_toml(&text);
+        let p = problem.lidar.average_power_w;
+        certify_by_hand(&problem, &[p; 24], &[w; 24]).expect("the uniform spin certifies");
+        if let Err(e) = optimize_with_certificate(&problem, 10.0) {
+            panic!("{mode}: {e}");
+        }
+    }
+}
+
+/// Bad input names its field (exit 2): an objective weight HiGHS cannot
+/// take (≥ its infinite cost, 1e20 less the chords' factors) ends as
+/// `solver: dwell step: Error` (an `OptError::Solver`, exit 1) instead of
+/// naming `objective.resolution_weight`.
+#[test]
+#[ignore = "finding: objective.resolution_weight = 1e19 gives 'solver: dwell step: Error' (exit 1), not a bad-input error naming the field"]
+fn a_huge_objective_weight_is_bad_input_naming_the_field() {
+    let text = "bins = 24\n[lidar]\npreset = \"paper\"\n[objective]\nmode = \"joint\"\nresolution_weight = 1e19\n";
+    let problem = problem_from_toml(text);
+    match optimize_with_certificate(&problem, 10.0) {
+        Ok(_) => {}
+        Err(e) => {
+            assert!(e.is_input_error(), "{e}");
+            assert!(e.to_string().contains("resolution_weight"), "{e}");
+        }
+    }
+}
