@@ -347,3 +347,31 @@ fn levels_and_setpoints_at_720_bins_solve_within_30_s() {
     assert!(r.is_ok(), "{:?}", r.err());
     assert!(secs < 30.0, "{secs:.1} s");
 }
+
+/// Claim 2 (the top-level figures are the dwell program's and describe the
+/// answer): the dwell program drops its utilities' constants
+/// (`λ_ρ θ_i w_i √r_0`, "its constant does not move the optimum"), while
+/// the power step keeps them on a column fixed at 1. So in `resolution`
+/// mode `optimality.objective` is not the profile's objective: with spin
+/// limits 125.66–125.67 rad/s (20 Hz: the mean spin 125.664 inside) it is
+/// 3.09e-4 while the profile's exact objective (`exact_objective`) is
+/// 10.49 (`optimality.global.objective`, which also counts the range term,
+/// 15.74), and the stated gap 2.0e-7 reads as 6.5e-4 relative where it is
+/// 2e-8 of the objective.
+#[test]
+#[ignore = "finding: resolution-mode optimality.objective omits the dwell utilities' constants (3.1e-4 vs the profile's 10.49; relative gap inflated ~3e4x)"]
+fn resolution_mode_objective_is_the_profiles_objective() {
+    let text = "bins = 90\n[lidar]\npreset = \"paper\"\npower_accounting = \"time\"\n[limits]\nspin_rad_s_min = 125.66\nspin_rad_s_max = 125.67\n[objective]\nmode = \"resolution\"\nresolution_weight = 2.0\n";
+    let problem = problem_from_toml(text);
+    let (c, cert) = optimize_with_certificate(&problem, 77.0).unwrap();
+    assert!(cert.is_ok());
+    let o = c.profile().optimality.clone().expect("optimality");
+    let exact = gaze_lidar::optimizer::exact_objective(&problem, 77.0, c.profile()).unwrap();
+    // Chords from below: the program's objective is at most the exact one
+    // and close to it, as the power step's (which keeps its constants) is.
+    assert!(
+        o.objective <= exact && o.objective >= exact * (1.0 - 1e-3),
+        "optimality.objective {} vs the profile's exact objective {exact}",
+        o.objective
+    );
+}
