@@ -266,14 +266,16 @@ fn setpoints_a_hair_off_the_frame_still_give_an_answer() {
 /// Claim 4 ("infeasible exit 1"): a feasible joint problem reported
 /// infeasible. The paper preset at 20 Hz under time accounting, spin
 /// 1–1000 rad/s, a generous acceleration limit (10⁴ rad/s²), `joint`: the
-/// uniform baseline certifies (below), but a later round of the sequential
-/// LP has no dwell within the trust region (±30 %) that meets the
-/// acceleration rows re-linearised at the faster iterate (their width
-/// shrinks as ω̃⁻³) together with the frame and the budget row at the
-/// power step's powers (tight, no margin), and the solve ends with
-/// `infeasible: the dwell step has no solution within the limits` (exit
-/// 1) at every bin count tried (36–360) and gaze. `resolution` mode on the
-/// same sensor solves.
+/// uniform baseline certifies (below), but the solve ends with
+/// `infeasible: the dwell step has no solution within the limits` (exit 1)
+/// at every bin count tried (36–360) and gaze. Likely cause (not proven):
+/// a later round of the sequential LP has no dwell within the trust region
+/// (±30 %) that meets the acceleration rows re-linearised at the faster
+/// iterate (their width shrinks as ω̃⁻³) together with the frame and the
+/// time-accounting budget row at the power step's powers (tight, no
+/// margin). The same sensor solves under angle accounting (no budget row
+/// in the dwell step), with 3·10³ or 3·10⁴ rad/s², and in `resolution`
+/// mode.
 #[test]
 #[ignore = "finding: joint mode with a finite acceleration limit reports a feasible problem infeasible (a later SLP dwell step is infeasible)"]
 fn a_generous_acceleration_limit_is_not_infeasible_in_joint_mode() {
