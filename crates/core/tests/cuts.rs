@@ -198,3 +198,80 @@ fn a_single_pulse_cut_by_hand() {
     );
     assert_eq!(two.rule, Rule::T2Train);
 }
+
+fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    (lo.ln()..hi.ln()).prop_map(f64::exp)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases() / 4 + 1))]
+
+    /// As `a_threshold_drops_only_the_cuts_below_it`, where every pruning
+    /// test decides: passes of a few pulses to a few hundred (every run, or
+    /// the runs to and from the bins' edges), pulse rates up to MHz in
+    /// 700–1050 nm (several pulses within `T_i`: the group cuts, C5 below 1
+    /// at their counts), and thresholds around the strongest cut of each
+    /// kind (runs, groups, whole passes), where dropping a cut it reaches
+    /// shows.
+    #[test]
+    fn a_threshold_drops_only_the_cuts_below_it_in_every_regime(
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 5.0f64..60.0, any::<bool>()), 1..8),
+        band in prop_oneof![3 => Just(Band::RetinalNir), 1 => Just(Band::Ir1400), 1 => Just(Band::Ir1500)],
+        half_deg in log_uniform(1e-3, 5.0),
+        pulses in log_uniform(1.5, 300.0),
+        kind in 0usize..3,
+        share in prop_oneof![0.0f64..1.2, 0.999f64..1.0],
+    ) {
+        let segs = profile(&bins);
+        let spin = segs.iter().map(|s| s.spin_start_rad_s).sum::<f64>() / segs.len() as f64;
+        let f_p = (pulses * spin / (2.0 * half_deg).to_radians()).min(2e7);
+        let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+        let p = powers(&segs);
+        let all = cuts(&segs, half_deg, &laser, &[], 0.0);
+        let frame_s = gaze_lidar_core::profile::kinematics::Timeline::from_bins(&segs).period_s();
+        let t_i = laser.band.t_i_s();
+        let of_kind = |c: &gaze_lidar_core::eye_safety::cuts::Cut| match kind {
+            // Runs within a pass (Rule 1's one-pulse cuts aside).
+            0 => c.window_s.0 < frame_s && c.window_s.1 > c.window_s.0,
+            // T_i groups.
+            1 => c.window_s == (t_i, t_i) && c.pulses.iter().map(|e| e.1).sum::<f64>() > 1.0,
+            // Whole passes.
+            _ => c.window_s.0 > frame_s,
+        };
+        let top = all.iter().filter(|c| of_kind(c)).map(|c| c.ratio(&p, f_p)).fold(0.0, f64::max);
+        prop_assume!(top > 0.0);
+        let t = top * share;
+        let key = |c: &gaze_lidar_core::eye_safety::cuts::Cut| (c.pulses.clone(), c.limit_j.to_bits());
+        let mut want: Vec<_> = all.iter().filter(|c| c.ratio(&p, f_p) >= t).map(key).collect();
+        let mut got: Vec<_> = cuts(&segs, half_deg, &laser, &[], t).iter().map(key).collect();
+        want.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        got.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        prop_assert_eq!(got, want);
+    }
+
+    /// The Rule 1 cuts' own threshold (`cuts_with`): with no other cut
+    /// wanted, the Rule 1 cuts are exactly those of all of them at or above
+    /// it, one per bin.
+    #[test]
+    fn the_rule_one_threshold_drops_only_rule_one_cuts_below_it(
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 2.0f64..80.0, any::<bool>()), 1..12),
+        f_p in 1e3f64..1e6,
+        half_deg in 0.05f64..5.0,
+        share in prop_oneof![0.0f64..1.2, Just(1.0)],
+    ) {
+        let segs = profile(&bins);
+        let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+        let p = powers(&segs);
+        let single = gaze_lidar_core::eye_safety::cuts::cuts_with(&segs, half_deg, &laser, &[], f64::INFINITY, 0.0);
+        prop_assert!(single.iter().all(|c| c.rule == Rule::SinglePulse && c.pulses.len() == 1 && c.pulses[0].1 == 1.0));
+        let mut bins_cut: Vec<usize> = single.iter().map(|c| c.pulses[0].0).collect();
+        bins_cut.sort_unstable();
+        bins_cut.dedup();
+        prop_assert_eq!(bins_cut.len(), single.len());
+        let ratios: Vec<f64> = single.iter().map(|c| c.ratio(&p, f_p)).collect();
+        let t1 = ratios.iter().copied().fold(0.0, f64::max) * share;
+        let got = gaze_lidar_core::eye_safety::cuts::cuts_with(&segs, half_deg, &laser, &[], f64::INFINITY, t1);
+        let want: Vec<_> = single.iter().zip(&ratios).filter(|(_, &r)| r >= t1).map(|(c, _)| c.clone()).collect();
+        prop_assert_eq!(got, want);
+    }
+}
