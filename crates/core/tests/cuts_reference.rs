@@ -431,13 +431,15 @@ proptest! {
     /// `pulses` sets the pulses of a typical pass (the pulse rate follows
     /// from it): up to 32, every run; beyond, the runs to and from the bins'
     /// edges. Pulse durations at the bands' `T_i` groups included (the pulse
-    /// rate of a pass of a few µs reaches MHz).
+    /// rate of a pass of a few µs reaches MHz). Pass angles of 360° and
+    /// more too: a pass of the whole frame meets its first bin again at its
+    /// end (one bin, two runs of its pulses).
     #[test]
     fn cuts_are_the_reference_s_exposures(
         bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 1.0f64..3.0), 1..8),
         base in 5.0f64..60.0,
         band in prop_oneof![Just(Band::RetinalNir), Just(Band::Ir1400), Just(Band::Ir1500)],
-        half_deg in prop_oneof![log_uniform(1e-3, 5.0), Just(1.0)],
+        half_deg in prop_oneof![4 => log_uniform(1e-3, 5.0), 1 => Just(1.0), 1 => Just(180.0), 1 => 180.0f64..400.0],
         pulses in prop_oneof![1.2f64..10.0, 10.0f64..60.0],
         pulse_s in prop_oneof![Just(5e-9), Just(1e-7)],
         extra in 0.0f64..360.0,
