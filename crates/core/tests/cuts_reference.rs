@@ -522,3 +522,39 @@ fn a_pass_of_an_integer_pulse_count_holds_one_pulse_less() {
         .iter()
         .any(|c| c.pulses.iter().map(|&(_, n)| n).sum::<f64>() == 20.0));
 }
+
+/// A `T_i` group is several pulses: on the knife edge where a pass holds
+/// one pulse with room but the bound counts two (`τ·f_p` = 1: 10 turns a
+/// second, pass angle 0.018°, τ = 5 µs, 200 kHz, `T_i` = 5 µs holds two
+/// pulses), there is no group cut of one pulse.
+#[test]
+fn no_group_cut_of_one_pulse() {
+    let spin = std::f64::consts::TAU * 10.0;
+    let segs: Vec<Seg> = (0..4)
+        .map(|i| Seg {
+            start_deg: 90.0 * f64::from(i),
+            width_deg: 90.0,
+            power_w: 1e-3,
+            spin_start_rad_s: spin,
+            spin_end_rad_s: spin,
+        })
+        .collect();
+    let laser = Laser {
+        band: Band::RetinalNir,
+        c4: 1.0,
+        pulse_duration_s: 5e-9,
+        pulse_rate_hz: 2e5,
+    };
+    assert_eq!(laser.group(2.0), 2.0);
+    let t_i = laser.band.t_i_s();
+    let all = cuts(&segs, 0.009, &laser, &[], 0.0);
+    assert!(!all.is_empty());
+    for c in &all {
+        if c.window_s == (t_i, t_i) {
+            assert!(
+                c.pulses.iter().map(|&(_, n)| n).sum::<f64>() >= 2.0,
+                "{c:?}"
+            );
+        }
+    }
+}
