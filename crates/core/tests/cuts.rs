@@ -198,3 +198,194 @@ fn a_single_pulse_cut_by_hand() {
     );
     assert_eq!(two.rule, Rule::T2Train);
 }
+
+fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    (lo.ln()..hi.ln()).prop_map(f64::exp)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases() / 4 + 1))]
+
+    /// As `a_threshold_drops_only_the_cuts_below_it`, where every pruning
+    /// test decides: passes of a few pulses to a few hundred (every run, or
+    /// the runs to and from the bins' edges), pulse rates up to MHz in
+    /// 700–1050 nm (several pulses within `T_i`: the group cuts, C5 below 1
+    /// at their counts), and thresholds around the strongest cut of each
+    /// kind (runs, groups, whole passes), where dropping a cut it reaches
+    /// shows.
+    #[test]
+    fn a_threshold_drops_only_the_cuts_below_it_in_every_regime(
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, log_uniform(5.0, 1000.0), any::<bool>()), 1..8),
+        band in prop_oneof![3 => Just(Band::RetinalNir), 1 => Just(Band::Ir1400), 1 => Just(Band::Ir1500)],
+        half_deg in log_uniform(1e-3, 5.0),
+        pulses in log_uniform(1.5, 300.0),
+        kind in 0usize..3,
+        share in prop_oneof![0.0f64..1.2, 0.999f64..1.0],
+    ) {
+        let segs = profile(&bins);
+        let spin = segs.iter().map(|s| s.spin_start_rad_s).sum::<f64>() / segs.len() as f64;
+        let f_p = (pulses * spin / (2.0 * half_deg).to_radians()).min(2e7);
+        let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+        let p = powers(&segs);
+        let all = cuts(&segs, half_deg, &laser, &[], 0.0);
+        let frame_s = gaze_lidar_core::profile::kinematics::Timeline::from_bins(&segs).period_s();
+        let t_i = laser.band.t_i_s();
+        let of_kind = |c: &gaze_lidar_core::eye_safety::cuts::Cut| match kind {
+            // Runs within a pass (Rule 1's one-pulse cuts aside).
+            0 => c.window_s.0 < frame_s && c.window_s.1 > c.window_s.0,
+            // T_i groups.
+            1 => c.window_s == (t_i, t_i) && c.pulses.iter().map(|e| e.1).sum::<f64>() > 1.0,
+            // Whole passes.
+            _ => c.window_s.0 > frame_s,
+        };
+        let top = all.iter().filter(|c| of_kind(c)).map(|c| c.ratio(&p, f_p)).fold(0.0, f64::max);
+        prop_assume!(top > 0.0);
+        let t = top * share;
+        let key = |c: &gaze_lidar_core::eye_safety::cuts::Cut| (c.pulses.clone(), c.limit_j.to_bits());
+        let mut want: Vec<_> = all.iter().filter(|c| c.ratio(&p, f_p) >= t).map(key).collect();
+        let mut got: Vec<_> = cuts(&segs, half_deg, &laser, &[], t).iter().map(key).collect();
+        want.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        got.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        prop_assert_eq!(got, want);
+    }
+
+    /// The Rule 1 cuts' own threshold (`cuts_with`): with no other cut
+    /// wanted, the Rule 1 cuts are exactly those of all of them at or above
+    /// it, one per bin.
+    #[test]
+    fn the_rule_one_threshold_drops_only_rule_one_cuts_below_it(
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4, 2.0f64..80.0, any::<bool>()), 1..12),
+        f_p in 1e3f64..1e6,
+        half_deg in 0.05f64..5.0,
+        share in prop_oneof![0.0f64..1.2, Just(1.0)],
+    ) {
+        let segs = profile(&bins);
+        let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+        let p = powers(&segs);
+        let single = gaze_lidar_core::eye_safety::cuts::cuts_with(&segs, half_deg, &laser, &[], f64::INFINITY, 0.0);
+        prop_assert!(single.iter().all(|c| c.rule == Rule::SinglePulse && c.pulses.len() == 1 && c.pulses[0].1 == 1.0));
+        let mut bins_cut: Vec<usize> = single.iter().map(|c| c.pulses[0].0).collect();
+        bins_cut.sort_unstable();
+        bins_cut.dedup();
+        prop_assert_eq!(bins_cut.len(), single.len());
+        let ratios: Vec<f64> = single.iter().map(|c| c.ratio(&p, f_p)).collect();
+        let t1 = ratios.iter().copied().fold(0.0, f64::max) * share;
+        let got = gaze_lidar_core::eye_safety::cuts::cuts_with(&segs, half_deg, &laser, &[], f64::INFINITY, t1);
+        let want: Vec<_> = single.iter().zip(&ratios).filter(|(_, &r)| r >= t1).map(|(c, _)| c.clone()).collect();
+        prop_assert_eq!(got, want);
+    }
+}
+
+/// By hand: the Rule 1 cap at 905 nm, 10 kHz, pass angle 4°, at most 10
+/// turns a second (62.83 rad/s) with a 0.1 s frame: the shortest pass is
+/// 4°/3600°/s = 1.111 ms, 12 pulses a pass, 101 passes meeting T2, C5 =
+/// 5·1212^−¼ = 0.84741, so a pulse may carry C5·7.7e-8·C4 = 1.6772e-7 J
+/// (C4 = 2.5704): 1.6772e-3 W at 10 kHz. At 20 turns a second the pass
+/// halves: 6 pulses, 101 passes (⌊(10 + 0.00056)/0.1⌋ + 1), C5 =
+/// 5·606^−¼ = 1.0 (clamped), 7.7e-8·C4·1e4 = 1.9792e-3 W. And a spin
+/// limit so slow that the shortest pass is the whole frame (0.111 s,
+/// capped at 0.1 s): about 1,000 pulses a pass, about 100 passes meeting
+/// T2, 5·N^−¼ ≈ 0.28: C5 clamped to 0.4, 0.4·7.7e-8·C4·1e4 W.
+#[test]
+fn the_rule_one_cap_by_hand() {
+    use gaze_lidar_core::eye_safety::cuts::rule_one_cap_w;
+    let c4 = ael::c4(905.0);
+    let laser = Laser {
+        band: Band::RetinalNir,
+        c4,
+        pulse_duration_s: 5e-9,
+        pulse_rate_hz: 1e4,
+    };
+    let tau = std::f64::consts::TAU;
+    let cap = rule_one_cap_w(&laser, 2.0, tau * 10.0, 0.1);
+    let want = 5.0 * 1212f64.powf(-0.25) * 7.7e-8 * c4 * 1e4;
+    assert!((want - 1.6772e-3).abs() < 1e-7, "{want}");
+    assert!((cap - want).abs() <= 1e-12 * want, "{cap} vs {want}");
+    let cap = rule_one_cap_w(&laser, 2.0, tau * 20.0, 0.1);
+    let want = 7.7e-8 * c4 * 1e4;
+    assert!((cap - want).abs() <= 1e-12 * want, "{cap} vs {want}");
+    // Half-angle 2° at 0.1 turn/s: a pass of 0.111 s, capped at the frame.
+    let cap = rule_one_cap_w(&laser, 2.0, tau * 0.1, 0.1);
+    let want = 0.4 * 7.7e-8 * c4 * 1e4;
+    assert!((cap - want).abs() <= 1e-12 * want, "{cap} vs {want}");
+}
+
+/// By hand: `Laser::c5` is the standard's C5 (5·N^−¼ above 600 pulses,
+/// 700–1050 nm, clamped to [0.4, 1]) for pulses up to and including
+/// `T_i` = 5 µs, and 1 for longer pulses; 1 outside 700–1050 nm.
+#[test]
+fn laser_c5_by_hand() {
+    let at = |band, pulse_duration_s| Laser {
+        band,
+        c4: 1.0,
+        pulse_duration_s,
+        pulse_rate_hz: 1e3,
+    };
+    let c5_1212 = 5.0 * 1212f64.powf(-0.25);
+    assert!((c5_1212 - 0.847_41).abs() < 1e-5);
+    for p in [5e-9, 1e-6, 5e-6] {
+        assert_eq!(at(Band::RetinalNir, p).c5(1212.0), c5_1212, "{p}");
+        assert_eq!(at(Band::RetinalNir, p).c5(100.0), 1.0, "{p}");
+        assert_eq!(at(Band::RetinalNir, p).c5(1e9), 0.4, "{p}");
+    }
+    for p in [5.000_001e-6, 1e-5, 1e-3] {
+        assert_eq!(at(Band::RetinalNir, p).c5(1212.0), 1.0, "{p}");
+    }
+    assert_eq!(at(Band::Ir1400, 5e-9).c5(1212.0), 1.0);
+    assert_eq!(at(Band::Ir1500, 5e-9).c5(1212.0), 1.0);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases() / 8 + 1))]
+
+    /// Where only the `T_i` groups reach the threshold: 700–1050 nm at 4
+    /// to 20 MHz (a group of g ≥ 21 pulses within `T_i`), passes of g + 1
+    /// or g + 2 pulses (two groups a pass), 200–255 rad/s (at most 4,096
+    /// whole-pass windows up to the time base, and about 800 groups in T2:
+    /// C5 ≈ 0.94). The group cut, `g` pulses against `C5·AEL(T_i)`, is
+    /// then above what any run of the pass can reach (`g + 2` pulses
+    /// against at least `AEL(T_i)`, `(g + 2)/g < 1/0.94`) or whole passes
+    /// (at most ~10⁵ per joule of a pulse, the group ~3·10⁸), so the search
+    /// must keep the aperture for its groups alone: the cuts at a threshold
+    /// near the strongest group cut are exactly those at or above it.
+    #[test]
+    fn a_threshold_keeps_the_group_cuts_where_only_they_reach_it(
+        bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.4), 1..5),
+        spin in 200.0f64..255.0,
+        f_p in 4e6f64..2e7,
+        extra_pulses in prop_oneof![Just(1.5f64), Just(2.5f64)],
+        share in 0.9f64..1.0,
+    ) {
+        let total: f64 = bins.iter().map(|b| b.0).sum();
+        let mut start = 0.0;
+        let segs: Vec<Seg> = bins
+            .iter()
+            .map(|&(w, p)| {
+                let width = 360.0 * w / total;
+                let seg = Seg { start_deg: start, width_deg: width, power_w: p, spin_start_rad_s: spin, spin_end_rad_s: spin };
+                start += width;
+                seg
+            })
+            .collect();
+        let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
+        let g = laser.group(f64::INFINITY);
+        prop_assert!(g >= 21.0);
+        let tau_s = (g - 1.0 + extra_pulses) / f_p;
+        let half_deg = (tau_s * spin / 2.0).to_degrees();
+        let p = powers(&segs);
+        let all = cuts(&segs, half_deg, &laser, &[], 0.0);
+        let t_i = laser.band.t_i_s();
+        let is_group = |c: &gaze_lidar_core::eye_safety::cuts::Cut| {
+            c.window_s == (t_i, t_i) && c.pulses.iter().map(|e| e.1).sum::<f64>() > 1.0
+        };
+        let top = all.iter().filter(|c| is_group(c)).map(|c| c.ratio(&p, f_p)).fold(0.0, f64::max);
+        prop_assume!(top > 0.0);
+        let t = top * share;
+        let key = |c: &gaze_lidar_core::eye_safety::cuts::Cut| (c.pulses.clone(), c.limit_j.to_bits());
+        let mut want: Vec<_> = all.iter().filter(|c| c.ratio(&p, f_p) >= t).map(key).collect();
+        let mut got: Vec<_> = cuts(&segs, half_deg, &laser, &[], t).iter().map(key).collect();
+        want.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        got.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        prop_assert_eq!(got, want);
+    }
+}
