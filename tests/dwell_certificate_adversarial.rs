@@ -112,7 +112,7 @@ fn setpoint_config(sp: &[f64], mode: &str) -> String {
 /// knapsack: the frame row), and the solve fails with
 /// `solver: dwell step: HiGHS status ReachedSolutionLimit`.
 #[test]
-#[ignore = "finding: node limit turns a feasible set-point problem into a solver error (ReachedSolutionLimit without an incumbent)"]
+// Fixed (was: node limit turns a feasible set-point problem into a solver error (ReachedSolutionLimit without an incumbent)).
 fn a_feasible_setpoint_problem_is_solved_despite_the_node_limit() {
     let (sp, n) = three_setpoints_360();
     // A certifiable profile on the set-points: n[k] one-degree bins at sp[k].
@@ -154,7 +154,7 @@ fn a_feasible_setpoint_problem_is_solved_despite_the_node_limit() {
 /// brings within 4e-4 of the frame (enumerated: the best is 21 bins at
 /// the first and 3 at the last, 4.1e-4 off in units of a bin's mean dwell).
 #[test]
-#[ignore = "finding: set-points that cannot meet the frame give 'solver: … ReachedSolutionLimit' instead of an infeasibility message"]
+// Fixed (was: set-points that cannot meet the frame give 'solver: … ReachedSolutionLimit' instead of an infeasibility message).
 fn setpoints_that_cannot_meet_the_frame_are_reported_infeasible() {
     let sp = [
         118.8631000948167,
@@ -213,7 +213,7 @@ fn certify_by_hand(
 /// limits: average_power_w …" although five high bins (or all low ones,
 /// certified below) are an answer.
 #[test]
-#[ignore = "finding: power-level MILP answer overspends the budget within HiGHS's MIP tolerance; the checker rejects it (error instead of answer)"]
+// Fixed (was: power-level MILP answer overspends the budget within HiGHS's MIP tolerance; the checker rejects it (error instead of answer)).
 fn hardware_levels_a_hair_over_the_budget_still_give_an_answer() {
     for mode in ["range", "joint"] {
         let text = format!(
@@ -243,7 +243,7 @@ fn hardware_levels_a_hair_over_the_budget_still_give_an_answer() {
 /// checker rejects the profile (exit 1, "frame period: the bins' dwell
 /// times sum to 0.0500000009375 s").
 #[test]
-#[ignore = "finding: set-point MILP answer misses the frame within HiGHS's MIP tolerance; the checker rejects it (error instead of answer)"]
+// Fixed (was: set-point MILP answer misses the frame within HiGHS's MIP tolerance; the checker rejects it (error instead of answer)).
 fn setpoints_a_hair_off_the_frame_still_give_an_answer() {
     let w_mean = 2.0 * std::f64::consts::PI * 20.0;
     let sp = [w_mean / 1.5, w_mean / (1.0 + 2.5e-8), w_mean / 0.75];
@@ -277,7 +277,7 @@ fn setpoints_a_hair_off_the_frame_still_give_an_answer() {
 /// in the dwell step), with 3·10³ or 3·10⁴ rad/s², and in `resolution`
 /// mode.
 #[test]
-#[ignore = "finding: joint mode with a finite acceleration limit reports a feasible problem infeasible (a later SLP dwell step is infeasible)"]
+// Fixed (was: joint mode with a finite acceleration limit reports a feasible problem infeasible (a later SLP dwell step is infeasible)).
 fn a_generous_acceleration_limit_is_not_infeasible_in_joint_mode() {
     let text = "bins = 36\n[lidar]\npreset = \"paper\"\npower_accounting = \"time\"\nframe_rate_hz = 20\n[limits]\nspin_rad_s_min = 1.0\nspin_rad_s_max = 1000.0\nspin_accel_rad_s2_max = 10000\n[focus]\nthreshold = 0.0831\nacuity = { model = \"levi_e2\", e2_deg = 2.72 }\n[objective]\nmode = \"joint\"\nresolution_weight = 3.0\n";
     let problem = problem_from_toml(text);
@@ -297,7 +297,7 @@ fn a_generous_acceleration_limit_is_not_infeasible_in_joint_mode() {
 /// `1 + 1e-6` and the frame row cannot hold: `infeasible: the dwell step
 /// has no solution within the limits` in `resolution` and `joint` modes.
 #[test]
-#[ignore = "finding: spin_rad_s_min = spin_rad_s_max = the mean spin is reported infeasible (the dwell box's MARGIN)"]
+// Fixed (was: spin_rad_s_min = spin_rad_s_max = the mean spin is reported infeasible (the dwell box's MARGIN)).
 fn a_spin_fixed_by_its_limits_is_not_infeasible() {
     for mode in ["resolution", "joint"] {
         let w = 2.0 * std::f64::consts::PI * 20.0;
@@ -318,10 +318,22 @@ fn a_spin_fixed_by_its_limits_is_not_infeasible() {
 /// `solver: dwell step: Error` (an `OptError::Solver`, exit 1) instead of
 /// naming `objective.resolution_weight`.
 #[test]
-#[ignore = "finding: objective.resolution_weight = 1e19 gives 'solver: dwell step: Error' (exit 1), not a bad-input error naming the field"]
+// Fixed (was: objective.resolution_weight = 1e19 gives 'solver: dwell step: Error' (exit 1), not a bad-input error naming the field).
 fn a_huge_objective_weight_is_bad_input_naming_the_field() {
     let text = "bins = 24\n[lidar]\npreset = \"paper\"\n[objective]\nmode = \"joint\"\nresolution_weight = 1e19\n";
-    let problem = problem_from_toml(text);
+    // From a config file: refused as bad input naming the key.
+    let e = OptimizerConfig::from_toml(text, "breaker3")
+        .unwrap()
+        .problem()
+        .unwrap_err();
+    assert!(
+        e.is_input_error() && e.to_string().contains("resolution_weight"),
+        "{e}"
+    );
+    // A `Problem` built in code: the same refusal from the optimizer.
+    let mut problem =
+        problem_from_toml(&text.replace("resolution_weight = 1e19", "resolution_weight = 1"));
+    problem.objective.resolution_weight = 1e19;
     match optimize_with_certificate(&problem, 10.0) {
         Ok(_) => {}
         Err(e) => {
@@ -361,7 +373,7 @@ fn levels_and_setpoints_at_720_bins_solve_within_30_s() {
 /// 15.74), and the stated gap 2.0e-7 reads as 6.5e-4 relative where it is
 /// 2e-8 of the objective.
 #[test]
-#[ignore = "finding: resolution-mode optimality.objective omits the dwell utilities' constants (3.1e-4 vs the profile's 10.49; relative gap inflated ~3e4x)"]
+// Fixed (was: resolution-mode optimality.objective omits the dwell utilities' constants (3.1e-4 vs the profile's 10.49; relative gap inflated ~3e4x)).
 fn resolution_mode_objective_is_the_profiles_objective() {
     let text = "bins = 90\n[lidar]\npreset = \"paper\"\npower_accounting = \"time\"\n[limits]\nspin_rad_s_min = 125.66\nspin_rad_s_max = 125.67\n[objective]\nmode = \"resolution\"\nresolution_weight = 2.0\n";
     let problem = problem_from_toml(text);

@@ -106,6 +106,7 @@ impl LinearProgram {
     fn highs_model(
         &self,
         relax: bool,
+        nodes: i32,
         what: &str,
         opts: &SolveOptions<'_>,
     ) -> Result<highs::Model, OptError> {
@@ -137,8 +138,13 @@ impl LinearProgram {
             m.set_option("mip_heuristic_run_feasibility_jump", false);
             // A deterministic work limit (nodes, not seconds): see
             // [`MIP_MAX_NODES`].
-            m.set_option("mip_max_nodes", MIP_MAX_NODES);
+            m.set_option("mip_max_nodes", nodes);
             m.set_option("mip_detect_symmetry", false);
+            // HiGHS accepts a MILP's rows (and integrality) to this
+            // tolerance, absolute; its default, 1e-6, lets a level choice
+            // overspend the budget by far more than the checker's relative
+            // 1e-9 (found by breaker3). Its minimum.
+            m.set_option("mip_feasibility_tolerance", MIP_FEASIBILITY_TOL);
         }
         // Measured on the shipped configs' power steps and global bound
         // (360 bins): HiGHS's presolve costs more than it saves on these
@@ -166,9 +172,9 @@ impl LinearProgram {
     /// columns then clamped into their bounds, meets exactly when HiGHS
     /// kept its tolerance (a row is off by at most `tol`, and the clamp
     /// moves it by at most `tol·Σ|a_j|`). A relaxation of this program, so
-    /// an upper bound of it bounds this program too. Integral columns are
-    /// not covered (the caller rounds them; their rows must hold as they
-    /// are).
+    /// an upper bound of it bounds this program too. Integral columns
+    /// rounded by the caller are covered as long as HiGHS's integrality
+    /// tolerance (`MIP_FEASIBILITY_TOL`, 1e-10) is at most `tol`.
     #[must_use]
     pub fn widened(&self, tol: f64) -> Self {
         let mut out = self.clone();
@@ -206,28 +212,36 @@ impl LinearProgram {
 
     /// [`Self::solve`] with options (a hot start, a feasibility tolerance).
     pub fn solve_with(&self, what: &str, opts: &SolveOptions<'_>) -> Result<Solved, OptError> {
-        let run = |relax: bool| -> Result<highs::SolvedModel, OptError> {
+        // `Ok(None)`: the node limit came without an incumbent.
+        let run = |relax: bool, nodes: i32| -> Result<Option<highs::SolvedModel>, OptError> {
             let solved = self
-                .highs_model(relax, what, opts)?
+                .highs_model(relax, nodes, what, opts)?
                 .try_solve()
                 .map_err(|e| OptError::Solver(format!("{what} step: {e:?}")))?;
             match solved.status() {
-                highs::HighsModelStatus::Optimal => Ok(solved),
+                highs::HighsModelStatus::Optimal => Ok(Some(solved)),
                 // The node limit of a MILP's branch and bound, with an
                 // incumbent: a feasible point (checked exactly like any
-                // other); its gap is stated, not assumed zero.
-                highs::HighsModelStatus::ReachedSolutionLimit
-                    if !relax
-                        && self.is_mip()
-                        && solved.primal_solution_status()
-                            == highs::HighsSolutionStatus::Feasible =>
-                {
-                    Ok(solved)
+                // other); its gap is stated, not assumed zero. Without one,
+                // the search goes on without the limit.
+                highs::HighsModelStatus::ReachedSolutionLimit if !relax && self.is_mip() => {
+                    Ok((solved.primal_solution_status() == highs::HighsSolutionStatus::Feasible)
+                        .then_some(solved))
                 }
                 highs::HighsModelStatus::Infeasible => Err(OptError::Infeasible(format!(
                     "the {what} step has no solution within the limits (power_w_min/max, the budget, spin limits, slew, acceleration and eye safety together)"
                 ))),
                 s => Err(OptError::Solver(format!("{what} step: HiGHS status {s:?}"))),
+            }
+        };
+        let run = |relax: bool| -> Result<highs::SolvedModel, OptError> {
+            match run(relax, MIP_MAX_NODES)? {
+                Some(solved) => Ok(solved),
+                None => run(relax, MIP_MAX_NODES_WITHOUT_INCUMBENT)?.ok_or_else(|| {
+                    OptError::Infeasible(format!(
+                        "the {what} step found no point meeting every limit within {MIP_MAX_NODES_WITHOUT_INCUMBENT} branch-and-bound nodes (hardware levels or spin set-points that cannot meet the budget or the frame period exactly, with the other limits)"
+                    ))
+                }),
             }
         };
         if !self.is_mip() {
@@ -404,6 +418,14 @@ impl Default for SolveOptions<'_> {
 /// LP relaxation's duals, not from the search. A node count, unlike a
 /// time limit, keeps answers deterministic; the exact gap is reported.
 pub(super) const MIP_MAX_NODES: i32 = 100;
+
+/// The search's second limit when the first ended without a feasible
+/// point (an equality knapsack: spin set-points meeting the frame period);
+/// without one there either, the step reports that it found none.
+pub(super) const MIP_MAX_NODES_WITHOUT_INCUMBENT: i32 = 5000;
+
+/// HiGHS's `mip_feasibility_tolerance` for every MILP (its minimum).
+pub(super) const MIP_FEASIBILITY_TOL: f64 = 1e-10;
 
 /// Distance from an integer within which a relaxation's value counts as
 /// integral (HiGHS's own `mip_feasibility_tolerance` is 1e-6).

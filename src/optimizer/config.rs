@@ -143,6 +143,27 @@ fn nonneg(field: &str, v: f64) -> Result<f64, OptError> {
     }
 }
 
+/// Largest objective weight accepted. Weights are relative (only their
+/// ratios move the optimum), and they become the programs' coefficients:
+/// HiGHS fails on coefficients near 1e19 (found by breaker3), so a weight
+/// beyond any sensible ratio is refused as bad input instead.
+pub const MAX_WEIGHT: f64 = 1e6;
+
+/// A weight: finite, in `[0, MAX_WEIGHT]`.
+pub(super) fn weight(field: &str, v: f64) -> Result<f64, OptError> {
+    nonneg(field, v)?;
+    if v > MAX_WEIGHT {
+        return Err(OptError::Invalid {
+            field: field.into(),
+            reason: format!(
+                "{} exceeds {MAX_WEIGHT:e}: weights are relative, scale them down together",
+                Num(v)
+            ),
+        });
+    }
+    Ok(v)
+}
+
 impl OptimizerConfig {
     /// Parses TOML; `origin` names the file in errors (toml names key and line).
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, OptError> {
@@ -243,11 +264,11 @@ impl OptimizerConfig {
             reason: e.to_string(),
         })?;
         let o = &self.objective;
-        nonneg("objective.range_weight", o.range_weight)?;
-        nonneg("objective.resolution_weight", o.resolution_weight)?;
-        nonneg("objective.floor_weight", o.floor_weight)?;
+        weight("objective.range_weight", o.range_weight)?;
+        weight("objective.resolution_weight", o.resolution_weight)?;
+        weight("objective.floor_weight", o.floor_weight)?;
         for (k, p) in o.priors.iter().enumerate() {
-            nonneg(&format!("objective.priors[{k}].weight"), p.weight)?;
+            weight(&format!("objective.priors[{k}].weight"), p.weight)?;
             if !(p.start_deg.is_finite()
                 && p.width_deg.is_finite()
                 && (0.0..=360.0).contains(&p.width_deg))

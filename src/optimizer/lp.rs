@@ -25,10 +25,12 @@ use crate::profile::{Bin, Profile, Region, PROFILE_FORMAT};
 
 /// Relative margin kept from continuous bounds, budget and caps.
 const MARGIN: f64 = 1e-6;
-/// Relative slack on the budget row of a level (MILP) power step: a few
-/// ulps of rounding in `Σ θ_i·level_i`, 1,000× inside the checker's
-/// `REL_TOL` (1e-9).
-const LEVEL_BUDGET_SLACK: f64 = 1e-12;
+/// Relative slack on the budget row of a level (MILP) power step: HiGHS
+/// accepts a MILP's rows to `MIP_FEASIBILITY_TOL` (1e-10, absolute, on a
+/// row of order one to 2π) and a level choice has no continuous part to
+/// trim, so the certified row allows 2e-10 relative; 5× inside the
+/// checker's `REL_TOL` (1e-9).
+const LEVEL_BUDGET_SLACK: f64 = 2e-10;
 /// Tie-break added to the weights, growing with signed eccentricity: makes
 /// the optimum unique where the acuity is symmetric about the gaze, and is
 /// itself rotation-equivariant (a function of eccentricity only), so a
@@ -102,6 +104,14 @@ pub(super) struct Grid {
 
 pub(super) fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
     super::validate_bins(problem.bins, "bins")?;
+    // A `Problem` built in code, not from a config, is checked too.
+    let o = &problem.objective;
+    super::config::weight("objective.range_weight", o.range_weight)?;
+    super::config::weight("objective.resolution_weight", o.resolution_weight)?;
+    super::config::weight("objective.floor_weight", o.floor_weight)?;
+    for (k, p) in o.priors.iter().enumerate() {
+        super::config::weight(&format!("objective.priors[{k}].weight"), p.weight)?;
+    }
     let b = Binning::uniform(problem.bins).map_err(|e| OptError::Invalid {
         field: "bins".into(),
         reason: e.to_string(),
@@ -768,6 +778,7 @@ fn dwell_step(
     // Per bin with set-points, (spin, binary column) per set-point.
     let mut sp_cols: Vec<Vec<(f64, usize)>> = Vec::new();
     let mut start: Vec<f64> = Vec::new();
+    let mut utility_constant = 0.0;
     let allowed: Vec<f64> = setpoints
         .iter()
         .copied()
@@ -787,7 +798,18 @@ fn dwell_step(
             } else {
                 1e9
             };
-            let (mut lo, mut hi) = (lo, hi.max(lo));
+            // Where the margins cross (spin limits within 2e-6 of each
+            // other, e.g. equal: a fixed spin), the limits themselves.
+            let (lo, hi) = if lo <= hi {
+                (lo, hi)
+            } else {
+                let bare = |w: f64| th / w / unit;
+                (
+                    bare(l.spin_rad_s_max),
+                    bare(l.spin_rad_s_min).max(bare(l.spin_rad_s_max)),
+                )
+            };
+            let (mut lo, mut hi) = (lo, hi);
             let trust = l.spin_accel_rad_s2_max.is_some() || touched[i];
             if trust {
                 lo = lo.max(current[i] / unit * (1.0 - TRUST));
@@ -817,7 +839,9 @@ fn dwell_step(
                 super::UTILITY_SEGMENTS
             };
             let shape = sqrt_segments_n(r_0, r_hi.min(k * hi).max(r_0), chords);
-            shape.add_to(&mut lp, ti, k, r_0, lam * th * g.weight[i]);
+            let c = lam * th * g.weight[i];
+            shape.add_to(&mut lp, ti, k, r_0, c);
+            utility_constant += c * shape.base;
             start.extend(shape.fill(r_0, k * t0));
             tau.push(vec![(ti, 1.0)]);
         } else {
@@ -834,6 +858,13 @@ fn dwell_step(
             tau.push(ys.iter().map(|&(w, y)| (y, th / w / unit)).collect());
             sp_cols.push(ys);
         }
+    }
+    // The utilities' constants Σ c·√r_0 as one column fixed at 1 (as the
+    // power step's), so the program's objective is the chord model's value
+    // of the profile, comparable with `exact_objective`.
+    if utility_constant != 0.0 {
+        lp.add_col(1.0, 1.0, utility_constant, false);
+        start.push(1.0);
     }
     let n = g.n as f64;
     lp.add_row(&tau.concat(), n, n);
@@ -1013,8 +1044,12 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
             last = Some(plp);
         }
         Mode::Resolution => {
-            for _ in 0..spin_rounds {
-                let step = dwell_step(problem, &g, &[], f_p, &p, &t)?;
+            for round in 0..spin_rounds {
+                let step = match dwell_step(problem, &g, &[], f_p, &p, &t) {
+                    // See the joint loop.
+                    Err(OptError::Infeasible(_)) if round > 0 => break,
+                    r => r?,
+                };
                 let next = DwellCertificates::push(&mut dwell, step);
                 let settled = settled(&next, &t);
                 t = next;
@@ -1026,7 +1061,15 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
         Mode::Joint => {
             let rounds = spin_rounds.max(2);
             for round in 0..rounds {
-                let step = dwell_step(problem, &g, &binding, f_p, &p, &t)?;
+                let step = match dwell_step(problem, &g, &binding, f_p, &p, &t) {
+                    // A later round's program (re-linearised acceleration
+                    // rows, trust region, the budget at the new powers) can
+                    // have no point even though the iterate is a certified
+                    // profile's (found by breaker3 at 10⁴ rad/s²): the
+                    // sequential LP cannot move from it, so it stops there.
+                    Err(OptError::Infeasible(_)) if round > 0 => break,
+                    r => r?,
+                };
                 let next = DwellCertificates::push(&mut dwell, step);
                 if last.is_some() && next == t {
                     // A fixed point: both steps are deterministic functions
