@@ -399,7 +399,7 @@ fn resolution_mode_objective_is_the_profiles_objective() {
 /// exceeds limits.power_slew_w_per_deg_max 0 W/deg" (`joint`; `range`
 /// passes at 0 but fails at 1e-15: "slew 1.00001e-15 W/deg exceeds … 1e-15").
 #[test]
-#[ignore = "finding: a zero (or 1e-15 W/deg) power slew limit gives a profile the checker rejects (error instead of the uniform answer)"]
+// Fixed (was: a zero (or 1e-15 W/deg) power slew limit gives a profile the checker rejects (error instead of the uniform answer)).
 fn a_zero_power_slew_limit_gives_an_answer() {
     for (slew, mode) in [("0.0", "range"), ("0.0", "joint"), ("1e-15", "range")] {
         let text = format!(

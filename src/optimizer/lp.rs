@@ -613,8 +613,57 @@ fn powers(
                 *pi = (*pi * scale).max(l.power_w_min);
             }
         }
+        if let Some(s) = l.power_slew_w_per_deg_max {
+            slew_down(&mut p, g, s);
+        }
     }
     p
+}
+
+/// Lowers powers (W) until every neighbour pair meets the program's slew
+/// rows, `|p_j − p_i| ≤ s·(Δ_i + Δ_j)/2·(1 − MARGIN)`, a few ulps inside:
+/// each power becomes the least over all bins of that bin's power plus the
+/// slew allowance along the circle between them (sweeps both ways until
+/// nothing moves). HiGHS meets those rows only to its absolute tolerance
+/// (1e-7 of `P̄`), more than the limit itself when the limit is tiny or 0
+/// (found by breaker3: a 0 W/deg limit gave a profile the checker
+/// rejected). Lowering never breaks the budget or an eye-safety cut (their
+/// coefficients are nonnegative) nor the floor (a power is only ever set to
+/// a neighbour's plus a nonnegative allowance); a no-op where HiGHS kept
+/// the rows.
+fn slew_down(p: &mut [f64], g: &Grid, s: f64) {
+    let n = p.len();
+    let lim: Vec<f64> = (0..n)
+        .map(|i| {
+            let j = next_index(i, n);
+            s * 0.5
+                * (g.width_deg[i] + g.width_deg[j])
+                * (1.0 - MARGIN)
+                * (1.0 - 8.0 * f64::EPSILON)
+        })
+        .collect();
+    // A min-plus closure on a cycle settles within a few sweeps each way;
+    // the cap only guards against a rounding cycle.
+    for _ in 0..4 * n + 4 {
+        let mut moved = false;
+        for i in 0..n {
+            let j = next_index(i, n);
+            if p[j] > p[i] + lim[i] {
+                p[j] = p[i] + lim[i];
+                moved = true;
+            }
+        }
+        for i in (0..n).rev() {
+            let j = next_index(i, n);
+            if p[i] > p[j] + lim[i] {
+                p[i] = p[j] + lim[i];
+                moved = true;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
 }
 
 /// How a bin's power enters the power step's program.
