@@ -1,0 +1,121 @@
+//! Adversarial review (breaker4) of the optimizer's global bound
+//! (`src/optimizer/global.rs`): the claim is that
+//! `optimality.global.upper_bound` ≥ `model_objective` of EVERY profile the
+//! checker (`gaze_lidar::checker::certify`) accepts for the problem. Each
+//! test builds a checker-accepted profile by hand and compares. Findings
+//! are `#[ignore = "finding: …"]` (they fail today); claims that held are
+//! ordinary tests.
+
+use gaze_lidar::checker::certify;
+use gaze_lidar::optimizer::global::{model_objective, upper_bound};
+use gaze_lidar::optimizer::{optimize, OptimizerConfig, Problem};
+use gaze_lidar::profile::Profile;
+
+fn problem(name: &str, bins: usize) -> Problem {
+    let text = std::fs::read_to_string(format!("examples/configs/{name}.toml")).unwrap();
+    let mut p = OptimizerConfig::from_toml(&text, name)
+        .unwrap()
+        .problem()
+        .unwrap();
+    p.bins = bins;
+    p
+}
+
+fn answer(problem: &Problem, gaze: f64) -> Profile {
+    optimize(problem, gaze).unwrap().profile().clone()
+}
+
+/// `dwell_s` is "informational; the checker recomputes it"
+/// (`profile::Bin`), but `objective_of` reads it when present: a profile
+/// that is the optimizer's answer with every `dwell_s` doubled is accepted
+/// by the checker unchanged and its model objective exceeds the bound.
+#[test]
+#[ignore = "finding: model_objective trusts the informational Bin::dwell_s (the checker ignores it); J can exceed the bound at will"]
+fn a_stale_dwell_field_lifts_the_model_objective_above_the_bound() {
+    let problem = problem("paper", 12);
+    let gaze = 90.0;
+    let mut prof = answer(&problem, gaze);
+    let ub = upper_bound(&problem, gaze).unwrap();
+    for b in &mut prof.bins {
+        b.dwell_s = Some(b.dwell_time_s() * 4.0);
+    }
+    let prof = certify(prof)
+        .expect("the checker ignores dwell_s")
+        .profile()
+        .clone();
+    let j = model_objective(&problem, gaze, &prof).unwrap();
+    assert!(j <= ub, "accepted profile: J = {j} above the bound {ub}");
+}
+
+/// The checker accepts bins of any widths that tile the circle (coverage
+/// within its angle tolerance), but `model_objective` evaluates a profile
+/// on the problem's uniform grid (`θ_i` of the grid, the profile's spins
+/// and powers), so a profile whose hot, slow bins are narrow (little time,
+/// little budget) and whose one cheap bin is wide and fast meets every
+/// limit while its model objective counts each narrow bin as a full grid
+/// bin at the slowest spin and highest power. (The optimizer's answer on
+/// `paper` at 12 bins, gaze 90°, sits at the bound: 11.1425.)
+#[test]
+#[ignore = "finding: model_objective uses the grid's widths, not the profile's; a checker-accepted non-uniform profile exceeds the bound"]
+fn a_profile_with_non_uniform_bins_exceeds_the_bound() {
+    let problem = problem("paper", 12);
+    let gaze = 90.0;
+    let base = answer(&problem, gaze);
+    let ub = upper_bound(&problem, gaze).unwrap();
+    let l = base.limits.clone();
+    let period = 1.0 / base.frame_rate_hz;
+    let p_hi = *problem
+        .levels
+        .power_w
+        .iter()
+        .max_by(|a, b| a.total_cmp(b))
+        .unwrap();
+    let p_lo = *problem
+        .levels
+        .power_w
+        .iter()
+        .min_by(|a, b| a.total_cmp(b))
+        .unwrap();
+    let w_slow = problem
+        .levels
+        .spin_rad_s
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+        .max(l.spin_rad_s_min);
+    let n = base.bins.len();
+    let narrow_deg = 0.5;
+    let wide_deg = 360.0 - narrow_deg * (n - 1) as f64;
+    let slow_s = (n - 1) as f64 * narrow_deg.to_radians() / w_slow;
+    let w_fast = wide_deg.to_radians() / (period - slow_s);
+    let mut prof = base.clone();
+    let mut start = 0.0;
+    for (i, b) in prof.bins.iter_mut().enumerate() {
+        // Bin 3 (90–120°) is under the gaze: the lowest weight.
+        let (w, p, spin) = if i == 3 {
+            (wide_deg, p_lo, w_fast)
+        } else {
+            (narrow_deg, p_hi, w_slow)
+        };
+        b.start_deg = start;
+        b.width_deg = w;
+        b.power_w = p;
+        b.spin_start_rad_s = spin;
+        b.spin_end_rad_s = spin;
+        b.dwell_s = None;
+        b.region = None;
+        start += w;
+    }
+    prof.summary = None;
+    prof.optimality = None;
+    let prof = match certify(prof) {
+        Ok(c) => c.profile().clone(),
+        Err(e) => panic!("rejected: {e:?}"),
+    };
+    let j = model_objective(&problem, gaze, &prof).unwrap();
+    eprintln!(
+        "non-uniform: J = {j}, bound {ub}, answer {}",
+        model_objective(&problem, gaze, &base).unwrap()
+    );
+    assert!(j <= ub, "accepted profile: J = {j} above the bound {ub}");
+}
