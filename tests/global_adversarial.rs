@@ -119,3 +119,45 @@ fn a_profile_with_non_uniform_bins_exceeds_the_bound() {
     );
     assert!(j <= ub, "accepted profile: J = {j} above the bound {ub}");
 }
+
+/// The bound takes the problem's hardware levels as exact (module docs:
+/// "boxes from limits (not levels, which are exact)"), but the checker
+/// knows only the profile's limits: on `paper` (levels 108.6 and 586.4
+/// rad/s, limits 31.4–628.3) the answer at 12 bins, gaze 90°, with its two
+/// fast bins at the limit 628.3 rad/s and the ten slow ones a little
+/// slower (108.33 rad/s, frame kept) is accepted and beats the bound by
+/// 0.06 % (the answer sits 3.6e-12 under it).
+#[test]
+#[ignore = "finding: the bound's boxes use the problem's levels, the checker does not enforce them; a checker-accepted off-level profile exceeds it"]
+fn an_off_level_spin_accepted_by_the_checker_exceeds_the_bound() {
+    let problem = problem("paper", 12);
+    let gaze = 90.0;
+    let base = answer(&problem, gaze);
+    let ub = upper_bound(&problem, gaze).unwrap();
+    let period = 1.0 / base.frame_rate_hz;
+    let w_max = base.limits.spin_rad_s_max;
+    let level_lo = problem.levels.spin_rad_s[0];
+    let fast: Vec<usize> = (0..base.bins.len())
+        .filter(|&i| base.bins[i].spin_start_rad_s > 2.0 * level_lo)
+        .collect();
+    let slow_n = (base.bins.len() - fast.len()) as f64;
+    let theta = base.bins[0].width_deg.to_radians();
+    let fast_s = fast.len() as f64 * theta / w_max;
+    let w_slow = slow_n * theta / (period - fast_s);
+    assert!(w_slow < level_lo && w_slow >= base.limits.spin_rad_s_min);
+    let mut prof = base.clone();
+    for (i, b) in prof.bins.iter_mut().enumerate() {
+        let w = if fast.contains(&i) { w_max } else { w_slow };
+        b.spin_start_rad_s = w;
+        b.spin_end_rad_s = w;
+        b.dwell_s = None;
+    }
+    prof.summary = None;
+    prof.optimality = None;
+    let prof = match certify(prof) {
+        Ok(c) => c.profile().clone(),
+        Err(e) => panic!("rejected: {e:?}"),
+    };
+    let j = model_objective(&problem, gaze, &prof).unwrap();
+    assert!(j <= ub, "accepted profile: J = {j} above the bound {ub}");
+}
