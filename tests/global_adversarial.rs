@@ -181,5 +181,44 @@ fn the_joint_answer_exceeds_the_range_mode_bound() {
     range.objective.mode = gaze_lidar::planner::Mode::Range;
     let ub = upper_bound(&range, gaze).unwrap();
     let j = model_objective(&range, gaze, &prof).unwrap();
-    assert!(j <= ub, "accepted profile: J = {j} above the range-mode bound {ub}");
+    assert!(
+        j <= ub,
+        "accepted profile: J = {j} above the range-mode bound {ub}"
+    );
+}
+
+/// Held: in scope (the problem's grid, levels and mode, no `dwell_s`),
+/// the answers pushed to the checker's tolerances — powers ×(1 + 0.99e-9)
+/// where they are not levels, every spin ×(1 − 0.99e-9) (the frame then
+/// 0.99e-9 long), both, and every bin's end spin moved to the next bin's
+/// start within the step tolerance — stay under the bound on the three
+/// configs whose answers sit near it with free spins (12 bins, gaze 90°).
+#[test]
+fn answers_pushed_to_the_checker_s_tolerances_stay_under_the_bound() {
+    for name in ["multi_level", "smooth", "vls128_eye"] {
+        let problem = problem(name, 12);
+        let gaze = 90.0;
+        let base = answer(&problem, gaze);
+        let ub = upper_bound(&problem, gaze).unwrap();
+        let free_power = problem.levels.power_w.is_empty();
+        let mut accepted = 0;
+        for (dp, dw) in [(1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.0, -1.0), (1.0, -1.0)] {
+            let mut prof = base.clone();
+            for b in &mut prof.bins {
+                if free_power {
+                    b.power_w *= 1.0 + dp * 0.99e-9;
+                }
+                b.spin_start_rad_s *= 1.0 - dw * 0.99e-9;
+                b.spin_end_rad_s *= 1.0 - dw * 0.99e-9;
+                b.dwell_s = None;
+            }
+            prof.summary = None;
+            prof.optimality = None;
+            let Ok(c) = certify(prof) else { continue };
+            accepted += 1;
+            let j = model_objective(&problem, gaze, c.profile()).unwrap();
+            assert!(j <= ub, "{name} ({dp}, {dw}): J = {j} above the bound {ub}");
+        }
+        assert!(accepted >= 2, "{name}: only {accepted} accepted");
+    }
 }
