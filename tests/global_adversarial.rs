@@ -222,3 +222,49 @@ fn answers_pushed_to_the_checker_s_tolerances_stay_under_the_bound() {
         assert!(accepted >= 2, "{name}: only {accepted} accepted");
     }
 }
+
+/// Held: on `smooth` (acceleration limit 1000 rad/s²) at 12 bins, the
+/// extreme spin profiles the acceleration box is built from — the
+/// triangle `ω² = W − 2a·d` (`d` the angle from the fastest point,
+/// at the limit in every bin) centred on each bin edge, at the mean power —
+/// are accepted by the checker and stay under the bound.
+#[test]
+fn triangle_spin_profiles_at_the_acceleration_limit_stay_under_the_bound() {
+    use std::f64::consts::PI;
+    let problem = problem("smooth", 12);
+    let gaze = 90.0;
+    let base = answer(&problem, gaze);
+    let ub = upper_bound(&problem, gaze).unwrap();
+    let a = base.limits.spin_accel_rad_s2_max.unwrap();
+    let period = 1.0 / base.frame_rate_hz;
+    let q = a * period / 2.0;
+    let (s1, s2) = ((2.0 * a * PI / q + q) / 2.0, (2.0 * a * PI / q - q) / 2.0);
+    let w_top = s1 * s1;
+    let n = base.bins.len();
+    let mut accepted = 0;
+    for centre in 0..n {
+        let spin_at = |k: usize| {
+            let th = (((k + n - centre) % n) as f64) * 2.0 * PI / n as f64;
+            let d = th.min(2.0 * PI - th);
+            (w_top - 2.0 * a * d).max(0.0).sqrt()
+        };
+        let mut prof = base.clone();
+        for (i, b) in prof.bins.iter_mut().enumerate() {
+            b.spin_start_rad_s = spin_at(i);
+            b.spin_end_rad_s = spin_at(i + 1);
+            b.power_w = base.average_power_w;
+            b.dwell_s = None;
+        }
+        prof.summary = None;
+        prof.optimality = None;
+        match certify(prof) {
+            Ok(c) => {
+                accepted += 1;
+                let j = model_objective(&problem, gaze, c.profile()).unwrap();
+                assert!(j <= ub, "centre {centre}: J = {j} above the bound {ub}");
+            }
+            Err(e) => eprintln!("centre {centre}: rejected {e:?} (spins {s2}..{s1})"),
+        }
+    }
+    assert!(accepted == n, "{accepted} of {n} accepted");
+}
