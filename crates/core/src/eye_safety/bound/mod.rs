@@ -60,6 +60,8 @@
 //! ([`evaluate_with`]).
 
 mod cells;
+#[cfg(test)]
+mod cells_adversarial;
 mod count;
 mod envelope;
 mod laser;
