@@ -2,8 +2,14 @@
 //!
 //! Block-coordinate ascent stops at a stationary point of a bilinear
 //! problem. This module bounds the true optimum from above with one LP, a
-//! *relaxation*: every profile the checker accepts (for this problem) is
-//! feasible for it, and its objective is at least the model's.
+//! *relaxation*: every profile the checker accepts **for this problem as
+//! the optimizer poses it** — on its grid of `N` equal bins, with its
+//! hardware power levels and spin set-points (where it has them) and with
+//! the block its mode does not move at its start value — is feasible for
+//! it, and its objective is at least the model's. (The checker alone knows
+//! none of the grid, the levels or the mode: a profile off them is another
+//! problem's, `tests/global_adversarial.rs`; [`model_objective`] refuses
+//! another grid.)
 //!
 //! Model objective (the one the steps approximate from below with chords):
 //! `J = λ_R Σ θ_i w_i √x_i + λ_ρ Σ θ_i w_i √r_i`, `x_i = p_i/P̄`, density
@@ -347,22 +353,14 @@ fn accel_spin_box_once(a: f64, period: f64, n: usize, lo: f64, hi: f64) -> (f64,
 
 /// The model objective `J` of a profile (floating point).
 fn objective_of(problem: &Problem, g: &Grid, profile: &Profile) -> f64 {
-    let lid = &problem.lidar;
-    let period = 1.0 / lid.frame_rate_hz;
     let o = &problem.objective;
     profile
         .bins
         .iter()
         .enumerate()
         .map(|(i, b)| {
-            let dwell = b
-                .dwell_s
-                .unwrap_or(2.0 * g.theta[i] / (b.spin_start_rad_s + b.spin_end_rad_s));
-            let r = dwell * TAU / (g.theta[i] * period);
-            g.theta[i]
-                * g.weight[i]
-                * (o.range_weight * (b.power_w / lid.average_power_w).max(0.0).sqrt()
-                    + o.resolution_weight * r.max(0.0).sqrt())
+            let (range, res) = super::utilities(problem, g.theta[i], b);
+            g.theta[i] * g.weight[i] * (o.range_weight * range + o.resolution_weight * res)
         })
         .sum()
 }
@@ -397,11 +395,27 @@ pub fn model_objective(
             reason: format!("{} bins, the problem has {}", profile.bins.len(), g.n),
         });
     }
+    // The bound is over the problem's own grid (breaker4: narrower bins
+    // elsewhere can score above it); a profile on another grid is refused.
+    for (i, b) in profile.bins.iter().enumerate() {
+        if (b.start_deg - g.start_deg[i]).abs() > 1e-9
+            || (b.width_deg - g.width_deg[i]).abs() > 1e-9
+        {
+            return Err(OptError::Invalid {
+                field: format!("bins[{i}]"),
+                reason: format!(
+                    "[{}, +{}]° is not the problem's bin [{}, +{}]°",
+                    b.start_deg, b.width_deg, g.start_deg[i], g.width_deg[i]
+                ),
+            });
+        }
+    }
     Ok(objective_of(problem, &g, profile))
 }
 
 /// A proven upper bound (rounded up) of `J` over every profile of this
-/// problem the checker accepts, from the relaxation in the module docs.
+/// problem (its grid, levels and mode; see the module docs) the checker
+/// accepts, from the relaxation in the module docs.
 pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let g = grid(problem, gaze_deg)?;
     let lid = &problem.lidar;

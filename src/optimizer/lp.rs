@@ -97,7 +97,7 @@ pub(super) struct Grid {
     pub(super) n: usize,
     pub(super) width_deg: Vec<f64>,
     pub(super) theta: Vec<f64>,
-    start_deg: Vec<f64>,
+    pub(super) start_deg: Vec<f64>,
     pub(super) weight: Vec<f64>,
     in_rof: Vec<bool>,
 }

@@ -315,26 +315,43 @@ pub fn exact_objective(
         });
     }
     let o = &problem.objective;
-    let p_mean = problem.lidar.average_power_w;
-    let period = 1.0 / problem.lidar.frame_rate_hz;
     Ok(profile
         .bins
         .iter()
         .enumerate()
         .map(|(i, b)| {
-            let dwell = crate::profile::kinematics::BinMotion::dwell_s(b);
-            let density = dwell * std::f64::consts::TAU / (g.theta[i] * period);
+            let (range, res) = utilities(problem, g.theta[i], b);
             let range = if o.mode.controls_range() {
-                o.range_weight * (b.power_w / p_mean).sqrt()
+                o.range_weight * range
             } else {
                 0.0
             };
             let res = if o.mode.controls_resolution() {
-                o.resolution_weight * density.sqrt()
+                o.resolution_weight * res
             } else {
                 0.0
             };
             g.theta[i] * g.weight[i] * (range + res)
         })
         .sum())
+}
+
+/// A bin's exact utilities: `√(p/P̄)` and `√r`, the density ratio
+/// `r = t·2π/(θ·T)` with the bin's dwell `t` from its spins (the
+/// kinematics, never the informational `dwell_s` field). The one
+/// definition [`exact_objective`] and the global bound's objective use.
+pub(crate) fn utilities(
+    problem: &Problem,
+    theta_rad: f64,
+    bin: &crate::profile::Bin,
+) -> (f64, f64) {
+    let period = 1.0 / problem.lidar.frame_rate_hz;
+    let dwell = crate::profile::kinematics::BinMotion::dwell_s(bin);
+    let r = dwell * std::f64::consts::TAU / (theta_rad * period);
+    (
+        (bin.power_w / problem.lidar.average_power_w)
+            .max(0.0)
+            .sqrt(),
+        r.max(0.0).sqrt(),
+    )
 }
