@@ -193,31 +193,13 @@ fn exact_figures(m: &Mps, x: &[f64], y: &[f64]) -> (bool, BigRational, Option<Bi
 
 /// HiGHS reads `path` with its own MPS reader and solves it afresh.
 fn highs_objective_of_file(path: &Path) -> f64 {
-    use std::ffi::CString;
-    let file = CString::new(path.to_str().unwrap()).unwrap();
-    // SAFETY: the documented HiGHS C API; the handle lives until destroy.
-    unsafe {
-        let h = highs_sys::Highs_create();
-        let quiet = CString::new("output_flag").unwrap();
-        highs_sys::Highs_setBoolOptionValue(h, quiet.as_ptr(), 0);
-        let threads = CString::new("threads").unwrap();
-        highs_sys::Highs_setIntOptionValue(h, threads.as_ptr(), 1);
-        // Tight tolerances: a point 1e-7 outside a row (HiGHS's default)
-        // can score above the exact optimum by that much times a dual.
-        for name in ["primal_feasibility_tolerance", "dual_feasibility_tolerance"] {
-            let key = CString::new(name).unwrap();
-            highs_sys::Highs_setDoubleOptionValue(h, key.as_ptr(), 1e-10);
-        }
-        let st = highs_sys::Highs_readModel(h, file.as_ptr());
-        assert_eq!(st, 0, "HiGHS read {}", path.display());
-        let st = highs_sys::Highs_run(h);
-        assert_eq!(st, 0, "HiGHS solved {}", path.display());
-        let ms = highs_sys::Highs_getModelStatus(h);
-        assert_eq!(ms, 7, "HiGHS model status optimal (7)");
-        let v = highs_sys::Highs_getObjectiveValue(h);
-        highs_sys::Highs_destroy(h);
-        v
-    }
+    let run = common::highs_solve_file(
+        path,
+        &["primal_feasibility_tolerance", "dual_feasibility_tolerance"],
+    );
+    assert_eq!(run.run_status, 0, "HiGHS solved {}", path.display());
+    assert_eq!(run.model_status, 7, "HiGHS model status optimal (7)");
+    run.objective
 }
 
 #[test]

@@ -87,3 +87,59 @@ pub fn profile_from(args: &[&str]) -> gaze_lidar::profile::Profile {
     assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
     gaze_lidar::profile::Profile::from_json(&stdout(&o), "stdout").unwrap()
 }
+
+/// What HiGHS said solving a model file afresh.
+#[cfg(feature = "solver")]
+pub struct HighsRun {
+    /// `Highs_run`'s return (0 ok, 1 warning, negative error).
+    pub run_status: i32,
+    /// `Highs_getModelStatus` (7 = optimal).
+    pub model_status: i32,
+    /// The objective HiGHS reports.
+    pub objective: f64,
+}
+
+/// HiGHS reads `path` (free MPS) with its own reader (through the C API,
+/// single-threaded, quiet) and solves it with every tolerance named in
+/// `tight` set to 1e-10: a point 1e-7 outside a row (HiGHS's default) can
+/// score above the exact optimum by that much times a dual.
+#[cfg(feature = "solver")]
+pub fn highs_solve_file(path: &std::path::Path, tight: &[&str]) -> HighsRun {
+    use std::ffi::CString;
+    let file = CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: the documented HiGHS C API; the handle lives until destroy.
+    unsafe {
+        let h = highs_sys::Highs_create();
+        let quiet = CString::new("output_flag").unwrap();
+        highs_sys::Highs_setBoolOptionValue(h, quiet.as_ptr(), 0);
+        let threads = CString::new("threads").unwrap();
+        highs_sys::Highs_setIntOptionValue(h, threads.as_ptr(), 1);
+        for name in tight {
+            let key = CString::new(*name).unwrap();
+            highs_sys::Highs_setDoubleOptionValue(h, key.as_ptr(), 1e-10);
+        }
+        let st = highs_sys::Highs_readModel(h, file.as_ptr());
+        assert_eq!(st, 0, "HiGHS read {}", path.display());
+        let run_status = highs_sys::Highs_run(h);
+        let run = HighsRun {
+            run_status,
+            model_status: highs_sys::Highs_getModelStatus(h),
+            objective: highs_sys::Highs_getObjectiveValue(h),
+        };
+        highs_sys::Highs_destroy(h);
+        run
+    }
+}
+
+/// A shipped optimizer config (`examples/configs/NAME.toml`) as a problem
+/// of `bins` bins.
+#[cfg(feature = "solver")]
+pub fn shipped_problem(name: &str, bins: usize) -> gaze_lidar::optimizer::Problem {
+    let text = std::fs::read_to_string(format!("examples/configs/{name}.toml")).unwrap();
+    let mut p = gaze_lidar::optimizer::OptimizerConfig::from_toml(&text, name)
+        .unwrap()
+        .problem()
+        .unwrap();
+    p.bins = bins;
+    p
+}

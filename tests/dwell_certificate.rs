@@ -6,18 +6,15 @@
 //! with spin steps the answer's own figures are that certificate's.
 #![cfg(feature = "solver")]
 
+mod common;
+
 use gaze_lidar::optimizer::certificate::Step;
-use gaze_lidar::optimizer::{optimize_with_certificate, OptimizerConfig};
+use gaze_lidar::optimizer::optimize_with_certificate;
 use gaze_lidar::planner::Mode;
 use proptest::prelude::*;
 
 fn problem(name: &str, bins: usize, mode: Mode) -> gaze_lidar::optimizer::Problem {
-    let text = std::fs::read_to_string(format!("examples/configs/{name}.toml")).unwrap();
-    let mut p = OptimizerConfig::from_toml(&text, name)
-        .unwrap()
-        .problem()
-        .unwrap();
-    p.bins = bins;
+    let mut p = common::shipped_problem(name, bins);
     p.objective.mode = mode;
     p
 }

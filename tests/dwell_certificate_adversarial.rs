@@ -12,38 +12,22 @@ use std::path::Path;
 /// HiGHS reads `path` (free MPS) with its own reader and solves it afresh
 /// at tight tolerances (as `tests/certificate.rs` does); the objective.
 fn highs_objective_of_file(path: &Path) -> f64 {
-    use std::ffi::CString;
-    let file = CString::new(path.to_str().unwrap()).unwrap();
-    // SAFETY: the documented HiGHS C API; the handle lives until destroy.
-    unsafe {
-        let h = highs_sys::Highs_create();
-        let quiet = CString::new("output_flag").unwrap();
-        highs_sys::Highs_setBoolOptionValue(h, quiet.as_ptr(), 0);
-        let threads = CString::new("threads").unwrap();
-        highs_sys::Highs_setIntOptionValue(h, threads.as_ptr(), 1);
-        for name in [
+    let run = common::highs_solve_file(
+        path,
+        &[
             "primal_feasibility_tolerance",
             "dual_feasibility_tolerance",
             "mip_feasibility_tolerance",
-        ] {
-            let key = CString::new(name).unwrap();
-            highs_sys::Highs_setDoubleOptionValue(h, key.as_ptr(), 1e-10);
-        }
-        let st = highs_sys::Highs_readModel(h, file.as_ptr());
-        assert_eq!(st, 0, "HiGHS read {}", path.display());
-        let st = highs_sys::Highs_run(h);
-        assert!(st >= 0, "HiGHS solved {}", path.display());
-        let ms = highs_sys::Highs_getModelStatus(h);
-        assert_eq!(
-            ms,
-            7,
-            "HiGHS model status optimal (7) for {}",
-            path.display()
-        );
-        let v = highs_sys::Highs_getObjectiveValue(h);
-        highs_sys::Highs_destroy(h);
-        v
-    }
+        ],
+    );
+    assert!(run.run_status >= 0, "HiGHS solved {}", path.display());
+    assert_eq!(
+        run.model_status,
+        7,
+        "HiGHS model status optimal (7) for {}",
+        path.display()
+    );
+    run.objective
 }
 
 /// Exploration helper, not a test of a claim: for every certificate

@@ -7,19 +7,17 @@
 //! showed the claim's scope (the problem's levels and mode), now stated in
 //! `specs/optimizer.md` and pinned here; the rest held.
 
+#![cfg(feature = "solver")]
+
+mod common;
+
 use gaze_lidar::checker::certify;
 use gaze_lidar::optimizer::global::{model_objective, upper_bound};
-use gaze_lidar::optimizer::{optimize, OptimizerConfig, Problem};
+use gaze_lidar::optimizer::{optimize, Problem};
 use gaze_lidar::profile::Profile;
 
 fn problem(name: &str, bins: usize) -> Problem {
-    let text = std::fs::read_to_string(format!("examples/configs/{name}.toml")).unwrap();
-    let mut p = OptimizerConfig::from_toml(&text, name)
-        .unwrap()
-        .problem()
-        .unwrap();
-    p.bins = bins;
-    p
+    common::shipped_problem(name, bins)
 }
 
 fn answer(problem: &Problem, gaze: f64) -> Profile {
