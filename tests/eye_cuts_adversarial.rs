@@ -36,6 +36,7 @@ fn variant(
         wavelength_nm,
         pulse_duration_s: pulse_s,
         beam_diameter_mm: 8.0,
+        head: None,
     });
     p.objective.mode = mode;
     p

@@ -429,6 +429,7 @@ fn build_table(s: &TableSpec) -> FirmwareTable {
             wavelength_nm: lambda,
             pulse_duration_s: 10f64.powf(s.pulse_log),
             beam_diameter_mm: s.beam_mm,
+            head: None,
         }),
         limits: IntLimits {
             power_code_min: 0,

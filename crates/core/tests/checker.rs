@@ -21,6 +21,7 @@ fn params() -> EyeSafetyParams {
         wavelength_nm: 905.0,
         pulse_duration_s: 5e-9,
         beam_diameter_mm: 8.0,
+        head: None,
     }
 }
 
@@ -522,6 +523,7 @@ fn sensor_limits_are_enforced_naming_the_key() {
             Box::new(|p| {
                 p.limits.eye_safety = Some(EyeSafetyParams {
                     beam_diameter_mm: 9.0,
+                    head: None,
                     ..params()
                 })
             }),

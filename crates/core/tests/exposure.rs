@@ -14,6 +14,7 @@ fn params() -> EyeSafetyParams {
         wavelength_nm: 905.0,
         pulse_duration_s: 5e-9,
         beam_diameter_mm: 8.0,
+        head: None,
     }
 }
 
@@ -59,6 +60,7 @@ fn pass_angle_is_aperture_plus_beam_over_100_mm() {
         wavelength_nm: 1550.0,
         pulse_duration_s: 5e-9,
         beam_diameter_mm: 1.5,
+        head: None,
     };
     let l = laser(&p1550, 20_000.0).unwrap();
     // 1550 nm: Table 10's largest aperture, 1.5·10^0.375 = 3.5571 mm, + 1.5 mm.
@@ -67,6 +69,7 @@ fn pass_angle_is_aperture_plus_beam_over_100_mm() {
     // A beam wider than the circle is capped at a full turn.
     let huge = EyeSafetyParams {
         beam_diameter_mm: 999.0,
+        head: None,
         ..params()
     };
     let l = laser(&huge, 20_000.0).unwrap();
@@ -234,6 +237,7 @@ fn eye_safety_params_are_validated_at_their_edges() {
         wavelength_nm,
         pulse_duration_s: 5e-9,
         beam_diameter_mm,
+        head: None,
     };
     // Bands by Table 3's wavelength ranges.
     assert_eq!(with(905.0, 8.0).validate(), Ok(Band::RetinalNir));

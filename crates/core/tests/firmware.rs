@@ -29,6 +29,7 @@ fn table(tick_hz: u64, bins: &[(u32, u64, u32)]) -> FirmwareTable {
             wavelength_nm: 905.0,
             pulse_duration_s: 5e-9,
             beam_diameter_mm: 8.0,
+            head: None,
         }),
         bins,
     )

@@ -27,6 +27,7 @@ fn params() -> EyeSafetyParams {
         wavelength_nm: 905.0,
         pulse_duration_s: 5e-9,
         beam_diameter_mm: 8.0,
+        head: None,
     }
 }
 

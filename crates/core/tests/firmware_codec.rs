@@ -151,6 +151,7 @@ fn table(bins: &[(u32, u64, u32)], eye: bool) -> FirmwareTable {
             wavelength_nm: 905.0,
             pulse_duration_s: 5e-9,
             beam_diameter_mm: 8.0,
+            head: None,
         }),
         limits: IntLimits {
             power_code_min: 0x2122_2324,

@@ -21,6 +21,7 @@ pub mod bound;
 pub mod cuts;
 #[cfg(feature = "std")]
 pub mod exposure;
+pub mod head;
 #[cfg(feature = "std")]
 pub mod report;
 pub mod rule;
@@ -48,6 +49,11 @@ pub struct EyeSafetyParams {
     pub pulse_duration_s: f64,
     /// Beam diameter at the measurement aperture (100 mm from the scan centre), mm.
     pub beam_diameter_mm: f64,
+    /// The multi-beam head (absent: one channel, the beam above). With a
+    /// head, the beam at the aperture is the head's (`head::Head`) and
+    /// `beam_diameter_mm` is not used by the bound.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub head: Option<head::Head>,
 }
 
 /// Errors evaluating eye safety.
@@ -57,6 +63,9 @@ pub enum EyeSafetyError {
     /// From the AEL tables.
     #[error(transparent)]
     Ael(#[from] AelError),
+    /// The head is invalid.
+    #[error("eye_safety.{0}")]
+    Head(#[from] head::HeadError),
     /// A parameter is invalid.
     #[error("eye_safety.{field} = {}: {reason}", crate::text::Num(*.value))]
     Param {
@@ -89,6 +98,9 @@ impl EyeSafetyParams {
                 value: self.beam_diameter_mm,
                 reason: "must be finite, > 0 (not subnormal) and < 1000",
             });
+        }
+        if let Some(head) = &self.head {
+            head.validate()?;
         }
         Ok(band)
     }

@@ -155,6 +155,7 @@ pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
             wavelength_nm: es[0].ok_or_else(short)?,
             pulse_duration_s: es[1].ok_or_else(short)?,
             beam_diameter_mm: es[2].ok_or_else(short)?,
+            head: None,
         })
     } else {
         // Absent means all-zero bytes (so -0.0 is not accepted: it would

@@ -174,6 +174,11 @@ impl LidarSpec {
                     value,
                     reason,
                 } => err(&format!("limits.eye_safety.{field}"), value, reason),
+                crate::eye_safety::EyeSafetyError::Head(h) => err(
+                    &format!("limits.eye_safety.head.{}", h.field),
+                    f64::NAN,
+                    h.reason,
+                ),
                 crate::eye_safety::EyeSafetyError::Ael(_) => err(
                     "limits.eye_safety.wavelength_nm",
                     params.wavelength_nm,
