@@ -7,7 +7,7 @@
 use super::order::{sort_runs, split_index, wrap_index};
 use super::seg::Seg;
 use super::sliding::Queue;
-use crate::profile::kinematics::{split_periods, Timeline};
+use crate::profile::kinematics::{split_periods, Compensated, Timeline};
 
 /// The max-filtered power `P̄` over one period, as pieces `[t_k, t_{k+1})`
 /// with prefix integrals, extended periodically.
@@ -94,11 +94,13 @@ impl Envelope {
         let mut t_s = cand;
         t_s.push(frame_s);
         let mut cum_j = Vec::with_capacity(m + 1);
-        let mut e = 0.0;
+        // Compensated (see `Compensated`): within a few `u` of the total
+        // whatever the number of pieces (`count::time_rounding_s`).
+        let mut e = Compensated::default();
         cum_j.push(0.0);
         for j in 0..m {
-            e += p_w[j] * (t_s[j + 1] - t_s[j]);
-            cum_j.push(e);
+            e.add(p_w[j] * (t_s[j + 1] - t_s[j]));
+            cum_j.push(e.value());
         }
         Self {
             t_s,
@@ -180,6 +182,35 @@ impl Envelope {
 
     pub(super) fn p_of(&self, idx: i64) -> f64 {
         self.p_w[wrap_index(idx, self.pieces() as i64)]
+    }
+
+    /// The largest total variation of `P̄` over any closed window of
+    /// `len_s` (the sum of `|ΔP̄|` over the breakpoints inside it), W: a
+    /// time error `δ` at every breakpoint moves an integral over such a
+    /// window by at most this times `δ` (the errors telescope to the
+    /// jumps), plus `P̂·δ` at each end. Two pointers over the breakpoints of
+    /// one period and the next: linear.
+    pub(super) fn max_variation_within(&self, len_s: f64) -> f64 {
+        let m = self.pieces() as i64;
+        let jump = |i: i64| (self.p_of(i) - self.p_of(i - 1)).abs();
+        if len_s >= self.frame_s {
+            let total: f64 = (0..m).map(jump).sum();
+            return total * ((len_s / self.frame_s).floor() + 1.0);
+        }
+        let (mut best, mut sum, mut r) = (0.0f64, 0.0f64, 0i64);
+        for i in 0..m {
+            if r < i {
+                r = i;
+                sum = 0.0;
+            }
+            while r < i + m && self.bp(r) <= self.bp(i) + len_s {
+                sum += jump(r);
+                r += 1;
+            }
+            best = best.max(sum);
+            sum -= jump(i);
+        }
+        best
     }
 }
 
