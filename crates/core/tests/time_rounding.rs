@@ -187,3 +187,61 @@ fn near_stopped_family_never_below_the_exact_truth() {
     }
     assert!(cases >= 150, "{cases}");
 }
+
+/// The two profiles as files would hold them, through the certifying
+/// checker: rejected, and for eye safety alone (every other limit holds).
+#[test]
+fn near_stopped_profiles_are_rejected_naming_eye_safety() {
+    use gaze_lidar_core::checker::{check, Violation};
+    use gaze_lidar_core::model::lidar::{Limits, PowerAccounting};
+    use gaze_lidar_core::profile::{Bin, Profile, PROFILE_FORMAT};
+    let two_h_1550 = (APERTURE_IR_MM + 0.5) / 100.0;
+    for (lambda, f_p, p, fast) in [
+        (905.0, 152e3, 16.2e-3, 600.0),
+        (1550.0, 20e3, 158.0, two_h_1550 * 20e3),
+    ] {
+        let segs = near_stopped(At::Last, p, fast, 2.6e-6);
+        let bins: Vec<Bin> = segs
+            .iter()
+            .map(|s| Bin {
+                start_deg: s.start_deg,
+                width_deg: s.width_deg,
+                power_w: s.power_w,
+                spin_start_rad_s: s.spin_start_rad_s,
+                spin_end_rad_s: s.spin_end_rad_s,
+                region: None,
+                dwell_s: None,
+            })
+            .collect();
+        let dwell = |b: &Bin| b.width_deg.to_radians() / b.spin_start_rad_s;
+        let frame_s: f64 = bins.iter().map(dwell).sum();
+        let energy: f64 = bins.iter().map(|b| dwell(b) * b.power_w).sum();
+        let profile = Profile {
+            format: PROFILE_FORMAT.to_owned(),
+            frame_rate_hz: 1.0 / frame_s,
+            pulse_rate_hz: f_p,
+            average_power_w: energy / frame_s,
+            power_accounting: PowerAccounting::Time,
+            gaze_deg: None,
+            limits: Limits {
+                power_w_min: 0.0,
+                power_w_max: 2.0 * p,
+                spin_rad_s_min: 1e-6,
+                spin_rad_s_max: 2.0 * fast,
+                spin_accel_rad_s2_max: None,
+                power_slew_w_per_deg_max: None,
+                eye_safety: Some(params(lambda, 0.5)),
+            },
+            bins,
+            mode: None,
+            summary: None,
+            optimality: None,
+        };
+        let v = check(&profile);
+        assert!(
+            matches!(v.as_slice(), [Violation::EyeSafety { .. }]),
+            "{lambda} nm: {v:?}"
+        );
+        assert!(v[0].to_string().contains("eye"), "{}", v[0]);
+    }
+}
