@@ -602,6 +602,33 @@ mod tests {
     }
 
     proptest! {
+        /// The compensated sum of nonnegative terms (a frame's dwells: one
+        /// huge, many tiny, or spread over 20 decades) is within
+        /// `2u·S + 4n·u²·S` of the exact sum (rationals): the bound
+        /// `eye_safety::bound::count::time_rounding_s` relies on. A plain
+        /// running sum fails it (a large term, then many small ones).
+        #[test]
+        fn compensated_sum_is_within_2u_of_the_exact_sum(
+            terms in proptest::collection::vec(prop_oneof![
+                1e-12f64..1e-6, 1e-3f64..1.0, Just(1e6), 0.0f64..1e9,
+            ], 1..400),
+        ) {
+            use num_rational::BigRational;
+            use num_traits::{Signed, ToPrimitive};
+            let mut c = Compensated::default();
+            let mut exact = BigRational::from_integer(0.into());
+            for &x in &terms {
+                c.add(x);
+                exact += BigRational::from_float(x).unwrap();
+            }
+            let got = BigRational::from_float(c.value()).unwrap();
+            let err = (got - exact.clone()).abs().to_f64().unwrap();
+            let s = exact.to_f64().unwrap();
+            let u = f64::EPSILON / 2.0;
+            let n = terms.len() as f64;
+            prop_assert!(err <= (2.0 * u + 4.0 * n * u * u) * s, "err {err} of {s}");
+        }
+
         /// ω(x) is the derivative of the angle law: the time to advance x
         /// is 2x/(ω_s + ω(x)) (the trapezoid rule, exact at constant
         /// acceleration), and the bin's ends give its declared spins.

@@ -236,6 +236,51 @@ mod tests {
         assert!((got - want).abs() <= 1e-12, "{got} vs {want}");
     }
 
+    proptest! {
+        /// `max_variation_within` against a plain double loop: for every
+        /// breakpoint of two periods, the sum of `|ΔP̄|` over the
+        /// breakpoints in the closed window from it, the largest; and every
+        /// window's variation is at most it.
+        #[test]
+        fn max_variation_is_the_largest_over_every_window(
+            bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..2.0, 1.0f64..50.0), 1..30),
+            delta in 1e-4f64..0.05,
+            frac in 0.0f64..1.5,
+        ) {
+            let total: f64 = bins.iter().map(|b| b.0).sum();
+            let mut start = 0.0;
+            let segs: Vec<Seg> = bins
+                .iter()
+                .map(|&(w, p, om)| {
+                    let width = 360.0 * w / total;
+                    let s = seg(start, width, p, om, om);
+                    start += width;
+                    s
+                })
+                .collect();
+            let tl = Timeline::from_bins(&segs);
+            let env = Envelope::new(&tl, delta);
+            let len = frac * env.frame_s;
+            let got = env.max_variation_within(len);
+            let m = env.pieces() as i64;
+            let jump = |i: i64| (env.p_of(i) - env.p_of(i - 1)).abs();
+            let mut want = 0.0f64;
+            for i in 0..2 * m {
+                let mut v = 0.0;
+                let mut r = i;
+                while r < i + 3 * m && env.bp(r) <= env.bp(i) + len {
+                    v += jump(r);
+                    r += 1;
+                }
+                want = want.max(v);
+            }
+            prop_assert!(got >= want * (1.0 - 1e-12), "got {got}, want {want}");
+            if len < env.frame_s {
+                prop_assert!(got <= want * (1.0 + 1e-12) + 1e-300, "got {got}, want {want}");
+            }
+        }
+    }
+
     /// Mutants 804:9 (`Envelope::locate` replaced by a constant) and 856:9
     /// (`Envelope::power_at` → 0) of the old `bound.rs` (11a69c7): the
     /// curved cells' exact figures read the envelope through them, and no
