@@ -17,7 +17,7 @@
 //! | [`PRUNE_SLACK`] | 1e-12 | relative, of a turn's time or envelope energy | curved cells' bounds, whole-pass interpolations (`2·`), the pruning thresholds (`1 + s`) | the few ulps by which two evaluations of one difference of cumulative totals may differ |
 //! | [`REACH_SLACK`] | 1e-9 | relative, of a turn's time | each walk's reach | the float inversions of the head's motion (time at an azimuth and back) |
 //! | [`TOUCH_SNAP_DEG`] | 1e-9 | deg | the arc a cell's pulses come from (Rule 1, pulse caps) | the rounding of the cuts (an ulp of 360° is 5.7e-14°) |
-//! | [`TIME_ROUNDING`] | 64·ε (ε = 2⁻⁵² = 2u) | of the frame period `T_f`, absolute, on every duration | every pulse count of a pass or of a bin's share of it (`Cells`, pulse caps), as `⌊(τ + time_rounding_s)·f⌋ + 1` | the rounding of a time *from 0°*: see "Times from 0°" below |
+//! | [`TIME_ROUNDING`] | 64·ε (ε = 2⁻⁵² = 2u) | of the frame period `T_f`, absolute, on every duration | every pulse count of a pass or of a bin's share of it (`Cells`, pulse caps), as `⌊(τ + time_rounding_s)·f⌋ + 1`; the multi-pass rules' `τ`; every within-pass window (walks, whole passes) takes the AEL of a window `time_rounding_s` shorter | the rounding of a time *from 0°*: see "Times from 0°" below |
 //! | [`energy_rounding_j`] | `(V + 2P̂)·time_rounding_s + 32ε·E_turn` | J, absolute, on every pass and window energy | `bound::evaluate`: added to the pass figures of the multi-pass rules and, over the smallest AEL of a window, to the within-pass ratio | the same rounding in the envelope integrals |
 //! | `firmware::eye::LIMIT_MARGIN` | 1e-9 | relative, on each integer limit before it is rounded down | `IntEyeLimits::derive` | the float rounding of the limits derived from this model |
 //! | (literal in `firmware::eye`) | 1e-12 | relative, up, on the pass arc in mdeg before its `ceil` | `IntEyeLimits::derive` | an arc that is an integer mdeg up to rounding is not taken one mdeg short |
@@ -56,7 +56,11 @@
 //!   duration is within `32ε·T_f` of the difference of the exact times:
 //!   [`time_rounding_s`] is **twice that**, `64ε·T_f` per duration, and
 //!   every pulse count takes `τ + time_rounding_s` (an envelope piece is
-//!   `Δ` wider on one side: the same bound). The rounding of an azimuth
+//!   `Δ` wider on one side: the same bound), and every within-pass window
+//!   (walks, whole passes) is compared with the AEL of a window that much
+//!   shorter (within a row the AEL grows with the length, and across a
+//!   row edge that steps up a window just past the edge would otherwise
+//!   read the upper row). The rounding of an azimuth
 //!   (`φ ± h`, `≤ u·720°`) is not a time error: it evaluates the pass of an
 //!   aperture within `u·720°` of the intended one, covered by the cells'
 //!   ends and [`TOUCH_SNAP_DEG`] as before.
