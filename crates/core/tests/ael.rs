@@ -40,7 +40,7 @@ fn band_constants_by_hand() {
     assert_eq!(Band::Ir1400.t_i_s(), 1e-3);
     assert_eq!(Band::Ir1500.t_i_s(), 10.0);
     assert_eq!(Band::of(1499.9).unwrap(), Band::Ir1400);
-    assert_eq!(Band::of(1500.0).unwrap(), Band::Ir1500);
+    assert_eq!(Band::of(1500.0).unwrap(), Band::Ir1400);
     assert_eq!(Band::of(905.0).unwrap(), Band::RetinalNir);
     assert_eq!(Band::of(699.9), Err(AelError::Wavelength(699.9)));
     assert_eq!(Band::of(1200.0), Err(AelError::Wavelength(1200.0)));

@@ -21,6 +21,10 @@ pub enum AelError {
     /// Wavelength outside the supported bands.
     #[error("wavelength_nm = {}: supported bands are 700–1050 nm and 1400–1800 nm", crate::text::Num(*.0))]
     Wavelength(f64),
+    /// Exactly on a band edge whose other column (1050–1400 nm) the model
+    /// does not have: the stricter of the two columns cannot be taken.
+    #[error("wavelength_nm = {}: exactly on the edge of the 1050–1400 nm column of Table 3, which this model does not cover; at a band edge the stricter of the two columns applies, so it cannot be evaluated (use a wavelength inside 700–1050 nm or 1400–1800 nm)", crate::text::Num(*.0))]
+    UnmodelledEdge(f64),
     /// Duration out of the tabulated domain.
     #[error("{what} = {} s: {reason}", crate::text::Num(*.value))]
     Duration {
@@ -34,14 +38,25 @@ pub enum AelError {
 }
 
 /// Spectral band, selecting the rows of Table 3.
+///
+/// **Band edges take the stricter column** ([`Band::of`]): at exactly
+/// 1500 nm and 1800 nm the wavelength belongs to two columns of Table 3 and
+/// the model takes the stricter, [`Band::Ir1400`]'s rows (the 1800–2600 nm
+/// column has the same rows and `T_i` as 1400–1500 nm: 8·10⁻⁴ J to 1 ms,
+/// `4.4·10⁻³·t^0.25` J to 0.35 s, `10⁻²·t` J to 10 s, 10 mW beyond; they are
+/// at most the 1500–1800 nm rows at every duration, the aperture is the
+/// same, C5 = 1 in both). At exactly 1050 nm and 1400 nm the other column
+/// is 1050–1400 nm, which the model does not have: refused
+/// ([`AelError::UnmodelledEdge`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Band {
     /// 700–1050 nm, retinal hazard region (thermal).
     RetinalNir,
-    /// 1400–1500 nm, corneal.
+    /// 1400–1500 nm, corneal (its rows also at exactly 1500 nm and
+    /// 1800 nm: the stricter column there).
     Ir1400,
-    /// 1500–1800 nm, corneal.
+    /// 1500–1800 nm (exclusive of both ends), corneal.
     Ir1500,
 }
 
@@ -68,16 +83,24 @@ pub const APERTURE_IR_LONG_MM: f64 = 3.5;
 pub const APERTURE_DISTANCE_MM: f64 = 100.0;
 
 impl Band {
-    /// The band of `wavelength_nm`.
+    /// The band of `wavelength_nm`: the column of Table 3 whose rows the
+    /// model evaluates. At an exact band edge the stricter of the two
+    /// adjacent columns (see [`Band`]): 1500.0 nm and 1800.0 nm take the
+    /// 1400–1500 nm rows ([`Band::Ir1400`]), which are at most the
+    /// 1500–1800 nm rows at every duration (tested over the whole table);
+    /// 1050.0 nm and 1400.0 nm border the 1050–1400 nm column, which the
+    /// model does not have, so they are refused by name.
     pub fn of(wavelength_nm: f64) -> Result<Self, AelError> {
         if !wavelength_nm.is_finite() {
             return Err(AelError::Wavelength(wavelength_nm));
         }
-        if (700.0..=1050.0).contains(&wavelength_nm) {
+        if wavelength_nm == 1050.0 || wavelength_nm == 1400.0 {
+            Err(AelError::UnmodelledEdge(wavelength_nm))
+        } else if (700.0..1050.0).contains(&wavelength_nm) {
             Ok(Self::RetinalNir)
-        } else if (1400.0..1500.0).contains(&wavelength_nm) {
+        } else if (1400.0..=1500.0).contains(&wavelength_nm) || wavelength_nm == 1800.0 {
             Ok(Self::Ir1400)
-        } else if (1500.0..=1800.0).contains(&wavelength_nm) {
+        } else if (1500.0..1800.0).contains(&wavelength_nm) {
             Ok(Self::Ir1500)
         } else {
             Err(AelError::Wavelength(wavelength_nm))
@@ -368,10 +391,17 @@ mod tests {
     #[test]
     fn band_edges_and_errors() {
         assert_eq!(Band::of(700.0).unwrap(), Band::RetinalNir);
-        assert_eq!(Band::of(1050.0).unwrap(), Band::RetinalNir);
+        assert_eq!(Band::of(1049.99).unwrap(), Band::RetinalNir);
+        // Exact band edges: the stricter column, or refused where the
+        // other column (1050–1400 nm) is not modelled.
+        assert_eq!(Band::of(1050.0), Err(AelError::UnmodelledEdge(1050.0)));
+        assert_eq!(Band::of(1400.0), Err(AelError::UnmodelledEdge(1400.0)));
+        assert_eq!(Band::of(1500.0).unwrap(), Band::Ir1400);
+        assert_eq!(Band::of(1800.0).unwrap(), Band::Ir1400);
+        assert_eq!(Band::of(1400.01).unwrap(), Band::Ir1400);
+        assert_eq!(Band::of(1500.01).unwrap(), Band::Ir1500);
+        assert_eq!(Band::of(1799.99).unwrap(), Band::Ir1500);
         assert!(Band::of(1051.0).is_err());
-        assert_eq!(Band::of(1400.0).unwrap(), Band::Ir1400);
-        assert_eq!(Band::of(1800.0).unwrap(), Band::Ir1500);
         assert!(Band::of(1800.1).is_err() && Band::of(f64::NAN).is_err());
         assert!(ael_j(905.0, 0.0).is_err());
         assert!(ael_j(905.0, 1e-12).is_err());

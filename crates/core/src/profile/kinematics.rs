@@ -205,6 +205,41 @@ pub fn angle_into_bin_rad(bin: &Bin, t_s: f64) -> f64 {
     bin.angle_into_rad(t_s)
 }
 
+/// A running sum with Neumaier's compensation (Higham, *Accuracy and
+/// Stability of Numerical Algorithms*, 2nd ed., §4.3): for `n` terms of one
+/// sign the value is within `2u·|S| + O(n·u²)·|S|` of the exact sum `S`
+/// (`u = 2⁻⁵³`), independent of `n` to first order, where a plain running
+/// sum is only within `(n − 1)·u·|S|`. The timeline's cumulative times
+/// use it, so a time from 0° is within a few `u·T_f` of the exact one
+/// whatever the number of bins: the bound's time-rounding slack
+/// (`eye_safety::bound::count::time_rounding_s`) relies on it.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Compensated {
+    sum: f64,
+    comp: f64,
+}
+
+impl Compensated {
+    /// Adds `x`.
+    #[inline]
+    pub fn add(&mut self, x: f64) {
+        let s = self.sum + x;
+        self.comp += if self.sum.abs() >= x.abs() {
+            (self.sum - s) + x
+        } else {
+            (x - s) + self.sum
+        };
+        self.sum = s;
+    }
+
+    /// The compensated sum so far.
+    #[inline]
+    #[must_use]
+    pub fn value(&self) -> f64 {
+        self.sum + self.comp
+    }
+}
+
 /// Cumulative time and energy at every bin start of a profile (or of any
 /// bins that cover the circle in order, see [`Timeline::from_bins`]).
 #[derive(Debug, Clone)]
@@ -236,16 +271,16 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
         let mut cum_time_s = Vec::with_capacity(n + 1);
         let mut cum_energy_j = Vec::with_capacity(n + 1);
         let mut motion = Vec::with_capacity(n);
-        let (mut t, mut e) = (0.0, 0.0);
+        let (mut t, mut e) = (Compensated::default(), Compensated::default());
         cum_time_s.push(0.0);
         cum_energy_j.push(0.0);
         for b in bins {
             let m = Motion::of(b);
             let dt = m.dwell_s;
-            t += dt;
-            e += dt * b.power_w();
-            cum_time_s.push(t);
-            cum_energy_j.push(e);
+            t.add(dt);
+            e.add(dt * b.power_w());
+            cum_time_s.push(t.value());
+            cum_energy_j.push(e.value());
             motion.push(m);
         }
         Self {
@@ -567,6 +602,33 @@ mod tests {
     }
 
     proptest! {
+        /// The compensated sum of nonnegative terms (a frame's dwells: one
+        /// huge, many tiny, or spread over 20 decades) is within
+        /// `2u·S + 4n·u²·S` of the exact sum (rationals): the bound
+        /// `eye_safety::bound::count::time_rounding_s` relies on. A plain
+        /// running sum fails it (a large term, then many small ones).
+        #[test]
+        fn compensated_sum_is_within_2u_of_the_exact_sum(
+            terms in proptest::collection::vec(prop_oneof![
+                1e-12f64..1e-6, 1e-3f64..1.0, Just(1e6), 0.0f64..1e9,
+            ], 1..400),
+        ) {
+            use num_rational::BigRational;
+            use num_traits::{Signed, ToPrimitive};
+            let mut c = Compensated::default();
+            let mut exact = BigRational::from_integer(0.into());
+            for &x in &terms {
+                c.add(x);
+                exact += BigRational::from_float(x).unwrap();
+            }
+            let got = BigRational::from_float(c.value()).unwrap();
+            let err = (got - exact.clone()).abs().to_f64().unwrap();
+            let s = exact.to_f64().unwrap();
+            let u = f64::EPSILON / 2.0;
+            let n = terms.len() as f64;
+            prop_assert!(err <= (2.0 * u + 4.0 * n * u * u) * s, "err {err} of {s}");
+        }
+
         /// ω(x) is the derivative of the angle law: the time to advance x
         /// is 2x/(ω_s + ω(x)) (the trapezoid rule, exact at constant
         /// acceleration), and the bin's ends give its declared spins.

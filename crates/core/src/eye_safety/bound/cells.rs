@@ -6,7 +6,9 @@
 //! order gives every cell's end values, its Rule 1 figure and cheap upper
 //! bounds for the branch and bound; [`Cells::exact`] evaluates one cell.
 
-use super::count::{max_pulses_in, passes_in_window, StepMemo, PRUNE_SLACK, TOUCH_SNAP_DEG};
+use super::count::{
+    max_pulses_in, passes_in_window, time_rounding_s, StepMemo, PRUNE_SLACK, TOUCH_SNAP_DEG,
+};
 use super::envelope::Envelope;
 use super::laser::{Laser, PerJouleCache};
 use super::order::{sort_runs, wrap_index};
@@ -51,6 +53,10 @@ pub(super) struct Cells<'a> {
     /// Each cell's figures from the sweep.
     pub(super) rows: Vec<CellRow>,
     per_j: PerJouleCache,
+    /// The rounding bound of every duration computed here
+    /// ([`time_rounding_s`]: times are from 0°, so their error is relative
+    /// to the frame), added to each before it is counted in pulses.
+    pub(super) t_pad: f64,
 }
 
 /// A cell as the sweep leaves it.
@@ -111,6 +117,7 @@ impl<'a> Cells<'a> {
             e_pt: Vec::new(),
             rows: Vec::new(),
             per_j: PerJouleCache::default(),
+            t_pad: time_rounding_s(frame_s),
         };
         cells.sweep();
         cells
@@ -152,6 +159,7 @@ impl<'a> Cells<'a> {
         let t2 = ael::T2_S.min(ael::TIME_BASE_S);
         let e_slack = PRUNE_SLACK * env.total_j();
         let t_slack = PRUNE_SLACK * frame_s;
+        let t_pad = self.t_pad;
         // Bins with angular acceleration (`ω²` not constant); with none, no
         // cell is curved and the edges' bins need not be looked up.
         let bin_curved: Vec<bool> = segs.iter().map(|s| s.spin_sq_line_deg().1 != 0.0).collect();
@@ -274,8 +282,8 @@ impl<'a> Cells<'a> {
             } else {
                 (ends_tau, ends_e, ends_tau_min)
             };
-            let per_pass = per_pass_of.get(tau, |t| max_pulses_in(t, f_p));
-            let passes = passes_of.get(tau, |t| passes_in_window(t2, t, frame_s));
+            let per_pass = per_pass_of.get(tau, |t| max_pulses_in(t + t_pad, f_p));
+            let passes = passes_of.get(tau, |t| passes_in_window(t2, t + t_pad, frame_s));
             let per_j = self.per_j.get(self.laser, per_pass, passes);
             let mut single = p * delta * per_j;
             if edges.is_none() {
@@ -305,8 +313,8 @@ impl<'a> Cells<'a> {
                 };
                 if p_in < p {
                     let mut at = |p_w: f64, tau_s: f64| {
-                        let k = max_pulses_in(tau_s, f_p);
-                        let q = passes_in_window(t2, tau_s, frame_s);
+                        let k = max_pulses_in(tau_s + t_pad, f_p);
+                        let q = passes_in_window(t2, tau_s + t_pad, frame_s);
                         p_w * delta * self.per_j.get(self.laser, k, q)
                     };
                     single = at(p_in, tau)
@@ -381,10 +389,10 @@ impl<'a> Cells<'a> {
             }
         }
         let p = self.rows[c].p;
-        let per_pass = max_pulses_in(cell_tau, self.laser.pulse_rate_hz);
+        let per_pass = max_pulses_in(cell_tau + self.t_pad, self.laser.pulse_rate_hz);
         let passes = passes_in_window(
             ael::T2_S.min(ael::TIME_BASE_S),
-            cell_tau,
+            cell_tau + self.t_pad,
             self.tl.period_s(),
         );
         // A pass also holds at most `per_pass` pulses of at most `p·Δ`, and

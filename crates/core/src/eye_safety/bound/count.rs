@@ -17,6 +17,8 @@
 //! | [`PRUNE_SLACK`] | 1e-12 | relative, of a turn's time or envelope energy | curved cells' bounds, whole-pass interpolations (`2·`), the pruning thresholds (`1 + s`) | the few ulps by which two evaluations of one difference of cumulative totals may differ |
 //! | [`REACH_SLACK`] | 1e-9 | relative, of a turn's time | each walk's reach | the float inversions of the head's motion (time at an azimuth and back) |
 //! | [`TOUCH_SNAP_DEG`] | 1e-9 | deg | the arc a cell's pulses come from (Rule 1, pulse caps) | the rounding of the cuts (an ulp of 360° is 5.7e-14°) |
+//! | [`TIME_ROUNDING`] | 64·ε (ε = 2⁻⁵² = 2u) | of the frame period `T_f`, absolute, on every duration | every pulse count of a pass or of a bin's share of it (`Cells`, pulse caps), as `⌊(τ + time_rounding_s)·f⌋ + 1`; the multi-pass rules' `τ`; every within-pass window (walks, whole passes) takes the AEL of a window `time_rounding_s` shorter | the rounding of a time *from 0°*: see "Times from 0°" below |
+//! | [`energy_rounding_j`] | `(V + 2P̂)·time_rounding_s + 32ε·E_turn` | J, absolute, on every pass and window energy | `bound::evaluate`: added to the pass figures of the multi-pass rules and, over the smallest AEL of a window, to the within-pass ratio | the same rounding in the envelope integrals |
 //! | `firmware::eye::LIMIT_MARGIN` | 1e-9 | relative, on each integer limit before it is rounded down | `IntEyeLimits::derive` | the float rounding of the limits derived from this model |
 //! | (literal in `firmware::eye`) | 1e-12 | relative, up, on the pass arc in mdeg before its `ceil` | `IntEyeLimits::derive` | an arc that is an integer mdeg up to rounding is not taken one mdeg short |
 //! | (literals in `firmware::eye`) | 1e-12 | relative, down, on the shortest span of `k` pulses or `m` passes before its AEL | `IntEyeLimits::derive` | a span rounded up would read a larger AEL; shorter spans are the conservative side |
@@ -34,6 +36,68 @@
 //! three 1e-12 literals are still literals in `firmware::eye::derive`
 //! (that code is being reworked for the AEL infimum; they are listed here so
 //! the table is complete).
+//!
+//! **Times from 0°.** Every time the bound computes is a time from 0° of
+//! the frame (`Timeline::time_at_unwrapped_s`: `k·T_f + cum_i + t_into`,
+//! `|k| ≤ 2`; the envelope's breakpoints are such times, or such times plus
+//! `Δ`), and every duration is a difference of two of them. So its
+//! rounding error is relative to the *frame*, not to the duration: about
+//! `u·T_f` where the relative margins above assume a few `u·τ`. On a frame
+//! of 2.29·10⁶ s whose fastest pass lasts 1.25·10⁻⁴ s the difference is
+//! ≈ 4·10⁻⁶ of the pass, 4000 times [`COUNT_MARGIN`] (a 20-pulse pass was
+//! counted 19). The bound adds the error's bound instead:
+//! - the cumulative times are compensated sums (`kinematics::Compensated`,
+//!   within `2u·T_f + O(n·u²)·T_f`); each dwell is within `4u` of its
+//!   exact value (a quotient, a sum, a product: `≤ 4u·T_f` summed over the
+//!   bins); the time into a bin within `6u` of its dwell; `k·T_f` and the
+//!   two sums `k·T_f + cum_i + t_into` (`|k| ≤ 2`, so every partial value
+//!   is below `3T_f`) at most `3·u·3T_f`. In all `< 32u·T_f = 16ε·T_f` per
+//!   time (the `O(n·u²)` term is below `u·T_f` for `n < 2⁵⁰` bins), so a
+//!   duration is within `32ε·T_f` of the difference of the exact times:
+//!   [`time_rounding_s`] is **twice that**, `64ε·T_f` per duration, and
+//!   every pulse count takes `τ + time_rounding_s` (an envelope piece is
+//!   `Δ` wider on one side: the same bound), and every within-pass window
+//!   (walks, whole passes) is compared with the AEL of a window that much
+//!   shorter (within a row the AEL grows with the length, and across a
+//!   row edge that steps up a window just past the edge would otherwise
+//!   read the upper row). The rounding of an azimuth
+//!   (`φ ± h`, `≤ u·720°`) is not a time error: it evaluates the pass of an
+//!   aperture within `u·720°` of the intended one, covered by the cells'
+//!   ends and [`TOUCH_SNAP_DEG`] as before.
+//! - An envelope integral between two such times is off by at most
+//!   `(V + 2P̂)·δ` (`δ` the time error, `V` the variation of `P̄` inside:
+//!   the errors of the breakpoints telescope to the jumps) plus the
+//!   compensated prefix sums' `≤ 16ε·E_turn` (`E_turn = ∫ P̄` over a frame)
+//!   at each end: [`energy_rounding_j`].
+//!
+//! On an ordinary profile both are far below the relative margins (a
+//! 0.1 s frame: `time_rounding_s` = 1.4·10⁻¹⁵ s); they decide only where
+//! the frame is many orders of magnitude longer than a pass.
+
+/// The absolute rounding slack of every duration the bound computes, per
+/// second of frame period (see "Times from 0°" in the module docs):
+/// `64·ε`, twice the proven `32·ε`.
+pub const TIME_ROUNDING: f64 = 64.0 * f64::EPSILON;
+
+/// The bound on the rounding of any duration the bound computes on a frame
+/// of `frame_s`, s: [`TIME_ROUNDING`]` · T_f`.
+#[must_use]
+pub fn time_rounding_s(frame_s: f64) -> f64 {
+    TIME_ROUNDING * frame_s
+}
+
+/// The bound on the rounding of any envelope integral over a window the
+/// bound computes, J: `(V + 2P̂)·time_rounding_s + 32ε·E_turn`, `V` the
+/// largest variation of `P̄` within the window (its breakpoints' errors
+/// telescope to the jumps), `P̂` the highest power (the two ends),
+/// `E_turn` the envelope's integral over one frame (the compensated prefix
+/// sums at both ends). Raised by [`COUNT_MARGIN`] for the rounding of this
+/// very expression.
+#[must_use]
+pub fn energy_rounding_j(frame_s: f64, variation_w: f64, p_hat_w: f64, turn_j: f64) -> f64 {
+    let e = (variation_w + 2.0 * p_hat_w) * time_rounding_s(frame_s) + 32.0 * f64::EPSILON * turn_j;
+    e * (1.0 + COUNT_MARGIN)
+}
 
 /// Relative margin by which every floor-count is rounded up (see module docs).
 pub const COUNT_MARGIN: f64 = 1e-9;

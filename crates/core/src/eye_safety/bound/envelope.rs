@@ -7,7 +7,7 @@
 use super::order::{sort_runs, split_index, wrap_index};
 use super::seg::Seg;
 use super::sliding::Queue;
-use crate::profile::kinematics::{split_periods, Timeline};
+use crate::profile::kinematics::{split_periods, Compensated, Timeline};
 
 /// The max-filtered power `P̄` over one period, as pieces `[t_k, t_{k+1})`
 /// with prefix integrals, extended periodically.
@@ -94,11 +94,13 @@ impl Envelope {
         let mut t_s = cand;
         t_s.push(frame_s);
         let mut cum_j = Vec::with_capacity(m + 1);
-        let mut e = 0.0;
+        // Compensated (see `Compensated`): within a few `u` of the total
+        // whatever the number of pieces (`count::time_rounding_s`).
+        let mut e = Compensated::default();
         cum_j.push(0.0);
         for j in 0..m {
-            e += p_w[j] * (t_s[j + 1] - t_s[j]);
-            cum_j.push(e);
+            e.add(p_w[j] * (t_s[j + 1] - t_s[j]));
+            cum_j.push(e.value());
         }
         Self {
             t_s,
@@ -181,6 +183,35 @@ impl Envelope {
     pub(super) fn p_of(&self, idx: i64) -> f64 {
         self.p_w[wrap_index(idx, self.pieces() as i64)]
     }
+
+    /// The largest total variation of `P̄` over any closed window of
+    /// `len_s` (the sum of `|ΔP̄|` over the breakpoints inside it), W: a
+    /// time error `δ` at every breakpoint moves an integral over such a
+    /// window by at most this times `δ` (the errors telescope to the
+    /// jumps), plus `P̂·δ` at each end. Two pointers over the breakpoints of
+    /// one period and the next: linear.
+    pub(super) fn max_variation_within(&self, len_s: f64) -> f64 {
+        let m = self.pieces() as i64;
+        let jump = |i: i64| (self.p_of(i) - self.p_of(i - 1)).abs();
+        if len_s >= self.frame_s {
+            let total: f64 = (0..m).map(jump).sum();
+            return total * ((len_s / self.frame_s).floor() + 1.0);
+        }
+        let (mut best, mut sum, mut r) = (0.0f64, 0.0f64, 0i64);
+        for i in 0..m {
+            if r < i {
+                r = i;
+                sum = 0.0;
+            }
+            while r < i + m && self.bp(r) <= self.bp(i) + len_s {
+                sum += jump(r);
+                r += 1;
+            }
+            best = best.max(sum);
+            sum -= jump(i);
+        }
+        best
+    }
 }
 
 #[cfg(test)]
@@ -203,6 +234,51 @@ mod tests {
 
     fn close(got: f64, want: f64) {
         assert!((got - want).abs() <= 1e-12, "{got} vs {want}");
+    }
+
+    proptest! {
+        /// `max_variation_within` against a plain double loop: for every
+        /// breakpoint of two periods, the sum of `|ΔP̄|` over the
+        /// breakpoints in the closed window from it, the largest; and every
+        /// window's variation is at most it.
+        #[test]
+        fn max_variation_is_the_largest_over_every_window(
+            bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..2.0, 1.0f64..50.0), 1..30),
+            delta in 1e-4f64..0.05,
+            frac in 0.0f64..1.5,
+        ) {
+            let total: f64 = bins.iter().map(|b| b.0).sum();
+            let mut start = 0.0;
+            let segs: Vec<Seg> = bins
+                .iter()
+                .map(|&(w, p, om)| {
+                    let width = 360.0 * w / total;
+                    let s = seg(start, width, p, om, om);
+                    start += width;
+                    s
+                })
+                .collect();
+            let tl = Timeline::from_bins(&segs);
+            let env = Envelope::new(&tl, delta);
+            let len = frac * env.frame_s;
+            let got = env.max_variation_within(len);
+            let m = env.pieces() as i64;
+            let jump = |i: i64| (env.p_of(i) - env.p_of(i - 1)).abs();
+            let mut want = 0.0f64;
+            for i in 0..2 * m {
+                let mut v = 0.0;
+                let mut r = i;
+                while r < i + 3 * m && env.bp(r) <= env.bp(i) + len {
+                    v += jump(r);
+                    r += 1;
+                }
+                want = want.max(v);
+            }
+            prop_assert!(got >= want * (1.0 - 1e-12), "got {got}, want {want}");
+            if len < env.frame_s {
+                prop_assert!(got <= want * (1.0 + 1e-12) + 1e-300, "got {got}, want {want}");
+            }
+        }
     }
 
     /// Mutants 804:9 (`Envelope::locate` replaced by a constant) and 856:9

@@ -79,8 +79,10 @@ pub use pulse_cap::PULSE_CAP_MAX_BINS;
 pub use seg::Seg;
 pub use walks::WALK_MAX_PIECES;
 
+use crate::eye_safety::ael;
 use crate::profile::kinematics::Timeline;
 use cells::Cells;
+use count::energy_rounding_j;
 use envelope::Envelope;
 use search::Best;
 use seg::coalesce;
@@ -166,11 +168,22 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
     let within = walks.search(search, first);
     let Best(pass_ratio, pass_window) =
         cells.full_pass_max(search, best.e_max.0, best.tau_max, one_pass, within);
+    // Every energy above is a difference of integrals from 0°: add the
+    // bound on its rounding (`count::energy_rounding_j`), to the pass
+    // figures and, over the smallest AEL any window can take, to the
+    // within-pass ratio.
+    let e_pad = energy_rounding_j(
+        frame_s,
+        env.max_variation_within(l_max + cells.t_pad) * (1.0 + COUNT_MARGIN),
+        p_hat,
+        env.total_j(),
+    );
+    let pass_ratio = pass_ratio + e_pad / laser.ael_inf_j(0.0, ael::T_MAX_TABLE_S);
     // Rule 2 over several passes, up to the time base.
     let pass = PassFigures {
-        envelope_j: best.e_env_max,
-        pulses_j: best.e_max.0,
-        duration_s: best.tau_max,
+        envelope_j: best.e_env_max + e_pad,
+        pulses_j: best.e_max.0 + e_pad,
+        duration_s: best.tau_max + cells.t_pad,
     };
     let (multi_ratio, multi_window) = laser.multi_pass_ratio(frame_s, pass, p_hat);
     let multi_rule = Rule::for_duration(multi_window, frame_s);
@@ -206,7 +219,7 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
         },
         ratios,
         max_pass_duration_s: best.tau_max,
-        max_pulses_per_pass: max_pulses_in(best.tau_max, laser.pulse_rate_hz),
+        max_pulses_per_pass: max_pulses_in(best.tau_max + cells.t_pad, laser.pulse_rate_hz),
         max_pass_energy_j: best.e_max.0,
         worst_window_s: if k_best == 1 {
             pass_window

@@ -51,7 +51,7 @@ impl Cells<'_> {
             let t_b = (tl.time_at_unwrapped_from_s(b, &mut hb)
                 - tl.time_at_unwrapped_from_s(a, &mut ha))
             .max(0.0);
-            *slot = (seg.power_w, max_pulses_in(t_b, f_p));
+            *slot = (seg.power_w, max_pulses_in(t_b + self.t_pad, f_p));
         }
         bins.sort_unstable_by(|x, y| y.0.total_cmp(&x.0));
         let mut left = per_pass;
@@ -93,7 +93,7 @@ impl Cells<'_> {
             let n = if curved {
                 per_pass
             } else {
-                max_pulses_in(tau_a.max(tau_b), f_p).min(per_pass)
+                max_pulses_in(tau_a.max(tau_b) + self.t_pad, f_p).min(per_pass)
             };
             let e = self.pulse_capped_j(a, b, n)?;
             best = Some(best.map_or(e, |x: f64| x.max(e)));
@@ -106,7 +106,7 @@ impl Cells<'_> {
     /// [`Self::pulse_capped_split`]: never above `x.e.0`, so `x.e.0` bounds
     /// it in the branch and bound.
     pub(super) fn e_refined(&self, c: usize, x: &CellExact) -> f64 {
-        let per_pass = max_pulses_in(x.tau_s, self.laser.pulse_rate_hz);
+        let per_pass = max_pulses_in(x.tau_s + self.t_pad, self.laser.pulse_rate_hz);
         let (u, v) = (self.cut(c), self.cut(c + 1));
         self.pulse_capped_split(c, u, v, per_pass)
             .map_or(x.e.0, |e| e.min(x.e.0))

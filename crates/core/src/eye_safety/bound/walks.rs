@@ -2,7 +2,7 @@
 //! (`specs/eye_safety.md`, "Walks"), each followed piece by piece up to its
 //! reach, in decreasing order of their bound when pruned.
 
-use super::count::{PRUNE_SLACK, REACH_SLACK};
+use super::count::{time_rounding_s, PRUNE_SLACK, REACH_SLACK};
 use super::envelope::Envelope;
 use super::laser::Laser;
 use super::search::Best;
@@ -64,6 +64,10 @@ impl Walks<'_> {
         let laser = self.laser;
         let delta = 1.0 / laser.pulse_rate_hz;
         let t_walk = self.l_max - delta;
+        // Window lengths are differences of times from 0°: each is compared
+        // with the AEL of a window `time_rounding_s` shorter (the same
+        // energies, every length shifted down by it), as in the walks.
+        let pad = time_rounding_s(self.env.frame_s);
         if t_walk <= 0.0 {
             return best;
         }
@@ -84,8 +88,8 @@ impl Walks<'_> {
                     let w = walks[k];
                     if g.0 != w.p_span {
                         let (r, _) = laser.linear_capped_max(
-                            0.0,
-                            t_walk,
+                            -pad,
+                            t_walk - pad,
                             w.p_span * delta,
                             w.p_span,
                             self.e_pass,
@@ -179,6 +183,9 @@ impl Walks<'_> {
         let e_pass = self.e_pass;
         let reach = w.reach_s;
         let t_reach = reach - delta;
+        // Every length below is a difference of times from 0°: the AEL is
+        // taken at a window `pad` shorter (`count::time_rounding_s`).
+        let pad = time_rounding_s(env.frame_s);
         let b0 = env.bp(w.start);
         let (mut e, mut l, mut idx) = (0.0f64, 0.0f64, w.start);
         for _ in 0..WALK_MAX_PIECES {
@@ -192,8 +199,8 @@ impl Walks<'_> {
                 let l0 = l.max(delta);
                 let e0 = e + piece_p * (l0 - l);
                 best.take(laser.linear_capped_max(
-                    l0 - delta,
-                    seg_end - delta,
+                    l0 - delta - pad,
+                    seg_end - delta - pad,
                     e0,
                     piece_p,
                     e_pass,
@@ -211,8 +218,8 @@ impl Walks<'_> {
                     (l - delta).max(0.0)
                 };
                 best.take(laser.linear_capped_max(
-                    t_c,
-                    t_reach.max(t_c),
+                    t_c - pad,
+                    t_reach.max(t_c) - pad,
                     e_pass,
                     0.0,
                     e_pass,
@@ -229,8 +236,8 @@ impl Walks<'_> {
         let l0 = l.max(delta);
         let e0 = e + w.p_span * (l0 - l);
         best.take(laser.linear_capped_max(
-            l0 - delta,
-            t_reach,
+            l0 - delta - pad,
+            t_reach - pad,
             e0,
             w.p_span,
             e_pass,

@@ -33,16 +33,20 @@ impl Cells<'_> {
     /// is largest at the same candidates, where `AEL_inf` is at most `m`.
     fn full_pass(&self, c: usize, e_cap: f64, one_pass_s: f64) -> (f64, f64) {
         let laser = self.laser;
+        // `τ` is a difference of times from 0°: the AEL of a pass
+        // `t_pad` shorter (`count::time_rounding_s`).
+        let pad = self.t_pad;
         if self.rows[c].curved {
             let x = self.exact(c);
-            let r = x.e_env.min(e_cap) / laser.ael_inf_j(x.tau_min_s, x.tau_s.max(one_pass_s));
+            let r =
+                x.e_env.min(e_cap) / laser.ael_inf_j(x.tau_min_s - pad, x.tau_s.max(one_pass_s));
             return (r, x.tau_min_s);
         }
         let (tu, tv) = (self.tau_pt[c], self.tau_pt[c + 1]);
         let (eu, ev) = (self.e_pt[c], self.e_pt[c + 1]);
         let mut best = Best(0.0, 0.0);
         let mut take =
-            |e: f64, t: f64| best.take((e.min(e_cap) / laser.ael_inf_j(t, one_pass_s), t));
+            |e: f64, t: f64| best.take((e.min(e_cap) / laser.ael_inf_j(t - pad, one_pass_s), t));
         take(eu, tu);
         take(ev, tv);
         // Along the cell `E` is affine in `τ`. Interpolations are widened by
@@ -91,7 +95,12 @@ impl Cells<'_> {
             }
             Search::Pruned => {
                 let laser = self.laser;
-                let k = laser.mean_power_factor(tau_max, one_pass_s) * (1.0 + PRUNE_SLACK);
+                // `τ/AEL_inf(τ − pad) ≤ K + pad/AEL_min` (the shift of
+                // `full_pass`), `AEL_min` the table's smallest.
+                let pad = self.t_pad;
+                let k = (laser.mean_power_factor(tau_max, one_pass_s)
+                    + pad / laser.ael_inf_j(0.0, crate::eye_safety::ael::T_MAX_TABLE_S))
+                    * (1.0 + PRUNE_SLACK);
                 for (c, row) in self.rows.iter().enumerate() {
                     // (A NaN bound never prunes; a bound `τ_lb ≤ 0` only
                     // through the AEL, which clamps it.)
@@ -99,7 +108,7 @@ impl Cells<'_> {
                     if row.tau_lb > 0.0 && e / row.tau_lb * k < best.0 {
                         continue;
                     }
-                    let ael = laser.ael_inf_j(row.tau_lb, row.tau_ub.max(one_pass_s));
+                    let ael = laser.ael_inf_j(row.tau_lb - pad, row.tau_ub.max(one_pass_s));
                     if e / ael * (1.0 + PRUNE_SLACK) < best.0 {
                         continue;
                     }

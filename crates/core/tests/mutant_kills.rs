@@ -1,0 +1,123 @@
+//! Tests that pin two parts of the bound no other core test reached
+//! (`specs/mutants.md`): a window walk over more than `WALK_MAX_PIECES`
+//! envelope pieces inside one pass, and the multi-pass pass-count rule on a
+//! pass longer than half a frame. Each names the mutant it kills.
+
+use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
+use gaze_lidar_core::eye_safety::bound::{Seg, WALK_MAX_PIECES};
+use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams, Rule};
+
+fn params(lambda_nm: f64, beam_mm: f64) -> EyeSafetyParams {
+    EyeSafetyParams {
+        wavelength_nm: lambda_nm,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: beam_mm,
+        head: None,
+    }
+}
+
+fn seg(start_deg: f64, width_deg: f64, power_w: f64, spin_rad_s: f64) -> Seg {
+    Seg {
+        start_deg,
+        width_deg,
+        power_w,
+        spin_start_rad_s: spin_rad_s,
+        spin_end_rad_s: spin_rad_s,
+    }
+}
+
+/// 1450 nm, 200 kHz, beam 1 mm: pass arc `2h = (3.5571 + 1)/100` rad =
+/// 2.6110°. At 1 rad/s everywhere, 100 pairs of a hot bin (0.9 of a pair,
+/// `p` W) and a cold one (0.1, dark) fill half the pass arc from 10°; the
+/// rest is dark.
+fn alternating_pass(p: f64) -> (Vec<Seg>, f64, f64) {
+    let two_h_deg = ((APERTURE_IR_MM + 1.0) / 100.0f64).to_degrees();
+    let region = 0.5 * two_h_deg;
+    let pair = region / 100.0;
+    let mut segs = vec![seg(0.0, 10.0, 0.0, 1.0)];
+    let mut a = 10.0;
+    for _ in 0..100 {
+        segs.push(seg(a, 0.9 * pair, p, 1.0));
+        segs.push(seg(a + 0.9 * pair, 0.1 * pair, 0.0, 1.0));
+        a += pair;
+    }
+    segs.push(seg(a, 360.0 - a, 0.0, 1.0));
+    (segs, region.to_radians(), (0.9 * pair).to_radians())
+}
+
+/// Kills `walks.rs` `Walks::walk`: `e + w.p_span * (l0 - l)` →
+/// `e * w.p_span * (l0 - l)` (a walk longer than `WALK_MAX_PIECES` pieces
+/// restarts its energy at 0, under-counting every long window inside one
+/// pass). The hot region is 200 bins, ≈ 400 envelope pieces (a hot bin's
+/// power lasts one spacing `Δ` past it, the 22.8 µs cold gaps outlast
+/// `Δ` = 5 µs), so no walk crosses it within `WALK_MAX_PIECES` = 96.
+///
+/// By hand: the region lasts `T_A` = 0.022785 s (1.3055° at 1 rad/s); each
+/// hot bin 2.0507e-4 s, so for any clock phase it holds at least
+/// `⌊2.0507e-4 · 2e5⌋` = 41 pulses: 4100 pulses of `p·Δ` within a window
+/// no longer than `T_A`, whose AEL is at most `4.4e-3·T_A^0.25` =
+/// 1.70949e-3 J (1 ms – 0.35 s row, growing): at `p` = 0.08506 W the true
+/// ratio is at least `4100 · 4.253e-7 / 1.70949e-3` = 1.0200. The whole
+/// passes are longer (0.0456 s: the region plus dark) and lower.
+#[test]
+fn long_walk_inside_one_pass_is_not_under_counted() {
+    assert_eq!(WALK_MAX_PIECES, 96);
+    let (f_p, p) = (2e5, 0.08506);
+    let (segs, t_a, t_hot) = alternating_pass(p);
+    let per_bin = (t_hot * f_p).floor();
+    assert_eq!(per_bin, 41.0);
+    let truth_lb = 100.0 * per_bin * p / f_p / (4.4e-3 * t_a.powf(0.25));
+    assert!((truth_lb - 1.0200).abs() < 1e-3, "{truth_lb}");
+    let r = evaluate_segments(&segs, &params(1450.0, 1.0), f_p).unwrap();
+    assert!(
+        r.rule_ratios[1] >= truth_lb,
+        "pass train {} below {truth_lb}",
+        r.rule_ratios[1]
+    );
+    assert!(r.worst_ratio > 1.0);
+}
+
+/// Kills `laser.rs` `Laser::pass_count_max`: `((lo + tau) / frame_s).ceil()`
+/// → `((lo - tau) / frame_s).ceil()` (when a pass lasts more than half a
+/// frame the first step of a Table 3 row drops out of the candidates).
+///
+/// 1450 nm, beam 1 mm (`2h` = 0.045571 rad), `T_f` = 1/11 s: a slow arc of
+/// `1.05·2h` at `ω_s = 2h/τ` with `τ = 0.9·T_f` = 0.081818 s, the rest of
+/// the turn fast so the frame is 1/11 s; one power `p` throughout; 12.1 Hz
+/// pulses, so `τ·f` = 0.99: a pass holds one pulse, `E⁺ = p·Δ`. Rule C
+/// (at most `⌊(T + τ)/T_f⌋ + 1` passes in a window of `T`) steps up at
+/// `T_k = k·T_f − τ`. The 0.35 s row edge: `(0.35 + τ)/T_f` = 4.75, so the
+/// first step in the `1e-2·t` row is `k = 5`, `T_5` = 0.372727 s, six
+/// passes: `6·p·Δ/(1e-2·T_5)` = 1609.76·`p·Δ`, larger than the edge itself
+/// (5 passes over 3.3843e-3 J: 1477.4) and the last step of the row before
+/// (`T_4` = 0.281818 s, 5 over `4.4e-3·T_4^0.25`: 1559.7). The mutant's
+/// candidates are `k` = 3, 4 and the row's last two: it misses `k = 5`.
+/// At `p·Δ` = 6.2742e-4 J the bound's figure is 1.0100; the mutant's
+/// 0.9789 would certify it.
+#[test]
+fn pass_count_rule_evaluates_the_first_step_of_a_row() {
+    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let frame = 1.0 / 11.0;
+    let tau = 0.9 * frame;
+    let w_s = two_h / tau;
+    let slow_deg = (1.05 * two_h).to_degrees();
+    let slow_time = 1.05 * two_h / w_s;
+    let w_f = (360.0 - slow_deg).to_radians() / (frame - slow_time);
+    let f_p = 12.1;
+    let e_pulse = 6.2742e-4;
+    let p = e_pulse * f_p;
+    let segs = vec![
+        seg(0.0, slow_deg, p, w_s),
+        seg(slow_deg, 360.0 - slow_deg, p, w_f),
+    ];
+    let t5 = 5.0 * frame - tau;
+    let by_hand = 6.0 * e_pulse / (1e-2 * t5);
+    assert!((by_hand - 1.0100).abs() < 1e-3, "{by_hand}");
+    let r = evaluate_segments(&segs, &params(1450.0, 1.0), f_p).unwrap();
+    assert!(
+        r.worst_ratio >= by_hand,
+        "{} below {by_hand}",
+        r.worst_ratio
+    );
+    assert_eq!(r.binding_rule, Rule::T2Train);
+}
