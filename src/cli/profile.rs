@@ -15,7 +15,7 @@ use gaze_lidar::model::presets::Preset;
 use gaze_lidar::planner::figures;
 use gaze_lidar::profile::{RegionFigure, RegionFigures};
 
-use super::args::{finite_positive, int_in};
+use super::args::{finite, finite_positive, int_in};
 use super::config::Overrides;
 use super::output::Outputs;
 use super::CliError;
@@ -158,6 +158,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         a.gaze_deg
     };
     if let Some(g) = a.gaze_deg {
+        finite("--gaze-deg", g)?;
         gaze_lidar::planner::validate_gaze(g).map_err(|e| CliError::input(format!("--{e}")))?;
     }
     if a.certificate.is_some() && !(a.optimize || a.config.is_some()) {
