@@ -231,7 +231,7 @@ fn a_dash_means_stdout_for_every_file_output_or_is_refused_by_name() {
 }
 
 #[test]
-fn stdout_on_a_full_device_leaves_the_certificate_folder_as_it_was() {
+fn stdout_or_out_on_a_full_device_leaves_the_certificate_folder_as_it_was() {
     let full = Path::new("/dev/full");
     if !full.exists() {
         eprintln!("note: no /dev/full; skipped");
@@ -259,6 +259,28 @@ fn stdout_on_a_full_device_leaves_the_certificate_folder_as_it_was() {
         );
         expect(&o, 1, &["stdout"], cert);
         assert_eq!(tree(d.path(), &[]), before, "{cert}: files changed");
+        // The same with the output file on the full device.
+        let o = run_in(
+            d.path(),
+            &[
+                "profile",
+                "--config",
+                PAPER_CONFIG,
+                "--gaze-deg",
+                "90",
+                "--certificate",
+                cert,
+                "--out",
+                "/dev/full",
+            ],
+            None,
+        );
+        expect(&o, 1, &["/dev/full"], cert);
+        assert_eq!(
+            tree(d.path(), &[]),
+            before,
+            "{cert} --out /dev/full: files changed"
+        );
     }
 }
 

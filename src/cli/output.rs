@@ -20,12 +20,12 @@
 //!
 //! At the end, [`Outputs::commit`] checks again, creates the missing
 //! folders, writes every regular file to a temporary file in its own
-//! folder, then the command's stdout data ([`Outputs::stdout`]), and only
-//! when all of that is written renames the files into place (keeping a
-//! hard-linked backup of each file it replaces, restored if a later rename
-//! fails); devices and FIFOs are written last, in place. A failure before
-//! the renames (a full disk, stdout on a full device) leaves every old
-//! output as it was, no temporary file and no folder this run created.
+//! folder, then the command's stdout data ([`Outputs::stdout`]) and any
+//! device or FIFO output (in place), and only when all of that is written
+//! renames the files into place (keeping a hard-linked backup of each file
+//! it replaces, restored if a later rename fails). A failure before the
+//! renames (a full disk, stdout or an output on a full device) leaves every
+//! old output as it was, no temporary file and no folder this run created.
 
 use std::fs::OpenOptions;
 use std::io::{self, ErrorKind, Write};
@@ -474,12 +474,16 @@ impl Outputs {
                 Target::Special(p) => special.push((p, bytes)),
             }
         }
-        // Stdout after staging, before any rename: a failure here (stdout
-        // on a full device) leaves every file as it was.
+        // Stdout, devices and FIFOs after staging, before any rename: a
+        // failure here (stdout or `--out /dev/full` on a full device) leaves
+        // every file as it was.
         if let Some(bytes) = &self.stdout {
             let mut out = super::io::Stdout::new();
             out.bytes(bytes)?;
             out.finish()?;
+        }
+        for (path, bytes) in special {
+            write_special(path, bytes)?;
         }
         // Replace: keep a hard-linked backup of each replaced file until
         // every rename has succeeded.
@@ -496,9 +500,6 @@ impl Outputs {
             done.push((real, previous));
         }
         drop(done);
-        for (path, bytes) in special {
-            write_special(path, bytes)?;
-        }
         Ok(())
     }
 }
