@@ -42,7 +42,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     finite("--wavelength-nm", a.wavelength_nm)?;
     finite_positive("--pulse-duration-s", a.pulse_duration_s)?;
     if let Some(r) = a.pulse_rate_hz {
-        rate("--pulse-rate-hz", r)?;
+        finite_positive("--pulse-rate-hz", r)?;
         // Pulses of this duration at this rate would overlap: not a pulse train.
         if r * a.pulse_duration_s >= 1.0 {
             return Err(CliError::input(format!(
@@ -51,6 +51,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 r * a.pulse_duration_s
             )));
         }
+        rate("--pulse-rate-hz", r)?;
     }
     if let Some(d) = a.beam_diameter_mm {
         finite_positive("--beam-diameter-mm", d)?;
