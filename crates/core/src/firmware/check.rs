@@ -199,8 +199,10 @@ pub fn check_table_evaluated(
     table: &FirmwareTable,
 ) -> (Vec<FwViolation>, Option<eye::IntEyeReport>) {
     let mut v = check_header(table);
+    let header_ok = v.is_empty();
     v.extend(check_integer(table));
-    if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+    // Eye safety reads the header's numbers: not evaluated on bad ones.
+    if !header_ok || v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
         return (v, None);
     }
     match IntEyeLimits::derive(table) {
@@ -235,8 +237,9 @@ pub fn check_table_evaluated(
 #[must_use]
 pub fn check_table_with(table: &FirmwareTable, limits: &IntEyeLimits) -> Vec<FwViolation> {
     let mut v = check_header(table);
+    let header_ok = v.is_empty();
     v.extend(check_integer(table));
-    if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+    if !header_ok || v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
         return v;
     }
     v.extend(eye_violation(table, limits));
