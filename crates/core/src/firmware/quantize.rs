@@ -152,8 +152,7 @@ pub fn lower_to_budget(codes: &mut [u32], weights: &[u64], min: u32, budget: u64
         .filter(|&&i| codes[i] > min)
         .map(|&i| u128::from(weights[i]))
         .sum();
-    if lowerable > 0 {
-        let passes = (energy - budget) / lowerable;
+    if let Some(passes) = (energy - budget).checked_div(lowerable) {
         if passes > 1 {
             let k = u32::try_from(passes - 1).unwrap_or(u32::MAX);
             for &i in &order {
