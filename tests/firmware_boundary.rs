@@ -203,6 +203,14 @@ fn the_header_boundary_is_part_of_the_library_checker() {
         })
         .collect();
     assert_eq!(fields, ["tick_hz", "pulse_rate_hz"]);
+    // Eye safety is not evaluated on such numbers; a table without its
+    // parameters still says it has none.
+    assert!(!check_table(&t).iter().any(|v| matches!(
+        v,
+        FwViolation::EyeSafety { .. } | FwViolation::EyeSafetyParams { .. }
+    )));
+    t.eye_safety = None;
+    assert!(check_table(&t).contains(&FwViolation::EyeSafetyMissing));
 }
 
 #[test]

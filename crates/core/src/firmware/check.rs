@@ -201,8 +201,12 @@ pub fn check_table_evaluated(
     let mut v = check_header(table);
     let header_ok = v.is_empty();
     v.extend(check_integer(table));
-    // Eye safety reads the header's numbers: not evaluated on bad ones.
+    // Eye safety reads the header's numbers: not evaluated on bad ones (a
+    // table without parameters still says so).
     if !header_ok || v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+        if !header_ok && table.eye_safety.is_none() {
+            v.push(FwViolation::EyeSafetyMissing);
+        }
         return (v, None);
     }
     match IntEyeLimits::derive(table) {
