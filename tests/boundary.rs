@@ -126,7 +126,7 @@ fn subnormal_flags_are_bad_input() {
         ],
         None,
     );
-    assert_bad_input(&o, "power_w_per_code");
+    assert_bad_input(&o, "--power-w-per-code");
     for (flag, value) in [
         ("--pulse-rate-hz", "5e-324"),
         ("--pulse-rate-hz", "4e-309"),
@@ -442,19 +442,19 @@ fn tables_against_the_wrong_sensor_and_broken_tables() {
     let (code, out, _) = check(&[s(&p), "--no-eye-safety"]);
     assert_eq!(code, Some(0), "{out}");
     assert!(out.contains("NOT evaluated"), "{out}");
-    // A subnormal pulse rate or DAC step is never certified.
-    for (rate, step) in [
-        (5e-324, table.power_w_per_code),
-        (table.pulse_rate_hz, 5e-324),
+    // A subnormal pulse rate or DAC step is never certified: bad input at
+    // the header boundary (exit 2), in JSON and binary alike.
+    for (rate, step, field) in [
+        (5e-324, table.power_w_per_code, "pulse_rate_hz"),
+        (table.pulse_rate_hz, 5e-324, "power_w_per_code"),
     ] {
         let mut t = table.clone();
         t.pulse_rate_hz = rate;
         t.power_w_per_code = step;
         let p = write(dir.path(), "sub.json", t.to_json().unwrap());
-        let (code, out, _) = check(&[s(&p)]);
-        assert_eq!(code, Some(1), "{out}");
+        assert_bad_input(&run(&["check", s(&p)], None), field);
         let p = write(dir.path(), "sub.bin", binary::encode(&t));
-        assert_ne!(check(&[s(&p)]).0, Some(0));
+        assert_bad_input(&run(&["check", s(&p)], None), field);
     }
     // Broken inputs.
     let text = std::fs::read_to_string(&json).unwrap();

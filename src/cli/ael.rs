@@ -7,6 +7,7 @@ use gaze_lidar::eye_safety::ael_report;
 use gaze_lidar::eye_safety::exposure::scan_pass_angle_deg;
 use gaze_lidar::text::Num;
 
+use super::args::{finite, finite_positive, rate};
 use super::{emit, CliError};
 
 /// Output format.
@@ -38,25 +39,10 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
-    if !(a.wavelength_nm.is_finite()) {
-        return Err(CliError::input(format!(
-            "--wavelength-nm: {} is not a finite number",
-            Num(a.wavelength_nm)
-        )));
-    }
-    if !(a.pulse_duration_s.is_finite() && a.pulse_duration_s > 0.0) {
-        return Err(CliError::input(format!(
-            "--pulse-duration-s: {} must be finite and > 0",
-            Num(a.pulse_duration_s)
-        )));
-    }
+    finite("--wavelength-nm", a.wavelength_nm)?;
+    finite_positive("--pulse-duration-s", a.pulse_duration_s)?;
     if let Some(r) = a.pulse_rate_hz {
-        if !(r.is_finite() && r > 0.0) {
-            return Err(CliError::input(format!(
-                "--pulse-rate-hz: {} must be finite and > 0",
-                Num(r)
-            )));
-        }
+        finite_positive("--pulse-rate-hz", r)?;
         // Pulses of this duration at this rate would overlap: not a pulse train.
         if r * a.pulse_duration_s >= 1.0 {
             return Err(CliError::input(format!(
@@ -65,18 +51,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 r * a.pulse_duration_s
             )));
         }
-        // The one numeric boundary: a rate of physical size (not subnormal).
-        if let Err(reason) = gaze_lidar::model::valid::rate_hz(r) {
-            return Err(CliError::input(format!("--pulse-rate-hz: {r:e}: {reason}")));
-        }
+        rate("--pulse-rate-hz", r)?;
     }
     if let Some(d) = a.beam_diameter_mm {
-        if gaze_lidar::model::valid::positive(d).is_err() {
-            return Err(CliError::input(format!(
-                "--beam-diameter-mm: {} must be finite and > 0 (not subnormal)",
-                Num(d)
-            )));
-        }
+        finite_positive("--beam-diameter-mm", d)?;
     }
     let r = ael_report(a.wavelength_nm, a.pulse_duration_s, a.pulse_rate_hz).map_err(|e| {
         let msg = e.to_string();

@@ -1,8 +1,10 @@
 //! Range checks of numeric options. Every numeric option is declared with
 //! `allow_hyphen_values` and a signed (or float) type, so `-1` or `-inf`
 //! reaches these checks and the message names the option, its value and
-//! its range (never clap's "unexpected argument '-1' found").
+//! its range (never clap's "unexpected argument '-1' found"). Every float
+//! goes through the one numeric boundary (`model::valid`).
 
+use gaze_lidar::model::valid;
 use gaze_lidar::text::Num;
 
 use super::CliError;
@@ -25,13 +27,15 @@ pub fn int_in<T: TryFrom<i128>>(
     )))
 }
 
-/// A float option, finite and within `(lo, hi)` (bounds exclusive).
+/// A float option within `(lo, hi)` (bounds exclusive) that passes the one
+/// numeric boundary (`model::valid::finite`: finite, zero or normal — a
+/// subnormal such as `5e-324` is no physical size and is refused).
 pub fn finite_between(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64, CliError> {
-    if value.is_finite() && value > lo && value < hi {
+    if valid::finite(value).is_ok() && value > lo && value < hi {
         Ok(value)
     } else {
         Err(CliError::input(format!(
-            "{flag}: {} must be finite, > {} and < {}",
+            "{flag}: {} must be finite (not subnormal), > {} and < {}",
             Num(value),
             Num(lo),
             Num(hi)
@@ -39,14 +43,22 @@ pub fn finite_between(flag: &str, value: f64, lo: f64, hi: f64) -> Result<f64, C
     }
 }
 
-/// A float option, finite and > 0.
+/// A float option, `> 0` at the one numeric boundary
+/// (`model::valid::positive`: finite, normal).
 pub fn finite_positive(flag: &str, value: f64) -> Result<f64, CliError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(CliError::input(format!(
-            "{flag}: {} must be finite and > 0",
-            Num(value)
-        )))
-    }
+    valid::positive(value)
+        .map_err(|reason| CliError::input(format!("{flag}: {} {reason}", Num(value))))
+}
+
+/// A rate option, Hz, at the one numeric boundary (`model::valid::rate_hz`).
+pub fn rate(flag: &str, value: f64) -> Result<f64, CliError> {
+    valid::rate_hz(value)
+        .map_err(|reason| CliError::input(format!("{flag}: {} {reason}", Num(value))))
+}
+
+/// A float option of any sign at the one numeric boundary
+/// (`model::valid::finite`).
+pub fn finite(flag: &str, value: f64) -> Result<f64, CliError> {
+    valid::finite(value)
+        .map_err(|reason| CliError::input(format!("{flag}: {} {reason}", Num(value))))
 }

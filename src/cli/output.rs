@@ -12,12 +12,20 @@
 //!   files are compared by device and inode, paths that do not exist yet by
 //!   their canonical folder.
 //!
-//! At the end, [`Outputs::commit`] checks again, writes every regular file
-//! to a temporary file in its own folder, and only when all of them are
-//! written renames them into place (keeping a hard-linked backup of each
-//! file it replaces, restored if a later rename fails); devices and FIFOs
-//! are written last, in place. A failure leaves every old output as it was
-//! and no temporary file behind.
+//! - is a folder of outputs and also another output's path (or lies
+//!   inside it): `--certificate nx --out nx`, or
+//! - is `-` where stdout is not free: `-` means stdout for a file output
+//!   (one output at most, and not when the command prints its own data
+//!   there, [`Outputs::claim_stdout`]); a folder cannot be `-`.
+//!
+//! At the end, [`Outputs::commit`] checks again, creates the missing
+//! folders, writes every regular file to a temporary file in its own
+//! folder, then the command's stdout data ([`Outputs::stdout`]) and any
+//! device or FIFO output (in place), and only when all of that is written
+//! renames the files into place (keeping a hard-linked backup of each file
+//! it replaces, restored if a later rename fails). A failure before the
+//! renames (a full disk, stdout or an output on a full device) leaves every
+//! old output as it was, no temporary file and no folder this run created.
 
 use std::fs::OpenOptions;
 use std::io::{self, ErrorKind, Write};
@@ -235,6 +243,16 @@ pub struct Outputs {
     inputs: Vec<(String, PathBuf)>,
     folders: Vec<(String, PathBuf)>,
     files: Vec<Declared>,
+    /// Who writes to stdout: the command itself (a description) or a file
+    /// option given `-`, in the order they were declared.
+    stdout_claims: Vec<String>,
+    /// The bytes for stdout, written after staging and before the renames.
+    stdout: Option<Vec<u8>>,
+}
+
+/// The path that means stdout for an output option.
+fn is_stdout(path: &Path) -> bool {
+    path.as_os_str() == "-"
 }
 
 /// A checked output, ready to stage.
@@ -260,8 +278,25 @@ impl Outputs {
         self
     }
 
-    /// Declares an output file.
+    /// Declares that the command prints its own data on stdout (`what`,
+    /// e.g. "the results table"): no output option may then be `-`.
+    pub fn claim_stdout(&mut self, what: &str) -> &mut Self {
+        self.stdout_claims.push(what.to_owned());
+        self
+    }
+
+    /// The command's stdout data, written with the files (see the module
+    /// documentation); also what a file option given `-` receives.
+    pub fn stdout(&mut self, bytes: impl Into<Vec<u8>>) {
+        self.stdout = Some(bytes.into());
+    }
+
+    /// Declares an output file (`-`: stdout).
     pub fn file(&mut self, label: &str, path: &Path) -> &mut Self {
+        if is_stdout(path) {
+            self.stdout_claims.push(format!("{label} -"));
+            return self;
+        }
         self.files.push(Declared {
             label: label.to_owned(),
             path: path.to_path_buf(),
@@ -296,6 +331,10 @@ impl Outputs {
     /// # Panics
     /// If `path` was not declared (a bug in the command).
     pub fn set(&mut self, path: &Path, bytes: impl Into<Vec<u8>>) {
+        if is_stdout(path) {
+            self.stdout(bytes);
+            return;
+        }
         let d = self
             .files
             .iter_mut()
@@ -311,10 +350,40 @@ impl Outputs {
     }
 
     fn checked(&self) -> Result<(Vec<Checked>, Vec<PathBuf>), CliError> {
+        if let [first, second, ..] = self.stdout_claims.as_slice() {
+            return Err(CliError::input(format!(
+                "{second}: stdout already carries {first}: give a file"
+            )));
+        }
         let mut create = Vec::new();
         for (label, dir) in &self.folders {
+            if is_stdout(dir) {
+                return Err(CliError::input(format!(
+                    "{label} -: a folder of files cannot go to stdout: give a folder"
+                )));
+            }
             if check_folder(label, dir)? {
                 create.push(dir.clone());
+            }
+        }
+        // A folder of outputs is no other output's path, nor inside one
+        // (`--certificate nx --out nx`): compared as normalized paths, so
+        // through links too.
+        for (label, dir) in &self.folders {
+            let folder = normalized(dir);
+            for d in &self.files {
+                if d.label == *label && d.path.parent() == Some(dir.as_path()) {
+                    continue;
+                }
+                let file = normalized(&d.path);
+                if folder.starts_with(&file) {
+                    return Err(CliError::input(format!(
+                        "{label} {}: the same path as {} {}: given for two outputs",
+                        dir.display(),
+                        d.label,
+                        d.path.display()
+                    )));
+                }
             }
         }
         let pending: Vec<PathBuf> = create.iter().map(|d| normalized(d)).collect();
@@ -405,6 +474,17 @@ impl Outputs {
                 Target::Special(p) => special.push((p, bytes)),
             }
         }
+        // Stdout, devices and FIFOs after staging, before any rename: a
+        // failure here (stdout or `--out /dev/full` on a full device) leaves
+        // every file as it was.
+        if let Some(bytes) = &self.stdout {
+            let mut out = super::io::Stdout::new();
+            out.bytes(bytes)?;
+            out.finish()?;
+        }
+        for (path, bytes) in special {
+            write_special(path, bytes)?;
+        }
         // Replace: keep a hard-linked backup of each replaced file until
         // every rename has succeeded.
         let mut done: Vec<(&Path, Previous)> = Vec::new();
@@ -420,9 +500,6 @@ impl Outputs {
             done.push((real, previous));
         }
         drop(done);
-        for (path, bytes) in special {
-            write_special(path, bytes)?;
-        }
         Ok(())
     }
 }

@@ -15,10 +15,10 @@ use gaze_lidar::model::presets::Preset;
 use gaze_lidar::planner::figures;
 use gaze_lidar::profile::{RegionFigure, RegionFigures};
 
-use super::args::{finite_positive, int_in};
+use super::args::{finite, finite_positive, int_in};
 use super::config::Overrides;
 use super::output::Outputs;
-use super::{emit_bytes, CliError};
+use super::CliError;
 
 /// Output format of a profile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -77,7 +77,7 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Json)]
     format: Format,
-    /// Write to this file (atomically) instead of stdout.
+    /// Write to this file (atomically) instead of stdout (`-`: stdout).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Firmware timer frequency, Hz (1..=1e10) [default: 80000000]; firmware formats only.
@@ -158,6 +158,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         a.gaze_deg
     };
     if let Some(g) = a.gaze_deg {
+        finite("--gaze-deg", g)?;
         gaze_lidar::planner::validate_gaze(g).map_err(|e| CliError::input(format!("--{e}")))?;
     }
     if a.certificate.is_some() && !(a.optimize || a.config.is_some()) {
@@ -218,15 +219,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         outputs.set(&path, b);
     }
     match &a.out {
-        Some(path) => {
-            outputs.set(path, bytes);
-            outputs.commit()?;
-        }
-        None => {
-            outputs.commit()?;
-            emit_bytes(&bytes)?;
-        }
+        Some(path) => outputs.set(path, bytes),
+        None => outputs.stdout(bytes),
     }
+    outputs.commit()?;
     Ok(0)
 }
 

@@ -9,14 +9,14 @@ use gaze_lidar::model::{presets, sensor};
 
 use super::io::{read_text, MAX_CONFIG_BYTES};
 use super::output::Outputs;
-use super::{emit, CliError};
+use super::CliError;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The preset to write: paper, vls128.
     #[arg(long)]
     preset: String,
-    /// Write to this file (atomically) instead of stdout.
+    /// Write to this file (atomically) instead of stdout (`-`: stdout).
     #[arg(long)]
     out: Option<PathBuf>,
 }
@@ -28,12 +28,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     outputs.check()?;
     let text = sensor::to_toml(&p.lidar).map_err(|e| CliError::input(e.to_string()))?;
     match &a.out {
-        Some(path) => {
-            outputs.set(path, text);
-            outputs.commit()?;
-        }
-        None => emit(&text)?,
+        Some(path) => outputs.set(path, text),
+        None => outputs.stdout(text),
     }
+    outputs.commit()?;
     Ok(0)
 }
 

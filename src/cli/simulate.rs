@@ -13,7 +13,7 @@ use gaze_lidar::sim::{
 use super::args::int_in;
 use super::io::{read_text, warn, MAX_CONFIG_BYTES};
 use super::output::Outputs;
-use super::{emit, CliError};
+use super::CliError;
 
 /// Output format of the table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -69,7 +69,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     sampling: Option<Sampling>,
     /// Detection rule k-of-n frames, e.g. `2/3` (paper: first return, `1/1`).
-    #[arg(long, default_value = "1/1")]
+    #[arg(long, default_value = "1/1", allow_hyphen_values = true)]
     detect: String,
     /// Table format on stdout.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -206,6 +206,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     // (the plots' file names included) and against the inputs: a bad one
     // fails now, and nothing is replaced.
     outputs
+        .claim_stdout("the results table")
         .file_opt("--export-json", a.export_json.as_deref())
         .file_opt("--export-csv", a.export_csv.as_deref())
         .file_opt("--trials-csv", a.trials_csv.as_deref())
@@ -332,7 +333,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             outputs.set(&dir.join(name), bytes);
         }
     }
-    emit(&text)?;
+    outputs.stdout(text);
     outputs.commit()?;
     if let Some(path) = &a.report {
         warn(format_args!("wrote {}", path.display()));

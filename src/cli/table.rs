@@ -7,11 +7,12 @@
 use std::path::Path;
 
 use gaze_lidar::firmware::{
-    binary, check_table_evaluated, check_table_for_sensor, FirmwareTable, FwViolation,
-    FIRMWARE_FORMAT,
+    binary, check_header, check_table_evaluated, check_table_for_sensor, FirmwareTable,
+    FwViolation, FIRMWARE_FORMAT,
 };
 use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::model::lidar::PowerAccounting;
+use gaze_lidar::profile::PROFILE_FORMAT;
 
 use super::check::Format;
 use super::io::{utf8, warn, Stdout};
@@ -45,9 +46,31 @@ pub fn table_json(text: &str, origin: &str) -> Option<Result<FirmwareTable, CliE
     struct Head {
         format: String,
     }
-    let is_table = text.contains(FIRMWARE_FORMAT)
-        && serde_json::from_str::<Head>(text).is_ok_and(|h| h.format == FIRMWARE_FORMAT);
-    is_table.then(|| FirmwareTable::from_json(text, origin).map_err(CliError::from))
+    let head = serde_json::from_str::<Head>(text).ok()?;
+    if head.format == FIRMWARE_FORMAT {
+        return Some(FirmwareTable::from_json(text, origin).map_err(CliError::from));
+    }
+    // A format this build does not read (`gaze-lidar/firmware@2`, a typo):
+    // named as such, not as the first field the profile reader trips on.
+    (head.format != PROFILE_FORMAT).then(|| {
+        Err(CliError::input(format!(
+            "{origin}: field 'format' is '{}': not a format this build reads ({PROFILE_FORMAT}, {FIRMWARE_FORMAT})",
+            head.format
+        )))
+    })
+}
+
+/// The header numbers of a table at the one numeric boundary
+/// (`firmware::check_header`): bad input (exit 2) whatever else is checked,
+/// the same for the JSON and the binary encoding (whose decoder already
+/// refuses a step that is not finite and > 0).
+pub fn check_boundary(table: &FirmwareTable, origin: &str) -> Result<(), CliError> {
+    let v = check_header(table);
+    if v.is_empty() {
+        return Ok(());
+    }
+    let list: Vec<String> = v.iter().map(ToString::to_string).collect();
+    Err(CliError::input(format!("{origin}: {}", list.join("; "))))
 }
 
 fn summary(t: &FirmwareTable) -> serde_json::Value {
@@ -83,6 +106,7 @@ pub fn check(
     format: Format,
     no_eye_safety: bool,
 ) -> Result<u8, CliError> {
+    check_boundary(table, origin)?;
     let (mut violations, report) = match sensor {
         Some(s) => check_table_for_sensor(table, s),
         None => check_table_evaluated(table),

@@ -75,9 +75,23 @@ pub enum LineError {
     /// A CSV row does not have the header's number of fields.
     #[error("row: {0}")]
     Row(String),
+    /// A field that is present but not a number (`column`: 1-based
+    /// character position of the field in its line).
+    #[error("column {column}: field '{field}': {reason}")]
+    Value {
+        /// 1-based column of the field's first character.
+        column: usize,
+        /// Column name.
+        field: String,
+        /// Why.
+        reason: String,
+    },
     /// The header lacks a required column.
     #[error("header: missing column '{0}'")]
     Header(String),
+    /// The header names a column twice (which one would be read?).
+    #[error("header: column '{0}' appears twice")]
+    DuplicateColumn(String),
     /// The line's bytes are not a text line at all (not UTF-8, too long,
     /// a byte-order mark).
     #[error("{0}")]
@@ -150,11 +164,12 @@ impl Parser {
     fn csv_line(&mut self, line: &str) -> Result<Option<GazeSample>, LineError> {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         let Some(cols) = &self.columns else {
-            let cols: HashMap<String, usize> = fields
-                .iter()
-                .enumerate()
-                .map(|(i, f)| ((*f).to_owned(), i))
-                .collect();
+            let mut cols: HashMap<String, usize> = HashMap::with_capacity(fields.len());
+            for (i, f) in fields.iter().enumerate() {
+                if cols.insert((*f).to_owned(), i).is_some() {
+                    return Err(LineError::DuplicateColumn((*f).to_owned()));
+                }
+            }
             let required: &[&str] = match self.format {
                 Format::Csv => &["t_s", "gaze_deg"],
                 Format::Varjo => &[
@@ -191,16 +206,37 @@ impl Parser {
                 self.header_fields
             )));
         }
+        // 1-based character column of field `i` (its first non-blank character).
+        let column = |i: usize| -> usize {
+            let mut col = 1;
+            for (k, raw) in line.split(',').enumerate() {
+                if k == i {
+                    return col + raw.chars().take_while(|c| c.is_whitespace()).count();
+                }
+                col += raw.chars().count() + 1;
+            }
+            col
+        };
         let get = |name: &str| -> Result<f64, LineError> {
             let i = cols[name];
             let raw = fields.get(i).ok_or_else(|| LineError::Field {
                 field: name.into(),
                 reason: "missing".into(),
             })?;
-            raw.parse::<f64>().map_err(|_| LineError::Field {
+            raw.parse::<f64>().map_err(|_| LineError::Value {
+                column: column(i),
                 field: name.into(),
                 reason: format!("'{raw}' is not a number"),
             })
+        };
+        // A gaze value: a number, `NaN` or an empty field (the tracker had
+        // no gaze: an invalid sample); anything else is a malformed row.
+        let gaze = |name: &str| -> Result<f64, LineError> {
+            if fields.get(cols[name]).is_some_and(|f| f.is_empty()) {
+                Ok(f64::NAN)
+            } else {
+                get(name)
+            }
         };
         let time = |name: &str, scale: f64| -> Result<f64, LineError> {
             let t = get(name)? * scale;
@@ -216,7 +252,7 @@ impl Parser {
         match self.format {
             Format::Csv => {
                 let t_s = time("t_s", 1.0)?;
-                let g = get("gaze_deg").unwrap_or(f64::NAN);
+                let g = gaze("gaze_deg")?;
                 let valid = match cols.get("valid").and_then(|&i| fields.get(i)) {
                     None => true,
                     Some(v) => match v.to_ascii_lowercase().as_str() {
@@ -262,7 +298,7 @@ impl Parser {
             }
             Format::Neon => {
                 let t_s = time("timestamp [ns]", 1e-9)?;
-                let az = get("azimuth [deg]").unwrap_or(f64::NAN);
+                let az = gaze("azimuth [deg]")?;
                 let worn = get("worn")?;
                 Ok(Some(GazeSample {
                     t_s,
@@ -324,6 +360,37 @@ mod tests {
         p.line("t_s,gaze_deg,valid").unwrap();
         assert!(p.line("0.1,90").is_err());
         assert!(!p.line("0.1,1e300,true").unwrap().unwrap().valid);
+    }
+
+    #[test]
+    fn a_malformed_gaze_is_an_error_an_absent_one_an_invalid_sample() {
+        let mut p = Parser::new(Format::Csv);
+        p.line("t_s,gaze_deg,valid").unwrap();
+        let e = p.line("0.1,abc,true").unwrap_err();
+        assert_eq!(
+            e,
+            LineError::Value {
+                column: 5,
+                field: "gaze_deg".into(),
+                reason: "'abc' is not a number".into()
+            }
+        );
+        assert!(!p.line("0.1,,true").unwrap().unwrap().valid);
+        assert!(!p.line("0.1,NaN,true").unwrap().unwrap().valid);
+        assert!(!p.line("0.1,10,false").unwrap().unwrap().valid);
+        assert!(p.line("0.1, 10 ,true").unwrap().unwrap().valid);
+        let mut p = Parser::new(Format::Neon);
+        p.line("timestamp [ns],azimuth [deg],worn").unwrap();
+        assert!(matches!(
+            p.line("1700000000000000000,x1,1"),
+            Err(LineError::Value { column: 21, .. })
+        ));
+        assert!(!p.line("1700000000000000000,,1").unwrap().unwrap().valid);
+        let mut p = Parser::new(Format::Neon);
+        assert_eq!(
+            p.line("timestamp [ns],azimuth [deg],worn,azimuth [deg]"),
+            Err(LineError::DuplicateColumn("azimuth [deg]".into()))
+        );
     }
 
     #[test]

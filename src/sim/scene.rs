@@ -39,6 +39,14 @@ pub const MAX_SPEED_KMH: f64 = 500.0;
 /// simulated second costs ≈ 10^4 ray casts per channel).
 pub const MAX_SIMULATED_S: f64 = 120.0;
 
+/// A `[lo, hi]` pair read as exactly two numbers: a third element is an
+/// error, not silently dropped.
+fn exact_pair<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    <[f64; 2]>::try_from(v.as_slice())
+        .map_err(|_| serde::de::Error::invalid_length(v.len(), &"exactly 2 numbers [min, max]"))
+}
+
 /// Scenario parameters (TOML); defaults reproduce the paper's scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -66,7 +74,8 @@ pub struct Scenario {
     /// when its front reaches |y| = this (ARGUS: 1.75 m), m.
     pub conflict_half_width_m: f64,
     /// Each car starts hidden, its front this far beyond the bend: a range
-    /// `[min, max]` drawn per trial, m.
+    /// `[min, max]` drawn per trial, m (exactly two numbers).
+    #[serde(deserialize_with = "exact_pair")]
     pub start_offset_m: [f64; 2],
     /// Driver's gaze azimuth, degrees (paper: fixed to the left, 90°).
     pub gaze_deg: f64,

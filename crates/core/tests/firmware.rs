@@ -651,15 +651,20 @@ fn check_table_with_reports_the_integer_verdict() {
             }
         ]
     );
-    // No bins: that alone.
+    // No bins: that alone, after the header's zero-tick frame.
     let empty = table(1000, &[]);
+    let zero_frame = FwViolation::Header {
+        field: "frame_ticks",
+        value: "0".into(),
+        reason: "must be >= 1 (a frame lasts at least one tick)",
+    };
     assert_eq!(
         check_table_with(&empty, &at),
-        vec![FwViolation::BinCount { count: 0 }]
+        vec![zero_frame.clone(), FwViolation::BinCount { count: 0 }]
     );
     assert_eq!(
         check_table(&empty),
-        vec![FwViolation::BinCount { count: 0 }]
+        vec![zero_frame, FwViolation::BinCount { count: 0 }]
     );
 }
 
@@ -691,9 +696,17 @@ fn check_table_derives_limits_or_says_why_not() {
     assert_eq!(check_table(&none), vec![FwViolation::EyeSafetyMissing]);
     let mut no_rate = t.clone();
     no_rate.pulse_rate_hz = 0.0;
+    // A pulse rate of 0 stops at the header boundary (eye safety, which
+    // reads it, is not evaluated).
     let v = check_table(&no_rate);
     assert!(
-        matches!(v.as_slice(), [FwViolation::EyeSafetyParams { reason }] if reason.contains("pulse_rate_hz")),
+        matches!(
+            v.as_slice(),
+            [FwViolation::Header {
+                field: "pulse_rate_hz",
+                ..
+            }]
+        ),
         "{v:?}"
     );
     // Integer violations are kept alongside.

@@ -1,8 +1,9 @@
 //! Building a table from a certified profile (floating point: `std` only).
 
 use super::{
-    apportion, check_table, eye, floor_code, FirmwareConfig, FirmwareTable, FwBin, FwViolation,
-    IntLimits, QuantizeError, TickTarget, FIRMWARE_FORMAT, FULL_TURN_MDEG, MAX_TABLE_BINS,
+    apportion, check_table, eye, floor_code, lower_to_budget, FirmwareConfig, FirmwareTable, FwBin,
+    FwViolation, IntLimits, QuantizeError, TickTarget, FIRMWARE_FORMAT, FULL_TURN_MDEG,
+    MAX_TABLE_BINS,
 };
 use crate::checker::CertifiedProfile;
 use crate::model::accounting::PowerAccounting;
@@ -210,6 +211,7 @@ impl FirmwareTable {
             bins,
         };
         let mut table = table;
+        lower_codes_to_budget(&mut table);
         lower_codes_for_eye_safety(&mut table);
         let v = check_table(&table);
         if v.is_empty() {
@@ -250,6 +252,31 @@ impl FirmwareTable {
         let mut s = serde_json::to_string_pretty(self)?;
         s.push('\n');
         Ok(s)
+    }
+}
+
+/// Lowers codes until the table's energy as the integer checker reads it
+/// (`Σ code · dwell_ticks`, or `· width_mdeg` under angle accounting) fits
+/// `limits.energy_budget` ([`lower_to_budget`]): rounding dwells to whole
+/// ticks can leave it a few units over.
+fn lower_codes_to_budget(table: &mut FirmwareTable) {
+    let weights: Vec<u64> = table
+        .bins
+        .iter()
+        .map(|b| match table.power_accounting {
+            PowerAccounting::Time => b.dwell_ticks,
+            PowerAccounting::Angle => u64::from(b.width_mdeg),
+        })
+        .collect();
+    let mut codes: Vec<u32> = table.bins.iter().map(|b| b.power_code).collect();
+    lower_to_budget(
+        &mut codes,
+        &weights,
+        table.limits.power_code_min,
+        table.limits.energy_budget,
+    );
+    for (b, c) in table.bins.iter_mut().zip(codes) {
+        b.power_code = c;
     }
 }
 

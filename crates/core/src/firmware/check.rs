@@ -93,6 +93,17 @@ pub enum FwViolation {
         /// What differs.
         detail: String,
     },
+    /// A header number outside the one numeric boundary
+    /// ([`model::valid`](crate::model::valid)): the timer, the frame, the
+    /// DAC step or the pulse rate ([`check_header`]).
+    Header {
+        /// The key.
+        field: &'static str,
+        /// The value, as text (integers and floats alike).
+        value: String,
+        /// Why.
+        reason: &'static str,
+    },
     /// Energy in a window of consecutive bins above the eye-safety bound.
     Window {
         /// First bin of the window.
@@ -136,6 +147,7 @@ impl fmt::Display for FwViolation {
                 write!(f, "{field} = {declared} is looser than the sensor's {sensor}")
             }
             Self::SensorMismatch { field, detail } => write!(f, "{field}: {detail}"),
+            Self::Header { field, value, reason } => write!(f, "{field} = {value}: {reason}"),
             Self::Window { bin, energy, limit } => write!(
                 f,
                 "eye safety: energy {energy} in the window starting at bins[{bin}] exceeds limits.window_energy_max {limit}"
@@ -157,7 +169,9 @@ impl FwViolation {
             Self::EyeSafety { .. } | Self::EyeSafetyMissing | Self::EyeSafetyParams { .. } => {
                 "eye_safety"
             }
-            Self::LooserThanSensor { field, .. } | Self::SensorMismatch { field, .. } => field,
+            Self::LooserThanSensor { field, .. }
+            | Self::SensorMismatch { field, .. }
+            | Self::Header { field, .. } => field,
             Self::Window { .. } => "window_energy_max",
         }
     }
@@ -184,8 +198,15 @@ pub fn check_table(table: &FirmwareTable) -> Vec<FwViolation> {
 pub fn check_table_evaluated(
     table: &FirmwareTable,
 ) -> (Vec<FwViolation>, Option<eye::IntEyeReport>) {
-    let mut v = check_integer(table);
-    if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+    let mut v = check_header(table);
+    let header_ok = v.is_empty();
+    v.extend(check_integer(table));
+    // Eye safety reads the header's numbers: not evaluated on bad ones (a
+    // table without parameters still says so).
+    if !header_ok || v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+        if !header_ok && table.eye_safety.is_none() {
+            v.push(FwViolation::EyeSafetyMissing);
+        }
         return (v, None);
     }
     match IntEyeLimits::derive(table) {
@@ -219,8 +240,10 @@ pub fn check_table_evaluated(
 /// with [`IntEyeLimits::derive`]); no floating point.
 #[must_use]
 pub fn check_table_with(table: &FirmwareTable, limits: &IntEyeLimits) -> Vec<FwViolation> {
-    let mut v = check_integer(table);
-    if v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
+    let mut v = check_header(table);
+    let header_ok = v.is_empty();
+    v.extend(check_integer(table));
+    if !header_ok || v.iter().any(|x| matches!(x, FwViolation::BinCount { .. })) {
         return v;
     }
     v.extend(eye_violation(table, limits));
@@ -243,6 +266,60 @@ fn report_violation(r: &eye::IntEyeReport) -> Option<FwViolation> {
         azimuth_mdeg: r.azimuth_mdeg,
         rule: r.rule.to_string(),
     })
+}
+
+/// Fastest timer a table may declare, Hz (the quantizer's `--tick-hz` range).
+pub const TICK_HZ_MAX: u64 = 10_000_000_000;
+
+/// The header numbers of `table` against the one numeric boundary
+/// ([`model::valid`](crate::model::valid)), as a profile's are checked:
+/// `tick_hz` within `1..=`[`TICK_HZ_MAX`]; `frame_ticks >= 1` with a frame
+/// rate `tick_hz / frame_ticks` that is a rate; `power_w_per_code` finite,
+/// `> 0` and normal; `pulse_rate_hz` a rate. Whatever else is checked or
+/// skipped (`--no-eye-safety` skips only the eye-safety rules), a table
+/// passes this boundary: every other rule reads these numbers.
+#[must_use]
+pub fn check_header(table: &FirmwareTable) -> Vec<FwViolation> {
+    use crate::model::valid;
+    use crate::text::Num;
+    use alloc::format;
+    let mut v = Vec::new();
+    let tick_ok = (1..=TICK_HZ_MAX).contains(&table.tick_hz);
+    if !tick_ok {
+        v.push(FwViolation::Header {
+            field: "tick_hz",
+            value: table.tick_hz.to_string(),
+            reason: "must lie in 1..=10000000000 Hz",
+        });
+    }
+    if table.frame_ticks == 0 {
+        v.push(FwViolation::Header {
+            field: "frame_ticks",
+            value: "0".to_string(),
+            reason: "must be >= 1 (a frame lasts at least one tick)",
+        });
+    } else if tick_ok && valid::rate_hz(table.tick_hz as f64 / table.frame_ticks as f64).is_err() {
+        v.push(FwViolation::Header {
+            field: "frame_ticks",
+            value: table.frame_ticks.to_string(),
+            reason: "gives a frame rate tick_hz / frame_ticks outside 1e-9..=1e12 Hz",
+        });
+    }
+    if let Err(reason) = valid::positive(table.power_w_per_code) {
+        v.push(FwViolation::Header {
+            field: "power_w_per_code",
+            value: format!("{}", Num(table.power_w_per_code)),
+            reason,
+        });
+    }
+    if let Err(reason) = valid::rate_hz(table.pulse_rate_hz) {
+        v.push(FwViolation::Header {
+            field: "pulse_rate_hz",
+            value: format!("{}", Num(table.pulse_rate_hz)),
+            reason,
+        });
+    }
+    v
 }
 
 /// Every integer violation of `table` (frame, coverage, dwell bounds, codes,

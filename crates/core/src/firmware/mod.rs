@@ -9,7 +9,9 @@
 //!   `frame_ticks` exactly ([`quantize::apportion`]);
 //! - power codes are rounded down: never above the certified power, within
 //!   one code of it (`quantize::floor_code`), then lowered further only if the
-//!   table **as it will run** (quantized dwell, quantized codes) is over the
+//!   table **as it will run** (quantized dwell, quantized codes) is over its
+//!   energy budget as the integer checker reads it ([`lower_to_budget`]:
+//!   rounding dwells to whole ticks can add a few code·ticks) or over the
 //!   Class 1 limits in the integer eye-safety check ([`eye`]);
 //! - the built table must pass [`check_table`] (integer rules and the
 //!   integer eye-safety check) or no table is returned.
@@ -44,12 +46,12 @@ pub use build::{
     as_run_segments, budget_weight_total, energy_budget, frame_ticks_for, table_exposure,
     FirmwareError,
 };
-pub use check::{check_integer, check_table_with, FwViolation};
+pub use check::{check_header, check_integer, check_table_with, FwViolation, TICK_HZ_MAX};
 #[cfg(feature = "std")]
 pub use check::{check_table, check_table_evaluated};
 #[cfg(feature = "std")]
 pub use quantize::floor_code;
-pub use quantize::{apportion, QuantizeError, TickTarget};
+pub use quantize::{apportion, lower_to_budget, QuantizeError, TickTarget};
 #[cfg(feature = "std")]
 pub use sensor::check_table_for_sensor;
 

@@ -120,6 +120,67 @@ pub fn apportion(targets: &[TickTarget], total: u64) -> Result<Vec<u64>, Quantiz
     Ok(out)
 }
 
+/// Lowers `codes` (never below `min`, never raised) until
+/// `Σ codes[i]·weights[i] <= budget`, in exact integer arithmetic: the
+/// energy budget as [`check_integer`](super::check_integer) reads it.
+///
+/// Rounding each dwell to a whole tick (and each code down to the DAC's step)
+/// can leave a table a few code·ticks over a budget its float profile met;
+/// the quantizer rounds towards safety, so it takes the excess out of the
+/// codes: one code at a time, heaviest bins first (ties: lower index first),
+/// in passes until the energy fits or every code is at `min`. Returns the
+/// energy left (`<= budget` unless every code reached `min`).
+///
+/// `weights` and `codes` have the same length (extra entries of the longer
+/// one are ignored).
+pub fn lower_to_budget(codes: &mut [u32], weights: &[u64], min: u32, budget: u64) -> u128 {
+    let n = codes.len().min(weights.len());
+    let mut energy: u128 = (0..n)
+        .map(|i| u128::from(codes[i]) * u128::from(weights[i]))
+        .sum();
+    let budget = u128::from(budget);
+    if energy <= budget {
+        return energy;
+    }
+    let mut order: Vec<usize> = (0..n).filter(|&i| weights[i] > 0).collect();
+    order.sort_by(|&a, &b| weights[b].cmp(&weights[a]).then(a.cmp(&b)));
+    // A whole pass lowers every code above `min` by one; when the excess
+    // needs many passes, take them at once (each code lowered by the same
+    // `k`, never below `min`), then finish one code at a time.
+    let lowerable: u128 = order
+        .iter()
+        .filter(|&&i| codes[i] > min)
+        .map(|&i| u128::from(weights[i]))
+        .sum();
+    if let Some(passes) = (energy - budget).checked_div(lowerable) {
+        if passes > 1 {
+            let k = u32::try_from(passes - 1).unwrap_or(u32::MAX);
+            for &i in &order {
+                let lowered = codes[i].saturating_sub(k).max(min).min(codes[i]);
+                energy -= u128::from(codes[i] - lowered) * u128::from(weights[i]);
+                codes[i] = lowered;
+            }
+        }
+    }
+    while energy > budget {
+        let mut progress = false;
+        for &i in &order {
+            if energy <= budget {
+                break;
+            }
+            if codes[i] > min {
+                codes[i] -= 1;
+                energy -= u128::from(weights[i]);
+                progress = true;
+            }
+        }
+        if !progress {
+            break;
+        }
+    }
+    energy
+}
+
 /// `floor(value / step)` for a non-negative power and a positive step, exact
 /// at the boundaries (a float quotient that rounds across an integer is
 /// corrected): `code·step <= value < (code+1)·step`. `None` if it does not
@@ -246,6 +307,45 @@ pub(crate) mod verification {
             "unreachable frame rejected",
             "bin without admissible rounding rejected",
         ]);
+    }
+
+    /// REQ-FW-2: lowering to a budget never raises a code, never goes
+    /// below the minimum, and meets the budget unless every code is at the
+    /// minimum; the energy it returns is the table's (plain restatement).
+    #[cfg_attr(kani, kani::proof, kani::unwind(8))]
+    #[cfg_attr(not(kani), test)]
+    fn lowering_to_a_budget_is_sound() {
+        for_all!(([(u8, u8); 4], u8, u8, u16), |(raw, n, min, budget)| {
+            let n = 1 + usize::from(n % 4);
+            let mut codes: Vec<u32> = raw[..n].iter().map(|r| u32::from(r.0)).collect();
+            let weights: Vec<u64> = raw[..n].iter().map(|r| u64::from(r.1)).collect();
+            let before = codes.clone();
+            let min = u32::from(min % 8);
+            let budget = u64::from(budget);
+            let energy = lower_to_budget(&mut codes, &weights, min, budget);
+            let plain: u128 = codes
+                .iter()
+                .zip(&weights)
+                .map(|(&c, &w)| u128::from(c) * u128::from(w))
+                .sum();
+            assert_eq!(energy, plain);
+            for (a, b) in codes.iter().zip(&before) {
+                assert!(a <= b);
+                assert!(*a >= min.min(*b));
+            }
+            let floor_reached = codes
+                .iter()
+                .zip(&before)
+                .zip(&weights)
+                .all(|((&c, &b), &w)| w == 0 || c == min.min(b));
+            cover!(
+                energy <= u128::from(budget) && codes != before,
+                "lowered to fit"
+            );
+            assert!(energy <= u128::from(budget) || floor_reached);
+        });
+        #[cfg(not(kani))]
+        crate::verification::assert_covered(&["lowered to fit"]);
     }
 
     /// REQ-FW-2: a power code never exceeds the certified power and is within one code of it.
