@@ -41,6 +41,8 @@ pub mod model;
 pub mod optimizer;
 pub mod planner;
 pub mod pointcloud;
+#[cfg(feature = "replay")]
+pub mod replay;
 pub mod profile;
 pub mod sim;
 pub mod text;
