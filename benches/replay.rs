@@ -29,7 +29,15 @@ fn run(input: &[u8], compression: Compression) -> Vec<u8> {
         bins: 360,
     };
     let mut out = Cursor::new(Vec::with_capacity(input.len() * 2));
-    replay(input, "bench", &mut out, planner, PipelineConfig::default(), &opts).unwrap();
+    replay(
+        input,
+        "bench",
+        &mut out,
+        planner,
+        PipelineConfig::default(),
+        &opts,
+    )
+    .unwrap();
     out.into_inner()
 }
 
@@ -58,10 +66,15 @@ fn bench(c: &mut Criterion) {
     g.bench_function("replay_2s_uncompressed", |b| {
         b.iter(|| run(&input, Compression::None))
     });
-    g.bench_function("replay_2s_lz4", |b| b.iter(|| run(&input, Compression::Lz4)));
+    g.bench_function("replay_2s_lz4", |b| {
+        b.iter(|| run(&input, Compression::Lz4))
+    });
     g.finish();
     // The real-time factor, best of 5.
-    for (name, compression) in [("uncompressed", Compression::None), ("lz4", Compression::Lz4)] {
+    for (name, compression) in [
+        ("uncompressed", Compression::None),
+        ("lz4", Compression::Lz4),
+    ] {
         let best = (0..5)
             .map(|_| {
                 let t = Instant::now();

@@ -1,6 +1,6 @@
 //! Writes a synthetic drive (see `benches/common/bag.rs`) for measuring
 //! `gaze-lidar replay`: `cargo run --release --example make_bag -- OUT.mcap SECONDS`
-//! (≈ 51 MB per second of drive: 400 s ≈ 2 GiB).
+//! (≈ 51 MB per second of drive: 43 s ≈ 2.1 GiB).
 
 #[path = "../benches/common/bag.rs"]
 mod bag;

@@ -41,9 +41,9 @@ pub mod model;
 pub mod optimizer;
 pub mod planner;
 pub mod pointcloud;
+pub mod profile;
 #[cfg(feature = "replay")]
 pub mod replay;
-pub mod profile;
 pub mod sim;
 pub mod text;
 #[cfg(any(test, kani))]

@@ -70,7 +70,11 @@ fn bag(compression: Option<mcap::Compression>) -> Vec<u8> {
         .unwrap();
     let mut chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
         let s = w
-            .add_schema(ty, schemas::ROS2MSG, schemas::ros2msg(ty).unwrap().as_bytes())
+            .add_schema(
+                ty,
+                schemas::ROS2MSG,
+                schemas::ros2msg(ty).unwrap().as_bytes(),
+            )
             .unwrap();
         w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
             .unwrap()
@@ -100,7 +104,12 @@ fn bag(compression: Option<mcap::Compression>) -> Vec<u8> {
         msgs.push((
             t,
             c,
-            cloud_msg((t / 1_000_000_000) as i32, (t % 1_000_000_000) as u32, k, 3000),
+            cloud_msg(
+                (t / 1_000_000_000) as i32,
+                (t % 1_000_000_000) as u32,
+                k,
+                3000,
+            ),
         ));
     }
     for k in 0..6u64 {
@@ -145,9 +154,11 @@ fn read_all(bytes: &[u8]) -> Vec<Msg> {
             let m = m.unwrap();
             Msg {
                 topic: m.channel.topic.clone(),
-                schema: m.channel.schema.as_ref().map_or(String::new(), |s| {
-                    format!("{} {}", s.encoding, s.name)
-                }),
+                schema: m
+                    .channel
+                    .schema
+                    .as_ref()
+                    .map_or(String::new(), |s| format!("{} {}", s.encoding, s.name)),
                 encoding: m.channel.message_encoding.clone(),
                 log_time: m.log_time,
                 data: m.data.into_owned(),
@@ -190,7 +201,12 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
         std::fs::write(&input, &bag).unwrap();
         let o = replay_cli(&input, &out);
         common::no_panic(&o, "replay");
-        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         let inp = read_all(&bag);
         let got = read_all(&std::fs::read(&out).unwrap());
         // Every input message, byte for byte, on its topic and time.
@@ -230,8 +246,8 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
             .iter()
             .filter(|m| m.topic == "/gaze_lidar/profile")
             .map(|m| {
-                let p = Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "profile")
-                    .unwrap();
+                let p =
+                    Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "profile").unwrap();
                 assert!(independent::recheck(&p).is_empty());
                 (m.log_time, check(&p).unwrap())
             })
@@ -247,13 +263,24 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
                 .collect::<Vec<_>>()
         };
         let before = gaze_of(0.3, 0.95);
-        assert!(!before.is_empty() && before.iter().all(|g| g.is_some_and(|g| (g - 90.0).abs() < 1.0)));
+        assert!(
+            !before.is_empty()
+                && before
+                    .iter()
+                    .all(|g| g.is_some_and(|g| (g - 90.0).abs() < 1.0))
+        );
         let gap = gaze_of(1.15, 1.5);
-        assert!(!gap.is_empty() && gap.iter().all(Option::is_none), "{gap:?}");
+        assert!(
+            !gap.is_empty() && gap.iter().all(Option::is_none),
+            "{gap:?}"
+        );
         assert!(gaze_of(1.8, 2.9).iter().all(Option::is_some));
         // One adapted cloud per input cloud, a subset in order, the rule's mask.
         let clouds_in: Vec<&Msg> = inp.iter().filter(|m| m.topic == CLOUD).collect();
-        let adapted: Vec<&Msg> = got.iter().filter(|m| m.topic == "/lidar/points/adapted").collect();
+        let adapted: Vec<&Msg> = got
+            .iter()
+            .filter(|m| m.topic == "/lidar/points/adapted")
+            .collect();
         assert_eq!(adapted.len(), clouds_in.len());
         let mut thinned = 0;
         for (k, (a, c)) in adapted.iter().zip(&clouds_in).enumerate() {
@@ -263,8 +290,14 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
             let sl = src.xyz().unwrap();
             let dst = PointCloud2::decode(&a.data).unwrap();
             let dl = dst.xyz().unwrap();
-            let (_, profile) = profiles.iter().rev().find(|(t, _)| *t <= a.log_time).unwrap();
-            let pts: Vec<[f64; 3]> = (0..sl.len()).map(|i| sl.xyz(sl.point(src.data, i))).collect();
+            let (_, profile) = profiles
+                .iter()
+                .rev()
+                .find(|(t, _)| *t <= a.log_time)
+                .unwrap();
+            let pts: Vec<[f64; 3]> = (0..sl.len())
+                .map(|i| sl.xyz(sl.point(src.data, i)))
+                .collect();
             let mut opts = CloudOptions::new(100.0);
             opts.frame = CloudFrame::Iso8855;
             opts.seed = k as u64;
@@ -337,7 +370,10 @@ fn a_topic_of_the_wrong_type_is_exit_2_naming_it() {
     common::no_panic(&o, "wrong type");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("/lidar/points") || err.contains("/dms/gaze"), "{err}");
+    assert!(
+        err.contains("/lidar/points") || err.contains("/dms/gaze"),
+        "{err}"
+    );
     assert!(!out.exists());
     // --out is the input.
     let o = replay_cli(&input, &input);

@@ -35,7 +35,11 @@ pub fn cloud(t_ns: u64, k: u64) -> Vec<u8> {
             // A range that varies with the column, the ring and the frame.
             let r = 2.0 + ((u64::from(col) * 7 + u64::from(ring) * 13 + k) % 280) as f64;
             let el = (f64::from(ring) - 64.0) * 0.2f64.to_radians();
-            let (x, y, z) = (r * el.cos() * az.cos(), r * el.cos() * az.sin(), r * el.sin());
+            let (x, y, z) = (
+                r * el.cos() * az.cos(),
+                r * el.cos() * az.sin(),
+                r * el.sin(),
+            );
             for v in [x as f32, y as f32, z as f32, 10.0] {
                 data.extend_from_slice(&v.to_le_bytes());
             }
@@ -77,7 +81,11 @@ pub fn write_bag<W: Write + Seek>(out: W, seconds: u64) -> mcap::McapResult<()> 
         .profile("ros2")
         .create(out)?;
     let mut chan = |w: &mut mcap::Writer<W>, topic: &str, ty: &str| -> mcap::McapResult<u16> {
-        let s = w.add_schema(ty, schemas::ROS2MSG, schemas::ros2msg(ty).unwrap_or_default().as_bytes())?;
+        let s = w.add_schema(
+            ty,
+            schemas::ROS2MSG,
+            schemas::ros2msg(ty).unwrap_or_default().as_bytes(),
+        )?;
         w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
     };
     let g = chan(&mut w, "/dms/gaze", schemas::VECTOR3_STAMPED)?;

@@ -8,8 +8,10 @@
 
 use std::path::{Path, PathBuf};
 
+#[cfg(feature = "solver")]
+use gaze_lidar::gaze::GazeError;
 use gaze_lidar::gaze::{
-    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeError, StreamConfig,
+    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, StreamConfig,
 };
 use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
 use gaze_lidar::model::presets;
@@ -116,6 +118,7 @@ pub struct Args {
     compression: CompressionArg,
 }
 
+#[cfg(feature = "solver")]
 fn gaze_error(e: GazeError) -> CliError {
     if e.is_input_error() {
         CliError::input(e.to_string())
@@ -261,8 +264,18 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let tmp = tempfile::Builder::new()
-        .prefix(".gaze-lidar-replay.")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".gaze-lidar-replay.");
+    // An ordinary output file (tempfile's default is 0600); an existing one
+    // keeps its mode.
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&a.out)
+            .map(|m| m.permissions().mode() & 0o7777)
+            .unwrap_or(0o644);
+        builder.permissions(std::fs::Permissions::from_mode(mode));
+    }
+    let tmp = builder
         .tempfile_in(&dir)
         .map_err(|e| CliError::input(format!("--out {}: {e}", a.out.display())))?;
     let origin = a.input.display().to_string();

@@ -187,7 +187,8 @@ impl Writer {
         self.buf.extend_from_slice(&v.to_le_bytes());
     }
 
-    /// A string; fails (naming `what`) past 4 GiB.
+    /// A string (its length saturates at `u32::MAX`: never reached by the
+    /// frame ids and field names written here).
     pub fn string(&mut self, s: &str) {
         self.u32(u32::try_from(s.len() + 1).unwrap_or(u32::MAX));
         self.buf.extend_from_slice(s.as_bytes());

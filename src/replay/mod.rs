@@ -43,8 +43,8 @@ pub mod schemas;
 use std::collections::{BTreeMap, BinaryHeap, HashMap, VecDeque};
 use std::io::{Read, Seek, Write};
 
-use mcap::sans_io::{MessageReadEvent, MessageReader};
 use mcap::records::MessageHeader;
+use mcap::sans_io::{MessageReadEvent, MessageReader};
 use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
@@ -406,9 +406,7 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         let topic = p.msg.channel.topic.as_str();
         let late = p.log_time < self.now_ns;
         if topic == self.opts.gaze_topic {
-            let sample = self
-                .gaze_sample(&p)
-                .map_err(|e| in_message(e, topic, &p))?;
+            let sample = self.gaze_sample(&p).map_err(|e| in_message(e, topic, &p))?;
             if late {
                 self.stats.late_gaze += 1;
                 return Ok(());
@@ -625,12 +623,8 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     // Fail early on bad cloud options (rated range, fog, model).
     crate::pointcloud::return_model(&opts.cloud)?;
     let baseline = planner.plan(None)?;
-    let stream = GazeStream::with_config(
-        planner,
-        pipeline.filter,
-        pipeline.failsafe,
-        pipeline.stream,
-    );
+    let stream =
+        GazeStream::with_config(planner, pipeline.filter, pipeline.failsafe, pipeline.stream);
     let period_ns = stream.period_us().saturating_mul(1000);
     let compression = match opts.compression {
         Compression::None => None,
@@ -693,7 +687,8 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     let mut held_bytes = 0usize;
     let mut newest = 0u64;
     let mut seq = 0u64;
-    let mcap_err = |offset: u64, e: mcap::McapError| ReplayError::Mcap {
+    let mcap_err = |offset: u64, e: mcap::McapError| {
+        ReplayError::Mcap {
         path: path.to_owned(),
         offset,
         reason: match e {
@@ -705,6 +700,7 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
             ),
             e => e.to_string(),
         },
+    }
     };
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| mcap_err(offset, e))? {

@@ -39,7 +39,10 @@ fn vector3_stamped_round_trips_and_matches_hand_encoded_bytes() {
 
 #[test]
 fn float64_round_trips() {
-    assert_eq!(cdr::decode_float64(&cdr::encode_float64(-12.5)).unwrap(), -12.5);
+    assert_eq!(
+        cdr::decode_float64(&cdr::encode_float64(-12.5)).unwrap(),
+        -12.5
+    );
     assert_eq!(cdr::encode_float64(1.0).len(), 12);
 }
 
@@ -52,10 +55,18 @@ fn cloud_bytes(big: bool, wide: bool, step: u32, pts: &[[f64; 3]]) -> Vec<u8> {
         let start = data.len();
         for v in p {
             if wide {
-                data.extend_from_slice(&if big { v.to_be_bytes() } else { v.to_le_bytes() });
+                data.extend_from_slice(&if big {
+                    v.to_be_bytes()
+                } else {
+                    v.to_le_bytes()
+                });
             } else {
                 let f = *v as f32;
-                data.extend_from_slice(&if big { f.to_be_bytes() } else { f.to_le_bytes() });
+                data.extend_from_slice(&if big {
+                    f.to_be_bytes()
+                } else {
+                    f.to_le_bytes()
+                });
             }
         }
         data.resize(start + step as usize, 0xAB);
@@ -71,9 +82,33 @@ fn cloud_bytes(big: bool, wide: bool, step: u32, pts: &[[f64; 3]]) -> Vec<u8> {
     w.u32(pts.len() as u32);
     w.u32(4);
     for (name, off, t) in [
-        ("x", 0, if wide { datatype::FLOAT64 } else { datatype::FLOAT32 }),
-        ("y", s, if wide { datatype::FLOAT64 } else { datatype::FLOAT32 }),
-        ("z", 2 * s, if wide { datatype::FLOAT64 } else { datatype::FLOAT32 }),
+        (
+            "x",
+            0,
+            if wide {
+                datatype::FLOAT64
+            } else {
+                datatype::FLOAT32
+            },
+        ),
+        (
+            "y",
+            s,
+            if wide {
+                datatype::FLOAT64
+            } else {
+                datatype::FLOAT32
+            },
+        ),
+        (
+            "z",
+            2 * s,
+            if wide {
+                datatype::FLOAT64
+            } else {
+                datatype::FLOAT32
+            },
+        ),
         ("intensity", 3 * s, datatype::UINT8),
     ] {
         w.string(name);
@@ -140,7 +175,11 @@ fn point_cloud2_layout_errors_name_the_field() {
     assert!(c.xyz().unwrap_err().to_string().starts_with("data"));
     let mut c = PointCloud2::decode(&b).unwrap();
     c.fields.retain(|f| f.name != "z");
-    assert!(c.xyz().unwrap_err().to_string().contains("no field named z"));
+    assert!(c
+        .xyz()
+        .unwrap_err()
+        .to_string()
+        .contains("no field named z"));
     assert!(PointCloud2::decode(&b[..b.len() - 3]).is_err());
 }
 
