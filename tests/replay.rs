@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::process::Command;
 
-use gaze_lidar::checker::check;
+use gaze_lidar::checker::certify;
 use gaze_lidar::pointcloud::{keep_mask, CloudFrame, CloudOptions};
 use gaze_lidar::profile::Profile;
 use gaze_lidar::replay::cdr::{self, datatype, Header, PointCloud2, Vector3Stamped};
@@ -68,7 +68,7 @@ fn bag(compression: Option<mcap::Compression>) -> Vec<u8> {
         .profile("ros2")
         .create(Cursor::new(&mut buf))
         .unwrap();
-    let mut chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
+    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
         let s = w
             .add_schema(
                 ty,
@@ -249,7 +249,7 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
                 let p =
                     Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "profile").unwrap();
                 assert!(independent::recheck(&p).is_empty());
-                (m.log_time, check(&p).unwrap())
+                (m.log_time, certify(p).unwrap())
             })
             .collect();
         let t0 = inp.iter().map(|m| m.log_time).min().unwrap();

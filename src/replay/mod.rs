@@ -44,7 +44,7 @@ use std::collections::{BTreeMap, BinaryHeap, HashMap, VecDeque};
 use std::io::{Read, Seek, Write};
 
 use mcap::records::MessageHeader;
-use mcap::sans_io::{MessageReadEvent, MessageReader};
+use mcap::sans_io::{LinearReaderOptions, MessageReadEvent, MessageReader};
 use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
@@ -270,6 +270,10 @@ const MAX_WINDOW_BYTES: usize = 96 << 20;
 
 /// Frames remembered for clouds that arrive late.
 const FRAME_HISTORY: usize = 64;
+
+/// Longest record (or chunk) read, bytes: 256 MiB, a cloud of ten million
+/// points.
+const MAX_RECORD_BYTES: usize = 256 << 20;
 
 /// Input bytes read per call.
 const READ_BYTES: usize = 1 << 20;
@@ -681,7 +685,16 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
         stats: ReplayStats::default(),
         yaw,
     };
-    let mut reader = MessageReader::new();
+    // Every CRC checked (a chunk before any of its messages is used), and
+    // no record longer than `MAX_RECORD_BYTES` (a corrupt length must not
+    // allocate without bound).
+    let mut reader = MessageReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_prevalidate_chunk_crcs(true)
+            .with_validate_data_section_crc(true)
+            .with_validate_summary_section_crc(true)
+            .with_record_length_limit(MAX_RECORD_BYTES),
+    );
     let mut offset: u64 = 0;
     let mut heap: BinaryHeap<Pending> = BinaryHeap::new();
     let mut held_bytes = 0usize;
