@@ -80,7 +80,7 @@ pub fn write_bag<W: Write + Seek>(out: W, seconds: u64) -> mcap::McapResult<()> 
         .compression(None)
         .profile("ros2")
         .create(out)?;
-    let mut chan = |w: &mut mcap::Writer<W>, topic: &str, ty: &str| -> mcap::McapResult<u16> {
+    let chan = |w: &mut mcap::Writer<W>, topic: &str, ty: &str| -> mcap::McapResult<u16> {
         let s = w.add_schema(
             ty,
             schemas::ROS2MSG,
