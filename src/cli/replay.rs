@@ -114,7 +114,7 @@ pub struct Args {
     #[arg(long, default_value = "/gaze_lidar/scene")]
     scene_topic: String,
     /// Output chunk compression.
-    #[arg(long, value_enum, default_value_t = CompressionArg::Lz4)]
+    #[arg(long, value_enum, default_value_t = CompressionArg::None)]
     compression: CompressionArg,
 }
 

@@ -146,9 +146,9 @@ pub enum GazeKind {
 /// Output compression of the MCAP chunks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Compression {
-    /// None.
+    /// None (the default, as rosbag2 records).
     None,
-    /// LZ4 (the default).
+    /// LZ4.
     Lz4,
 }
 
@@ -187,7 +187,7 @@ impl ReplayOptions {
     /// Defaults for the two topics: Vector3Stamped gaze, `<cloud>/adapted`,
     /// `/gaze_lidar/profile`, `/gaze_lidar/scene`, no mounting yaw, the
     /// physical return model at `rated_range_m`, seed 0, a 200 ms reorder
-    /// window, LZ4.
+    /// window, uncompressed chunks.
     #[must_use]
     pub fn new(gaze_topic: &str, cloud_topic: &str, rated_range_m: f64) -> Self {
         let mut cloud = CloudOptions::new(rated_range_m);
@@ -202,7 +202,7 @@ impl ReplayOptions {
             sensor_yaw_deg: 0.0,
             cloud,
             reorder_window_ns: 200_000_000,
-            compression: Compression::Lz4,
+            compression: Compression::None,
         }
     }
 }
