@@ -390,3 +390,121 @@ fn replay_is_deterministic() {
     assert_eq!(replay_cli(&input, &b).status.code(), Some(0));
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
 }
+
+#[test]
+fn float64_yaw_gaze_and_a_mounting_yaw() {
+    // Gaze as std_msgs/Float64 yaw (90° = left) at 100 Hz, clouds at 10 Hz
+    // from a sensor turned 90° left: a cloud point at sensor azimuth β is at
+    // β + 90° for the profile.
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .compression(None)
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
+        let s = w
+            .add_schema(
+                ty,
+                schemas::ROS2MSG,
+                schemas::ros2msg(ty).unwrap().as_bytes(),
+            )
+            .unwrap();
+        w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
+            .unwrap()
+    };
+    let g = chan(&mut w, "/yaw", schemas::FLOAT64);
+    let c = chan(&mut w, CLOUD, schemas::POINT_CLOUD2);
+    let t0: u64 = 5_000_000_000;
+    for k in 0..100u64 {
+        let t = t0 + k * 10_000_000;
+        let header = |ch| MessageHeader {
+            channel_id: ch,
+            sequence: k as u32,
+            log_time: t,
+            publish_time: t,
+        };
+        w.write_to_known_channel(&header(g), &cdr::encode_float64(90.0))
+            .unwrap();
+        if k % 10 == 5 {
+            w.write_to_known_channel(&header(c), &cloud_msg(5, 0, k, 3000))
+                .unwrap();
+        }
+    }
+    w.finish().unwrap();
+    drop(w);
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    std::fs::write(&input, &buf).unwrap();
+    let o = bin()
+        .arg("replay")
+        .arg(&input)
+        .args([
+            "--gaze-topic",
+            "/yaw",
+            "--gaze-yaw-deg",
+            "--cloud-topic",
+            CLOUD,
+            "--sensor-yaw-deg",
+            "90",
+            "--seed",
+            "7",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let got = read_all(&std::fs::read(&out).unwrap());
+    let profiles: Vec<(u64, gaze_lidar::checker::CertifiedProfile)> = got
+        .iter()
+        .filter(|m| m.topic == "/gaze_lidar/profile")
+        .map(|m| {
+            let p = Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "p").unwrap();
+            (m.log_time, certify(p).unwrap())
+        })
+        .collect();
+    assert!(profiles
+        .iter()
+        .filter(|(t, _)| *t > t0 + 100_000_000)
+        .all(|(_, p)| p.profile().gaze_deg == Some(90.0)));
+    let clouds: Vec<&Msg> = got.iter().filter(|m| m.topic == CLOUD).collect();
+    let adapted: Vec<&Msg> = got
+        .iter()
+        .filter(|m| m.topic == "/lidar/points/adapted")
+        .collect();
+    assert_eq!(clouds.len(), 10);
+    assert_eq!(adapted.len(), 10);
+    let (s, c) = 90f64.to_radians().sin_cos();
+    for (k, (a, cl)) in adapted.iter().zip(&clouds).enumerate() {
+        let src = PointCloud2::decode(&cl.data).unwrap();
+        let sl = src.xyz().unwrap();
+        let dst = PointCloud2::decode(&a.data).unwrap();
+        let dl = dst.xyz().unwrap();
+        let (_, profile) = profiles
+            .iter()
+            .rev()
+            .find(|(t, _)| *t <= a.log_time)
+            .unwrap();
+        let turned: Vec<[f64; 3]> = (0..sl.len())
+            .map(|i| {
+                let [x, y, z] = sl.xyz(sl.point(src.data, i));
+                [c * x - s * y, s * x + c * y, z]
+            })
+            .collect();
+        let mut opts = CloudOptions::new(100.0);
+        opts.frame = CloudFrame::Iso8855;
+        opts.seed = 7 + k as u64;
+        let mask = keep_mask(profile, turned.iter().copied(), &opts).unwrap();
+        let want: Vec<&[u8]> = (0..sl.len())
+            .filter(|&i| mask[i])
+            .map(|i| sl.point(src.data, i))
+            .collect();
+        let have: Vec<&[u8]> = (0..dl.len()).map(|i| dl.point(dst.data, i)).collect();
+        assert_eq!(want, have, "cloud {k}");
+    }
+}
