@@ -293,6 +293,18 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     tmp.persist(&a.out)
         .map_err(|e| CliError::output(format!("--out {}: {}", a.out.display(), e.error)))?;
     let s = stats.stream;
+    if s.samples == 0 {
+        super::io::warn(format!(
+            "warning: no message on the gaze topic {}: every frame is fail-safe (the uniform baseline)",
+            a.gaze_topic
+        ));
+    }
+    if stats.clouds == 0 {
+        super::io::warn(format!(
+            "warning: no message on the cloud topic {}: no adapted cloud written",
+            a.cloud_topic
+        ));
+    }
     super::io::warn(format!(
         "{} messages, {} clouds ({} of {} points kept), {} gaze samples ({} invalid, {} outliers, {} late) → {} frames, {} in fail-safe{}",
         stats.messages,
