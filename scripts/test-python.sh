@@ -23,6 +23,8 @@ echo "== python: pip install ./python into a fresh venv ($venv)"
 "$PY" -m venv "$venv"
 "$venv/bin/pip" install -q ./python   # exactly what a user runs
 "$venv/bin/python" -m pip install -q pytest hypothesis mypy
+# An independent MCAP writer and reader for the replay test (issue 33).
+"$venv/bin/python" -m pip install -q mcap mcap-ros2-support
 
 echo "== python: pytest"
 # From outside the source tree, so the installed package is what is tested.

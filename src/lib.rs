@@ -42,6 +42,8 @@ pub mod optimizer;
 pub mod planner;
 pub mod pointcloud;
 pub mod profile;
+#[cfg(feature = "replay")]
+pub mod replay;
 pub mod sim;
 pub mod text;
 #[cfg(any(test, kani))]

@@ -16,6 +16,7 @@ mod config;
 pub mod io;
 pub mod output;
 mod profile;
+mod replay;
 mod sensor;
 mod simulate;
 mod stream;
@@ -105,6 +106,10 @@ enum Command {
     Simulate(simulate::Args),
     /// Gaze samples on stdin → one certified profile per LiDAR frame (JSON lines).
     Stream(stream::Args),
+    /// A rosbag2 MCAP (gaze and point-cloud topics) through the gaze
+    /// pipeline → an MCAP with the adapted clouds, the profiles and a
+    /// Foxglove picture.
+    Replay(replay::Args),
     /// Write a preset's sensor as a sensor file (TOML) for `check --sensor`.
     Sensor(sensor::Args),
 }
@@ -175,6 +180,7 @@ pub fn main() -> ExitCode {
         Command::Ael(a) => ael::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Stream(a) => stream::run(&a),
+        Command::Replay(a) => replay::run(&a),
         Command::Sensor(a) => sensor::run(&a),
     };
     match result {

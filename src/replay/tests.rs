@@ -1,0 +1,195 @@
+//! Unit tests of the CDR codec and the gaze conversion.
+
+use super::cdr::{self, datatype, Header, PointCloud2, PointField, Vector3Stamped};
+use super::*;
+
+#[test]
+fn vector3_stamped_round_trips_and_matches_hand_encoded_bytes() {
+    let v = Vector3Stamped {
+        header: Header {
+            sec: 7,
+            nanosec: 9,
+            frame_id: "ab",
+        },
+        xyz: [1.0, -2.0, 0.5],
+    };
+    let b = v.encode();
+    // Header 4, sec 4, nanosec 4, len 4, "ab\0" 3, pad to 8 (rel 15 → 16), 3 × 8.
+    assert_eq!(b.len(), 4 + 4 + 4 + 4 + 3 + 1 + 24);
+    assert_eq!(&b[..4], &[0, 1, 0, 0]);
+    assert_eq!(&b[12..16], &3u32.to_le_bytes());
+    assert_eq!(&b[16..19], b"ab\0");
+    assert_eq!(&b[20..28], &1.0f64.to_le_bytes());
+    assert_eq!(Vector3Stamped::decode(&b).unwrap(), v);
+    // Big-endian input decodes too.
+    let mut be = vec![0, 0, 0, 0];
+    be.extend_from_slice(&7i32.to_be_bytes());
+    be.extend_from_slice(&9u32.to_be_bytes());
+    be.extend_from_slice(&3u32.to_be_bytes());
+    be.extend_from_slice(b"ab\0\0");
+    for x in [1.0f64, -2.0, 0.5] {
+        be.extend_from_slice(&x.to_be_bytes());
+    }
+    assert_eq!(Vector3Stamped::decode(&be).unwrap(), v);
+    // Truncated: names the field.
+    let e = Vector3Stamped::decode(&b[..25]).unwrap_err().to_string();
+    assert!(e.starts_with("vector.x"), "{e}");
+    assert!(Vector3Stamped::decode(&[0, 2, 0, 0]).is_err());
+}
+
+#[test]
+fn float64_round_trips() {
+    assert_eq!(
+        cdr::decode_float64(&cdr::encode_float64(-12.5)).unwrap(),
+        -12.5
+    );
+    assert_eq!(cdr::encode_float64(1.0).len(), 12);
+}
+
+fn cloud_bytes(big: bool, wide: bool, step: u32, pts: &[[f64; 3]]) -> Vec<u8> {
+    // Written by hand (not by `encode_subset`): fields x, y, z at 0, s, 2s
+    // and an intensity after them, padding to `step`.
+    let s = if wide { 8 } else { 4 };
+    let mut data = Vec::new();
+    for p in pts {
+        let start = data.len();
+        for v in p {
+            if wide {
+                data.extend_from_slice(&if big {
+                    v.to_be_bytes()
+                } else {
+                    v.to_le_bytes()
+                });
+            } else {
+                let f = *v as f32;
+                data.extend_from_slice(&if big {
+                    f.to_be_bytes()
+                } else {
+                    f.to_le_bytes()
+                });
+            }
+        }
+        data.resize(start + step as usize, 0xAB);
+    }
+    let mut w = cdr::Writer::new(64);
+    Header {
+        sec: 1,
+        nanosec: 2,
+        frame_id: "lidar",
+    }
+    .write(&mut w);
+    w.u32(1);
+    w.u32(pts.len() as u32);
+    w.u32(4);
+    for (name, off, t) in [
+        (
+            "x",
+            0,
+            if wide {
+                datatype::FLOAT64
+            } else {
+                datatype::FLOAT32
+            },
+        ),
+        (
+            "y",
+            s,
+            if wide {
+                datatype::FLOAT64
+            } else {
+                datatype::FLOAT32
+            },
+        ),
+        (
+            "z",
+            2 * s,
+            if wide {
+                datatype::FLOAT64
+            } else {
+                datatype::FLOAT32
+            },
+        ),
+        ("intensity", 3 * s, datatype::UINT8),
+    ] {
+        w.string(name);
+        w.u32(off);
+        w.u8(t);
+        w.u32(1);
+    }
+    w.u8(u8::from(big));
+    w.u32(step);
+    w.u32(step * pts.len() as u32);
+    w.bytes_from(data.len(), std::iter::once(&data[..]));
+    w.u8(0);
+    w.finish()
+}
+
+#[test]
+fn point_cloud2_reads_every_layout_and_keeps_a_subset_byte_for_byte() {
+    let pts = [[1.0, 2.0, 3.0], [-4.5, 0.25, 8.0], [f64::NAN, 0.0, 0.0]];
+    for (big, wide, step) in [
+        (false, false, 16),
+        (true, false, 13),
+        (false, true, 32),
+        (true, true, 25),
+    ] {
+        let b = cloud_bytes(big, wide, step, &pts);
+        let c = PointCloud2::decode(&b).unwrap();
+        assert_eq!(c.fields.len(), 4);
+        assert_eq!(
+            c.fields[3],
+            PointField {
+                name: "intensity",
+                offset: if wide { 24 } else { 12 },
+                datatype: datatype::UINT8,
+                count: 1
+            }
+        );
+        let l = c.xyz().unwrap();
+        assert_eq!(l.len(), 3);
+        assert_eq!(l.xyz(l.point(c.data, 1)), [-4.5, 0.25, 8.0]);
+        assert!(l.xyz(l.point(c.data, 2))[0].is_nan());
+        let sub = cdr::encode_subset(&c, &l, &[false, true, false], true);
+        let s = PointCloud2::decode(&sub).unwrap();
+        assert_eq!((s.height, s.width, s.point_step), (1, 1, step));
+        assert_eq!(s.row_step, step);
+        assert_eq!(s.data, l.point(c.data, 1));
+        assert_eq!(s.header, c.header);
+        assert_eq!(s.fields, c.fields);
+        assert_eq!(s.is_bigendian, big);
+        assert!(s.is_dense);
+    }
+}
+
+#[test]
+fn point_cloud2_layout_errors_name_the_field() {
+    let b = cloud_bytes(false, false, 16, &[[1.0, 2.0, 3.0]]);
+    let mut c = PointCloud2::decode(&b).unwrap();
+    c.point_step = 8;
+    assert!(c.xyz().unwrap_err().to_string().starts_with("fields"));
+    let mut c = PointCloud2::decode(&b).unwrap();
+    c.width = 2;
+    assert!(c.xyz().unwrap_err().to_string().starts_with("row_step"));
+    let mut c = PointCloud2::decode(&b).unwrap();
+    c.height = 2;
+    assert!(c.xyz().unwrap_err().to_string().starts_with("data"));
+    let mut c = PointCloud2::decode(&b).unwrap();
+    c.fields.retain(|f| f.name != "z");
+    assert!(c
+        .xyz()
+        .unwrap_err()
+        .to_string()
+        .contains("no field named z"));
+    assert!(PointCloud2::decode(&b[..b.len() - 3]).is_err());
+}
+
+#[test]
+fn vector_azimuth_follows_iso_8855() {
+    assert_eq!(vector_azimuth_deg([1.0, 0.0, 0.0]), Some(0.0));
+    assert_eq!(vector_azimuth_deg([0.0, 1.0, 0.0]), Some(90.0));
+    assert_eq!(vector_azimuth_deg([0.0, -2.0, 5.0]), Some(270.0));
+    assert_eq!(vector_azimuth_deg([0.0, 0.0, 1.0]), None);
+    assert_eq!(vector_azimuth_deg([0.0, 0.0, 0.0]), None);
+    assert_eq!(vector_azimuth_deg([f64::NAN, 1.0, 0.0]), None);
+    assert_eq!(vector_azimuth_deg([1.0, f64::INFINITY, 0.0]), None);
+}

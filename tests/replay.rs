@@ -1,0 +1,510 @@
+//! Issue 33: `gaze-lidar replay` on a bag written here with the mcap crate
+//! (no Python needed), read back with the mcap crate.
+
+mod common;
+mod independent;
+
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::process::Command;
+
+use gaze_lidar::checker::certify;
+use gaze_lidar::pointcloud::{keep_mask, CloudFrame, CloudOptions};
+use gaze_lidar::profile::Profile;
+use gaze_lidar::replay::cdr::{self, datatype, Header, PointCloud2, Vector3Stamped};
+use gaze_lidar::replay::schemas;
+use mcap::records::MessageHeader;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const GAZE: &str = "/dms/gaze";
+const CLOUD: &str = "/lidar/points";
+const OTHER: &str = "/chatter";
+
+/// A cloud of `n` points, float32 x, y, z and a float32 intensity (16-byte
+/// points), some beyond the rated range.
+fn cloud_msg(sec: i32, nanosec: u32, seed: u64, n: usize) -> Vec<u8> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut data = Vec::with_capacity(16 * n);
+    for _ in 0..n {
+        let az = rng.random::<f64>() * std::f64::consts::TAU;
+        let r = 1.0 + rng.random::<f64>() * 130.0;
+        for v in [r * az.cos(), r * az.sin(), rng.random::<f64>() - 0.5, 7.0] {
+            data.extend_from_slice(&(v as f32).to_le_bytes());
+        }
+    }
+    let mut w = cdr::Writer::new(data.len() + 128);
+    Header {
+        sec,
+        nanosec,
+        frame_id: "lidar",
+    }
+    .write(&mut w);
+    w.u32(1);
+    w.u32(n as u32);
+    w.u32(4);
+    for (i, name) in ["x", "y", "z", "intensity"].iter().enumerate() {
+        w.string(name);
+        w.u32(4 * i as u32);
+        w.u8(datatype::FLOAT32);
+        w.u32(1);
+    }
+    w.u8(0);
+    w.u32(16);
+    w.u32(16 * n as u32);
+    w.bytes_from(data.len(), std::iter::once(&data[..]));
+    w.u8(1);
+    w.finish()
+}
+
+/// Clouds at 10 Hz for 3 s, gaze at 100 Hz looking left with a gap from
+/// 1.0 s to 1.5 s, an unrelated topic at 2 Hz; one gaze sample written out
+/// of order and one duplicate timestamp.
+fn bag(compression: Option<mcap::Compression>) -> Vec<u8> {
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .compression(compression)
+        .chunk_size(Some(64 * 1024))
+        .profile("ros2")
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
+        let s = w
+            .add_schema(
+                ty,
+                schemas::ROS2MSG,
+                schemas::ros2msg(ty).unwrap().as_bytes(),
+            )
+            .unwrap();
+        w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
+            .unwrap()
+    };
+    let g = chan(&mut w, GAZE, schemas::VECTOR3_STAMPED);
+    let c = chan(&mut w, CLOUD, schemas::POINT_CLOUD2);
+    let o = chan(&mut w, OTHER, schemas::STRING);
+    let t0: u64 = 1_700_000_000_000_000_000;
+    let mut msgs: Vec<(u64, u16, Vec<u8>)> = Vec::new();
+    for k in 0..300u64 {
+        let t = k * 10_000_000;
+        if (100..150).contains(&k) {
+            continue;
+        }
+        let v = Vector3Stamped {
+            header: Header {
+                sec: ((t0 + t) / 1_000_000_000) as i32,
+                nanosec: ((t0 + t) % 1_000_000_000) as u32,
+                frame_id: "base_link",
+            },
+            xyz: [0.0, 1.0, 0.01 * (k % 3) as f64],
+        };
+        msgs.push((t0 + t, g, v.encode()));
+    }
+    for k in 0..30u64 {
+        let t = t0 + k * 100_000_000 + 3_000_000;
+        msgs.push((
+            t,
+            c,
+            cloud_msg(
+                (t / 1_000_000_000) as i32,
+                (t % 1_000_000_000) as u32,
+                k,
+                3000,
+            ),
+        ));
+    }
+    for k in 0..6u64 {
+        let mut s = cdr::Writer::new(16);
+        s.string(&format!("hello {k}"));
+        msgs.push((t0 + k * 500_000_000, o, s.finish()));
+    }
+    msgs.sort_by_key(|m| m.0);
+    // Out of order (by 30 ms, inside the reorder window) and a duplicate time.
+    msgs.swap(20, 23);
+    let dup = msgs[40].clone();
+    msgs.insert(41, (dup.0, dup.1, dup.2));
+    for (seq, (t, ch, data)) in msgs.iter().enumerate() {
+        w.write_to_known_channel(
+            &MessageHeader {
+                channel_id: *ch,
+                sequence: seq as u32,
+                log_time: *t,
+                publish_time: *t,
+            },
+            data,
+        )
+        .unwrap();
+    }
+    w.finish().unwrap();
+    drop(w);
+    buf
+}
+
+struct Msg {
+    topic: String,
+    schema: String,
+    encoding: String,
+    log_time: u64,
+    data: Vec<u8>,
+}
+
+fn read_all(bytes: &[u8]) -> Vec<Msg> {
+    mcap::MessageStream::new(bytes)
+        .unwrap()
+        .map(|m| {
+            let m = m.unwrap();
+            Msg {
+                topic: m.channel.topic.clone(),
+                schema: m
+                    .channel
+                    .schema
+                    .as_ref()
+                    .map_or(String::new(), |s| format!("{} {}", s.encoding, s.name)),
+                encoding: m.channel.message_encoding.clone(),
+                log_time: m.log_time,
+                data: m.data.into_owned(),
+            }
+        })
+        .collect()
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_gaze-lidar"))
+}
+
+fn replay_cli(input: &std::path::Path, out: &std::path::Path) -> std::process::Output {
+    bin()
+        .args(["replay"])
+        .arg(input)
+        .args([
+            "--gaze-topic",
+            GAZE,
+            "--cloud-topic",
+            CLOUD,
+            "--preset",
+            "paper",
+            "--mode",
+            "range",
+            "--out",
+        ])
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, compression) in [("plain", None), ("lz4", Some(mcap::Compression::Lz4))] {
+        let input = dir.path().join(format!("{name}.mcap"));
+        let out = dir.path().join(format!("{name}-out.mcap"));
+        let bag = bag(compression);
+        std::fs::write(&input, &bag).unwrap();
+        let o = replay_cli(&input, &out);
+        common::no_panic(&o, "replay");
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let inp = read_all(&bag);
+        let got = read_all(&std::fs::read(&out).unwrap());
+        // Every input message, byte for byte, on its topic and time.
+        let key = |m: &Msg| (m.topic.clone(), m.log_time, m.data.clone());
+        let mut want: Vec<_> = inp.iter().map(key).collect();
+        let mut have: Vec<_> = got
+            .iter()
+            .filter(|m| [GAZE, CLOUD, OTHER].contains(&m.topic.as_str()))
+            .map(key)
+            .collect();
+        want.sort();
+        have.sort();
+        assert_eq!(want, have);
+        // Schemas embedded.
+        for m in &got {
+            match m.topic.as_str() {
+                "/gaze_lidar/profile" => {
+                    assert_eq!(m.schema, "jsonschema gaze_lidar.Profile");
+                    assert_eq!(m.encoding, "json");
+                }
+                "/gaze_lidar/scene" => {
+                    assert_eq!(m.schema, "jsonschema foxglove.SceneUpdate");
+                    let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+                    assert!(!v["entities"][0]["triangles"][0]["points"]
+                        .as_array()
+                        .unwrap()
+                        .is_empty());
+                }
+                t => {
+                    assert!(m.schema.starts_with("ros2msg "), "{t}: {}", m.schema);
+                    assert_eq!(m.encoding, "cdr");
+                }
+            }
+        }
+        // Profiles: each certified again, fail-safe through the gap.
+        let profiles: Vec<(u64, gaze_lidar::checker::CertifiedProfile)> = got
+            .iter()
+            .filter(|m| m.topic == "/gaze_lidar/profile")
+            .map(|m| {
+                let p =
+                    Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "profile").unwrap();
+                assert!(independent::recheck(&p).is_empty());
+                (m.log_time, certify(p).unwrap())
+            })
+            .collect();
+        let t0 = inp.iter().map(|m| m.log_time).min().unwrap();
+        let at = |s: f64| t0 + (s * 1e9) as u64;
+        assert!(profiles.len() >= 55, "{} frames", profiles.len());
+        let gaze_of = |lo: f64, hi: f64| {
+            profiles
+                .iter()
+                .filter(|(t, _)| *t >= at(lo) && *t < at(hi))
+                .map(|(_, p)| p.profile().gaze_deg)
+                .collect::<Vec<_>>()
+        };
+        let before = gaze_of(0.3, 0.95);
+        assert!(
+            !before.is_empty()
+                && before
+                    .iter()
+                    .all(|g| g.is_some_and(|g| (g - 90.0).abs() < 1.0))
+        );
+        let gap = gaze_of(1.15, 1.5);
+        assert!(
+            !gap.is_empty() && gap.iter().all(Option::is_none),
+            "{gap:?}"
+        );
+        assert!(gaze_of(1.8, 2.9).iter().all(Option::is_some));
+        // One adapted cloud per input cloud, a subset in order, the rule's mask.
+        let clouds_in: Vec<&Msg> = inp.iter().filter(|m| m.topic == CLOUD).collect();
+        let adapted: Vec<&Msg> = got
+            .iter()
+            .filter(|m| m.topic == "/lidar/points/adapted")
+            .collect();
+        assert_eq!(adapted.len(), clouds_in.len());
+        let mut thinned = 0;
+        for (k, (a, c)) in adapted.iter().zip(&clouds_in).enumerate() {
+            assert_eq!(a.log_time, c.log_time);
+            assert_eq!(a.schema, format!("ros2msg {}", schemas::POINT_CLOUD2));
+            let src = PointCloud2::decode(&c.data).unwrap();
+            let sl = src.xyz().unwrap();
+            let dst = PointCloud2::decode(&a.data).unwrap();
+            let dl = dst.xyz().unwrap();
+            let (_, profile) = profiles
+                .iter()
+                .rev()
+                .find(|(t, _)| *t <= a.log_time)
+                .unwrap();
+            let pts: Vec<[f64; 3]> = (0..sl.len())
+                .map(|i| sl.xyz(sl.point(src.data, i)))
+                .collect();
+            let mut opts = CloudOptions::new(100.0);
+            opts.frame = CloudFrame::Iso8855;
+            opts.seed = k as u64;
+            let mask = keep_mask(profile, pts.iter().copied(), &opts).unwrap();
+            let want: Vec<&[u8]> = (0..sl.len())
+                .filter(|&i| mask[i])
+                .map(|i| sl.point(src.data, i))
+                .collect();
+            let have: Vec<&[u8]> = (0..dl.len()).map(|i| dl.point(dst.data, i)).collect();
+            assert_eq!(want, have, "cloud {k}");
+            assert!(have.len() < sl.len());
+            thinned += sl.len() - have.len();
+        }
+        assert!(thinned > 0);
+    }
+}
+
+#[test]
+fn a_truncated_or_corrupt_bag_is_exit_2_naming_the_offset_and_leaves_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = bag(None);
+    let out = dir.path().join("out.mcap");
+    std::fs::write(&out, b"old").unwrap();
+    let input = dir.path().join("cut.mcap");
+    std::fs::write(&input, &bag[..bag.len() / 2]).unwrap();
+    let o = replay_cli(&input, &out);
+    common::no_panic(&o, "truncated");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("at byte {}", bag.len() / 2)), "{err}");
+    assert!(err.contains("truncated"), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"old");
+    // A flipped byte inside the data: a CRC or parse error, exit 2.
+    let mut bad = bag.clone();
+    let mid = bag.len() / 3;
+    bad[mid] ^= 0xFF;
+    std::fs::write(&input, &bad).unwrap();
+    let o = replay_cli(&input, &out);
+    common::no_panic(&o, "corrupt");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("at byte "), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"old");
+    // No temporary file left beside the output.
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with(".gaze-lidar-replay"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    // Not an MCAP at all.
+    std::fs::write(&input, b"hello").unwrap();
+    let o = replay_cli(&input, &out);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn a_topic_of_the_wrong_type_is_exit_2_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let out = dir.path().join("out.mcap");
+    let o = bin()
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", CLOUD, "--cloud-topic", GAZE, "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    common::no_panic(&o, "wrong type");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("/lidar/points") || err.contains("/dms/gaze"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // --out is the input.
+    let o = replay_cli(&input, &input);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn replay_is_deterministic() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(Some(mcap::Compression::Lz4))).unwrap();
+    let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    assert_eq!(replay_cli(&input, &a).status.code(), Some(0));
+    assert_eq!(replay_cli(&input, &b).status.code(), Some(0));
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn float64_yaw_gaze_and_a_mounting_yaw() {
+    // Gaze as std_msgs/Float64 yaw (90° = left) at 100 Hz, clouds at 10 Hz
+    // from a sensor turned 90° left: a cloud point at sensor azimuth β is at
+    // β + 90° for the profile.
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .compression(None)
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
+        let s = w
+            .add_schema(
+                ty,
+                schemas::ROS2MSG,
+                schemas::ros2msg(ty).unwrap().as_bytes(),
+            )
+            .unwrap();
+        w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
+            .unwrap()
+    };
+    let g = chan(&mut w, "/yaw", schemas::FLOAT64);
+    let c = chan(&mut w, CLOUD, schemas::POINT_CLOUD2);
+    let t0: u64 = 5_000_000_000;
+    for k in 0..100u64 {
+        let t = t0 + k * 10_000_000;
+        let header = |ch| MessageHeader {
+            channel_id: ch,
+            sequence: k as u32,
+            log_time: t,
+            publish_time: t,
+        };
+        w.write_to_known_channel(&header(g), &cdr::encode_float64(90.0))
+            .unwrap();
+        if k % 10 == 5 {
+            w.write_to_known_channel(&header(c), &cloud_msg(5, 0, k, 3000))
+                .unwrap();
+        }
+    }
+    w.finish().unwrap();
+    drop(w);
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    std::fs::write(&input, &buf).unwrap();
+    let o = bin()
+        .arg("replay")
+        .arg(&input)
+        .args([
+            "--gaze-topic",
+            "/yaw",
+            "--gaze-yaw-deg",
+            "--cloud-topic",
+            CLOUD,
+            "--sensor-yaw-deg",
+            "90",
+            "--seed",
+            "7",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let got = read_all(&std::fs::read(&out).unwrap());
+    let profiles: Vec<(u64, gaze_lidar::checker::CertifiedProfile)> = got
+        .iter()
+        .filter(|m| m.topic == "/gaze_lidar/profile")
+        .map(|m| {
+            let p = Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "p").unwrap();
+            (m.log_time, certify(p).unwrap())
+        })
+        .collect();
+    assert!(profiles
+        .iter()
+        .filter(|(t, _)| *t > t0 + 100_000_000)
+        .all(|(_, p)| p.profile().gaze_deg == Some(90.0)));
+    let clouds: Vec<&Msg> = got.iter().filter(|m| m.topic == CLOUD).collect();
+    let adapted: Vec<&Msg> = got
+        .iter()
+        .filter(|m| m.topic == "/lidar/points/adapted")
+        .collect();
+    assert_eq!(clouds.len(), 10);
+    assert_eq!(adapted.len(), 10);
+    let (s, c) = 90f64.to_radians().sin_cos();
+    for (k, (a, cl)) in adapted.iter().zip(&clouds).enumerate() {
+        let src = PointCloud2::decode(&cl.data).unwrap();
+        let sl = src.xyz().unwrap();
+        let dst = PointCloud2::decode(&a.data).unwrap();
+        let dl = dst.xyz().unwrap();
+        let (_, profile) = profiles
+            .iter()
+            .rev()
+            .find(|(t, _)| *t <= a.log_time)
+            .unwrap();
+        let turned: Vec<[f64; 3]> = (0..sl.len())
+            .map(|i| {
+                let [x, y, z] = sl.xyz(sl.point(src.data, i));
+                [c * x - s * y, s * x + c * y, z]
+            })
+            .collect();
+        let mut opts = CloudOptions::new(100.0);
+        opts.frame = CloudFrame::Iso8855;
+        opts.seed = 7 + k as u64;
+        let mask = keep_mask(profile, turned.iter().copied(), &opts).unwrap();
+        let want: Vec<&[u8]> = (0..sl.len())
+            .filter(|&i| mask[i])
+            .map(|i| sl.point(src.data, i))
+            .collect();
+        let have: Vec<&[u8]> = (0..dl.len()).map(|i| dl.point(dst.data, i)).collect();
+        assert_eq!(want, have, "cloud {k}");
+    }
+}
