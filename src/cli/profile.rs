@@ -293,9 +293,9 @@ fn optimized(
         }
     };
     let (c, cert) = optimize_with_certificate(&problem, gaze).map_err(err)?;
-    let c = figures::attach_to_optimum(c, &problem, named.levels.clone());
+    let c = gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels.clone());
     let basis = Basis {
-        preset: figures::closed_form_basis(&problem, named.levels),
+        preset: gaze_lidar::optimizer::figures::closed_form_basis(&problem, named.levels),
         mode: problem.objective.mode,
         bins: problem.bins,
         optimized: true,

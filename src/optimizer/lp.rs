@@ -20,7 +20,7 @@ use crate::eye_safety::cuts::{cuts_with, Cut};
 use crate::eye_safety::{exposure, EyeSafetyParams};
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning};
 use crate::model::lidar::PowerAccounting;
-use crate::planner::Mode;
+use crate::model::Mode;
 use crate::profile::{Bin, Profile, Region, PROFILE_FORMAT};
 
 /// Relative margin kept from continuous bounds, budget and caps.

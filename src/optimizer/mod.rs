@@ -45,6 +45,7 @@ pub mod certificate;
 pub mod config;
 mod exact;
 pub mod fast;
+pub mod figures;
 pub mod global;
 mod lp;
 mod utility;
@@ -55,7 +56,7 @@ use thiserror::Error;
 use crate::checker::{certify, CertifiedProfile, Rejected};
 use crate::model::acuity::FocusModel;
 use crate::model::lidar::{LidarSpec, PowerAccounting};
-use crate::planner::Mode;
+use crate::model::Mode;
 
 pub use config::OptimizerConfig;
 
