@@ -94,28 +94,19 @@ use std::f64::consts::TAU;
 
 use super::certificate::{check, next_down, to_f64_up, LinearProgram};
 use super::lp::{grid, Grid};
+use super::settings::S;
 use super::{OptError, Problem};
 use crate::model::angle::next_index;
 use crate::model::lidar::PowerAccounting;
 use crate::profile::{GlobalOptimality, Profile};
 
-/// Tangents per utility and bin.
-const TANGENTS: usize = 12;
-/// The checker's relative tolerance, by which every row is widened.
-const WIDEN: f64 = 1e-9;
-/// τ slices per bin in the coupled Lagrangian's final evaluation.
-const LAGRANGIAN_SLICES: usize = 256;
-/// Relative lowering of the floating-point objective, and raising of the
-/// bound (rounding cover).
-const OBJECTIVE_MARGIN: f64 = 1e-12;
-
 /// Tangent rows `u ≤ √a + (k·v − a)/(2√a)` of `√(k·v)` for `v ∈ [lo, hi]`,
 /// as (slope in v, intercept) pairs; points spread evenly in `√`.
 fn tangents(k: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
     let (a, b) = ((k * lo).max(0.0).sqrt(), (k * hi).max(0.0).sqrt());
-    (0..=TANGENTS)
+    (0..=S.global_tangents)
         .filter_map(|j| {
-            let s = a + (b - a) * j as f64 / TANGENTS as f64;
+            let s = a + (b - a) * j as f64 / S.global_tangents as f64;
             // Slope rounded up (v ≥ 0): the line stays above the tangent.
             (s > 0.0).then(|| (-next_down(-(k / (2.0 * s))), s / 2.0))
         })
@@ -373,7 +364,7 @@ pub(super) fn bound(
 ) -> Result<GlobalOptimality, OptError> {
     let upper_bound = upper_bound(problem, gaze_deg)?;
     let j = model_objective(problem, gaze_deg, profile)?;
-    let objective = j - OBJECTIVE_MARGIN * j.abs();
+    let objective = j - S.objective_margin * j.abs();
     Ok(GlobalOptimality {
         objective,
         upper_bound,
@@ -465,7 +456,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     // Limits (not levels, which are exact) are met to the checker's
     // tolerance: the boxes widened by it.
     let (x_lo, x_hi) = if mode.controls_range() && problem.levels.power_w.is_empty() {
-        (x_lo * (1.0 - WIDEN), x_hi * (1.0 + WIDEN))
+        (x_lo * (1.0 - S.global_widen), x_hi * (1.0 + S.global_widen))
     } else {
         (x_lo, x_hi)
     };
@@ -473,7 +464,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         .spin_accel_rad_s2_max
         .filter(|a| mode.controls_resolution() && a.is_finite() && *a >= 0.0);
     let (w_lo, w_hi) = if mode.controls_resolution() && problem.levels.spin_rad_s.is_empty() {
-        let (lo, hi) = (w_lo * (1.0 - WIDEN), w_hi * (1.0 + WIDEN));
+        let (lo, hi) = (w_lo * (1.0 - S.global_widen), w_hi * (1.0 + S.global_widen));
         match accel {
             Some(a) => accel_spin_box(a, period, g.n, lo, hi),
             None => (lo, hi),
@@ -534,7 +525,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         let budget = match lid.power_accounting {
             PowerAccounting::Angle => TAU,
             PowerAccounting::Time => n,
-        } * (1.0 + WIDEN);
+        } * (1.0 + S.global_widen);
         let dwell: Vec<Term> = (0..g.n)
             .map(|i| {
                 let (lo, hi) = tau_box(i);
@@ -547,14 +538,14 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
                 }
             })
             .collect();
-        // The dwell part's row is the frame, an equality: Σ τ ≥ N(1−WIDEN)
-        // is dropped (a relaxation), Σ τ ≤ N(1+WIDEN) kept; its multiplier
+        // The dwell part's row is the frame, an equality: Σ τ ≥ N(1−S.global_widen)
+        // is dropped (a relaxation), Σ τ ≤ N(1+S.global_widen) kept; its multiplier
         // is ≥ 0 because the utility grows with τ.
         if let (Some(bp), Some(bd)) = (
             lagrangian_bound(&power, budget),
-            lagrangian_bound(&dwell, n * (1.0 + WIDEN)),
+            lagrangian_bound(&dwell, n * (1.0 + S.global_widen)),
         ) {
-            return Ok((bp + bd) * (1.0 + OBJECTIVE_MARGIN));
+            return Ok((bp + bd) * (1.0 + S.objective_margin));
         }
     }
     let mut lp = LinearProgram::default();
@@ -592,12 +583,16 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     }
     let frame: Vec<(usize, f64)> = taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
     let frame_row = lp.rows.len();
-    lp.add_row(&frame, n * (1.0 - WIDEN), n * (1.0 + WIDEN));
+    lp.add_row(
+        &frame,
+        n * (1.0 - S.global_widen),
+        n * (1.0 + S.global_widen),
+    );
     let mut budget_row = frame_row;
     match lid.power_accounting {
         PowerAccounting::Angle => {
             let spend: Vec<(usize, f64)> = (0..g.n).map(|i| (xs[i].0, g.theta[i])).collect();
-            lp.add_row(&spend, f64::NEG_INFINITY, TAU * (1.0 + WIDEN));
+            lp.add_row(&spend, f64::NEG_INFINITY, TAU * (1.0 + S.global_widen));
         }
         PowerAccounting::Time => {
             let mut spend = Vec::with_capacity(g.n);
@@ -611,14 +606,14 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
                 spend.push((w, 1.0));
             }
             budget_row = lp.rows.len();
-            lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + WIDEN));
+            lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + S.global_widen));
         }
     }
     let mut slews = Vec::new();
     if let (Some(s), true) = (l.power_slew_w_per_deg_max, mode.controls_range()) {
         for i in 0..g.n {
             let j = next_index(i, g.n);
-            let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + WIDEN);
+            let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + S.global_widen);
             slews.push((lp.rows.len(), i, j, lim));
             lp.add_row(&[(xs[j].0, 1.0), (xs[i].0, -1.0)], -lim, lim);
         }
@@ -628,9 +623,9 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let ub = exact
         .upper_bound
         .ok_or_else(|| OptError::Solver("global bound: no finite dual bound".into()))?;
-    // Raised by OBJECTIVE_MARGIN: covers the float evaluation of the model's
+    // Raised by S.objective_margin: covers the float evaluation of the model's
     // constants (k, √ of a fixed block) the rows were built from.
-    let lp_bound = to_f64_up(&ub) * (1.0 + OBJECTIVE_MARGIN);
+    let lp_bound = to_f64_up(&ub) * (1.0 + S.objective_margin);
     // The Lagrangian's slices need x ≥ 0 (powers are never negative).
     if !coupled || xs.iter().any(|&(_, lo, _)| lo.is_nan() || lo < 0.0) {
         return Ok(lp_bound);
@@ -648,18 +643,22 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         })
         .collect();
     let duals = Duals {
-        frame: (solved.y[frame_row], n * (1.0 - WIDEN), n * (1.0 + WIDEN)),
-        budget: (solved.y[budget_row].max(0.0), n * (1.0 + WIDEN)),
+        frame: (
+            solved.y[frame_row],
+            n * (1.0 - S.global_widen),
+            n * (1.0 + S.global_widen),
+        ),
+        budget: (solved.y[budget_row].max(0.0), n * (1.0 + S.global_widen)),
         slews: slews
             .iter()
             .map(|&(r, i, j, lim)| (solved.y[r], i, j, lim))
             .collect(),
     };
     let duals = improve_multipliers(&bins, duals);
-    let lag = coupled_lagrangian(&bins, &duals, LAGRANGIAN_SLICES);
+    let lag = coupled_lagrangian(&bins, &duals, S.lagrangian_slices);
     // The smaller of two valid bounds (the Lagrangian's constants are the
-    // same floats the rows were built from: OBJECTIVE_MARGIN as above).
-    Ok(lp_bound.min(lag * (1.0 + OBJECTIVE_MARGIN)))
+    // same floats the rows were built from: S.objective_margin as above).
+    Ok(lp_bound.min(lag * (1.0 + S.objective_margin)))
 }
 
 /// Lowers the Lagrangian over the frame's and the budget's multipliers
@@ -669,8 +668,6 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
 fn improve_multipliers(bins: &[Bilinear], mut d: Duals) -> Duals {
     // Measured on `smooth` (bound 8.91687 at the LP's multipliers): one
     // round 8.91094 in 4 ms, three 8.91085 in 15 ms.
-    const PIECES: usize = 16;
-    const ROUNDS: usize = 1;
     let golden = |lo: f64, hi: f64, f: &dyn Fn(f64) -> f64| -> f64 {
         let r = 0.5 * (5f64.sqrt() - 1.0);
         let (mut a, mut b) = (lo, hi);
@@ -693,20 +690,24 @@ fn improve_multipliers(bins: &[Bilinear], mut d: Duals) -> Duals {
         }
         0.5 * (a + b)
     };
-    let start = (d.budget.0, d.frame.0, coupled_lagrangian(bins, &d, PIECES));
-    for _ in 0..ROUNDS {
+    let start = (
+        d.budget.0,
+        d.frame.0,
+        coupled_lagrangian(bins, &d, S.multiplier_pieces),
+    );
+    for _ in 0..S.multiplier_rounds {
         let (mu, nu) = (d.budget.0, d.frame.0);
         let span = mu.abs() + nu.abs() + 1e-6;
         d.budget.0 = golden(0.0, mu + span, &|m| {
-            coupled_lagrangian_at(bins, &d, m, nu, PIECES)
+            coupled_lagrangian_at(bins, &d, m, nu, S.multiplier_pieces)
         });
         let mu = d.budget.0;
         d.frame.0 = golden(nu - span, nu + span, &|v| {
-            coupled_lagrangian_at(bins, &d, mu, v, PIECES)
+            coupled_lagrangian_at(bins, &d, mu, v, S.multiplier_pieces)
         });
     }
     // Keep the start where the search did not improve on it.
-    let after = coupled_lagrangian(bins, &d, PIECES);
+    let after = coupled_lagrangian(bins, &d, S.multiplier_pieces);
     if after.is_nan() || after > start.2 {
         (d.budget.0, d.frame.0) = (start.0, start.1);
     }

@@ -3,7 +3,7 @@
 //! Variables are normalised to order one (`x = p/P̄`, `τ = t·N/T`) because
 //! HiGHS's feasibility tolerances are absolute (1e-7). Continuous solutions
 //! are clamped and rescaled to meet bounds, budget and frame exactly, which
-//! is why continuous bounds carry a [`MARGIN`]; level (MILP) solutions are
+//! is why continuous bounds carry a `settings::margin`; level (MILP) solutions are
 //! exact by construction.
 
 // Loops over bins index several parallel per-bin arrays (θ, weights, caps,
@@ -14,6 +14,7 @@ use super::certificate::{Certified, LinearProgram, SolveOptions, Step};
 use super::utility::{sqrt_segments, sqrt_segments_n, SqrtSegments};
 use std::f64::consts::TAU;
 
+use super::settings::S;
 use super::{OptError, Problem};
 use crate::eye_safety::bound::{Laser, Rule, Seg, RATIO_MARGIN};
 use crate::eye_safety::cuts::{cuts_with, Cut};
@@ -23,74 +24,25 @@ use crate::model::lidar::PowerAccounting;
 use crate::model::Mode;
 use crate::profile::{Bin, Profile, Region, PROFILE_FORMAT};
 
-/// Relative margin kept from continuous bounds, budget and caps.
-const MARGIN: f64 = 1e-6;
-/// Relative slack on the budget row of a level (MILP) power step: HiGHS
-/// accepts a MILP's rows to `MIP_FEASIBILITY_TOL` (1e-10, absolute, on a
-/// row of order one to 2π) and a level choice has no continuous part to
-/// trim, so the certified row allows 2e-10 relative; 5× inside the
-/// checker's `REL_TOL` (1e-9).
-const LEVEL_BUDGET_SLACK: f64 = 2e-10;
-/// Tie-break added to the weights, growing with signed eccentricity: makes
-/// the optimum unique where the acuity is symmetric about the gaze, and is
-/// itself rotation-equivariant (a function of eccentricity only), so a
-/// rotated problem has the rotated optimum.
-const TIE_BREAK: f64 = 1e-3;
-/// Trust region of the sequential LP for acceleration limits.
-const TRUST: f64 = 0.3;
-/// Share of the acceleration limit the linearised constraint may use.
-const ACCEL_SHARE: f64 = 0.8;
-/// Relative margin every eye-safety cut keeps below its limit: HiGHS's
-/// feasibility tolerance (1e-7 on rows normalised to 1) beyond the
-/// head-room and the bound's own rounding margin (`RATIO_MARGIN`).
-const CUT_MARGIN: f64 = 2e-7;
-/// Head-room the power step leaves under the Class 1 limit of the bound, so
-/// that a rotated copy of its answer (the fast path) still certifies.
-pub(super) const EYE_SAFETY_HEADROOM: f64 = 1e-9;
 /// Right-hand side of a cut row normalised to its limit: a power vector
 /// that meets it with equality is at `1 − headroom` of the bound's figure
 /// for that cut once the bound's rounding margin is applied.
 fn cut_rhs() -> f64 {
-    level_rhs() * (1.0 - CUT_MARGIN)
+    level_rhs() * (1.0 - S.cut_margin)
 }
 
 /// As [`cut_rhs`] for a cut on one bin when the power takes hardware
 /// levels: the levels are exact (no solver tolerance enters), so only the
 /// head-room and the bound's rounding margin.
 fn level_rhs() -> f64 {
-    (1.0 - EYE_SAFETY_HEADROOM) / (1.0 + RATIO_MARGIN)
+    (1.0 - S.eye_safety_headroom) / (1.0 + RATIO_MARGIN)
 }
 
-/// Rounds of the cutting-plane loop of one power step.
-const CUT_ROUNDS: usize = 60;
-/// Cuts at or above this ratio of the current iterate are binding: the
-/// dwell step linearises them.
-const BINDING: f64 = 1.0 - 1e-3;
-/// Chords of the density utility on a dwell column inside a trust region
-/// (±[`TRUST`] around the iterate: a sequential LP's first-order model,
-/// where the acceleration rows allow far smaller moves still). Measured on
-/// `smooth` (360 bins, joint): 16 chords → 4 makes the whole solve 1.8×
-/// faster (99 → 55 ms) and moves the answer's exact objective by 2e-14
-/// relative (`optimality.global.objective` 8.864885452179 either way).
-/// Columns without a trust region keep [`super::UTILITY_SEGMENTS`].
-const TRUST_REGION_SEGMENTS: usize = 4;
-
-/// Dwell-step iterations when the acceleration limit is finite (at most).
-const SLP_ROUNDS: usize = 5;
-/// The sequential LP stops once a dwell step moves no bin's dwell by more
-/// than this (relative). On `smooth` (360 bins, joint) the five rounds'
-/// moves were 2.7e-2, 7.6e-4, 2.4e-5, 3.2e-6, 3.7e-6; stopping after the
-/// second changes the answer's exact objective by −1.4e-7 relative
-/// (8.864885070 with five rounds, 8.864884199 with two; the global gap is
-/// 2.4e-2) and makes the whole process 1.24× faster than stopping after the
-/// third (1e-4).
-const SLP_SETTLED: f64 = 1e-3;
-
-/// Whether the dwell `next` is within [`SLP_SETTLED`] of `t` in every bin.
+/// Whether the dwell `next` is within `settings::slp_settled` of `t` in every bin.
 fn settled(next: &[f64], t: &[f64]) -> bool {
     next.iter()
         .zip(t)
-        .all(|(a, b)| (a - b).abs() <= SLP_SETTLED * b.abs())
+        .all(|(a, b)| (a - b).abs() <= S.slp_settled * b.abs())
 }
 
 pub(super) struct Grid {
@@ -138,7 +90,7 @@ pub(super) fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
             .sum();
         let ecc = crate::model::angle::diff_deg(c, gaze_deg);
         weight.push(
-            problem.focus.acuity.deficit(ecc) + prior + eps + TIE_BREAK * (ecc + 180.0) / 360.0,
+            problem.focus.acuity.deficit(ecc) + prior + eps + S.tie_break * (ecc + 180.0) / 360.0,
         );
         in_rof.push(regions.rof.contains(c));
     }
@@ -369,7 +321,7 @@ fn power_step(
             let hi = l.power_w_max.min(caps_i);
             if levels.is_empty() {
                 let lo_x = l.power_w_min / p_mean;
-                let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
+                let hi_x = (hi / p_mean * (1.0 - S.margin)).max(lo_x);
                 let xi = lp.add_col(lo_x, hi_x, 0.0, false);
                 // The utility as boxed segment columns (see `utility`).
                 let c = lam * g.theta[i] * g.weight[i];
@@ -414,14 +366,14 @@ fn power_step(
             out.extend(form.iter().map(|&(j, a)| (j, k * a)));
         };
         // Budget.
-        // Levels: the budget exactly, plus [`LEVEL_BUDGET_SLACK`] (far inside
+        // Levels: the budget exactly, plus `settings::level_budget_slack` (far inside
         // the checker's REL_TOL) so that a level choice that meets it in
         // floating point (the closed form's does, to the last bit) also meets
         // it in the exact arithmetic of the certificate.
         let budget_margin = if levels.is_empty() {
-            1.0 - MARGIN
+            1.0 - S.margin
         } else {
-            1.0 + LEVEL_BUDGET_SLACK
+            1.0 + S.level_budget_slack
         };
         let mut spend = Vec::new();
         let budget = match lid.power_accounting {
@@ -447,7 +399,7 @@ fn power_step(
         if let Some(s) = l.power_slew_w_per_deg_max {
             for i in 0..g.n {
                 let j = next_index(i, g.n);
-                let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - MARGIN);
+                let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
                 let mut d = Vec::new();
                 scaled(1.0, &x[j], &mut d);
                 scaled(-1.0, &x[i], &mut d);
@@ -495,7 +447,7 @@ fn power_step(
             let s = segs(g, spins, &p);
             let report = e.report(&s)?;
             let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
-            if ratio > 1.0 - EYE_SAFETY_HEADROOM {
+            if ratio > 1.0 - S.eye_safety_headroom {
                 round += 1;
                 // Every bin edge ± h first (rotation-equivariant: a rotated
                 // problem gets the rotated cuts); the bound's witness only
@@ -510,7 +462,7 @@ fn power_step(
                 if fresh.is_empty() {
                     fresh = new_cuts(&[witness]);
                 }
-                if round > CUT_ROUNDS {
+                if round > S.cut_rounds {
                     return Err(OptError::Solver(format!(
                         "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° ({} cuts, limits divided by {factor:?})",
                         pool.len(),
@@ -538,7 +490,8 @@ fn power_step(
                             report.binding_rule
                         )));
                     }
-                    factor[k] = (factor[k] * ratio / (1.0 - EYE_SAFETY_HEADROOM)).max(ratio / top)
+                    factor[k] = (factor[k] * ratio / (1.0 - S.eye_safety_headroom))
+                        .max(ratio / top)
                         * (1.0 + 1e-9);
                     let top_cuts: Vec<Cut> = near
                         .into_iter()
@@ -621,7 +574,7 @@ fn powers(
 }
 
 /// Lowers powers (W) until every neighbour pair meets the program's slew
-/// rows, `|p_j − p_i| ≤ s·(Δ_i + Δ_j)/2·(1 − MARGIN)`, a few ulps inside:
+/// rows, `|p_j − p_i| ≤ s·(Δ_i + Δ_j)/2·(1 − S.margin)`, a few ulps inside:
 /// each power becomes the least over all bins of that bin's power plus the
 /// slew allowance along the circle between them (sweeps both ways until
 /// nothing moves). HiGHS meets those rows only to its absolute tolerance
@@ -638,7 +591,7 @@ fn slew_down(p: &mut [f64], g: &Grid, s: f64) {
             let j = next_index(i, n);
             s * 0.5
                 * (g.width_deg[i] + g.width_deg[j])
-                * (1.0 - MARGIN)
+                * (1.0 - S.margin)
                 * (1.0 - 8.0 * f64::EPSILON)
         })
         .collect();
@@ -695,10 +648,6 @@ pub(super) struct PowerLp {
     solver_dual_bound: Option<f64>,
 }
 
-/// Shrink steps tried (towards the power floor) when rounding leaves a
-/// row a few ulps over.
-const REPAIR_TRIES: usize = 40;
-
 impl PowerLp {
     /// The program's point for powers `p` (W): `x = p/P̄`, the segments
     /// filled greedily (a few ulps short, so the row holds exactly); `None`
@@ -739,7 +688,7 @@ impl PowerLp {
     pub(super) fn certify(&self, p: &[f64]) -> Result<(Certified, Vec<f64>), String> {
         let floor = self.floor_w;
         let mut q = p.to_vec();
-        for k in 0..REPAIR_TRIES {
+        for k in 0..S.repair_tries {
             let v = self.point(&q).ok_or_else(|| {
                 "a power is not one of the hardware levels (the eye-safety fit scaled it)"
                     .to_owned()
@@ -753,7 +702,7 @@ impl PowerLp {
             ) {
                 Ok(c) => return Ok((c, q)),
                 Err(e)
-                    if k + 1 == REPAIR_TRIES
+                    if k + 1 == S.repair_tries
                         || self.bins.iter().any(|b| matches!(b, PowerBin::Levels(_))) =>
                 {
                     return Err(e.to_string())
@@ -769,11 +718,6 @@ impl PowerLp {
     }
 }
 
-/// HiGHS's primal feasibility tolerance on the dwell step's program (its
-/// default is 1e-7): the certified program's rows are widened by
-/// `2·DWELL_FEASIBILITY_TOL·(1 + Σ|a|)` ([`LinearProgram::widened`]).
-const DWELL_FEASIBILITY_TOL: f64 = 1e-9;
-
 /// A dwell step's answer: the dwell (s), and its program's exact
 /// certificate or why there is none.
 pub(super) struct DwellStep {
@@ -787,13 +731,13 @@ pub(super) struct DwellStep {
 /// their limit, found by the power step before) linearised in dwell — the
 /// pulses a cut counts from bin `b` scaled by `t_b/t_b⁰` (a pass over `b`
 /// holds pulses in proportion to its time there), the limits held at the
-/// iterate's — inside a trust region of ±[`TRUST`] on the bins they touch.
+/// iterate's — inside a trust region of ±`settings::trust` on the bins they touch.
 /// Exact at the iterate, first order around it; the bound decides after
 /// (the power step that follows restores certified powers; without one the
 /// move is shortened until the bound certifies, see [`solve`]).
 ///
 /// Certificate (`specs/optimizer.md`, "The dwell step's certificate"):
-/// HiGHS solves the program at [`DWELL_FEASIBILITY_TOL`]; its point, with
+/// HiGHS solves the program at `settings::dwell_feasibility_tol`; its point, with
 /// the columns clamped into their bounds and the binaries rounded, is
 /// checked exactly against the program with every row widened by twice
 /// that tolerance (the frame equality `Σ τ = N` becomes a range of width
@@ -841,9 +785,9 @@ fn dwell_step(
     for i in 0..g.n {
         let th = g.theta[i];
         if setpoints.is_empty() {
-            let lo = th / l.spin_rad_s_max / unit * (1.0 + MARGIN);
+            let lo = th / l.spin_rad_s_max / unit * (1.0 + S.margin);
             let hi = if l.spin_rad_s_min > 0.0 {
-                th / l.spin_rad_s_min / unit * (1.0 - MARGIN)
+                th / l.spin_rad_s_min / unit * (1.0 - S.margin)
             } else {
                 1e9
             };
@@ -861,8 +805,8 @@ fn dwell_step(
             let (mut lo, mut hi) = (lo, hi);
             let trust = l.spin_accel_rad_s2_max.is_some() || touched[i];
             if trust {
-                lo = lo.max(current[i] / unit * (1.0 - TRUST));
-                hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
+                lo = lo.max(current[i] / unit * (1.0 - S.trust));
+                hi = hi.min(current[i] / unit * (1.0 + S.trust)).max(lo);
             }
             let t0 = (current[i] / unit).max(lo).min(hi);
             let ti = lp.add_col(lo, hi, 0.0, false);
@@ -883,7 +827,7 @@ fn dwell_step(
             // constant does not move the optimum).
             let r_0 = r_lo.max(k * lo);
             let chords = if trust {
-                TRUST_REGION_SEGMENTS
+                S.trust_region_segments
             } else {
                 super::UTILITY_SEGMENTS
             };
@@ -935,7 +879,7 @@ fn dwell_step(
             let j = next_index(i, g.n);
             let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
             let dtheta = 0.5 * (g.theta[i] + g.theta[j]);
-            let ds = ACCEL_SHARE * a_max * dtheta * (1.0 - TRUST).powi(3) / w_cur.powi(3);
+            let ds = S.accel_share * a_max * dtheta * (1.0 - S.trust).powi(3) / w_cur.powi(3);
             // s = t/θ = τ·unit/θ.
             let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
             let scaled = |form: &[(usize, f64)], k: f64| -> Vec<(usize, f64)> {
@@ -958,7 +902,7 @@ fn dwell_step(
         "dwell",
         &SolveOptions {
             initial: Some(&start),
-            primal_feasibility_tolerance: DWELL_FEASIBILITY_TOL,
+            primal_feasibility_tolerance: S.dwell_feasibility_tol,
         },
     )?;
     let x = lp.clamped(&solved.x);
@@ -987,7 +931,7 @@ fn dwell_step(
     }
     let cert = Certified::new(
         Step::Dwell,
-        lp.widened(2.0 * DWELL_FEASIBILITY_TOL),
+        lp.widened(2.0 * S.dwell_feasibility_tol),
         x,
         solved.y,
         solved.solver_dual_bound,
@@ -1072,13 +1016,13 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
     let mode = problem.objective.mode;
     let mut last: Option<PowerLp> = None;
     let smooth_spin = lid.limits.spin_accel_rad_s2_max.is_some();
-    let spin_rounds = if smooth_spin { SLP_ROUNDS } else { 1 };
+    let spin_rounds = if smooth_spin { S.slp_rounds } else { 1 };
     let f_p = lid.pulse_rate_hz;
     // The cuts of new spins, found at the powers before the step (a warm
     // start: valid whatever the powers).
     let warm = |spins: &[(f64, f64)], p: &[f64]| -> Vec<Cut> {
         eye.as_ref()
-            .map_or_else(Vec::new, |e| e.cuts(&segs(&g, spins, p), &[], BINDING))
+            .map_or_else(Vec::new, |e| e.cuts(&segs(&g, spins, p), &[], S.binding))
     };
     let steps = |t: &[f64]| spins_of(&g, t, false, lid.frame_rate_hz);
     let mut binding: Vec<Cut> = Vec::new();
@@ -1143,7 +1087,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
                 // function of the iterate alone, not of the loop's path).
                 binding = warm(&sp, &p)
                     .into_iter()
-                    .filter(|c| c.ratio(&p, f_p) >= BINDING)
+                    .filter(|c| c.ratio(&p, f_p) >= S.binding)
                     .collect();
             }
         }
@@ -1163,7 +1107,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
         // uniform spin until the bound certifies (the uniform spin itself
         // is the last resort, and the checker has the last word).
         let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
-            Ok(e.verdict(&segs(&g, sp, &p))?.0 <= 1.0 - EYE_SAFETY_HEADROOM)
+            Ok(e.verdict(&segs(&g, sp, &p))?.0 <= 1.0 - S.eye_safety_headroom)
         };
         let mut alpha = 1.0;
         while !safe(&spins)? && alpha > 0.0 {
@@ -1177,7 +1121,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
             spins = spins_of(&g, &ta, smooth, lid.frame_rate_hz);
         }
         let (ratio, at) = e.verdict(&segs(&g, &spins, &p))?;
-        if ratio > 1.0 - EYE_SAFETY_HEADROOM {
+        if ratio > 1.0 - S.eye_safety_headroom {
             return Err(OptError::Infeasible(format!(
                 "eye safety: the power ({:.4e} W in every bin; resolution mode does not move it) is {:.1} % of the Class 1 limit at {at:.3}° even at the uniform spin",
                 p[0],

@@ -48,6 +48,7 @@ pub mod fast;
 pub mod figures;
 pub mod global;
 mod lp;
+pub mod settings;
 mod utility;
 
 use serde::{Deserialize, Serialize};
@@ -59,9 +60,10 @@ use crate::model::lidar::{LidarSpec, PowerAccounting};
 use crate::model::Mode;
 
 pub use config::OptimizerConfig;
+pub use settings::OptimizerSettings;
 
-/// Chords of the piecewise-linear utilities.
-pub const UTILITY_SEGMENTS: usize = 16;
+/// Chords of the piecewise-linear utilities ([`OptimizerSettings::utility_segments`]).
+pub const UTILITY_SEGMENTS: usize = OptimizerSettings::DEFAULT.utility_segments;
 
 /// A static prior: extra weight on a sector (e.g. cross-traffic directions).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -113,13 +115,9 @@ pub struct Levels {
     pub spin_rad_s: Vec<f64>,
 }
 
-/// Most bins the optimizer accepts (0.25° bins). The profile format and
-/// the closed forms go to `model::angle::MAX_BINS` (36,000), but the LP
-/// grows with the bin count and with the eye-safety windows aligned with
-/// every bin edge, and its solve time grows faster than linearly: measured
-/// on a shared 2-core machine, 1,440 bins ≈ 4.5 s of CPU, 3,600 bins
-/// ≈ 22 s, 36,000 bins did not finish in 20 s. 1,440 keeps a solve in seconds.
-pub const MAX_OPTIMIZER_BINS: usize = 1440;
+/// Most bins the optimizer accepts ([`OptimizerSettings::max_bins`], which
+/// gives the reason).
+pub const MAX_OPTIMIZER_BINS: usize = OptimizerSettings::DEFAULT.max_bins;
 
 /// Checks the optimizer's bin count (`field` names it in the error).
 pub fn validate_bins(bins: usize, field: &str) -> Result<(), OptError> {
