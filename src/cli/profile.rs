@@ -234,7 +234,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
 #[cfg(feature = "solver")]
 fn certificate_files(
     dir: &std::path::Path,
-    cert: Result<gaze_lidar::optimizer::certificate::Certified, String>,
+    cert: Result<
+        gaze_lidar::optimizer::certificate::Certified,
+        gaze_lidar::optimizer::CertificateError,
+    >,
 ) -> Result<Vec<(PathBuf, Vec<u8>)>, CliError> {
     let cert = cert.map_err(|e| CliError::input(format!("--certificate: {e}")))?;
     let json = serde_json::to_string_pretty(&cert.file())
@@ -262,7 +265,10 @@ fn optimized(
 ) -> Result<
     (
         CertifiedProfile,
-        Result<gaze_lidar::optimizer::certificate::Certified, String>,
+        Result<
+            gaze_lidar::optimizer::certificate::Certified,
+            gaze_lidar::optimizer::CertificateError,
+        >,
         Basis,
     ),
     CliError,

@@ -32,6 +32,7 @@ use num_traits::{Signed, Zero};
 
 use serde::Serialize;
 
+use super::error::{CertificateError, Infeasible};
 use super::settings::S;
 use super::OptError;
 
@@ -225,13 +226,14 @@ impl LinearProgram {
                 // incumbent: a feasible point (checked exactly like any
                 // other); its gap is stated, not assumed zero. Without one,
                 // the search goes on without the limit.
-                highs::HighsModelStatus::ReachedSolutionLimit if !relax && self.is_mip() => {
-                    Ok((solved.primal_solution_status() == highs::HighsSolutionStatus::Feasible)
-                        .then_some(solved))
+                highs::HighsModelStatus::ReachedSolutionLimit if !relax && self.is_mip() => Ok(
+                    (solved.primal_solution_status() == highs::HighsSolutionStatus::Feasible)
+                        .then_some(solved),
+                ),
+                highs::HighsModelStatus::Infeasible => Err(Infeasible::Step {
+                    step: what.to_owned(),
                 }
-                highs::HighsModelStatus::Infeasible => Err(OptError::Infeasible(format!(
-                    "the {what} step has no solution within the limits (power_w_min/max, the budget, spin limits, slew, acceleration and eye safety together)"
-                ))),
+                .into()),
                 s => Err(OptError::Solver(format!("{what} step: HiGHS status {s:?}"))),
             }
         };
@@ -239,10 +241,11 @@ impl LinearProgram {
             match run(relax, S.mip_max_nodes)? {
                 Some(solved) => Ok(solved),
                 None => run(relax, S.mip_max_nodes_without_incumbent)?.ok_or_else(|| {
-                    OptError::Infeasible(format!(
-                        "the {what} step found no point meeting every limit within {} branch-and-bound nodes (hardware levels or spin set-points that cannot meet the budget or the frame period exactly, with the other limits)",
-                        S.mip_max_nodes_without_incumbent
-                    ))
+                    Infeasible::NoIncumbent {
+                        step: what.to_owned(),
+                        nodes: S.mip_max_nodes_without_incumbent,
+                    }
+                    .into()
                 }),
             }
         };
@@ -673,17 +676,13 @@ impl Certified {
         x: Vec<f64>,
         y: Vec<f64>,
         solver_dual_bound: Option<f64>,
-    ) -> Result<Self, OptError> {
+    ) -> Result<Self, CertificateError> {
         let exact = check(&lp, &x, &y);
         if let Some(v) = &exact.violation {
-            return Err(OptError::Solver(format!(
-                "the primal point is not exactly feasible: {v}"
-            )));
+            return Err(CertificateError::NotFeasible(v.clone()));
         }
         if exact.upper_bound.is_none() {
-            return Err(OptError::Solver(
-                "the row duals give no finite bound (an unbounded column)".into(),
-            ));
+            return Err(CertificateError::Unbounded);
         }
         Ok(Self {
             step,

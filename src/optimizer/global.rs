@@ -451,7 +451,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
             })
     };
     if !(x_lo <= x_hi && w_lo <= w_hi && w_hi > 0.0) {
-        return Err(OptError::Infeasible("empty power or spin box".into()));
+        return Err(super::error::Infeasible::EmptyBox.into());
     }
     // Limits (not levels, which are exact) are met to the checker's
     // tolerance: the boxes widened by it.

@@ -14,6 +14,7 @@ use super::certificate::{Certified, LinearProgram, SolveOptions, Step};
 use super::utility::{sqrt_segments, sqrt_segments_n, SqrtSegments};
 use std::f64::consts::TAU;
 
+use super::error::{CertificateError, Infeasible, SpinLimit};
 use super::settings::S;
 use super::{OptError, Problem};
 use crate::eye_safety::bound::{Laser, Rule, Seg, RATIO_MARGIN};
@@ -156,7 +157,7 @@ impl Eye {
     /// The bound's whole report.
     fn report(&self, segs: &[Seg]) -> Result<exposure::ExposureReport, OptError> {
         exposure::evaluate_segments(segs, &self.params, self.pulse_rate_hz)
-            .map_err(|e| OptError::Infeasible(format!("eye safety: {e}")))
+            .map_err(|e| Infeasible::EyeSafety(e.to_string()).into())
     }
 
     /// The concrete exposures at or above `threshold` for these bins.
@@ -179,24 +180,29 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
     let lid = &problem.lidar;
     let w_mean = lid.mean_spin_rad_s();
     if l.spin_rad_s_max < w_mean * (1.0 - 1e-12) {
-        return Err(OptError::Infeasible(format!(
-            "spin_rad_s_max {:.3} rad/s cannot meet the frame period: one turn in 1/frame_rate_hz = {:.4} s needs a mean spin of {:.3} rad/s",
-            l.spin_rad_s_max,
-            1.0 / lid.frame_rate_hz,
-            w_mean
-        )));
+        return Err(Infeasible::FrameUnreachable {
+            limit: SpinLimit::Max,
+            spin_rad_s: l.spin_rad_s_max,
+            mean_spin_rad_s: w_mean,
+            frame_rate_hz: lid.frame_rate_hz,
+        }
+        .into());
     }
     if l.spin_rad_s_min > w_mean * (1.0 + 1e-12) {
-        return Err(OptError::Infeasible(format!(
-            "spin_rad_s_min {:.3} rad/s is above the mean spin {w_mean:.3} rad/s that frame_rate_hz {} requires",
-            l.spin_rad_s_min, lid.frame_rate_hz
-        )));
+        return Err(Infeasible::FrameUnreachable {
+            limit: SpinLimit::Min,
+            spin_rad_s: l.spin_rad_s_min,
+            mean_spin_rad_s: w_mean,
+            frame_rate_hz: lid.frame_rate_hz,
+        }
+        .into());
     }
     if l.power_w_min > lid.average_power_w * (1.0 + 1e-12) {
-        return Err(OptError::Infeasible(format!(
-            "power_w_min {:.4e} W alone exceeds the average power budget {:.4e} W",
-            l.power_w_min, lid.average_power_w
-        )));
+        return Err(Infeasible::FloorOverBudget {
+            power_w_min: l.power_w_min,
+            average_power_w: lid.average_power_w,
+        }
+        .into());
     }
     if l.power_w_min > l.power_w_max {
         return Err(OptError::Invalid {
@@ -213,12 +219,13 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
             let (ratio, at) =
                 e.verdict(&segs(&g, &vec![(w, w); g.n], &vec![l.power_w_min; g.n]))?;
             if ratio > 1.0 {
-                return Err(OptError::Infeasible(format!(
-                    "eye safety: power_w_min {:.4e} W everywhere at the mean spin is {:.1} % of the Class 1 limit (worst at {at:.3}°) at {} nm",
-                    l.power_w_min,
-                    100.0 * ratio,
-                    e.params.wavelength_nm
-                )));
+                return Err(Infeasible::EyeFloorOverLimit {
+                    power_w_min: l.power_w_min,
+                    ratio,
+                    at_deg: at,
+                    wavelength_nm: e.params.wavelength_nm,
+                }
+                .into());
             }
         }
     }
@@ -312,10 +319,13 @@ fn power_step(
         for i in 0..g.n {
             if bare[i] < l.power_w_min {
                 let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
-                return Err(OptError::Infeasible(format!(
-                    "eye-safety cap {:.4e} W at {wl} nm in bin {i} (the single-pulse limit at this spin) is below power_w_min {:.4e} W",
-                    bare[i], l.power_w_min
-                )));
+                return Err(Infeasible::EyeCapBelowFloor {
+                    cap_w: bare[i],
+                    wavelength_nm: wl,
+                    bin: i,
+                    power_w_min: l.power_w_min,
+                }
+                .into());
             }
             let caps_i = caps[i].max(l.power_w_min);
             let hi = l.power_w_max.min(caps_i);
@@ -342,10 +352,12 @@ fn power_step(
                     .filter(|&lv| lv >= l.power_w_min && lv <= hi)
                     .collect();
                 if allowed.is_empty() {
-                    return Err(OptError::Infeasible(format!(
-                            "no power level lies within [power_w_min, min(power_w_max, the bin's eye-safety cut)] = [{:.4e}, {:.4e}] W in bin {i}",
-                            l.power_w_min, hi
-                        )));
+                    return Err(Infeasible::NoLevelFits {
+                        power_w_min: l.power_w_min,
+                        hi_w: hi,
+                        bin: i,
+                    }
+                    .into());
                 }
                 let zs: Vec<(f64, usize)> = allowed
                     .iter()
@@ -420,13 +432,14 @@ fn power_step(
                     / (e.pulse_rate_hz * limit);
                 if at_floor > factor[class(c)] {
                     let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
-                    return Err(OptError::Infeasible(format!(
-                        "eye safety at {wl} nm: power_w_min {:.4e} W in every bin is {:.4} of the limit of a window at {:.3}° ({:?})",
-                        l.power_w_min,
-                        at_floor / factor[class(c)],
-                        c.azimuth_deg,
-                        c.rule
-                    )));
+                    return Err(Infeasible::EyeWindowAtFloor {
+                        wavelength_nm: wl,
+                        power_w_min: l.power_w_min,
+                        ratio: at_floor / factor[class(c)],
+                        azimuth_deg: c.azimuth_deg,
+                        rule: format!("{:?}", c.rule),
+                    }
+                    .into());
                 }
                 lp.add_row(
                     &row,
@@ -436,10 +449,9 @@ fn power_step(
             }
         }
         let solved = lp.solve("power").map_err(|err| match (err, eye) {
-            (OptError::Infeasible(_), Some(_)) => OptError::Infeasible(format!(
-                "the power step has no solution within the limits: {} eye-safety cuts (concrete exposures at the Class 1 limit) leave no powers within power_w_min/max, the budget and the slew limit",
-                pool.len()
-            )),
+            (OptError::Infeasible(_), Some(_)) => {
+                Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
+            }
             (other, _) => other,
         })?;
         let p = powers(problem, g, t, &bins, &x, &solved.x);
@@ -685,14 +697,11 @@ impl PowerLp {
     /// floor by a few ulps where rounding left a row over.
     /// Returns the certificate and the powers it is for (`p`, or `p` shrunk
     /// by a few ulps; never higher).
-    pub(super) fn certify(&self, p: &[f64]) -> Result<(Certified, Vec<f64>), String> {
+    pub(super) fn certify(&self, p: &[f64]) -> Result<(Certified, Vec<f64>), CertificateError> {
         let floor = self.floor_w;
         let mut q = p.to_vec();
         for k in 0..S.repair_tries {
-            let v = self.point(&q).ok_or_else(|| {
-                "a power is not one of the hardware levels (the eye-safety fit scaled it)"
-                    .to_owned()
-            })?;
+            let v = self.point(&q).ok_or(CertificateError::NotALevel)?;
             match Certified::new(
                 Step::Power,
                 self.lp.clone(),
@@ -705,7 +714,7 @@ impl PowerLp {
                     if k + 1 == S.repair_tries
                         || self.bins.iter().any(|b| matches!(b, PowerBin::Levels(_))) =>
                 {
-                    return Err(e.to_string())
+                    return Err(e)
                 }
                 Err(_) => {}
             }
@@ -714,7 +723,7 @@ impl PowerLp {
                 *qi = floor + (*qi - floor).max(0.0) * shrink;
             }
         }
-        Err("the power step's answer could not be certified exactly".into())
+        Err(CertificateError::PowerStep)
     }
 }
 
@@ -722,7 +731,7 @@ impl PowerLp {
 /// certificate or why there is none.
 pub(super) struct DwellStep {
     t: Vec<f64>,
-    cert: Result<Certified, String>,
+    cert: Result<Certified, CertificateError>,
 }
 
 /// Dwell step: power `p` fixed; `current` is the iterate for linearisation.
@@ -778,9 +787,7 @@ fn dwell_step(
         .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
         .collect();
     if !setpoints.is_empty() && allowed.is_empty() {
-        return Err(OptError::Infeasible(
-            "no spin set-point lies within [spin_rad_s_min, spin_rad_s_max]".into(),
-        ));
+        return Err(Infeasible::NoSetPointFits.into());
     }
     for i in 0..g.n {
         let th = g.theta[i];
@@ -936,7 +943,7 @@ fn dwell_step(
         solved.y,
         solved.solver_dual_bound,
     )
-    .map_err(|e| format!("the dwell step's answer could not be certified exactly: {e}"));
+    .map_err(|e| CertificateError::DwellStep(Box::new(e)));
     Ok(DwellStep { t, cert })
 }
 
@@ -976,7 +983,7 @@ pub(super) struct Solution {
 /// The dwell steps' certificates.
 pub(super) struct DwellCertificates {
     /// The last program's certificate, or the first failure.
-    pub(super) last: Result<Certified, String>,
+    pub(super) last: Result<Certified, CertificateError>,
     /// Programs solved.
     pub(super) programs: usize,
     /// Whether the profile's dwell is the last program's point (rescaled
@@ -988,7 +995,7 @@ pub(super) struct DwellCertificates {
 impl DwellCertificates {
     fn push(this: &mut Option<Self>, step: DwellStep) -> Vec<f64> {
         let d = this.get_or_insert(Self {
-            last: Err(String::new()),
+            last: Err(CertificateError::NoProgram),
             programs: 0,
             is_answer: false,
         });
@@ -1122,11 +1129,12 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
         }
         let (ratio, at) = e.verdict(&segs(&g, &spins, &p))?;
         if ratio > 1.0 - S.eye_safety_headroom {
-            return Err(OptError::Infeasible(format!(
-                "eye safety: the power ({:.4e} W in every bin; resolution mode does not move it) is {:.1} % of the Class 1 limit at {at:.3}° even at the uniform spin",
-                p[0],
-                100.0 * ratio
-            )));
+            return Err(Infeasible::EyeAtUniformSpin {
+                power_w: p[0],
+                ratio,
+                at_deg: at,
+            }
+            .into());
         }
     }
     let bins = (0..g.n)

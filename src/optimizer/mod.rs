@@ -43,6 +43,7 @@
 
 pub mod certificate;
 pub mod config;
+pub mod error;
 mod exact;
 pub mod fast;
 pub mod figures;
@@ -60,6 +61,7 @@ use crate::model::lidar::{LidarSpec, PowerAccounting};
 use crate::model::Mode;
 
 pub use config::OptimizerConfig;
+pub use error::{CertificateError, Infeasible, SpinLimit};
 pub use settings::OptimizerSettings;
 
 /// Chords of the piecewise-linear utilities ([`OptimizerSettings::utility_segments`]).
@@ -162,7 +164,7 @@ pub enum OptError {
     },
     /// The limits cannot all be met (exit 1); says which.
     #[error("infeasible: {0}")]
-    Infeasible(String),
+    Infeasible(#[from] Infeasible),
     /// HiGHS failed.
     #[error("solver: {0}")]
     Solver(String),
@@ -246,7 +248,13 @@ pub(crate) fn optimize_unrated(
 pub fn optimize_with_certificate(
     problem: &Problem,
     gaze_deg: f64,
-) -> Result<(CertifiedProfile, Result<certificate::Certified, String>), OptError> {
+) -> Result<
+    (
+        CertifiedProfile,
+        Result<certificate::Certified, CertificateError>,
+    ),
+    OptError,
+> {
     crate::planner::validate_gaze(gaze_deg).map_err(|e| OptError::Invalid {
         field: "gaze-deg".into(),
         reason: e.to_string(),
@@ -270,7 +278,7 @@ pub fn optimize_with_certificate(
                 Ok(c)
             }
             Some(lp::DwellCertificates { last: Err(e), .. }) => Err(e),
-            _ => Err("this mode has no power step, and the profile's dwell is not the dwell step's answer (smoothed spin, or the move shortened for eye safety)".into()),
+            _ => Err(CertificateError::NoProgram),
         },
         Some(plp) => {
             let p: Vec<f64> = profile.bins.iter().map(|b| b.power_w).collect();
