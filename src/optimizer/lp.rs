@@ -272,6 +272,10 @@ fn dwell_of(g: &Grid, spins: &[(f64, f64)]) -> Vec<f64> {
 /// add the concrete exposures the answer breaks (valid for every power
 /// vector), repeat until the bound certifies. `pool` holds the cuts of
 /// these spins (empty for new spins) and keeps the ones added.
+///
+/// The loop is a skeleton of named steps: [`power_program`] builds the
+/// program from the pool, HiGHS solves it, [`powers`] repairs the answer,
+/// and [`power_checkpoint`] decides what comes next.
 fn power_step(
     problem: &Problem,
     g: &Grid,
@@ -280,259 +284,399 @@ fn power_step(
     pool: &mut Vec<Cut>,
 ) -> Result<(Vec<f64>, PowerLp), OptError> {
     let t = &dwell_of(g, spins)[..];
-    let lid = &problem.lidar;
-    let l = &lid.limits;
-    let p_mean = lid.average_power_w;
-    let period: f64 = t.iter().sum();
-    let lam = problem.objective.range_weight;
-    let levels = &problem.levels.power_w;
-    let mut round = 0;
-    // Where no valid cut separates (see below), the limits of one class of
-    // cuts — Rule 1's (0) or the windows' (1) — are divided by a factor.
+    // Where no valid cut separates (see `power_checkpoint`), the limits of
+    // one class of cuts — Rule 1's (0) or the windows' (1) — are divided
+    // by a factor.
     let mut factor = [1.0f64; 2];
-    let class = |c: &Cut| usize::from(c.rule != Rule::SinglePulse);
+    let mut round = 0;
     loop {
-        // A cut on one bin's power alone is that bin's column bound (the
-        // utility's chords then span the reachable powers only).
-        let rhs = if levels.is_empty() {
-            cut_rhs()
-        } else {
-            level_rhs()
-        };
-        let mut caps = vec![f64::INFINITY; g.n];
-        // The same without margins: a floor between the two is kept (the
-        // bound decides), one above the bare limit is infeasible.
-        let mut bare = vec![f64::INFINITY; g.n];
-        if let Some(e) = eye {
-            for c in pool.iter() {
-                if let [(b, n)] = c.pulses[..] {
-                    caps[b] = caps[b].min(rhs * c.limit_j / factor[class(c)] * e.pulse_rate_hz / n);
-                    bare[b] = bare[b].min(c.limit_j * e.pulse_rate_hz / n);
-                }
-            }
-        }
-        let mut lp = LinearProgram::default();
-        // x_i = p_i / P̄ as a linear form (a continuous column or Σ levels·z).
-        let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
-        let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
-        let mut utility_constant = 0.0;
-        for i in 0..g.n {
-            if bare[i] < l.power_w_min {
-                let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
-                return Err(Infeasible::EyeCapBelowFloor {
-                    cap_w: bare[i],
-                    wavelength_nm: wl,
-                    bin: i,
-                    power_w_min: l.power_w_min,
-                }
-                .into());
-            }
-            let caps_i = caps[i].max(l.power_w_min);
-            let hi = l.power_w_max.min(caps_i);
-            if levels.is_empty() {
-                let lo_x = l.power_w_min / p_mean;
-                let hi_x = (hi / p_mean * (1.0 - S.margin)).max(lo_x);
-                let xi = lp.add_col(lo_x, hi_x, 0.0, false);
-                // The utility as boxed segment columns (see `utility`).
-                let c = lam * g.theta[i] * g.weight[i];
-                let shape = sqrt_segments(lo_x, hi_x);
-                let deltas = shape.add_to(&mut lp, xi, 1.0, lo_x, c);
-                utility_constant += c * shape.base;
-                x.push(vec![(xi, 1.0)]);
-                bins.push(PowerBin::Continuous {
-                    x: xi,
-                    lo: lo_x,
-                    deltas,
-                    shape,
-                });
-            } else {
-                let allowed: Vec<f64> = levels
-                    .iter()
-                    .copied()
-                    .filter(|&lv| lv >= l.power_w_min && lv <= hi)
-                    .collect();
-                if allowed.is_empty() {
-                    return Err(Infeasible::NoLevelFits {
-                        power_w_min: l.power_w_min,
-                        hi_w: hi,
-                        bin: i,
-                    }
-                    .into());
-                }
-                let zs: Vec<(f64, usize)> = allowed
-                    .iter()
-                    .map(|&lv| {
-                        let cost = lam * g.theta[i] * g.weight[i] * (lv / p_mean).sqrt();
-                        (lv, lp.add_col(0.0, 1.0, cost, true))
-                    })
-                    .collect();
-                let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
-                lp.add_row(&one, 1.0, 1.0);
-                x.push(zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect());
-                bins.push(PowerBin::Levels(zs));
-            }
-        }
-        // The utilities' constants Σ c·√lo as one column fixed at 1.
-        let one = (utility_constant != 0.0).then(|| lp.add_col(1.0, 1.0, utility_constant, false));
-        let scaled = |k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>| {
-            out.extend(form.iter().map(|&(j, a)| (j, k * a)));
-        };
-        // Budget.
-        // Levels: the budget exactly, plus `settings::level_budget_slack` (far inside
-        // the checker's REL_TOL) so that a level choice that meets it in
-        // floating point (the closed form's does, to the last bit) also meets
-        // it in the exact arithmetic of the certificate.
-        let budget_margin = if levels.is_empty() {
-            1.0 - S.margin
-        } else {
-            1.0 + S.level_budget_slack
-        };
-        let mut spend = Vec::new();
-        let budget = match lid.power_accounting {
-            PowerAccounting::Angle => {
-                for i in 0..g.n {
-                    scaled(g.theta[i], &x[i], &mut spend);
-                }
-                TAU * budget_margin
-            }
-            PowerAccounting::Time => {
-                for i in 0..g.n {
-                    scaled(t[i] / period, &x[i], &mut spend);
-                }
-                budget_margin
-            }
-        };
-        // A floor that spends the whole budget (power_w_min = P̄) keeps its
-        // own spend: the margin must not make the all-floor answer
-        // infeasible.
-        let floor_spend: f64 = spend.iter().map(|&(j, a)| a * lp.col_lo[j]).sum();
-        lp.add_row(&spend, f64::NEG_INFINITY, budget.max(floor_spend));
-        // Slew.
-        if let Some(s) = l.power_slew_w_per_deg_max {
-            for i in 0..g.n {
-                let j = next_index(i, g.n);
-                let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
-                let mut d = Vec::new();
-                scaled(1.0, &x[j], &mut d);
-                scaled(-1.0, &x[i], &mut d);
-                lp.add_row(&d, -lim, lim);
-            }
-        }
-
-        if let Some(e) = eye {
-            for c in pool.iter().filter(|c| c.pulses.len() > 1) {
-                let mut row = Vec::new();
-                let limit = c.limit_j / factor[class(c)];
-                for &(b, n) in &c.pulses {
-                    scaled(n * p_mean / (e.pulse_rate_hz * limit), &x[b], &mut row);
-                }
-                // A floor alone at more than the row's side (but within the
-                // bare limit: checked below) keeps its own value.
-                let at_floor: f64 = c.pulses.iter().map(|&(_, n)| n).sum::<f64>() * l.power_w_min
-                    / (e.pulse_rate_hz * limit);
-                if at_floor > factor[class(c)] {
-                    let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
-                    return Err(Infeasible::EyeWindowAtFloor {
-                        wavelength_nm: wl,
-                        power_w_min: l.power_w_min,
-                        ratio: at_floor / factor[class(c)],
-                        azimuth_deg: c.azimuth_deg,
-                        rule: format!("{:?}", c.rule),
-                    }
-                    .into());
-                }
-                lp.add_row(
-                    &row,
-                    f64::NEG_INFINITY,
-                    cut_rhs().max(at_floor * (1.0 + 1e-12)),
-                );
-            }
-        }
-        let solved = lp.solve("power").map_err(|err| match (err, eye) {
+        let program = power_program(problem, g, eye, t, pool, &factor)?;
+        let solved = program.lp.solve("power").map_err(|err| match (err, eye) {
             (OptError::Infeasible(_), Some(_)) => {
                 Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
             }
             (other, _) => other,
         })?;
-        let p = powers(problem, g, t, &bins, &x, &solved.x);
-        if let Some(e) = eye {
-            let s = segs(g, spins, &p);
-            let report = e.report(&s)?;
-            let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
-            if ratio > 1.0 - S.eye_safety_headroom {
-                round += 1;
-                // Every bin edge ± h first (rotation-equivariant: a rotated
-                // problem gets the rotated cuts); the bound's witness only
-                // when those hold.
-                let new_cuts = |extra: &[f64]| -> Vec<Cut> {
-                    e.cuts(&s, extra, cut_rhs())
-                        .into_iter()
-                        .filter(|c| !pool.contains(c))
-                        .collect()
-                };
-                let mut fresh = new_cuts(&[]);
-                if fresh.is_empty() {
-                    fresh = new_cuts(&[witness]);
-                }
-                if round > S.cut_rounds {
-                    return Err(OptError::Solver(format!(
-                        "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° ({} cuts, limits divided by {factor:?})",
-                        pool.len(),
-                    )));
-                }
-                if fresh.is_empty() {
-                    // The bound exceeds every valid cut here (its
-                    // conservatism in the rule that binds): divide the
-                    // limits of that rule's class of cuts by the bound's
-                    // excess over the strongest of them, so the next answer
-                    // meets them where the bound would.
-                    let k = usize::from(report.binding_rule != Rule::SinglePulse);
-                    let near: Vec<Cut> = e
-                        .cuts(&s, &[witness], 0.0)
-                        .into_iter()
-                        .filter(|c| class(c) == k)
-                        .collect();
-                    let top = near
-                        .iter()
-                        .map(|c| c.ratio(&p, e.pulse_rate_hz))
-                        .fold(0.0, f64::max);
-                    if top <= 0.0 {
-                        return Err(OptError::Solver(format!(
-                            "eye-safety cuts: the bound gives {ratio:.6} at {witness:.3}° ({:?}) and no cut of that rule has any exposure there",
-                            report.binding_rule
-                        )));
-                    }
-                    factor[k] = (factor[k] * ratio / (1.0 - S.eye_safety_headroom))
-                        .max(ratio / top)
-                        * (1.0 + 1e-9);
-                    let top_cuts: Vec<Cut> = near
-                        .into_iter()
-                        .filter(|c| {
-                            c.ratio(&p, e.pulse_rate_hz) * factor[k] >= cut_rhs()
-                                && !pool.contains(c)
-                        })
-                        .collect();
-                    pool.extend(top_cuts);
-                    continue;
-                }
-                pool.extend(fresh);
-                continue;
+        let p = powers(problem, g, t, &program.bins, &program.x, &solved.x);
+        let checkpoint = match eye {
+            None => Checkpoint::Certified,
+            Some(e) => power_checkpoint(e, g, spins, &p, pool, &factor, round)?,
+        };
+        match checkpoint {
+            Checkpoint::Certified => {
+                let top = factor[0].max(factor[1]);
+                return Ok((
+                    p,
+                    PowerLp {
+                        lp: program.lp,
+                        bins: program.bins,
+                        one: program.one,
+                        tightening: (top > 1.0).then_some(top),
+                        p_mean: problem.lidar.average_power_w,
+                        floor_w: problem.lidar.limits.power_w_min,
+                        y: solved.y,
+                        solver_dual_bound: solved.solver_dual_bound,
+                    },
+                ));
+            }
+            Checkpoint::AddCuts(fresh) => pool.extend(fresh),
+            Checkpoint::Tighten {
+                class,
+                factor: f,
+                cuts,
+            } => {
+                factor[class] = f;
+                pool.extend(cuts);
+            }
+            Checkpoint::Fail(why) => return Err(why),
+        }
+        round += 1;
+    }
+}
+
+/// What one round of the power step's cutting-plane loop decides (in the
+/// manner of Clarabel's `solve()`: each named step returns where to go).
+enum Checkpoint {
+    /// The core's bound certifies the answer: done.
+    Certified,
+    /// Concrete exposures the answer breaks: add them and solve again.
+    AddCuts(Vec<Cut>),
+    /// No valid cut separates (the bound's conservatism in the rule that
+    /// binds): divide the limits of cut class `class` by `factor`, add
+    /// `cuts`, solve again.
+    Tighten {
+        class: usize,
+        factor: f64,
+        cuts: Vec<Cut>,
+    },
+    /// No way on: why.
+    Fail(OptError),
+}
+
+/// Rule 1's cuts are class 0, the windows' class 1.
+fn cut_class(c: &Cut) -> usize {
+    usize::from(c.rule != Rule::SinglePulse)
+}
+
+/// Asks the core's bound about the powers `p` of round `round` and decides
+/// the next step of the cutting-plane loop.
+fn power_checkpoint(
+    e: &Eye,
+    g: &Grid,
+    spins: &[(f64, f64)],
+    p: &[f64],
+    pool: &[Cut],
+    factor: &[f64; 2],
+    round: usize,
+) -> Result<Checkpoint, OptError> {
+    let s = segs(g, spins, p);
+    let report = e.report(&s)?;
+    let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
+    if ratio <= 1.0 - S.eye_safety_headroom {
+        return Ok(Checkpoint::Certified);
+    }
+    let round = round + 1;
+    // Every bin edge ± h first (rotation-equivariant: a rotated problem gets
+    // the rotated cuts); the bound's witness only when those hold.
+    let new_cuts = |extra: &[f64]| -> Vec<Cut> {
+        e.cuts(&s, extra, cut_rhs())
+            .into_iter()
+            .filter(|c| !pool.contains(c))
+            .collect()
+    };
+    let mut fresh = new_cuts(&[]);
+    if fresh.is_empty() {
+        fresh = new_cuts(&[witness]);
+    }
+    if round > S.cut_rounds {
+        return Ok(Checkpoint::Fail(OptError::Solver(format!(
+            "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° ({} cuts, limits divided by {factor:?})",
+            pool.len(),
+        ))));
+    }
+    if !fresh.is_empty() {
+        return Ok(Checkpoint::AddCuts(fresh));
+    }
+    // The bound exceeds every valid cut here: divide the limits of that
+    // rule's class of cuts by the bound's excess over the strongest of
+    // them, so the next answer meets them where the bound would.
+    let k = usize::from(report.binding_rule != Rule::SinglePulse);
+    let near: Vec<Cut> = e
+        .cuts(&s, &[witness], 0.0)
+        .into_iter()
+        .filter(|c| cut_class(c) == k)
+        .collect();
+    let top = near
+        .iter()
+        .map(|c| c.ratio(p, e.pulse_rate_hz))
+        .fold(0.0, f64::max);
+    if top <= 0.0 {
+        return Ok(Checkpoint::Fail(OptError::Solver(format!(
+            "eye-safety cuts: the bound gives {ratio:.6} at {witness:.3}° ({:?}) and no cut of that rule has any exposure there",
+            report.binding_rule
+        ))));
+    }
+    let f = (factor[k] * ratio / (1.0 - S.eye_safety_headroom)).max(ratio / top) * (1.0 + 1e-9);
+    let cuts = near
+        .into_iter()
+        .filter(|c| c.ratio(p, e.pulse_rate_hz) * f >= cut_rhs() && !pool.contains(c))
+        .collect();
+    Ok(Checkpoint::Tighten {
+        class: k,
+        factor: f,
+        cuts,
+    })
+}
+
+/// The power step's program for the cuts in `pool` (their limits divided by
+/// `factor`), and how each bin's power reads from its columns.
+struct PowerProgram {
+    lp: LinearProgram,
+    /// `x_i = p_i / P̄` as a linear form (a continuous column or Σ levels·z).
+    x: Vec<Vec<(usize, f64)>>,
+    bins: Vec<PowerBin>,
+    /// The column fixed at 1 that carries the utilities' constants.
+    one: Option<usize>,
+}
+
+/// Builds the power step's program: per bin its columns and utility (and
+/// with levels its one-hot row), then the constraint families in a fixed
+/// order — `budget`, `slew`, `eye_cuts` — so HiGHS sees the same rows in
+/// the same order every time.
+fn power_program(
+    problem: &Problem,
+    g: &Grid,
+    eye: Option<&Eye>,
+    t: &[f64],
+    pool: &[Cut],
+    factor: &[f64; 2],
+) -> Result<PowerProgram, OptError> {
+    let (caps, bare) = eye_caps(problem, g, eye, pool, factor);
+    let mut lp = LinearProgram::default();
+    let mut x = Vec::with_capacity(g.n);
+    let mut bins = Vec::with_capacity(g.n);
+    let mut utility_constant = 0.0;
+    for i in 0..g.n {
+        let (form, bin, constant) = power_bin(&mut lp, problem, g, i, caps[i], bare[i])?;
+        x.push(form);
+        bins.push(bin);
+        utility_constant += constant;
+    }
+    // The utilities' constants Σ c·√lo as one column fixed at 1.
+    let one = (utility_constant != 0.0).then(|| lp.add_col(1.0, 1.0, utility_constant, false));
+    budget(&mut lp, problem, g, t, &x);
+    if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
+        slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
+    }
+    if let Some(e) = eye {
+        eye_cuts(&mut lp, problem, e, pool, factor, &x)?;
+    }
+    Ok(PowerProgram { lp, x, bins, one })
+}
+
+/// Per bin, the eye-safety caps of the single-bin cuts in `pool` as column
+/// bounds, W: with the cut margins (`caps`), and bare (a floor between the
+/// two is kept, the bound decides; one above the bare limit is infeasible).
+fn eye_caps(
+    problem: &Problem,
+    g: &Grid,
+    eye: Option<&Eye>,
+    pool: &[Cut],
+    factor: &[f64; 2],
+) -> (Vec<f64>, Vec<f64>) {
+    // A cut on one bin's power alone is that bin's column bound (the
+    // utility's chords then span the reachable powers only).
+    let rhs = if problem.levels.power_w.is_empty() {
+        cut_rhs()
+    } else {
+        level_rhs()
+    };
+    let mut caps = vec![f64::INFINITY; g.n];
+    let mut bare = vec![f64::INFINITY; g.n];
+    if let Some(e) = eye {
+        for c in pool {
+            if let [(b, n)] = c.pulses[..] {
+                caps[b] = caps[b].min(rhs * c.limit_j / factor[cut_class(c)] * e.pulse_rate_hz / n);
+                bare[b] = bare[b].min(c.limit_j * e.pulse_rate_hz / n);
             }
         }
-        return Ok((
-            p,
-            PowerLp {
-                lp,
-                bins,
-                one,
-                tightening: (factor[0].max(factor[1]) > 1.0).then_some(factor[0].max(factor[1])),
-                p_mean,
-                floor_w: l.power_w_min,
-                y: solved.y,
-                solver_dual_bound: solved.solver_dual_bound,
-            },
-        ));
     }
+    (caps, bare)
+}
+
+/// Bin `i`'s columns, boxed by the power limits and its eye-safety cap
+/// (`levels`: one binary per allowed level and their one-hot row; else a
+/// continuous column and its utility's segments). Returns `x_i` as a linear
+/// form, how the bin reads back, and its utility's constant.
+fn power_bin(
+    lp: &mut LinearProgram,
+    problem: &Problem,
+    g: &Grid,
+    i: usize,
+    cap_w: f64,
+    bare_w: f64,
+) -> Result<(Vec<(usize, f64)>, PowerBin, f64), OptError> {
+    let l = &problem.lidar.limits;
+    let p_mean = problem.lidar.average_power_w;
+    if bare_w < l.power_w_min {
+        return Err(Infeasible::EyeCapBelowFloor {
+            cap_w: bare_w,
+            wavelength_nm: l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm),
+            bin: i,
+            power_w_min: l.power_w_min,
+        }
+        .into());
+    }
+    let hi = l.power_w_max.min(cap_w.max(l.power_w_min));
+    let c = problem.objective.range_weight * g.theta[i] * g.weight[i];
+    if !problem.levels.power_w.is_empty() {
+        let (form, bin) = levels(lp, problem, i, hi, c)?;
+        return Ok((form, bin, 0.0));
+    }
+    let lo_x = l.power_w_min / p_mean;
+    let hi_x = (hi / p_mean * (1.0 - S.margin)).max(lo_x);
+    let xi = lp.add_col(lo_x, hi_x, 0.0, false);
+    // The utility as boxed segment columns (see `utility`).
+    let shape = sqrt_segments(lo_x, hi_x);
+    let deltas = shape.add_to(lp, xi, 1.0, lo_x, c);
+    let constant = c * shape.base;
+    let bin = PowerBin::Continuous {
+        x: xi,
+        lo: lo_x,
+        deltas,
+        shape,
+    };
+    Ok((vec![(xi, 1.0)], bin, constant))
+}
+
+/// `levels`: one binary column per hardware level within
+/// `[power_w_min, hi_w]` (cost `c·√(level/P̄)`) and the one-hot row `Σ z = 1`.
+fn levels(
+    lp: &mut LinearProgram,
+    problem: &Problem,
+    i: usize,
+    hi_w: f64,
+    c: f64,
+) -> Result<(Vec<(usize, f64)>, PowerBin), OptError> {
+    let floor = problem.lidar.limits.power_w_min;
+    let p_mean = problem.lidar.average_power_w;
+    let allowed: Vec<f64> = problem
+        .levels
+        .power_w
+        .iter()
+        .copied()
+        .filter(|&lv| lv >= floor && lv <= hi_w)
+        .collect();
+    if allowed.is_empty() {
+        return Err(Infeasible::NoLevelFits {
+            power_w_min: floor,
+            hi_w,
+            bin: i,
+        }
+        .into());
+    }
+    let zs: Vec<(f64, usize)> = allowed
+        .iter()
+        .map(|&lv| (lv, lp.add_col(0.0, 1.0, c * (lv / p_mean).sqrt(), true)))
+        .collect();
+    let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
+    lp.add_row(&one, 1.0, 1.0);
+    let form = zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect();
+    Ok((form, PowerBin::Levels(zs)))
+}
+
+/// `k·form` appended to `out`.
+fn scaled(k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>) {
+    out.extend(form.iter().map(|&(j, a)| (j, k * a)));
+}
+
+/// `budget`: `Σ θ_i x_i ≤ 2π` (angle accounting) or `Σ (t_i/T) x_i ≤ 1`
+/// (time), with the continuous margin, or for levels the budget exactly
+/// plus `level_budget_slack` (far inside the checker's REL_TOL) so that a
+/// level choice that meets it in floating point (the closed form's does, to
+/// the last bit) also meets it in the exact arithmetic of the certificate.
+fn budget(lp: &mut LinearProgram, problem: &Problem, g: &Grid, t: &[f64], x: &[Vec<(usize, f64)>]) {
+    let budget_margin = if problem.levels.power_w.is_empty() {
+        1.0 - S.margin
+    } else {
+        1.0 + S.level_budget_slack
+    };
+    let period: f64 = t.iter().sum();
+    let mut spend = Vec::new();
+    let budget = match problem.lidar.power_accounting {
+        PowerAccounting::Angle => {
+            for i in 0..g.n {
+                scaled(g.theta[i], &x[i], &mut spend);
+            }
+            TAU * budget_margin
+        }
+        PowerAccounting::Time => {
+            for i in 0..g.n {
+                scaled(t[i] / period, &x[i], &mut spend);
+            }
+            budget_margin
+        }
+    };
+    // A floor that spends the whole budget (power_w_min = P̄) keeps its own
+    // spend: the margin must not make the all-floor answer infeasible.
+    let floor_spend: f64 = spend.iter().map(|&(j, a)| a * lp.col_lo[j]).sum();
+    lp.add_row(&spend, f64::NEG_INFINITY, budget.max(floor_spend));
+}
+
+/// `slew`: `|x_{i+1} − x_i| ≤ s·(Δ_i + Δ_{i+1})/2·(1 − margin)` around the
+/// circle (`s` in W per degree, `x` in units of `p_mean`).
+fn slew(lp: &mut LinearProgram, g: &Grid, x: &[Vec<(usize, f64)>], s: f64, p_mean: f64) {
+    for i in 0..g.n {
+        let j = next_index(i, g.n);
+        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
+        let mut d = Vec::new();
+        scaled(1.0, &x[j], &mut d);
+        scaled(-1.0, &x[i], &mut d);
+        lp.add_row(&d, -lim, lim);
+    }
+}
+
+/// `eye_cuts`: every cut of the pool on more than one bin as a row
+/// `Σ n_b·x_b·P̄ / (f_p·limit) ≤ cut_rhs` (single-bin cuts are column
+/// bounds, see [`eye_caps`]).
+fn eye_cuts(
+    lp: &mut LinearProgram,
+    problem: &Problem,
+    e: &Eye,
+    pool: &[Cut],
+    factor: &[f64; 2],
+    x: &[Vec<(usize, f64)>],
+) -> Result<(), OptError> {
+    let l = &problem.lidar.limits;
+    let p_mean = problem.lidar.average_power_w;
+    for c in pool.iter().filter(|c| c.pulses.len() > 1) {
+        let mut row = Vec::new();
+        let f = factor[cut_class(c)];
+        let limit = c.limit_j / f;
+        for &(b, n) in &c.pulses {
+            scaled(n * p_mean / (e.pulse_rate_hz * limit), &x[b], &mut row);
+        }
+        // A floor alone at more than the row's side (but within the bare
+        // limit: checked below) keeps its own value.
+        let at_floor: f64 = c.pulses.iter().map(|&(_, n)| n).sum::<f64>() * l.power_w_min
+            / (e.pulse_rate_hz * limit);
+        if at_floor > f {
+            return Err(Infeasible::EyeWindowAtFloor {
+                wavelength_nm: l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm),
+                power_w_min: l.power_w_min,
+                ratio: at_floor / f,
+                azimuth_deg: c.azimuth_deg,
+                rule: format!("{:?}", c.rule),
+            }
+            .into());
+        }
+        lp.add_row(
+            &row,
+            f64::NEG_INFINITY,
+            cut_rhs().max(at_floor * (1.0 + 1e-12)),
+        );
+    }
+    Ok(())
 }
 
 /// The powers (W) of a solved power step: levels as chosen, continuous
