@@ -905,26 +905,54 @@ fn dwell_step(
     p: &[f64],
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
-    let mut touched = vec![false; g.n];
-    for c in binding {
-        for &(b, _) in &c.pulses {
-            touched[b] = true;
-        }
-    }
-    let lid = &problem.lidar;
-    let l = &lid.limits;
-    let period = 1.0 / lid.frame_rate_hz;
-    let unit = period / g.n as f64; // τ = t / unit
-    let w_mean = lid.mean_spin_rad_s();
-    let lam = problem.objective.resolution_weight;
+    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current)?;
+    let solved = d.lp.solve_with(
+        "dwell",
+        &SolveOptions {
+            initial: Some(&d.start),
+            primal_feasibility_tolerance: S.dwell_feasibility_tol,
+        },
+    )?;
+    let x = d.lp.clamped(&solved.x);
+    let t = dwell_answer(problem, g, &d, &x);
+    let cert = Certified::new(
+        Step::Dwell,
+        d.lp.widened(2.0 * S.dwell_feasibility_tol),
+        x,
+        solved.y,
+        solved.solver_dual_bound,
+    )
+    .map_err(|e| CertificateError::DwellStep(Box::new(e)));
+    Ok(DwellStep { t, cert })
+}
+
+/// The dwell step's program and how each bin's dwell reads from it.
+struct DwellProgram {
+    lp: LinearProgram,
+    /// `τ_i = t_i / unit` as a linear form over the columns.
+    tau: Vec<Vec<(usize, f64)>>,
+    /// Per bin with set-points, (spin, binary column) per set-point.
+    sp_cols: Vec<Vec<(f64, usize)>>,
+    /// The hot start, one value per column.
+    start: Vec<f64>,
+    /// `T / N`, s.
+    unit: f64,
+}
+
+/// Builds the dwell step's program: per bin its columns and utility (with
+/// set-points: the `levels` family, one binary per set-point and a one-hot
+/// row), then the constraint families in a fixed order — `frame`,
+/// `budget` (time accounting), `accel`, `eye_cuts` (linearised).
+fn dwell_program(
+    problem: &Problem,
+    g: &Grid,
+    binding: &[Cut],
+    pulse_rate_hz: f64,
+    p: &[f64],
+    current: &[f64],
+) -> Result<DwellProgram, OptError> {
+    let l = &problem.lidar.limits;
     let setpoints = &problem.levels.spin_rad_s;
-    let mut lp = LinearProgram::default();
-    // τ_i as a linear form over the columns.
-    let mut tau: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
-    // Per bin with set-points, (spin, binary column) per set-point.
-    let mut sp_cols: Vec<Vec<(f64, usize)>> = Vec::new();
-    let mut start: Vec<f64> = Vec::new();
-    let mut utility_constant = 0.0;
     let allowed: Vec<f64> = setpoints
         .iter()
         .copied()
@@ -933,135 +961,204 @@ fn dwell_step(
     if !setpoints.is_empty() && allowed.is_empty() {
         return Err(Infeasible::NoSetPointFits.into());
     }
+    let mut touched = vec![false; g.n];
+    for c in binding {
+        for &(b, _) in &c.pulses {
+            touched[b] = true;
+        }
+    }
+    let mut d = DwellProgram {
+        lp: LinearProgram::default(),
+        tau: Vec::with_capacity(g.n),
+        sp_cols: Vec::new(),
+        start: Vec::new(),
+        unit: 1.0 / problem.lidar.frame_rate_hz / g.n as f64,
+    };
+    let mut utility_constant = 0.0;
     for i in 0..g.n {
-        let th = g.theta[i];
         if setpoints.is_empty() {
-            let lo = th / l.spin_rad_s_max / unit * (1.0 + S.margin);
-            let hi = if l.spin_rad_s_min > 0.0 {
-                th / l.spin_rad_s_min / unit * (1.0 - S.margin)
-            } else {
-                1e9
-            };
-            // Where the margins cross (spin limits within 2e-6 of each
-            // other, e.g. equal: a fixed spin), the limits themselves.
-            let (lo, hi) = if lo <= hi {
-                (lo, hi)
-            } else {
-                let bare = |w: f64| th / w / unit;
-                (
-                    bare(l.spin_rad_s_max),
-                    bare(l.spin_rad_s_min).max(bare(l.spin_rad_s_max)),
-                )
-            };
-            let (mut lo, mut hi) = (lo, hi);
             let trust = l.spin_accel_rad_s2_max.is_some() || touched[i];
-            if trust {
-                lo = lo.max(current[i] / unit * (1.0 - S.trust));
-                hi = hi.min(current[i] / unit * (1.0 + S.trust)).max(lo);
-            }
-            let t0 = (current[i] / unit).max(lo).min(hi);
-            let ti = lp.add_col(lo, hi, 0.0, false);
-            start.push(t0);
-            // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
-            let k = unit * TAU / (th * period);
-            let (r_lo, r_hi) = (
-                w_mean / l.spin_rad_s_max,
-                if l.spin_rad_s_min > 0.0 {
-                    w_mean / l.spin_rad_s_min
-                } else {
-                    1e3
-                },
-            );
-            // The utility as boxed segment columns on the densities this
-            // column reaches (its box: the spin limits, and the trust region
-            // where it applies), Σ δ ≤ k·τ − r_0 (see `utility`; its
-            // constant does not move the optimum).
-            let r_0 = r_lo.max(k * lo);
-            let chords = if trust {
-                S.trust_region_segments
-            } else {
-                super::UTILITY_SEGMENTS
-            };
-            let shape = sqrt_segments_n(r_0, r_hi.min(k * hi).max(r_0), chords);
-            let c = lam * th * g.weight[i];
-            shape.add_to(&mut lp, ti, k, r_0, c);
-            utility_constant += c * shape.base;
-            start.extend(shape.fill(r_0, k * t0));
-            tau.push(vec![(ti, 1.0)]);
+            utility_constant += dwell_column(&mut d, problem, g, i, current[i], trust);
         } else {
-            let ys: Vec<(f64, usize)> = allowed
-                .iter()
-                .map(|&w| {
-                    let cost = lam * th * g.weight[i] * (w_mean / w).sqrt();
-                    start.push(0.0);
-                    (w, lp.add_col(0.0, 1.0, cost, true))
-                })
-                .collect();
-            let one: Vec<(usize, f64)> = ys.iter().map(|&(_, y)| (y, 1.0)).collect();
-            lp.add_row(&one, 1.0, 1.0);
-            tau.push(ys.iter().map(|&(w, y)| (y, th / w / unit)).collect());
-            sp_cols.push(ys);
+            spin_levels(&mut d, problem, g, i, &allowed);
         }
     }
     // The utilities' constants Σ c·√r_0 as one column fixed at 1 (as the
     // power step's), so the program's objective is the chord model's value
     // of the profile, comparable with `exact_objective`.
     if utility_constant != 0.0 {
-        lp.add_col(1.0, 1.0, utility_constant, false);
-        start.push(1.0);
+        d.lp.add_col(1.0, 1.0, utility_constant, false);
+        d.start.push(1.0);
     }
-    let n = g.n as f64;
-    lp.add_row(&tau.concat(), n, n);
-    if lid.power_accounting == PowerAccounting::Time {
-        // No margin here: with uniform P̄ the budget is exactly tight. The
-        // power step that ends every joint solve trims the budget exactly.
-        let spend: Vec<(usize, f64)> = tau
-            .iter()
-            .zip(p)
-            .flat_map(|(form, &pi)| {
-                form.iter()
-                    .map(move |&(j, a)| (j, a * pi / lid.average_power_w))
-            })
-            .collect();
-        lp.add_row(&spend, f64::NEG_INFINITY, n);
+    frame(&mut d, g.n);
+    if problem.lidar.power_accounting == PowerAccounting::Time {
+        dwell_budget(&mut d, p, problem.lidar.average_power_w, g.n);
     }
     if let Some(a_max) = l.spin_accel_rad_s2_max {
-        for i in 0..g.n {
-            let j = next_index(i, g.n);
-            let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
-            let dtheta = 0.5 * (g.theta[i] + g.theta[j]);
-            let ds = S.accel_share * a_max * dtheta * (1.0 - S.trust).powi(3) / w_cur.powi(3);
-            // s = t/θ = τ·unit/θ.
-            let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
-            let scaled = |form: &[(usize, f64)], k: f64| -> Vec<(usize, f64)> {
-                form.iter().map(|&(c, a)| (c, a * k)).collect()
-            };
-            let diff = [scaled(&tau[j], kj), scaled(&tau[i], -ki)].concat();
-            lp.add_row(&diff, -ds, ds);
-        }
+        accel(&mut d, g, current, a_max);
     }
+    linearised_eye_cuts(&mut d, binding, pulse_rate_hz, p, current);
+    Ok(d)
+}
+
+/// Bin `i`'s continuous dwell column `τ_i` (boxed by the spin limits and,
+/// where `trust`, the trust region around the iterate `current_s`) and its
+/// density utility's segments; returns the utility's constant.
+fn dwell_column(
+    d: &mut DwellProgram,
+    problem: &Problem,
+    g: &Grid,
+    i: usize,
+    current_s: f64,
+    trust: bool,
+) -> f64 {
+    let l = &problem.lidar.limits;
+    let period = 1.0 / problem.lidar.frame_rate_hz;
+    let unit = d.unit;
+    let th = g.theta[i];
+    let (mut lo, mut hi) = dwell_box(l, th, unit);
+    if trust {
+        lo = lo.max(current_s / unit * (1.0 - S.trust));
+        hi = hi.min(current_s / unit * (1.0 + S.trust)).max(lo);
+    }
+    let t0 = (current_s / unit).max(lo).min(hi);
+    let ti = d.lp.add_col(lo, hi, 0.0, false);
+    d.start.push(t0);
+    // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
+    let k = unit * TAU / (th * period);
+    let w_mean = problem.lidar.mean_spin_rad_s();
+    let r_lo = w_mean / l.spin_rad_s_max;
+    let r_hi = if l.spin_rad_s_min > 0.0 {
+        w_mean / l.spin_rad_s_min
+    } else {
+        1e3
+    };
+    // The utility as boxed segment columns on the densities this column
+    // reaches (its box: the spin limits, and the trust region where it
+    // applies), Σ δ ≤ k·τ − r_0 (see `utility`; its constant does not move
+    // the optimum).
+    let r_0 = r_lo.max(k * lo);
+    let chords = if trust {
+        S.trust_region_segments
+    } else {
+        super::UTILITY_SEGMENTS
+    };
+    let shape = sqrt_segments_n(r_0, r_hi.min(k * hi).max(r_0), chords);
+    let c = problem.objective.resolution_weight * th * g.weight[i];
+    shape.add_to(&mut d.lp, ti, k, r_0, c);
+    d.start.extend(shape.fill(r_0, k * t0));
+    d.tau.push(vec![(ti, 1.0)]);
+    c * shape.base
+}
+
+/// The box of a bin's `τ` from the spin limits, with the margin; where the
+/// margins cross (spin limits within 2e-6 of each other, e.g. equal: a
+/// fixed spin), the limits themselves.
+fn dwell_box(l: &crate::model::lidar::Limits, th: f64, unit: f64) -> (f64, f64) {
+    let lo = th / l.spin_rad_s_max / unit * (1.0 + S.margin);
+    let hi = if l.spin_rad_s_min > 0.0 {
+        th / l.spin_rad_s_min / unit * (1.0 - S.margin)
+    } else {
+        1e9
+    };
+    if lo <= hi {
+        (lo, hi)
+    } else {
+        let bare = |w: f64| th / w / unit;
+        (
+            bare(l.spin_rad_s_max),
+            bare(l.spin_rad_s_min).max(bare(l.spin_rad_s_max)),
+        )
+    }
+}
+
+/// `levels` for the spin: one binary per allowed set-point `w` (cost
+/// `c·√(ω̄/w)`) and the one-hot row `Σ y = 1`; `τ_i = Σ (θ_i/w)/unit · y_w`.
+fn spin_levels(d: &mut DwellProgram, problem: &Problem, g: &Grid, i: usize, allowed: &[f64]) {
+    let th = g.theta[i];
+    let w_mean = problem.lidar.mean_spin_rad_s();
+    let lam = problem.objective.resolution_weight;
+    let ys: Vec<(f64, usize)> = allowed
+        .iter()
+        .map(|&w| {
+            let cost = lam * th * g.weight[i] * (w_mean / w).sqrt();
+            d.start.push(0.0);
+            (w, d.lp.add_col(0.0, 1.0, cost, true))
+        })
+        .collect();
+    let one: Vec<(usize, f64)> = ys.iter().map(|&(_, y)| (y, 1.0)).collect();
+    d.lp.add_row(&one, 1.0, 1.0);
+    let unit = d.unit;
+    d.tau
+        .push(ys.iter().map(|&(w, y)| (y, th / w / unit)).collect());
+    d.sp_cols.push(ys);
+}
+
+/// `frame`: `Σ τ_i = N` (one turn per frame period).
+fn frame(d: &mut DwellProgram, n: usize) {
+    let n = n as f64;
+    d.lp.add_row(&d.tau.concat(), n, n);
+}
+
+/// `budget` under time accounting at the fixed powers `p`:
+/// `Σ τ_i·p_i/P̄ ≤ N`. No margin here: with uniform P̄ the budget is exactly
+/// tight. The power step that ends every joint solve trims the budget
+/// exactly.
+fn dwell_budget(d: &mut DwellProgram, p: &[f64], p_mean: f64, n: usize) {
+    let spend: Vec<(usize, f64)> = d
+        .tau
+        .iter()
+        .zip(p)
+        .flat_map(|(form, &pi)| form.iter().map(move |&(j, a)| (j, a * pi / p_mean)))
+        .collect();
+    d.lp.add_row(&spend, f64::NEG_INFINITY, n as f64);
+}
+
+/// `accel`: the change of slowness `s = t/θ` between neighbours,
+/// `|Δs| ≤ accel_share·a·Δθ·(1−trust)³/ω̃³`, linearised at the iterate.
+fn accel(d: &mut DwellProgram, g: &Grid, current: &[f64], a_max: f64) {
+    let unit = d.unit;
+    let scaled = |form: &[(usize, f64)], k: f64| -> Vec<(usize, f64)> {
+        form.iter().map(|&(c, a)| (c, a * k)).collect()
+    };
+    for i in 0..g.n {
+        let j = next_index(i, g.n);
+        let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
+        let dtheta = 0.5 * (g.theta[i] + g.theta[j]);
+        let ds = S.accel_share * a_max * dtheta * (1.0 - S.trust).powi(3) / w_cur.powi(3);
+        // s = t/θ = τ·unit/θ.
+        let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
+        let diff = [scaled(&d.tau[j], kj), scaled(&d.tau[i], -ki)].concat();
+        d.lp.add_row(&diff, -ds, ds);
+    }
+}
+
+/// `eye_cuts` linearised in dwell: the pulses a binding cut counts from bin
+/// `b` scaled by `τ_b/τ_b⁰`, the limits held at the iterate's.
+fn linearised_eye_cuts(
+    d: &mut DwellProgram,
+    binding: &[Cut],
+    pulse_rate_hz: f64,
+    p: &[f64],
+    current: &[f64],
+) {
     for c in binding {
         let mut en: Vec<(usize, f64)> = Vec::new();
         for &(b, cnt) in &c.pulses {
-            let tau0 = current[b] / unit;
+            let tau0 = current[b] / d.unit;
             let k = cnt * p[b] / (pulse_rate_hz * c.limit_j) / tau0;
-            en.extend(tau[b].iter().map(|&(col, a)| (col, a * k)));
+            en.extend(d.tau[b].iter().map(|&(col, a)| (col, a * k)));
         }
-        lp.add_row(&en, f64::NEG_INFINITY, cut_rhs());
+        d.lp.add_row(&en, f64::NEG_INFINITY, cut_rhs());
     }
-    let solved = lp.solve_with(
-        "dwell",
-        &SolveOptions {
-            initial: Some(&start),
-            primal_feasibility_tolerance: S.dwell_feasibility_tol,
-        },
-    )?;
-    let x = lp.clamped(&solved.x);
-    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * x[j]).sum::<f64>();
-    let mut t: Vec<f64> = if setpoints.is_empty() {
-        tau.iter().map(|form| eval(form) * unit).collect()
-    } else {
-        sp_cols
+}
+
+/// The dwell (s) of the solved point `x`: continuous columns rescaled to
+/// the exact frame period, or each bin's chosen set-point.
+fn dwell_answer(problem: &Problem, g: &Grid, d: &DwellProgram, x: &[f64]) -> Vec<f64> {
+    if !problem.levels.spin_rad_s.is_empty() {
+        return d
+            .sp_cols
             .iter()
             .zip(&g.theta)
             .map(|(ys, th)| {
@@ -1071,24 +1168,17 @@ fn dwell_step(
                     .map_or(0.0, |&(w, _)| w);
                 th / w
             })
-            .collect()
-    };
-    if setpoints.is_empty() {
-        // Exact frame period.
-        let s: f64 = t.iter().sum();
-        for ti in &mut t {
-            *ti *= period / s;
-        }
+            .collect();
     }
-    let cert = Certified::new(
-        Step::Dwell,
-        lp.widened(2.0 * S.dwell_feasibility_tol),
-        x,
-        solved.y,
-        solved.solver_dual_bound,
-    )
-    .map_err(|e| CertificateError::DwellStep(Box::new(e)));
-    Ok(DwellStep { t, cert })
+    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * x[j]).sum::<f64>();
+    let mut t: Vec<f64> = d.tau.iter().map(|form| eval(form) * d.unit).collect();
+    // Exact frame period.
+    let period = 1.0 / problem.lidar.frame_rate_hz;
+    let s: f64 = t.iter().sum();
+    for ti in &mut t {
+        *ti *= period / s;
+    }
+    t
 }
 
 /// The spin of dwell `t`: one spin per bin (steps) when `smooth` is
