@@ -1241,7 +1241,11 @@ impl DwellCertificates {
     }
 }
 
-/// Solves and builds the (uncertified) profile, with the programs' certificates.
+/// Solves and builds the (uncertified) profile, with the programs'
+/// certificates: block-coordinate ascent from the uniform baseline as named
+/// steps — the mode's rounds ([`range_rounds`], [`resolution_rounds`],
+/// [`joint_rounds`]), the final power step on a smoothed spin, the
+/// eye-safety shortening of a resolution-mode move, the profile.
 pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptError> {
     let g = grid(problem, gaze_deg)?;
     let lid = &problem.lidar;
@@ -1249,128 +1253,221 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
     prechecks(problem, eye.as_ref())?;
     let w_mean = lid.mean_spin_rad_s();
     let t_base: Vec<f64> = g.theta.iter().map(|th| th / w_mean).collect();
-    let mut t = t_base.clone();
     let p_start = lid
         .average_power_w
         .clamp(lid.limits.power_w_min, lid.limits.power_w_max);
-    let mut p: Vec<f64> = vec![p_start; g.n];
-    let mode = problem.objective.mode;
-    let mut last: Option<PowerLp> = None;
-    let smooth_spin = lid.limits.spin_accel_rad_s2_max.is_some();
-    let spin_rounds = if smooth_spin { S.slp_rounds } else { 1 };
-    let f_p = lid.pulse_rate_hz;
-    // The cuts of new spins, found at the powers before the step (a warm
-    // start: valid whatever the powers).
-    let warm = |spins: &[(f64, f64)], p: &[f64]| -> Vec<Cut> {
-        eye.as_ref()
-            .map_or_else(Vec::new, |e| e.cuts(&segs(&g, spins, p), &[], S.binding))
+    let mut it = Iterate {
+        p: vec![p_start; g.n],
+        t: t_base.clone(),
+        last: None,
+        dwell: None,
     };
-    let steps = |t: &[f64]| spins_of(&g, t, false, lid.frame_rate_hz);
-    let mut binding: Vec<Cut> = Vec::new();
-    let mut dwell: Option<DwellCertificates> = None;
+    let ctx = Ctx {
+        problem,
+        g: &g,
+        eye: eye.as_ref(),
+    };
+    let mode = problem.objective.mode;
     match mode {
         Mode::Baseline => {}
-        Mode::Range => {
-            let sp = steps(&t);
-            let mut pool = warm(&sp, &p);
-            let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
-            p = pp;
-            last = Some(plp);
-        }
-        Mode::Resolution => {
-            for round in 0..spin_rounds {
-                let step = match dwell_step(problem, &g, &[], f_p, &p, &t) {
-                    // See the joint loop.
-                    Err(OptError::Infeasible(_)) if round > 0 => break,
-                    r => r?,
-                };
-                let next = DwellCertificates::push(&mut dwell, step);
-                let settled = settled(&next, &t);
-                t = next;
-                if settled {
-                    break;
-                }
-            }
-        }
-        Mode::Joint => {
-            let rounds = spin_rounds.max(2);
-            for round in 0..rounds {
-                let step = match dwell_step(problem, &g, &binding, f_p, &p, &t) {
-                    // A later round's program (re-linearised acceleration
-                    // rows, trust region, the budget at the new powers) can
-                    // have no point even though the iterate is a certified
-                    // profile's (found by breaker3 at 10⁴ rad/s²): the
-                    // sequential LP cannot move from it, so it stops there.
-                    Err(OptError::Infeasible(_)) if round > 0 => break,
-                    r => r?,
-                };
-                let next = DwellCertificates::push(&mut dwell, step);
-                if last.is_some() && next == t {
-                    // A fixed point: both steps are deterministic functions
-                    // of (p, t) (the binding cuts are found afresh from
-                    // them), so every further round repeats this one.
-                    break;
-                }
-                let settled = smooth_spin && settled(&next, &t);
-                t = next;
-                if smooth_spin && (settled || round + 1 == rounds) {
-                    // The last dwell of a smoothed spin: the final power
-                    // step below, on the rebuilt spin, replaces this
-                    // round's power step on the step spins.
-                    break;
-                }
-                let sp = steps(&t);
-                let mut pool = warm(&sp, &p);
-                let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
-                p = pp;
-                last = Some(plp);
-                // The binding cuts of the new iterate, found afresh (a
-                // function of the iterate alone, not of the loop's path).
-                binding = warm(&sp, &p)
-                    .into_iter()
-                    .filter(|c| c.ratio(&p, f_p) >= S.binding)
-                    .collect();
-            }
-        }
+        Mode::Range => range_rounds(&ctx, &mut it)?,
+        Mode::Resolution => resolution_rounds(&ctx, &mut it)?,
+        Mode::Joint => joint_rounds(&ctx, &mut it)?,
     }
-    let smooth = smooth_spin && mode.controls_resolution();
-    let mut spins = spins_of(&g, &t, smooth, lid.frame_rate_hz);
+    let smooth = lid.limits.spin_accel_rad_s2_max.is_some() && mode.controls_resolution();
+    let mut spins = spins_of(&g, &it.t, smooth, lid.frame_rate_hz);
     if smooth && mode.controls_range() {
         // Final power step on the exact spin of the rebuilt profile.
-        let mut pool = warm(&spins, &p);
-        let (pp, plp) = power_step(problem, &g, eye.as_ref(), &spins, &mut pool)?;
-        p = pp;
-        last = Some(plp);
+        let mut pool = ctx.warm(&spins, &it.p);
+        let (pp, plp) = power_step(problem, &g, ctx.eye, &spins, &mut pool)?;
+        it.p = pp;
+        it.last = Some(plp);
     }
     let mut shortened = false;
-    if let (Some(e), Mode::Resolution) = (eye.as_ref(), mode) {
-        // No power step follows the dwell steps: shorten the move from the
-        // uniform spin until the bound certifies (the uniform spin itself
-        // is the last resort, and the checker has the last word).
-        let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
-            Ok(e.verdict(&segs(&g, sp, &p))?.0 <= 1.0 - S.eye_safety_headroom)
-        };
-        let mut alpha = 1.0;
-        while !safe(&spins)? && alpha > 0.0 {
-            shortened = true;
-            alpha = if alpha > 1.0 / 64.0 { alpha / 2.0 } else { 0.0 };
-            let ta: Vec<f64> = t_base
-                .iter()
-                .zip(&t)
-                .map(|(b, x)| b + alpha * (x - b))
-                .collect();
-            spins = spins_of(&g, &ta, smooth, lid.frame_rate_hz);
-        }
-        let (ratio, at) = e.verdict(&segs(&g, &spins, &p))?;
-        if ratio > 1.0 - S.eye_safety_headroom {
-            return Err(Infeasible::EyeAtUniformSpin {
-                power_w: p[0],
-                ratio,
-                at_deg: at,
-            }
-            .into());
+    if let (Some(e), Mode::Resolution) = (ctx.eye, mode) {
+        (spins, shortened) = shorten_for_eye_safety(&ctx, e, &it, &t_base, spins, smooth)?;
+    }
+    let profile = build_profile(problem, &g, gaze_deg, &it.p, &spins);
+    if let Some(d) = it.dwell.as_mut() {
+        d.is_answer = mode == Mode::Resolution && !smooth && !shortened;
+    }
+    Ok(Solution {
+        profile,
+        power: it.last,
+        dwell: it.dwell,
+    })
+}
+
+/// What every step of [`solve`] reads.
+struct Ctx<'a> {
+    problem: &'a Problem,
+    g: &'a Grid,
+    eye: Option<&'a Eye>,
+}
+
+impl Ctx<'_> {
+    /// The cuts of new spins, found at the powers before the step (a warm
+    /// start: valid whatever the powers).
+    fn warm(&self, spins: &[(f64, f64)], p: &[f64]) -> Vec<Cut> {
+        self.eye.map_or_else(Vec::new, |e| {
+            e.cuts(&segs(self.g, spins, p), &[], S.binding)
+        })
+    }
+
+    /// Step spins of dwell `t` (one spin per bin).
+    fn steps(&self, t: &[f64]) -> Vec<(f64, f64)> {
+        spins_of(self.g, t, false, self.problem.lidar.frame_rate_hz)
+    }
+
+    /// Dwell-step rounds: the sequential LP's with a finite acceleration
+    /// limit, else one.
+    fn spin_rounds(&self) -> usize {
+        if self.problem.lidar.limits.spin_accel_rad_s2_max.is_some() {
+            S.slp_rounds
+        } else {
+            1
         }
     }
+
+    /// A power step on `spins` from the iterate's powers.
+    fn power(&self, it: &mut Iterate, spins: &[(f64, f64)]) -> Result<(), OptError> {
+        let mut pool = self.warm(spins, &it.p);
+        let (pp, plp) = power_step(self.problem, self.g, self.eye, spins, &mut pool)?;
+        it.p = pp;
+        it.last = Some(plp);
+        Ok(())
+    }
+}
+
+/// The block-coordinate iterate: powers (W), dwell (s), the last power
+/// step's program and the dwell steps' certificates.
+struct Iterate {
+    p: Vec<f64>,
+    t: Vec<f64>,
+    last: Option<PowerLp>,
+    dwell: Option<DwellCertificates>,
+}
+
+/// `range`: one power step on the uniform spin.
+fn range_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
+    let sp = ctx.steps(&it.t);
+    ctx.power(it, &sp)
+}
+
+/// `resolution`: dwell steps at the fixed power until settled.
+fn resolution_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
+    let f_p = ctx.problem.lidar.pulse_rate_hz;
+    for round in 0..ctx.spin_rounds() {
+        let step = match dwell_step(ctx.problem, ctx.g, &[], f_p, &it.p, &it.t) {
+            // See `joint_rounds`.
+            Err(OptError::Infeasible(_)) if round > 0 => break,
+            r => r?,
+        };
+        let next = DwellCertificates::push(&mut it.dwell, step);
+        let settled = settled(&next, &it.t);
+        it.t = next;
+        if settled {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// `joint`: alternating dwell and power steps until a fixed point, the
+/// sequential LP settles, or the rounds run out.
+fn joint_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
+    let f_p = ctx.problem.lidar.pulse_rate_hz;
+    let smooth_spin = ctx.problem.lidar.limits.spin_accel_rad_s2_max.is_some();
+    let rounds = ctx.spin_rounds().max(2);
+    let mut binding: Vec<Cut> = Vec::new();
+    for round in 0..rounds {
+        let step = match dwell_step(ctx.problem, ctx.g, &binding, f_p, &it.p, &it.t) {
+            // A later round's program (re-linearised acceleration rows,
+            // trust region, the budget at the new powers) can have no point
+            // even though the iterate is a certified profile's (found by
+            // breaker3 at 10⁴ rad/s²): the sequential LP cannot move from
+            // it, so it stops there.
+            Err(OptError::Infeasible(_)) if round > 0 => break,
+            r => r?,
+        };
+        let next = DwellCertificates::push(&mut it.dwell, step);
+        if it.last.is_some() && next == it.t {
+            // A fixed point: both steps are deterministic functions of
+            // (p, t) (the binding cuts are found afresh from them), so every
+            // further round repeats this one.
+            break;
+        }
+        let settled = smooth_spin && settled(&next, &it.t);
+        it.t = next;
+        if smooth_spin && (settled || round + 1 == rounds) {
+            // The last dwell of a smoothed spin: the final power step in
+            // `solve`, on the rebuilt spin, replaces this round's power
+            // step on the step spins.
+            break;
+        }
+        let sp = ctx.steps(&it.t);
+        ctx.power(it, &sp)?;
+        // The binding cuts of the new iterate, found afresh (a function of
+        // the iterate alone, not of the loop's path).
+        binding = ctx
+            .warm(&sp, &it.p)
+            .into_iter()
+            .filter(|c| c.ratio(&it.p, f_p) >= S.binding)
+            .collect();
+    }
+    Ok(())
+}
+
+/// `resolution` with eye safety: no power step follows the dwell steps, so
+/// the move from the uniform spin is shortened until the bound certifies
+/// (the uniform spin itself is the last resort, and the checker has the
+/// last word). Returns the spins and whether the move was shortened.
+fn shorten_for_eye_safety(
+    ctx: &Ctx<'_>,
+    e: &Eye,
+    it: &Iterate,
+    t_base: &[f64],
+    mut spins: Vec<(f64, f64)>,
+    smooth: bool,
+) -> Result<(Vec<(f64, f64)>, bool), OptError> {
+    let g = ctx.g;
+    let p = &it.p;
+    let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
+        Ok(e.verdict(&segs(g, sp, p))?.0 <= 1.0 - S.eye_safety_headroom)
+    };
+    let mut shortened = false;
+    let mut alpha = 1.0;
+    while !safe(&spins)? && alpha > 0.0 {
+        shortened = true;
+        alpha = if alpha > 1.0 / 64.0 { alpha / 2.0 } else { 0.0 };
+        let ta: Vec<f64> = t_base
+            .iter()
+            .zip(&it.t)
+            .map(|(b, x)| b + alpha * (x - b))
+            .collect();
+        spins = spins_of(g, &ta, smooth, ctx.problem.lidar.frame_rate_hz);
+    }
+    let (ratio, at) = e.verdict(&segs(g, &spins, p))?;
+    if ratio > 1.0 - S.eye_safety_headroom {
+        return Err(Infeasible::EyeAtUniformSpin {
+            power_w: p[0],
+            ratio,
+            at_deg: at,
+        }
+        .into());
+    }
+    Ok((spins, shortened))
+}
+
+/// The (uncertified) profile of powers `p` and `spins`.
+fn build_profile(
+    problem: &Problem,
+    g: &Grid,
+    gaze_deg: f64,
+    p: &[f64],
+    spins: &[(f64, f64)],
+) -> Profile {
+    let lid = &problem.lidar;
     let bins = (0..g.n)
         .map(|i| Bin {
             start_deg: g.start_deg[i],
@@ -1386,7 +1483,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
             dwell_s: Some(2.0 * g.theta[i] / (spins[i].0 + spins[i].1)),
         })
         .collect();
-    let profile = Profile {
+    Profile {
         format: PROFILE_FORMAT.to_owned(),
         frame_rate_hz: lid.frame_rate_hz,
         pulse_rate_hz: lid.pulse_rate_hz,
@@ -1395,16 +1492,8 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
         gaze_deg: Some(wrap_deg(gaze_deg)),
         limits: lid.limits.clone(),
         bins,
-        mode: Some(format!("optimized {}", mode.name())),
+        mode: Some(format!("optimized {}", problem.objective.mode.name())),
         summary: None,
         optimality: None,
-    };
-    if let Some(d) = dwell.as_mut() {
-        d.is_answer = mode == Mode::Resolution && !smooth && !shortened;
     }
-    Ok(Solution {
-        profile,
-        power: last,
-        dwell,
-    })
 }
