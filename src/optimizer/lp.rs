@@ -334,6 +334,9 @@ fn power_step(
     }
 }
 
+/// A linear form over a program's columns: (column, coefficient) pairs.
+type LinearForm = Vec<(usize, f64)>;
+
 /// What one round of the power step's cutting-plane loop decides (in the
 /// manner of Clarabel's `solve()`: each named step returns where to go).
 enum Checkpoint {
@@ -515,7 +518,7 @@ fn power_bin(
     i: usize,
     cap_w: f64,
     bare_w: f64,
-) -> Result<(Vec<(usize, f64)>, PowerBin, f64), OptError> {
+) -> Result<(LinearForm, PowerBin, f64), OptError> {
     let l = &problem.lidar.limits;
     let p_mean = problem.lidar.average_power_w;
     if bare_w < l.power_w_min {
@@ -557,7 +560,7 @@ fn levels(
     i: usize,
     hi_w: f64,
     c: f64,
-) -> Result<(Vec<(usize, f64)>, PowerBin), OptError> {
+) -> Result<(LinearForm, PowerBin), OptError> {
     let floor = problem.lidar.limits.power_w_min;
     let p_mean = problem.lidar.average_power_w;
     let allowed: Vec<f64> = problem
