@@ -407,10 +407,10 @@ pub fn model_objective(
 /// A proven upper bound (rounded up) of `J` over every profile of this
 /// problem (its grid, levels and mode; see the module docs) the checker
 /// accepts, from the relaxation in the module docs. Named steps: the
-/// boxes ([`boxes`]), the separable Lagrangian where it applies
-/// ([`separable_bound`]), the relaxation's LP ([`relaxation`]: utilities,
-/// then `frame`, `budget`, `slew`), its exact dual bound, and for the
-/// coupled case the Lagrangian of [`coupled_bound`].
+/// boxes (`boxes`), the separable Lagrangian where it applies
+/// (`separable_bound`), the relaxation's LP (`relaxation`: utilities, then
+/// `frame`, `budget`, `slew`), its exact dual bound, and for the coupled
+/// case the Lagrangian of `coupled_bound`.
 pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let g = grid(problem, gaze_deg)?;
     let b = boxes(problem, &g)?;
