@@ -8,6 +8,7 @@
 //!
 //! Regenerate only for a change that is meant to move the answers (and say
 //! why in the commit): `scripts/optimizer_golden.sh`.
+#![cfg(all(feature = "solver", feature = "cli"))]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
