@@ -591,7 +591,7 @@ fn optimize(py: Python<'_>, config_text: &str, gaze_deg: f64, json: bool) -> PyR
             .map_err(|e| opt_error(py, e))?;
         detached(py, || {
             gaze_lidar::optimizer::optimize(&problem, gaze_deg)
-                .map(|c| gaze_lidar::planner::figures::attach_to_optimum(c, &problem, named.levels))
+                .map(|c| gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels))
         })?
         .map(|inner| PyProfile { inner })
         .map_err(|e| opt_error(py, e))

@@ -230,7 +230,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
 #[cfg(feature = "solver")]
 fn certificate_files(
     dir: &std::path::Path,
-    cert: Result<gaze_lidar::optimizer::certificate::Certified, String>,
+    cert: Result<
+        gaze_lidar::optimizer::certificate::Certified,
+        gaze_lidar::optimizer::CertificateError,
+    >,
 ) -> Result<Vec<(PathBuf, Vec<u8>)>, CliError> {
     let cert = cert.map_err(|e| CliError::input(format!("--certificate: {e}")))?;
     let json = serde_json::to_string_pretty(&cert.file())
@@ -258,7 +261,10 @@ fn optimized(
 ) -> Result<
     (
         CertifiedProfile,
-        Result<gaze_lidar::optimizer::certificate::Certified, String>,
+        Result<
+            gaze_lidar::optimizer::certificate::Certified,
+            gaze_lidar::optimizer::CertificateError,
+        >,
         Basis,
     ),
     CliError,
@@ -289,9 +295,9 @@ fn optimized(
         }
     };
     let (c, cert) = optimize_with_certificate(&problem, gaze).map_err(err)?;
-    let c = figures::attach_to_optimum(c, &problem, named.levels.clone());
+    let c = gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels.clone());
     let basis = Basis {
-        preset: figures::closed_form_basis(&problem, named.levels),
+        preset: gaze_lidar::optimizer::figures::closed_form_basis(&problem, named.levels),
         mode: problem.objective.mode,
         bins: problem.bins,
         optimized: true,

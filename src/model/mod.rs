@@ -5,6 +5,7 @@
 
 pub mod acuity;
 pub use gaze_lidar_core::model::{angle, lidar, valid};
+pub mod mode;
 pub mod presets;
 pub mod range;
 pub mod sensor;
@@ -12,4 +13,5 @@ pub mod sensor;
 pub use acuity::{AcuityModel, FocusModel, Regions};
 pub use angle::{Arc, Binning, CircularSet};
 pub use lidar::{LidarSpec, Limits, PowerAccounting};
+pub use mode::Mode;
 pub use presets::{preset, Preset};

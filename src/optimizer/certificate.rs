@@ -32,6 +32,8 @@ use num_traits::{Signed, Zero};
 
 use serde::Serialize;
 
+use super::error::{CertificateError, Infeasible};
+use super::settings::S;
 use super::OptError;
 
 /// One row: `lo ≤ Σ coef·x ≤ hi` (either side may be infinite).
@@ -137,14 +139,14 @@ impl LinearProgram {
             // steps' multiple-choice programs.
             m.set_option("mip_heuristic_run_feasibility_jump", false);
             // A deterministic work limit (nodes, not seconds): see
-            // [`MIP_MAX_NODES`].
+            // `settings::mip_max_nodes`.
             m.set_option("mip_max_nodes", nodes);
             m.set_option("mip_detect_symmetry", false);
             // HiGHS accepts a MILP's rows (and integrality) to this
             // tolerance, absolute; its default, 1e-6, lets a level choice
             // overspend the budget by far more than the checker's relative
             // 1e-9 (found by breaker3). Its minimum.
-            m.set_option("mip_feasibility_tolerance", MIP_FEASIBILITY_TOL);
+            m.set_option("mip_feasibility_tolerance", S.mip_feasibility_tol);
         }
         // Measured on the shipped configs' power steps and global bound
         // (360 bins): HiGHS's presolve costs more than it saves on these
@@ -174,7 +176,7 @@ impl LinearProgram {
     /// moves it by at most `tol·Σ|a_j|`). A relaxation of this program, so
     /// an upper bound of it bounds this program too. Integral columns
     /// rounded by the caller are covered as long as HiGHS's integrality
-    /// tolerance (`MIP_FEASIBILITY_TOL`, 1e-10) is at most `tol`.
+    /// tolerance (`settings::mip_feasibility_tol`, 1e-10) is at most `tol`.
     #[must_use]
     pub fn widened(&self, tol: f64) -> Self {
         let mut out = self.clone();
@@ -224,23 +226,26 @@ impl LinearProgram {
                 // incumbent: a feasible point (checked exactly like any
                 // other); its gap is stated, not assumed zero. Without one,
                 // the search goes on without the limit.
-                highs::HighsModelStatus::ReachedSolutionLimit if !relax && self.is_mip() => {
-                    Ok((solved.primal_solution_status() == highs::HighsSolutionStatus::Feasible)
-                        .then_some(solved))
+                highs::HighsModelStatus::ReachedSolutionLimit if !relax && self.is_mip() => Ok(
+                    (solved.primal_solution_status() == highs::HighsSolutionStatus::Feasible)
+                        .then_some(solved),
+                ),
+                highs::HighsModelStatus::Infeasible => Err(Infeasible::Step {
+                    step: what.to_owned(),
                 }
-                highs::HighsModelStatus::Infeasible => Err(OptError::Infeasible(format!(
-                    "the {what} step has no solution within the limits (power_w_min/max, the budget, spin limits, slew, acceleration and eye safety together)"
-                ))),
+                .into()),
                 s => Err(OptError::Solver(format!("{what} step: HiGHS status {s:?}"))),
             }
         };
         let run = |relax: bool| -> Result<highs::SolvedModel, OptError> {
-            match run(relax, MIP_MAX_NODES)? {
+            match run(relax, S.mip_max_nodes)? {
                 Some(solved) => Ok(solved),
-                None => run(relax, MIP_MAX_NODES_WITHOUT_INCUMBENT)?.ok_or_else(|| {
-                    OptError::Infeasible(format!(
-                        "the {what} step found no point meeting every limit within {MIP_MAX_NODES_WITHOUT_INCUMBENT} branch-and-bound nodes (hardware levels or spin set-points that cannot meet the budget or the frame period exactly, with the other limits)"
-                    ))
+                None => run(relax, S.mip_max_nodes_without_incumbent)?.ok_or_else(|| {
+                    Infeasible::NoIncumbent {
+                        step: what.to_owned(),
+                        nodes: S.mip_max_nodes_without_incumbent,
+                    }
+                    .into()
                 }),
             }
         };
@@ -268,7 +273,7 @@ impl LinearProgram {
             .columns()
             .iter()
             .zip(&self.integer)
-            .all(|(v, &int)| !int || (v - v.round()).abs() <= RELAXATION_INTEGRALITY_TOL);
+            .all(|(v, &int)| !int || (v - v.round()).abs() <= S.relaxation_integrality_tol);
         let (x, solver_objective, solver_dual_bound) = if integral {
             let x = rsol
                 .columns()
@@ -405,31 +410,10 @@ impl Default for SolveOptions<'_> {
     fn default() -> Self {
         Self {
             initial: None,
-            primal_feasibility_tolerance: 1e-7,
+            primal_feasibility_tolerance: S.primal_feasibility_tol,
         }
     }
 }
-
-/// Branch-and-bound nodes a MILP may use before its best incumbent is
-/// taken. Multiple-choice knapsacks with unequal weights (hardware power
-/// levels under time accounting once the dwell moves, `joint` mode) take
-/// HiGHS minutes to close to a zero gap at 90 bins (measured: 66–82 s) for
-/// an answer the certificate cannot tell apart: its bound comes from the
-/// LP relaxation's duals, not from the search. A node count, unlike a
-/// time limit, keeps answers deterministic; the exact gap is reported.
-pub(super) const MIP_MAX_NODES: i32 = 100;
-
-/// The search's second limit when the first ended without a feasible
-/// point (an equality knapsack: spin set-points meeting the frame period);
-/// without one there either, the step reports that it found none.
-pub(super) const MIP_MAX_NODES_WITHOUT_INCUMBENT: i32 = 5000;
-
-/// HiGHS's `mip_feasibility_tolerance` for every MILP (its minimum).
-pub(super) const MIP_FEASIBILITY_TOL: f64 = 1e-10;
-
-/// Distance from an integer within which a relaxation's value counts as
-/// integral (HiGHS's own `mip_feasibility_tolerance` is 1e-6).
-pub(super) const RELAXATION_INTEGRALITY_TOL: f64 = 1e-9;
 
 /// HiGHS's floating-point answer (untrusted).
 #[derive(Debug, Clone, PartialEq)]
@@ -692,17 +676,13 @@ impl Certified {
         x: Vec<f64>,
         y: Vec<f64>,
         solver_dual_bound: Option<f64>,
-    ) -> Result<Self, OptError> {
+    ) -> Result<Self, CertificateError> {
         let exact = check(&lp, &x, &y);
         if let Some(v) = &exact.violation {
-            return Err(OptError::Solver(format!(
-                "the primal point is not exactly feasible: {v}"
-            )));
+            return Err(CertificateError::NotFeasible(v.clone()));
         }
         if exact.upper_bound.is_none() {
-            return Err(OptError::Solver(
-                "the row duals give no finite bound (an unbounded column)".into(),
-            ));
+            return Err(CertificateError::Unbounded);
         }
         Ok(Self {
             step,

@@ -281,7 +281,7 @@ impl OptimizerConfig {
         }
         let bins = self.bins.unwrap_or(360);
         super::validate_bins(bins, "bins")?;
-        if o.mode == crate::planner::Mode::Baseline {
+        if o.mode == crate::model::Mode::Baseline {
             return Err(OptError::Invalid {
                 field: "objective.mode".into(),
                 reason: "baseline has nothing to optimize; use range, resolution or joint".into(),

@@ -21,8 +21,8 @@ use crate::checker::{certify, CertifiedProfile};
 use crate::model::angle::{rotate_index, wrap_deg, FULL_TURN_DEG};
 use crate::profile::Profile;
 
-/// Gaze phases per bin.
-pub const PHASE_STEPS: u32 = 64;
+/// Gaze phases per bin ([`super::OptimizerSettings::phase_steps`]).
+pub const PHASE_STEPS: u32 = super::OptimizerSettings::DEFAULT.phase_steps;
 
 /// A planner with a solution cache.
 #[derive(Debug, Clone)]

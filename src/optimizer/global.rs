@@ -94,28 +94,19 @@ use std::f64::consts::TAU;
 
 use super::certificate::{check, next_down, to_f64_up, LinearProgram};
 use super::lp::{grid, Grid};
+use super::settings::S;
 use super::{OptError, Problem};
 use crate::model::angle::next_index;
 use crate::model::lidar::PowerAccounting;
 use crate::profile::{GlobalOptimality, Profile};
 
-/// Tangents per utility and bin.
-const TANGENTS: usize = 12;
-/// The checker's relative tolerance, by which every row is widened.
-const WIDEN: f64 = 1e-9;
-/// τ slices per bin in the coupled Lagrangian's final evaluation.
-const LAGRANGIAN_SLICES: usize = 256;
-/// Relative lowering of the floating-point objective, and raising of the
-/// bound (rounding cover).
-const OBJECTIVE_MARGIN: f64 = 1e-12;
-
 /// Tangent rows `u ≤ √a + (k·v − a)/(2√a)` of `√(k·v)` for `v ∈ [lo, hi]`,
 /// as (slope in v, intercept) pairs; points spread evenly in `√`.
 fn tangents(k: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
     let (a, b) = ((k * lo).max(0.0).sqrt(), (k * hi).max(0.0).sqrt());
-    (0..=TANGENTS)
+    (0..=S.global_tangents)
         .filter_map(|j| {
-            let s = a + (b - a) * j as f64 / TANGENTS as f64;
+            let s = a + (b - a) * j as f64 / S.global_tangents as f64;
             // Slope rounded up (v ≥ 0): the line stays above the tangent.
             (s > 0.0).then(|| (-next_down(-(k / (2.0 * s))), s / 2.0))
         })
@@ -373,7 +364,7 @@ pub(super) fn bound(
 ) -> Result<GlobalOptimality, OptError> {
     let upper_bound = upper_bound(problem, gaze_deg)?;
     let j = model_objective(problem, gaze_deg, profile)?;
-    let objective = j - OBJECTIVE_MARGIN * j.abs();
+    let objective = j - S.objective_margin * j.abs();
     Ok(GlobalOptimality {
         objective,
         upper_bound,
@@ -415,65 +406,140 @@ pub fn model_objective(
 
 /// A proven upper bound (rounded up) of `J` over every profile of this
 /// problem (its grid, levels and mode; see the module docs) the checker
-/// accepts, from the relaxation in the module docs.
+/// accepts, from the relaxation in the module docs. Named steps: the
+/// boxes (`boxes`), the separable Lagrangian where it applies
+/// (`separable_bound`), the relaxation's LP (`relaxation`: utilities, then
+/// `frame`, `budget`, `slew`), its exact dual bound, and for the coupled
+/// case the Lagrangian of `coupled_bound`.
 pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let g = grid(problem, gaze_deg)?;
+    let b = boxes(problem, &g)?;
+    let mode = problem.objective.mode;
+    let slew_moves =
+        mode.controls_range() && problem.lidar.limits.power_slew_w_per_deg_max.is_some();
+    let coupled = problem.lidar.power_accounting == PowerAccounting::Time
+        && mode.controls_range()
+        && mode.controls_resolution();
+    if !slew_moves && !coupled {
+        if let Some(bound) = separable_bound(problem, &g, &b) {
+            return Ok(bound);
+        }
+    }
+    let r = relaxation(problem, &g, &b);
+    let solved = r.lp.solve("global bound")?;
+    let exact = check(&r.lp, &solved.x, &solved.y);
+    let ub = exact
+        .upper_bound
+        .ok_or_else(|| OptError::Solver("global bound: no finite dual bound".into()))?;
+    // Raised by objective_margin: covers the float evaluation of the model's
+    // constants (k, √ of a fixed block) the rows were built from.
+    let lp_bound = to_f64_up(&ub) * (1.0 + S.objective_margin);
+    // The Lagrangian's slices need x ≥ 0 (powers are never negative).
+    if !coupled || r.xs.iter().any(|&(_, lo, _)| lo.is_nan() || lo < 0.0) {
+        return Ok(lp_bound);
+    }
+    let lag = coupled_bound(problem, &g, &b, &r, &solved.y);
+    // The smaller of two valid bounds (the Lagrangian's constants are the
+    // same floats the rows were built from: objective_margin as above).
+    Ok(lp_bound.min(lag * (1.0 + S.objective_margin)))
+}
+
+/// The relaxation's boxes: normalised power `x ∈ [x_lo, x_hi]` and spin
+/// `ω ∈ [w_lo, w_hi]` (rad/s), widened by the checker's tolerance where a
+/// limit (not a level) bounds them, the spin box narrowed by the
+/// acceleration limit and the power box by the eye-safety Rule 1 cap.
+struct Boxes {
+    x_lo: f64,
+    x_hi: f64,
+    w_lo: f64,
+    w_hi: f64,
+    n: f64,
+    period: f64,
+    unit: f64,
+}
+
+impl Boxes {
+    /// τ = t/unit with t = 2θ/(ω_start + ω_end), both in the spin box;
+    /// rounded outward where the spin moves (a few ulps).
+    fn tau(&self, theta: f64) -> (f64, f64) {
+        let outward = if self.w_lo < self.w_hi {
+            4.0 * f64::EPSILON
+        } else {
+            0.0
+        };
+        let t_lo = theta / self.w_hi / self.unit * (1.0 - outward);
+        let t_hi = if self.w_lo > 0.0 {
+            (theta / self.w_lo / self.unit * (1.0 + outward)).min(self.n)
+        } else {
+            self.n
+        };
+        (t_lo, t_hi)
+    }
+
+    /// `r = k·τ`, `k = unit·2π/(θ·T)`.
+    fn k(&self, theta: f64) -> f64 {
+        self.unit * TAU / (theta * self.period)
+    }
+}
+
+/// The smallest and largest of `values`.
+fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    })
+}
+
+/// See [`Boxes`].
+fn boxes(problem: &Problem, g: &Grid) -> Result<Boxes, OptError> {
     let lid = &problem.lidar;
     let l = &lid.limits;
     let p_mean = lid.average_power_w;
     let n = g.n as f64;
     let period = 1.0 / lid.frame_rate_hz;
-    let unit = period / n;
     let mode = problem.objective.mode;
-    // Power box (normalised).
+    let levels = &problem.levels;
     let (x_lo, x_hi) = if !mode.controls_range() {
         let p0 = p_mean.clamp(l.power_w_min, l.power_w_max) / p_mean;
         (p0, p0)
-    } else if problem.levels.power_w.is_empty() {
+    } else if levels.power_w.is_empty() {
         (l.power_w_min / p_mean, l.power_w_max / p_mean)
     } else {
-        let allowed = problem
-            .levels
+        let allowed = levels
             .power_w
             .iter()
             .copied()
             .filter(|&v| v >= l.power_w_min && v <= l.power_w_max);
-        let (lo, hi) = allowed.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        });
+        let (lo, hi) = span(allowed);
         (lo / p_mean, hi / p_mean)
     };
-    // Spin box → τ box per bin.
     let (w_lo, w_hi) = if !mode.controls_resolution() {
         (lid.mean_spin_rad_s(), lid.mean_spin_rad_s())
-    } else if problem.levels.spin_rad_s.is_empty() {
+    } else if levels.spin_rad_s.is_empty() {
         (l.spin_rad_s_min, l.spin_rad_s_max)
     } else {
-        problem
-            .levels
-            .spin_rad_s
-            .iter()
-            .copied()
-            .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            })
+        span(
+            levels
+                .spin_rad_s
+                .iter()
+                .copied()
+                .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max),
+        )
     };
     if !(x_lo <= x_hi && w_lo <= w_hi && w_hi > 0.0) {
-        return Err(OptError::Infeasible("empty power or spin box".into()));
+        return Err(super::error::Infeasible::EmptyBox.into());
     }
     // Limits (not levels, which are exact) are met to the checker's
     // tolerance: the boxes widened by it.
-    let (x_lo, x_hi) = if mode.controls_range() && problem.levels.power_w.is_empty() {
-        (x_lo * (1.0 - WIDEN), x_hi * (1.0 + WIDEN))
+    let (x_lo, x_hi) = if mode.controls_range() && levels.power_w.is_empty() {
+        (x_lo * (1.0 - S.global_widen), x_hi * (1.0 + S.global_widen))
     } else {
         (x_lo, x_hi)
     };
     let accel = l
         .spin_accel_rad_s2_max
         .filter(|a| mode.controls_resolution() && a.is_finite() && *a >= 0.0);
-    let (w_lo, w_hi) = if mode.controls_resolution() && problem.levels.spin_rad_s.is_empty() {
-        let (lo, hi) = (w_lo * (1.0 - WIDEN), w_hi * (1.0 + WIDEN));
+    let (w_lo, w_hi) = if mode.controls_resolution() && levels.spin_rad_s.is_empty() {
+        let (lo, hi) = (w_lo * (1.0 - S.global_widen), w_hi * (1.0 + S.global_widen));
         match accel {
             Some(a) => accel_spin_box(a, period, g.n, lo, hi),
             None => (lo, hi),
@@ -481,11 +547,31 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     } else {
         (w_lo, w_hi)
     };
-    // Eye safety: no bin of a certifiable profile carries more than the
-    // bound's Rule 1 cap at the fastest spin the box allows (the core's
-    // `rule_one_cap_w`, valid for every spin profile in the box).
-    let x_hi = match &l.eye_safety {
-        Some(params) if mode.controls_range() => {
+    let x_hi = eye_capped(problem, x_lo, x_hi, w_hi, period)?;
+    Ok(Boxes {
+        x_lo,
+        x_hi,
+        w_lo,
+        w_hi,
+        n,
+        period,
+        unit: period / n,
+    })
+}
+
+/// Eye safety: no bin of a certifiable profile carries more than the
+/// bound's Rule 1 cap at the fastest spin the box allows (the core's
+/// `rule_one_cap_w`, valid for every spin profile in the box).
+fn eye_capped(
+    problem: &Problem,
+    x_lo: f64,
+    x_hi: f64,
+    w_hi: f64,
+    period: f64,
+) -> Result<f64, OptError> {
+    let lid = &problem.lidar;
+    match &lid.limits.eye_safety {
+        Some(params) if problem.objective.mode.controls_range() => {
             let laser =
                 crate::eye_safety::exposure::laser(params, lid.pulse_rate_hz).map_err(|e| {
                     OptError::Invalid {
@@ -495,74 +581,79 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
                 })?;
             let half = 0.5 * crate::eye_safety::exposure::pass_angle_deg(params, &laser);
             let cap = crate::eye_safety::cuts::rule_one_cap_w(&laser, half, w_hi, period);
-            x_hi.min(cap / p_mean).max(x_lo)
+            Ok(x_hi.min(cap / lid.average_power_w).max(x_lo))
         }
-        _ => x_hi,
-    };
-    let o = &problem.objective;
-    let slew_moves = mode.controls_range() && l.power_slew_w_per_deg_max.is_some();
-    let coupled = lid.power_accounting == PowerAccounting::Time
-        && mode.controls_range()
-        && mode.controls_resolution();
-    // τ = t/unit with t = 2θ/(ω_start + ω_end), both in the spin box;
-    // rounded outward where the spin moves (a few ulps).
-    let tau_box = |i: usize| {
-        let outward = if w_lo < w_hi { 4.0 * f64::EPSILON } else { 0.0 };
-        let t_lo = g.theta[i] / w_hi / unit * (1.0 - outward);
-        let t_hi = if w_lo > 0.0 {
-            (g.theta[i] / w_lo / unit * (1.0 + outward)).min(n)
-        } else {
-            n
-        };
-        (t_lo, t_hi)
-    };
-    if !slew_moves && !coupled {
-        // Separable: power against one budget row, dwell against the frame.
-        let power: Vec<Term> = (0..g.n)
-            .map(|i| Term {
-                c: o.range_weight * g.theta[i] * g.weight[i],
-                s: 1.0,
-                a: match lid.power_accounting {
-                    PowerAccounting::Angle => g.theta[i],
-                    // τ fixed here (time accounting is not coupled).
-                    PowerAccounting::Time => tau_box(i).1,
-                },
-                lo: x_lo,
-                hi: x_hi,
-            })
-            .collect();
-        let budget = match lid.power_accounting {
-            PowerAccounting::Angle => TAU,
-            PowerAccounting::Time => n,
-        } * (1.0 + WIDEN);
-        let dwell: Vec<Term> = (0..g.n)
-            .map(|i| {
-                let (lo, hi) = tau_box(i);
-                Term {
-                    c: o.resolution_weight * g.theta[i] * g.weight[i],
-                    s: unit * TAU / (g.theta[i] * period),
-                    a: 1.0,
-                    lo,
-                    hi,
-                }
-            })
-            .collect();
-        // The dwell part's row is the frame, an equality: Σ τ ≥ N(1−WIDEN)
-        // is dropped (a relaxation), Σ τ ≤ N(1+WIDEN) kept; its multiplier
-        // is ≥ 0 because the utility grows with τ.
-        if let (Some(bp), Some(bd)) = (
-            lagrangian_bound(&power, budget),
-            lagrangian_bound(&dwell, n * (1.0 + WIDEN)),
-        ) {
-            return Ok((bp + bd) * (1.0 + OBJECTIVE_MARGIN));
-        }
+        _ => Ok(x_hi),
     }
+}
+
+/// Separable case (no slew, not time-coupled): power against one budget
+/// row, dwell against the frame, each bounded by its Lagrangian.
+fn separable_bound(problem: &Problem, g: &Grid, b: &Boxes) -> Option<f64> {
+    let lid = &problem.lidar;
+    let o = &problem.objective;
+    let n = b.n;
+    let power: Vec<Term> = (0..g.n)
+        .map(|i| Term {
+            c: o.range_weight * g.theta[i] * g.weight[i],
+            s: 1.0,
+            a: match lid.power_accounting {
+                PowerAccounting::Angle => g.theta[i],
+                // τ fixed here (time accounting is not coupled).
+                PowerAccounting::Time => b.tau(g.theta[i]).1,
+            },
+            lo: b.x_lo,
+            hi: b.x_hi,
+        })
+        .collect();
+    let budget = match lid.power_accounting {
+        PowerAccounting::Angle => TAU,
+        PowerAccounting::Time => n,
+    } * (1.0 + S.global_widen);
+    let dwell: Vec<Term> = (0..g.n)
+        .map(|i| {
+            let (lo, hi) = b.tau(g.theta[i]);
+            Term {
+                c: o.resolution_weight * g.theta[i] * g.weight[i],
+                s: b.unit * TAU / (g.theta[i] * b.period),
+                a: 1.0,
+                lo,
+                hi,
+            }
+        })
+        .collect();
+    // The dwell part's row is the frame, an equality: Σ τ ≥ N(1−widen) is
+    // dropped (a relaxation), Σ τ ≤ N(1+widen) kept; its multiplier is ≥ 0
+    // because the utility grows with τ.
+    let bp = lagrangian_bound(&power, budget)?;
+    let bd = lagrangian_bound(&dwell, n * (1.0 + S.global_widen))?;
+    Some((bp + bd) * (1.0 + S.objective_margin))
+}
+
+/// The relaxation's LP and where its rows are.
+struct Relaxation {
+    lp: LinearProgram,
+    /// Per bin (column, lo, hi) of `x` and of `τ`.
+    xs: Vec<(usize, f64, f64)>,
+    taus: Vec<(usize, f64, f64)>,
+    frame_row: usize,
+    budget_row: usize,
+    /// (row, i, j, limit) per slew row.
+    slews: Vec<(usize, usize, usize, f64)>,
+}
+
+/// The relaxation's LP: per bin `x`, `τ` and the utilities' concave
+/// over-estimators, then the constraint families `frame`, `budget`
+/// (McCormick envelopes under time accounting), `slew`.
+fn relaxation(problem: &Problem, g: &Grid, b: &Boxes) -> Relaxation {
+    let o = &problem.objective;
     let mut lp = LinearProgram::default();
     let mut xs = Vec::with_capacity(g.n);
     let mut taus = Vec::with_capacity(g.n);
     let mut constant = 0.0;
+    let (x_lo, x_hi) = (b.x_lo, b.x_hi);
     for i in 0..g.n {
-        let (t_lo, t_hi) = tau_box(i);
+        let (t_lo, t_hi) = b.tau(g.theta[i]);
         let x = lp.add_col(x_lo, x_hi, 0.0, false);
         let tau = lp.add_col(t_lo, t_hi, 0.0, false);
         let cw = g.theta[i] * g.weight[i];
@@ -574,8 +665,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         } else {
             lp.add_col(0.0, up(x_hi), o.range_weight * cw, false);
         }
-        // r = k·τ, k = unit·2π/(θ·T).
-        let k = unit * TAU / (g.theta[i] * period);
+        let k = b.k(g.theta[i]);
         if t_lo < t_hi {
             constant += add_concave_bound(&mut lp, tau, k, t_lo, t_hi, o.resolution_weight * cw);
         } else {
@@ -584,82 +674,108 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
         xs.push((x, x_lo, x_hi));
         taus.push((tau, t_lo, t_hi));
     }
-    // The over-estimators' constants on one column fixed at 1: a sum of
-    // at most 2N non-negative doubles, each rounded up, raised by a
-    // relative 1e-12 (far above the 2N·ε its rounding can lose).
+    // The over-estimators' constants on one column fixed at 1: a sum of at
+    // most 2N non-negative doubles, each rounded up, raised by a relative
+    // 1e-12 (far above the 2N·ε its rounding can lose).
     if constant > 0.0 {
         lp.add_col(1.0, 1.0, constant * (1.0 + 1e-12), false);
     }
-    let frame: Vec<(usize, f64)> = taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
-    let frame_row = lp.rows.len();
-    lp.add_row(&frame, n * (1.0 - WIDEN), n * (1.0 + WIDEN));
-    let mut budget_row = frame_row;
-    match lid.power_accounting {
+    let mut r = Relaxation {
+        lp,
+        xs,
+        taus,
+        frame_row: 0,
+        budget_row: 0,
+        slews: Vec::new(),
+    };
+    relaxed_frame(&mut r, b.n);
+    relaxed_budget(&mut r, problem, g, b.n);
+    let l = &problem.lidar.limits;
+    if let (Some(s), true) = (l.power_slew_w_per_deg_max, o.mode.controls_range()) {
+        relaxed_slew(&mut r, g, s, problem.lidar.average_power_w);
+    }
+    r
+}
+
+/// `frame`: `N(1−widen) ≤ Σ τ ≤ N(1+widen)`.
+fn relaxed_frame(r: &mut Relaxation, n: f64) {
+    let frame: Vec<(usize, f64)> = r.taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
+    r.frame_row = r.lp.rows.len();
+    r.budget_row = r.frame_row;
+    r.lp.add_row(
+        &frame,
+        n * (1.0 - S.global_widen),
+        n * (1.0 + S.global_widen),
+    );
+}
+
+/// `budget`: `Σ θ x ≤ 2π(1+widen)` (angle), or under time accounting
+/// `Σ w ≤ N(1+widen)` with `w ≥ x·τ` by its McCormick under-estimators.
+fn relaxed_budget(r: &mut Relaxation, problem: &Problem, g: &Grid, n: f64) {
+    match problem.lidar.power_accounting {
         PowerAccounting::Angle => {
-            let spend: Vec<(usize, f64)> = (0..g.n).map(|i| (xs[i].0, g.theta[i])).collect();
-            lp.add_row(&spend, f64::NEG_INFINITY, TAU * (1.0 + WIDEN));
+            let spend: Vec<(usize, f64)> = (0..g.n).map(|i| (r.xs[i].0, g.theta[i])).collect();
+            r.lp.add_row(&spend, f64::NEG_INFINITY, TAU * (1.0 + S.global_widen));
         }
         PowerAccounting::Time => {
             let mut spend = Vec::with_capacity(g.n);
             for i in 0..g.n {
-                let (x, xl, xh) = xs[i];
-                let (t, tl, th) = taus[i];
-                let w = lp.add_col(xl * tl, xh * th, 0.0, false);
+                let (x, xl, xh) = r.xs[i];
+                let (t, tl, th) = r.taus[i];
+                let w = r.lp.add_col(xl * tl, xh * th, 0.0, false);
                 // w ≥ tl·x + xl·τ − tl·xl and w ≥ th·x + xh·τ − th·xh.
-                lp.add_row(&[(w, 1.0), (x, -tl), (t, -xl)], -tl * xl, f64::INFINITY);
-                lp.add_row(&[(w, 1.0), (x, -th), (t, -xh)], -th * xh, f64::INFINITY);
+                r.lp.add_row(&[(w, 1.0), (x, -tl), (t, -xl)], -tl * xl, f64::INFINITY);
+                r.lp.add_row(&[(w, 1.0), (x, -th), (t, -xh)], -th * xh, f64::INFINITY);
                 spend.push((w, 1.0));
             }
-            budget_row = lp.rows.len();
-            lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + WIDEN));
+            r.budget_row = r.lp.rows.len();
+            r.lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + S.global_widen));
         }
     }
-    let mut slews = Vec::new();
-    if let (Some(s), true) = (l.power_slew_w_per_deg_max, mode.controls_range()) {
-        for i in 0..g.n {
-            let j = next_index(i, g.n);
-            let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + WIDEN);
-            slews.push((lp.rows.len(), i, j, lim));
-            lp.add_row(&[(xs[j].0, 1.0), (xs[i].0, -1.0)], -lim, lim);
-        }
+}
+
+/// `slew`: `|x_j − x_i| ≤ s·(Δ_i+Δ_j)/2/P̄·(1+widen)` around the circle.
+fn relaxed_slew(r: &mut Relaxation, g: &Grid, s: f64, p_mean: f64) {
+    for i in 0..g.n {
+        let j = next_index(i, g.n);
+        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + S.global_widen);
+        r.slews.push((r.lp.rows.len(), i, j, lim));
+        r.lp.add_row(&[(r.xs[j].0, 1.0), (r.xs[i].0, -1.0)], -lim, lim);
     }
-    let solved = lp.solve("global bound")?;
-    let exact = check(&lp, &solved.x, &solved.y);
-    let ub = exact
-        .upper_bound
-        .ok_or_else(|| OptError::Solver("global bound: no finite dual bound".into()))?;
-    // Raised by OBJECTIVE_MARGIN: covers the float evaluation of the model's
-    // constants (k, √ of a fixed block) the rows were built from.
-    let lp_bound = to_f64_up(&ub) * (1.0 + OBJECTIVE_MARGIN);
-    // The Lagrangian's slices need x ≥ 0 (powers are never negative).
-    if !coupled || xs.iter().any(|&(_, lo, _)| lo.is_nan() || lo < 0.0) {
-        return Ok(lp_bound);
-    }
+}
+
+/// The coupled case's Lagrangian bound at the LP's multipliers `y`,
+/// improved by a coordinate search.
+fn coupled_bound(problem: &Problem, g: &Grid, b: &Boxes, r: &Relaxation, y: &[f64]) -> f64 {
+    let o = &problem.objective;
+    let n = b.n;
     let bins: Vec<Bilinear> = (0..g.n)
         .map(|i| {
             let cw = g.theta[i] * g.weight[i];
             Bilinear {
                 cx: o.range_weight * cw,
                 ct: o.resolution_weight * cw,
-                k: unit * TAU / (g.theta[i] * period),
-                x: (xs[i].1, xs[i].2),
-                t: (taus[i].1, taus[i].2),
+                k: b.k(g.theta[i]),
+                x: (r.xs[i].1, r.xs[i].2),
+                t: (r.taus[i].1, r.taus[i].2),
             }
         })
         .collect();
     let duals = Duals {
-        frame: (solved.y[frame_row], n * (1.0 - WIDEN), n * (1.0 + WIDEN)),
-        budget: (solved.y[budget_row].max(0.0), n * (1.0 + WIDEN)),
-        slews: slews
+        frame: (
+            y[r.frame_row],
+            n * (1.0 - S.global_widen),
+            n * (1.0 + S.global_widen),
+        ),
+        budget: (y[r.budget_row].max(0.0), n * (1.0 + S.global_widen)),
+        slews: r
+            .slews
             .iter()
-            .map(|&(r, i, j, lim)| (solved.y[r], i, j, lim))
+            .map(|&(row, i, j, lim)| (y[row], i, j, lim))
             .collect(),
     };
     let duals = improve_multipliers(&bins, duals);
-    let lag = coupled_lagrangian(&bins, &duals, LAGRANGIAN_SLICES);
-    // The smaller of two valid bounds (the Lagrangian's constants are the
-    // same floats the rows were built from: OBJECTIVE_MARGIN as above).
-    Ok(lp_bound.min(lag * (1.0 + OBJECTIVE_MARGIN)))
+    coupled_lagrangian(&bins, &duals, S.lagrangian_slices)
 }
 
 /// Lowers the Lagrangian over the frame's and the budget's multipliers
@@ -669,8 +785,6 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
 fn improve_multipliers(bins: &[Bilinear], mut d: Duals) -> Duals {
     // Measured on `smooth` (bound 8.91687 at the LP's multipliers): one
     // round 8.91094 in 4 ms, three 8.91085 in 15 ms.
-    const PIECES: usize = 16;
-    const ROUNDS: usize = 1;
     let golden = |lo: f64, hi: f64, f: &dyn Fn(f64) -> f64| -> f64 {
         let r = 0.5 * (5f64.sqrt() - 1.0);
         let (mut a, mut b) = (lo, hi);
@@ -693,20 +807,24 @@ fn improve_multipliers(bins: &[Bilinear], mut d: Duals) -> Duals {
         }
         0.5 * (a + b)
     };
-    let start = (d.budget.0, d.frame.0, coupled_lagrangian(bins, &d, PIECES));
-    for _ in 0..ROUNDS {
+    let start = (
+        d.budget.0,
+        d.frame.0,
+        coupled_lagrangian(bins, &d, S.multiplier_pieces),
+    );
+    for _ in 0..S.multiplier_rounds {
         let (mu, nu) = (d.budget.0, d.frame.0);
         let span = mu.abs() + nu.abs() + 1e-6;
         d.budget.0 = golden(0.0, mu + span, &|m| {
-            coupled_lagrangian_at(bins, &d, m, nu, PIECES)
+            coupled_lagrangian_at(bins, &d, m, nu, S.multiplier_pieces)
         });
         let mu = d.budget.0;
         d.frame.0 = golden(nu - span, nu + span, &|v| {
-            coupled_lagrangian_at(bins, &d, mu, v, PIECES)
+            coupled_lagrangian_at(bins, &d, mu, v, S.multiplier_pieces)
         });
     }
     // Keep the start where the search did not improve on it.
-    let after = coupled_lagrangian(bins, &d, PIECES);
+    let after = coupled_lagrangian(bins, &d, S.multiplier_pieces);
     if after.is_nan() || after > start.2 {
         (d.budget.0, d.frame.0) = (start.0, start.1);
     }

@@ -3,7 +3,7 @@
 //! Variables are normalised to order one (`x = p/P̄`, `τ = t·N/T`) because
 //! HiGHS's feasibility tolerances are absolute (1e-7). Continuous solutions
 //! are clamped and rescaled to meet bounds, budget and frame exactly, which
-//! is why continuous bounds carry a [`MARGIN`]; level (MILP) solutions are
+//! is why continuous bounds carry a `settings::margin`; level (MILP) solutions are
 //! exact by construction.
 
 // Loops over bins index several parallel per-bin arrays (θ, weights, caps,
@@ -14,83 +14,36 @@ use super::certificate::{Certified, LinearProgram, SolveOptions, Step};
 use super::utility::{sqrt_segments, sqrt_segments_n, SqrtSegments};
 use std::f64::consts::TAU;
 
+use super::error::{CertificateError, Infeasible, SpinLimit};
+use super::settings::S;
 use super::{OptError, Problem};
 use crate::eye_safety::bound::{Laser, Rule, Seg, RATIO_MARGIN};
 use crate::eye_safety::cuts::{cuts_with, Cut};
 use crate::eye_safety::{exposure, EyeSafetyParams};
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning};
 use crate::model::lidar::PowerAccounting;
-use crate::planner::Mode;
+use crate::model::Mode;
 use crate::profile::{Bin, Profile, Region, PROFILE_FORMAT};
 
-/// Relative margin kept from continuous bounds, budget and caps.
-const MARGIN: f64 = 1e-6;
-/// Relative slack on the budget row of a level (MILP) power step: HiGHS
-/// accepts a MILP's rows to `MIP_FEASIBILITY_TOL` (1e-10, absolute, on a
-/// row of order one to 2π) and a level choice has no continuous part to
-/// trim, so the certified row allows 2e-10 relative; 5× inside the
-/// checker's `REL_TOL` (1e-9).
-const LEVEL_BUDGET_SLACK: f64 = 2e-10;
-/// Tie-break added to the weights, growing with signed eccentricity: makes
-/// the optimum unique where the acuity is symmetric about the gaze, and is
-/// itself rotation-equivariant (a function of eccentricity only), so a
-/// rotated problem has the rotated optimum.
-const TIE_BREAK: f64 = 1e-3;
-/// Trust region of the sequential LP for acceleration limits.
-const TRUST: f64 = 0.3;
-/// Share of the acceleration limit the linearised constraint may use.
-const ACCEL_SHARE: f64 = 0.8;
-/// Relative margin every eye-safety cut keeps below its limit: HiGHS's
-/// feasibility tolerance (1e-7 on rows normalised to 1) beyond the
-/// head-room and the bound's own rounding margin (`RATIO_MARGIN`).
-const CUT_MARGIN: f64 = 2e-7;
-/// Head-room the power step leaves under the Class 1 limit of the bound, so
-/// that a rotated copy of its answer (the fast path) still certifies.
-pub(super) const EYE_SAFETY_HEADROOM: f64 = 1e-9;
 /// Right-hand side of a cut row normalised to its limit: a power vector
 /// that meets it with equality is at `1 − headroom` of the bound's figure
 /// for that cut once the bound's rounding margin is applied.
 fn cut_rhs() -> f64 {
-    level_rhs() * (1.0 - CUT_MARGIN)
+    level_rhs() * (1.0 - S.cut_margin)
 }
 
 /// As [`cut_rhs`] for a cut on one bin when the power takes hardware
 /// levels: the levels are exact (no solver tolerance enters), so only the
 /// head-room and the bound's rounding margin.
 fn level_rhs() -> f64 {
-    (1.0 - EYE_SAFETY_HEADROOM) / (1.0 + RATIO_MARGIN)
+    (1.0 - S.eye_safety_headroom) / (1.0 + RATIO_MARGIN)
 }
 
-/// Rounds of the cutting-plane loop of one power step.
-const CUT_ROUNDS: usize = 60;
-/// Cuts at or above this ratio of the current iterate are binding: the
-/// dwell step linearises them.
-const BINDING: f64 = 1.0 - 1e-3;
-/// Chords of the density utility on a dwell column inside a trust region
-/// (±[`TRUST`] around the iterate: a sequential LP's first-order model,
-/// where the acceleration rows allow far smaller moves still). Measured on
-/// `smooth` (360 bins, joint): 16 chords → 4 makes the whole solve 1.8×
-/// faster (99 → 55 ms) and moves the answer's exact objective by 2e-14
-/// relative (`optimality.global.objective` 8.864885452179 either way).
-/// Columns without a trust region keep [`super::UTILITY_SEGMENTS`].
-const TRUST_REGION_SEGMENTS: usize = 4;
-
-/// Dwell-step iterations when the acceleration limit is finite (at most).
-const SLP_ROUNDS: usize = 5;
-/// The sequential LP stops once a dwell step moves no bin's dwell by more
-/// than this (relative). On `smooth` (360 bins, joint) the five rounds'
-/// moves were 2.7e-2, 7.6e-4, 2.4e-5, 3.2e-6, 3.7e-6; stopping after the
-/// second changes the answer's exact objective by −1.4e-7 relative
-/// (8.864885070 with five rounds, 8.864884199 with two; the global gap is
-/// 2.4e-2) and makes the whole process 1.24× faster than stopping after the
-/// third (1e-4).
-const SLP_SETTLED: f64 = 1e-3;
-
-/// Whether the dwell `next` is within [`SLP_SETTLED`] of `t` in every bin.
+/// Whether the dwell `next` is within `settings::slp_settled` of `t` in every bin.
 fn settled(next: &[f64], t: &[f64]) -> bool {
     next.iter()
         .zip(t)
-        .all(|(a, b)| (a - b).abs() <= SLP_SETTLED * b.abs())
+        .all(|(a, b)| (a - b).abs() <= S.slp_settled * b.abs())
 }
 
 pub(super) struct Grid {
@@ -138,7 +91,7 @@ pub(super) fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
             .sum();
         let ecc = crate::model::angle::diff_deg(c, gaze_deg);
         weight.push(
-            problem.focus.acuity.deficit(ecc) + prior + eps + TIE_BREAK * (ecc + 180.0) / 360.0,
+            problem.focus.acuity.deficit(ecc) + prior + eps + S.tie_break * (ecc + 180.0) / 360.0,
         );
         in_rof.push(regions.rof.contains(c));
     }
@@ -204,7 +157,7 @@ impl Eye {
     /// The bound's whole report.
     fn report(&self, segs: &[Seg]) -> Result<exposure::ExposureReport, OptError> {
         exposure::evaluate_segments(segs, &self.params, self.pulse_rate_hz)
-            .map_err(|e| OptError::Infeasible(format!("eye safety: {e}")))
+            .map_err(|e| Infeasible::EyeSafety(e.to_string()).into())
     }
 
     /// The concrete exposures at or above `threshold` for these bins.
@@ -227,24 +180,29 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
     let lid = &problem.lidar;
     let w_mean = lid.mean_spin_rad_s();
     if l.spin_rad_s_max < w_mean * (1.0 - 1e-12) {
-        return Err(OptError::Infeasible(format!(
-            "spin_rad_s_max {:.3} rad/s cannot meet the frame period: one turn in 1/frame_rate_hz = {:.4} s needs a mean spin of {:.3} rad/s",
-            l.spin_rad_s_max,
-            1.0 / lid.frame_rate_hz,
-            w_mean
-        )));
+        return Err(Infeasible::FrameUnreachable {
+            limit: SpinLimit::Max,
+            spin_rad_s: l.spin_rad_s_max,
+            mean_spin_rad_s: w_mean,
+            frame_rate_hz: lid.frame_rate_hz,
+        }
+        .into());
     }
     if l.spin_rad_s_min > w_mean * (1.0 + 1e-12) {
-        return Err(OptError::Infeasible(format!(
-            "spin_rad_s_min {:.3} rad/s is above the mean spin {w_mean:.3} rad/s that frame_rate_hz {} requires",
-            l.spin_rad_s_min, lid.frame_rate_hz
-        )));
+        return Err(Infeasible::FrameUnreachable {
+            limit: SpinLimit::Min,
+            spin_rad_s: l.spin_rad_s_min,
+            mean_spin_rad_s: w_mean,
+            frame_rate_hz: lid.frame_rate_hz,
+        }
+        .into());
     }
     if l.power_w_min > lid.average_power_w * (1.0 + 1e-12) {
-        return Err(OptError::Infeasible(format!(
-            "power_w_min {:.4e} W alone exceeds the average power budget {:.4e} W",
-            l.power_w_min, lid.average_power_w
-        )));
+        return Err(Infeasible::FloorOverBudget {
+            power_w_min: l.power_w_min,
+            average_power_w: lid.average_power_w,
+        }
+        .into());
     }
     if l.power_w_min > l.power_w_max {
         return Err(OptError::Invalid {
@@ -261,12 +219,13 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
             let (ratio, at) =
                 e.verdict(&segs(&g, &vec![(w, w); g.n], &vec![l.power_w_min; g.n]))?;
             if ratio > 1.0 {
-                return Err(OptError::Infeasible(format!(
-                    "eye safety: power_w_min {:.4e} W everywhere at the mean spin is {:.1} % of the Class 1 limit (worst at {at:.3}°) at {} nm",
-                    l.power_w_min,
-                    100.0 * ratio,
-                    e.params.wavelength_nm
-                )));
+                return Err(Infeasible::EyeFloorOverLimit {
+                    power_w_min: l.power_w_min,
+                    ratio,
+                    at_deg: at,
+                    wavelength_nm: e.params.wavelength_nm,
+                }
+                .into());
             }
         }
     }
@@ -313,6 +272,10 @@ fn dwell_of(g: &Grid, spins: &[(f64, f64)]) -> Vec<f64> {
 /// add the concrete exposures the answer breaks (valid for every power
 /// vector), repeat until the bound certifies. `pool` holds the cuts of
 /// these spins (empty for new spins) and keeps the ones added.
+///
+/// The loop is a skeleton of named steps: [`power_program`] builds the
+/// program from the pool, HiGHS solves it, [`powers`] repairs the answer,
+/// and [`power_checkpoint`] decides what comes next.
 fn power_step(
     problem: &Problem,
     g: &Grid,
@@ -321,253 +284,402 @@ fn power_step(
     pool: &mut Vec<Cut>,
 ) -> Result<(Vec<f64>, PowerLp), OptError> {
     let t = &dwell_of(g, spins)[..];
-    let lid = &problem.lidar;
-    let l = &lid.limits;
-    let p_mean = lid.average_power_w;
-    let period: f64 = t.iter().sum();
-    let lam = problem.objective.range_weight;
-    let levels = &problem.levels.power_w;
-    let mut round = 0;
-    // Where no valid cut separates (see below), the limits of one class of
-    // cuts — Rule 1's (0) or the windows' (1) — are divided by a factor.
+    // Where no valid cut separates (see `power_checkpoint`), the limits of
+    // one class of cuts — Rule 1's (0) or the windows' (1) — are divided
+    // by a factor.
     let mut factor = [1.0f64; 2];
-    let class = |c: &Cut| usize::from(c.rule != Rule::SinglePulse);
+    let mut round = 0;
     loop {
-        // A cut on one bin's power alone is that bin's column bound (the
-        // utility's chords then span the reachable powers only).
-        let rhs = if levels.is_empty() {
-            cut_rhs()
-        } else {
-            level_rhs()
-        };
-        let mut caps = vec![f64::INFINITY; g.n];
-        // The same without margins: a floor between the two is kept (the
-        // bound decides), one above the bare limit is infeasible.
-        let mut bare = vec![f64::INFINITY; g.n];
-        if let Some(e) = eye {
-            for c in pool.iter() {
-                if let [(b, n)] = c.pulses[..] {
-                    caps[b] = caps[b].min(rhs * c.limit_j / factor[class(c)] * e.pulse_rate_hz / n);
-                    bare[b] = bare[b].min(c.limit_j * e.pulse_rate_hz / n);
-                }
+        let program = power_program(problem, g, eye, t, pool, &factor)?;
+        let solved = program.lp.solve("power").map_err(|err| match (err, eye) {
+            (OptError::Infeasible(_), Some(_)) => {
+                Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
             }
-        }
-        let mut lp = LinearProgram::default();
-        // x_i = p_i / P̄ as a linear form (a continuous column or Σ levels·z).
-        let mut x: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
-        let mut bins: Vec<PowerBin> = Vec::with_capacity(g.n);
-        let mut utility_constant = 0.0;
-        for i in 0..g.n {
-            if bare[i] < l.power_w_min {
-                let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
-                return Err(OptError::Infeasible(format!(
-                    "eye-safety cap {:.4e} W at {wl} nm in bin {i} (the single-pulse limit at this spin) is below power_w_min {:.4e} W",
-                    bare[i], l.power_w_min
-                )));
-            }
-            let caps_i = caps[i].max(l.power_w_min);
-            let hi = l.power_w_max.min(caps_i);
-            if levels.is_empty() {
-                let lo_x = l.power_w_min / p_mean;
-                let hi_x = (hi / p_mean * (1.0 - MARGIN)).max(lo_x);
-                let xi = lp.add_col(lo_x, hi_x, 0.0, false);
-                // The utility as boxed segment columns (see `utility`).
-                let c = lam * g.theta[i] * g.weight[i];
-                let shape = sqrt_segments(lo_x, hi_x);
-                let deltas = shape.add_to(&mut lp, xi, 1.0, lo_x, c);
-                utility_constant += c * shape.base;
-                x.push(vec![(xi, 1.0)]);
-                bins.push(PowerBin::Continuous {
-                    x: xi,
-                    lo: lo_x,
-                    deltas,
-                    shape,
-                });
-            } else {
-                let allowed: Vec<f64> = levels
-                    .iter()
-                    .copied()
-                    .filter(|&lv| lv >= l.power_w_min && lv <= hi)
-                    .collect();
-                if allowed.is_empty() {
-                    return Err(OptError::Infeasible(format!(
-                            "no power level lies within [power_w_min, min(power_w_max, the bin's eye-safety cut)] = [{:.4e}, {:.4e}] W in bin {i}",
-                            l.power_w_min, hi
-                        )));
-                }
-                let zs: Vec<(f64, usize)> = allowed
-                    .iter()
-                    .map(|&lv| {
-                        let cost = lam * g.theta[i] * g.weight[i] * (lv / p_mean).sqrt();
-                        (lv, lp.add_col(0.0, 1.0, cost, true))
-                    })
-                    .collect();
-                let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
-                lp.add_row(&one, 1.0, 1.0);
-                x.push(zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect());
-                bins.push(PowerBin::Levels(zs));
-            }
-        }
-        // The utilities' constants Σ c·√lo as one column fixed at 1.
-        let one = (utility_constant != 0.0).then(|| lp.add_col(1.0, 1.0, utility_constant, false));
-        let scaled = |k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>| {
-            out.extend(form.iter().map(|&(j, a)| (j, k * a)));
-        };
-        // Budget.
-        // Levels: the budget exactly, plus [`LEVEL_BUDGET_SLACK`] (far inside
-        // the checker's REL_TOL) so that a level choice that meets it in
-        // floating point (the closed form's does, to the last bit) also meets
-        // it in the exact arithmetic of the certificate.
-        let budget_margin = if levels.is_empty() {
-            1.0 - MARGIN
-        } else {
-            1.0 + LEVEL_BUDGET_SLACK
-        };
-        let mut spend = Vec::new();
-        let budget = match lid.power_accounting {
-            PowerAccounting::Angle => {
-                for i in 0..g.n {
-                    scaled(g.theta[i], &x[i], &mut spend);
-                }
-                TAU * budget_margin
-            }
-            PowerAccounting::Time => {
-                for i in 0..g.n {
-                    scaled(t[i] / period, &x[i], &mut spend);
-                }
-                budget_margin
-            }
-        };
-        // A floor that spends the whole budget (power_w_min = P̄) keeps its
-        // own spend: the margin must not make the all-floor answer
-        // infeasible.
-        let floor_spend: f64 = spend.iter().map(|&(j, a)| a * lp.col_lo[j]).sum();
-        lp.add_row(&spend, f64::NEG_INFINITY, budget.max(floor_spend));
-        // Slew.
-        if let Some(s) = l.power_slew_w_per_deg_max {
-            for i in 0..g.n {
-                let j = next_index(i, g.n);
-                let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - MARGIN);
-                let mut d = Vec::new();
-                scaled(1.0, &x[j], &mut d);
-                scaled(-1.0, &x[i], &mut d);
-                lp.add_row(&d, -lim, lim);
-            }
-        }
-
-        if let Some(e) = eye {
-            for c in pool.iter().filter(|c| c.pulses.len() > 1) {
-                let mut row = Vec::new();
-                let limit = c.limit_j / factor[class(c)];
-                for &(b, n) in &c.pulses {
-                    scaled(n * p_mean / (e.pulse_rate_hz * limit), &x[b], &mut row);
-                }
-                // A floor alone at more than the row's side (but within the
-                // bare limit: checked below) keeps its own value.
-                let at_floor: f64 = c.pulses.iter().map(|&(_, n)| n).sum::<f64>() * l.power_w_min
-                    / (e.pulse_rate_hz * limit);
-                if at_floor > factor[class(c)] {
-                    let wl = l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm);
-                    return Err(OptError::Infeasible(format!(
-                        "eye safety at {wl} nm: power_w_min {:.4e} W in every bin is {:.4} of the limit of a window at {:.3}° ({:?})",
-                        l.power_w_min,
-                        at_floor / factor[class(c)],
-                        c.azimuth_deg,
-                        c.rule
-                    )));
-                }
-                lp.add_row(
-                    &row,
-                    f64::NEG_INFINITY,
-                    cut_rhs().max(at_floor * (1.0 + 1e-12)),
-                );
-            }
-        }
-        let solved = lp.solve("power").map_err(|err| match (err, eye) {
-            (OptError::Infeasible(_), Some(_)) => OptError::Infeasible(format!(
-                "the power step has no solution within the limits: {} eye-safety cuts (concrete exposures at the Class 1 limit) leave no powers within power_w_min/max, the budget and the slew limit",
-                pool.len()
-            )),
             (other, _) => other,
         })?;
-        let p = powers(problem, g, t, &bins, &x, &solved.x);
-        if let Some(e) = eye {
-            let s = segs(g, spins, &p);
-            let report = e.report(&s)?;
-            let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
-            if ratio > 1.0 - EYE_SAFETY_HEADROOM {
-                round += 1;
-                // Every bin edge ± h first (rotation-equivariant: a rotated
-                // problem gets the rotated cuts); the bound's witness only
-                // when those hold.
-                let new_cuts = |extra: &[f64]| -> Vec<Cut> {
-                    e.cuts(&s, extra, cut_rhs())
-                        .into_iter()
-                        .filter(|c| !pool.contains(c))
-                        .collect()
-                };
-                let mut fresh = new_cuts(&[]);
-                if fresh.is_empty() {
-                    fresh = new_cuts(&[witness]);
-                }
-                if round > CUT_ROUNDS {
-                    return Err(OptError::Solver(format!(
-                        "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° ({} cuts, limits divided by {factor:?})",
-                        pool.len(),
-                    )));
-                }
-                if fresh.is_empty() {
-                    // The bound exceeds every valid cut here (its
-                    // conservatism in the rule that binds): divide the
-                    // limits of that rule's class of cuts by the bound's
-                    // excess over the strongest of them, so the next answer
-                    // meets them where the bound would.
-                    let k = usize::from(report.binding_rule != Rule::SinglePulse);
-                    let near: Vec<Cut> = e
-                        .cuts(&s, &[witness], 0.0)
-                        .into_iter()
-                        .filter(|c| class(c) == k)
-                        .collect();
-                    let top = near
-                        .iter()
-                        .map(|c| c.ratio(&p, e.pulse_rate_hz))
-                        .fold(0.0, f64::max);
-                    if top <= 0.0 {
-                        return Err(OptError::Solver(format!(
-                            "eye-safety cuts: the bound gives {ratio:.6} at {witness:.3}° ({:?}) and no cut of that rule has any exposure there",
-                            report.binding_rule
-                        )));
-                    }
-                    factor[k] = (factor[k] * ratio / (1.0 - EYE_SAFETY_HEADROOM)).max(ratio / top)
-                        * (1.0 + 1e-9);
-                    let top_cuts: Vec<Cut> = near
-                        .into_iter()
-                        .filter(|c| {
-                            c.ratio(&p, e.pulse_rate_hz) * factor[k] >= cut_rhs()
-                                && !pool.contains(c)
-                        })
-                        .collect();
-                    pool.extend(top_cuts);
-                    continue;
-                }
-                pool.extend(fresh);
-                continue;
+        let p = powers(problem, g, t, &program.bins, &program.x, &solved.x);
+        let checkpoint = match eye {
+            None => Checkpoint::Certified,
+            Some(e) => power_checkpoint(e, g, spins, &p, pool, &factor, round)?,
+        };
+        match checkpoint {
+            Checkpoint::Certified => {
+                let top = factor[0].max(factor[1]);
+                return Ok((
+                    p,
+                    PowerLp {
+                        lp: program.lp,
+                        bins: program.bins,
+                        one: program.one,
+                        tightening: (top > 1.0).then_some(top),
+                        p_mean: problem.lidar.average_power_w,
+                        floor_w: problem.lidar.limits.power_w_min,
+                        y: solved.y,
+                        solver_dual_bound: solved.solver_dual_bound,
+                    },
+                ));
+            }
+            Checkpoint::AddCuts(fresh) => pool.extend(fresh),
+            Checkpoint::Tighten {
+                class,
+                factor: f,
+                cuts,
+            } => {
+                factor[class] = f;
+                pool.extend(cuts);
+            }
+            Checkpoint::Fail(why) => return Err(why),
+        }
+        round += 1;
+    }
+}
+
+/// A linear form over a program's columns: (column, coefficient) pairs.
+type LinearForm = Vec<(usize, f64)>;
+
+/// What one round of the power step's cutting-plane loop decides (in the
+/// manner of Clarabel's `solve()`: each named step returns where to go).
+enum Checkpoint {
+    /// The core's bound certifies the answer: done.
+    Certified,
+    /// Concrete exposures the answer breaks: add them and solve again.
+    AddCuts(Vec<Cut>),
+    /// No valid cut separates (the bound's conservatism in the rule that
+    /// binds): divide the limits of cut class `class` by `factor`, add
+    /// `cuts`, solve again.
+    Tighten {
+        class: usize,
+        factor: f64,
+        cuts: Vec<Cut>,
+    },
+    /// No way on: why.
+    Fail(OptError),
+}
+
+/// Rule 1's cuts are class 0, the windows' class 1.
+fn cut_class(c: &Cut) -> usize {
+    usize::from(c.rule != Rule::SinglePulse)
+}
+
+/// Asks the core's bound about the powers `p` of round `round` and decides
+/// the next step of the cutting-plane loop.
+fn power_checkpoint(
+    e: &Eye,
+    g: &Grid,
+    spins: &[(f64, f64)],
+    p: &[f64],
+    pool: &[Cut],
+    factor: &[f64; 2],
+    round: usize,
+) -> Result<Checkpoint, OptError> {
+    let s = segs(g, spins, p);
+    let report = e.report(&s)?;
+    let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
+    if ratio <= 1.0 - S.eye_safety_headroom {
+        return Ok(Checkpoint::Certified);
+    }
+    let round = round + 1;
+    // Every bin edge ± h first (rotation-equivariant: a rotated problem gets
+    // the rotated cuts); the bound's witness only when those hold.
+    let new_cuts = |extra: &[f64]| -> Vec<Cut> {
+        e.cuts(&s, extra, cut_rhs())
+            .into_iter()
+            .filter(|c| !pool.contains(c))
+            .collect()
+    };
+    let mut fresh = new_cuts(&[]);
+    if fresh.is_empty() {
+        fresh = new_cuts(&[witness]);
+    }
+    if round > S.cut_rounds {
+        return Ok(Checkpoint::Fail(OptError::Solver(format!(
+            "eye-safety cuts: after {round} rounds the bound still gives {ratio:.6} at {witness:.3}° ({} cuts, limits divided by {factor:?})",
+            pool.len(),
+        ))));
+    }
+    if !fresh.is_empty() {
+        return Ok(Checkpoint::AddCuts(fresh));
+    }
+    // The bound exceeds every valid cut here: divide the limits of that
+    // rule's class of cuts by the bound's excess over the strongest of
+    // them, so the next answer meets them where the bound would.
+    let k = usize::from(report.binding_rule != Rule::SinglePulse);
+    let near: Vec<Cut> = e
+        .cuts(&s, &[witness], 0.0)
+        .into_iter()
+        .filter(|c| cut_class(c) == k)
+        .collect();
+    let top = near
+        .iter()
+        .map(|c| c.ratio(p, e.pulse_rate_hz))
+        .fold(0.0, f64::max);
+    if top <= 0.0 {
+        return Ok(Checkpoint::Fail(OptError::Solver(format!(
+            "eye-safety cuts: the bound gives {ratio:.6} at {witness:.3}° ({:?}) and no cut of that rule has any exposure there",
+            report.binding_rule
+        ))));
+    }
+    let f = (factor[k] * ratio / (1.0 - S.eye_safety_headroom)).max(ratio / top) * (1.0 + 1e-9);
+    let cuts = near
+        .into_iter()
+        .filter(|c| c.ratio(p, e.pulse_rate_hz) * f >= cut_rhs() && !pool.contains(c))
+        .collect();
+    Ok(Checkpoint::Tighten {
+        class: k,
+        factor: f,
+        cuts,
+    })
+}
+
+/// The power step's program for the cuts in `pool` (their limits divided by
+/// `factor`), and how each bin's power reads from its columns.
+struct PowerProgram {
+    lp: LinearProgram,
+    /// `x_i = p_i / P̄` as a linear form (a continuous column or Σ levels·z).
+    x: Vec<Vec<(usize, f64)>>,
+    bins: Vec<PowerBin>,
+    /// The column fixed at 1 that carries the utilities' constants.
+    one: Option<usize>,
+}
+
+/// Builds the power step's program: per bin its columns and utility (and
+/// with levels its one-hot row), then the constraint families in a fixed
+/// order — `budget`, `slew`, `eye_cuts` — so HiGHS sees the same rows in
+/// the same order every time.
+fn power_program(
+    problem: &Problem,
+    g: &Grid,
+    eye: Option<&Eye>,
+    t: &[f64],
+    pool: &[Cut],
+    factor: &[f64; 2],
+) -> Result<PowerProgram, OptError> {
+    let (caps, bare) = eye_caps(problem, g, eye, pool, factor);
+    let mut lp = LinearProgram::default();
+    let mut x = Vec::with_capacity(g.n);
+    let mut bins = Vec::with_capacity(g.n);
+    let mut utility_constant = 0.0;
+    for i in 0..g.n {
+        let (form, bin, constant) = power_bin(&mut lp, problem, g, i, caps[i], bare[i])?;
+        x.push(form);
+        bins.push(bin);
+        utility_constant += constant;
+    }
+    // The utilities' constants Σ c·√lo as one column fixed at 1.
+    let one = (utility_constant != 0.0).then(|| lp.add_col(1.0, 1.0, utility_constant, false));
+    budget(&mut lp, problem, g, t, &x);
+    if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
+        slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
+    }
+    if let Some(e) = eye {
+        eye_cuts(&mut lp, problem, e, pool, factor, &x)?;
+    }
+    Ok(PowerProgram { lp, x, bins, one })
+}
+
+/// Per bin, the eye-safety caps of the single-bin cuts in `pool` as column
+/// bounds, W: with the cut margins (`caps`), and bare (a floor between the
+/// two is kept, the bound decides; one above the bare limit is infeasible).
+fn eye_caps(
+    problem: &Problem,
+    g: &Grid,
+    eye: Option<&Eye>,
+    pool: &[Cut],
+    factor: &[f64; 2],
+) -> (Vec<f64>, Vec<f64>) {
+    // A cut on one bin's power alone is that bin's column bound (the
+    // utility's chords then span the reachable powers only).
+    let rhs = if problem.levels.power_w.is_empty() {
+        cut_rhs()
+    } else {
+        level_rhs()
+    };
+    let mut caps = vec![f64::INFINITY; g.n];
+    let mut bare = vec![f64::INFINITY; g.n];
+    if let Some(e) = eye {
+        for c in pool {
+            if let [(b, n)] = c.pulses[..] {
+                caps[b] = caps[b].min(rhs * c.limit_j / factor[cut_class(c)] * e.pulse_rate_hz / n);
+                bare[b] = bare[b].min(c.limit_j * e.pulse_rate_hz / n);
             }
         }
-        return Ok((
-            p,
-            PowerLp {
-                lp,
-                bins,
-                one,
-                tightening: (factor[0].max(factor[1]) > 1.0).then_some(factor[0].max(factor[1])),
-                p_mean,
-                floor_w: l.power_w_min,
-                y: solved.y,
-                solver_dual_bound: solved.solver_dual_bound,
-            },
-        ));
     }
+    (caps, bare)
+}
+
+/// Bin `i`'s columns, boxed by the power limits and its eye-safety cap
+/// (`levels`: one binary per allowed level and their one-hot row; else a
+/// continuous column and its utility's segments). Returns `x_i` as a linear
+/// form, how the bin reads back, and its utility's constant.
+fn power_bin(
+    lp: &mut LinearProgram,
+    problem: &Problem,
+    g: &Grid,
+    i: usize,
+    cap_w: f64,
+    bare_w: f64,
+) -> Result<(LinearForm, PowerBin, f64), OptError> {
+    let l = &problem.lidar.limits;
+    let p_mean = problem.lidar.average_power_w;
+    if bare_w < l.power_w_min {
+        return Err(Infeasible::EyeCapBelowFloor {
+            cap_w: bare_w,
+            wavelength_nm: l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm),
+            bin: i,
+            power_w_min: l.power_w_min,
+        }
+        .into());
+    }
+    let hi = l.power_w_max.min(cap_w.max(l.power_w_min));
+    let c = problem.objective.range_weight * g.theta[i] * g.weight[i];
+    if !problem.levels.power_w.is_empty() {
+        let (form, bin) = levels(lp, problem, i, hi, c)?;
+        return Ok((form, bin, 0.0));
+    }
+    let lo_x = l.power_w_min / p_mean;
+    let hi_x = (hi / p_mean * (1.0 - S.margin)).max(lo_x);
+    let xi = lp.add_col(lo_x, hi_x, 0.0, false);
+    // The utility as boxed segment columns (see `utility`).
+    let shape = sqrt_segments(lo_x, hi_x);
+    let deltas = shape.add_to(lp, xi, 1.0, lo_x, c);
+    let constant = c * shape.base;
+    let bin = PowerBin::Continuous {
+        x: xi,
+        lo: lo_x,
+        deltas,
+        shape,
+    };
+    Ok((vec![(xi, 1.0)], bin, constant))
+}
+
+/// `levels`: one binary column per hardware level within
+/// `[power_w_min, hi_w]` (cost `c·√(level/P̄)`) and the one-hot row `Σ z = 1`.
+fn levels(
+    lp: &mut LinearProgram,
+    problem: &Problem,
+    i: usize,
+    hi_w: f64,
+    c: f64,
+) -> Result<(LinearForm, PowerBin), OptError> {
+    let floor = problem.lidar.limits.power_w_min;
+    let p_mean = problem.lidar.average_power_w;
+    let allowed: Vec<f64> = problem
+        .levels
+        .power_w
+        .iter()
+        .copied()
+        .filter(|&lv| lv >= floor && lv <= hi_w)
+        .collect();
+    if allowed.is_empty() {
+        return Err(Infeasible::NoLevelFits {
+            power_w_min: floor,
+            hi_w,
+            bin: i,
+        }
+        .into());
+    }
+    let zs: Vec<(f64, usize)> = allowed
+        .iter()
+        .map(|&lv| (lv, lp.add_col(0.0, 1.0, c * (lv / p_mean).sqrt(), true)))
+        .collect();
+    let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
+    lp.add_row(&one, 1.0, 1.0);
+    let form = zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect();
+    Ok((form, PowerBin::Levels(zs)))
+}
+
+/// `k·form` appended to `out`.
+fn scaled(k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>) {
+    out.extend(form.iter().map(|&(j, a)| (j, k * a)));
+}
+
+/// `budget`: `Σ θ_i x_i ≤ 2π` (angle accounting) or `Σ (t_i/T) x_i ≤ 1`
+/// (time), with the continuous margin, or for levels the budget exactly
+/// plus `level_budget_slack` (far inside the checker's REL_TOL) so that a
+/// level choice that meets it in floating point (the closed form's does, to
+/// the last bit) also meets it in the exact arithmetic of the certificate.
+fn budget(lp: &mut LinearProgram, problem: &Problem, g: &Grid, t: &[f64], x: &[Vec<(usize, f64)>]) {
+    let budget_margin = if problem.levels.power_w.is_empty() {
+        1.0 - S.margin
+    } else {
+        1.0 + S.level_budget_slack
+    };
+    let period: f64 = t.iter().sum();
+    let mut spend = Vec::new();
+    let budget = match problem.lidar.power_accounting {
+        PowerAccounting::Angle => {
+            for i in 0..g.n {
+                scaled(g.theta[i], &x[i], &mut spend);
+            }
+            TAU * budget_margin
+        }
+        PowerAccounting::Time => {
+            for i in 0..g.n {
+                scaled(t[i] / period, &x[i], &mut spend);
+            }
+            budget_margin
+        }
+    };
+    // A floor that spends the whole budget (power_w_min = P̄) keeps its own
+    // spend: the margin must not make the all-floor answer infeasible.
+    let floor_spend: f64 = spend.iter().map(|&(j, a)| a * lp.col_lo[j]).sum();
+    lp.add_row(&spend, f64::NEG_INFINITY, budget.max(floor_spend));
+}
+
+/// `slew`: `|x_{i+1} − x_i| ≤ s·(Δ_i + Δ_{i+1})/2·(1 − margin)` around the
+/// circle (`s` in W per degree, `x` in units of `p_mean`).
+fn slew(lp: &mut LinearProgram, g: &Grid, x: &[Vec<(usize, f64)>], s: f64, p_mean: f64) {
+    for i in 0..g.n {
+        let j = next_index(i, g.n);
+        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
+        let mut d = Vec::new();
+        scaled(1.0, &x[j], &mut d);
+        scaled(-1.0, &x[i], &mut d);
+        lp.add_row(&d, -lim, lim);
+    }
+}
+
+/// `eye_cuts`: every cut of the pool on more than one bin as a row
+/// `Σ n_b·x_b·P̄ / (f_p·limit) ≤ cut_rhs` (single-bin cuts are column
+/// bounds, see [`eye_caps`]).
+fn eye_cuts(
+    lp: &mut LinearProgram,
+    problem: &Problem,
+    e: &Eye,
+    pool: &[Cut],
+    factor: &[f64; 2],
+    x: &[Vec<(usize, f64)>],
+) -> Result<(), OptError> {
+    let l = &problem.lidar.limits;
+    let p_mean = problem.lidar.average_power_w;
+    for c in pool.iter().filter(|c| c.pulses.len() > 1) {
+        let mut row = Vec::new();
+        let f = factor[cut_class(c)];
+        let limit = c.limit_j / f;
+        for &(b, n) in &c.pulses {
+            scaled(n * p_mean / (e.pulse_rate_hz * limit), &x[b], &mut row);
+        }
+        // A floor alone at more than the row's side (but within the bare
+        // limit: checked below) keeps its own value.
+        let at_floor: f64 = c.pulses.iter().map(|&(_, n)| n).sum::<f64>() * l.power_w_min
+            / (e.pulse_rate_hz * limit);
+        if at_floor > f {
+            return Err(Infeasible::EyeWindowAtFloor {
+                wavelength_nm: l.eye_safety.as_ref().map_or(0.0, |p| p.wavelength_nm),
+                power_w_min: l.power_w_min,
+                ratio: at_floor / f,
+                azimuth_deg: c.azimuth_deg,
+                rule: format!("{:?}", c.rule),
+            }
+            .into());
+        }
+        lp.add_row(
+            &row,
+            f64::NEG_INFINITY,
+            cut_rhs().max(at_floor * (1.0 + 1e-12)),
+        );
+    }
+    Ok(())
 }
 
 /// The powers (W) of a solved power step: levels as chosen, continuous
@@ -621,7 +733,7 @@ fn powers(
 }
 
 /// Lowers powers (W) until every neighbour pair meets the program's slew
-/// rows, `|p_j − p_i| ≤ s·(Δ_i + Δ_j)/2·(1 − MARGIN)`, a few ulps inside:
+/// rows, `|p_j − p_i| ≤ s·(Δ_i + Δ_j)/2·(1 − S.margin)`, a few ulps inside:
 /// each power becomes the least over all bins of that bin's power plus the
 /// slew allowance along the circle between them (sweeps both ways until
 /// nothing moves). HiGHS meets those rows only to its absolute tolerance
@@ -638,7 +750,7 @@ fn slew_down(p: &mut [f64], g: &Grid, s: f64) {
             let j = next_index(i, n);
             s * 0.5
                 * (g.width_deg[i] + g.width_deg[j])
-                * (1.0 - MARGIN)
+                * (1.0 - S.margin)
                 * (1.0 - 8.0 * f64::EPSILON)
         })
         .collect();
@@ -695,10 +807,6 @@ pub(super) struct PowerLp {
     solver_dual_bound: Option<f64>,
 }
 
-/// Shrink steps tried (towards the power floor) when rounding leaves a
-/// row a few ulps over.
-const REPAIR_TRIES: usize = 40;
-
 impl PowerLp {
     /// The program's point for powers `p` (W): `x = p/P̄`, the segments
     /// filled greedily (a few ulps short, so the row holds exactly); `None`
@@ -736,14 +844,11 @@ impl PowerLp {
     /// floor by a few ulps where rounding left a row over.
     /// Returns the certificate and the powers it is for (`p`, or `p` shrunk
     /// by a few ulps; never higher).
-    pub(super) fn certify(&self, p: &[f64]) -> Result<(Certified, Vec<f64>), String> {
+    pub(super) fn certify(&self, p: &[f64]) -> Result<(Certified, Vec<f64>), CertificateError> {
         let floor = self.floor_w;
         let mut q = p.to_vec();
-        for k in 0..REPAIR_TRIES {
-            let v = self.point(&q).ok_or_else(|| {
-                "a power is not one of the hardware levels (the eye-safety fit scaled it)"
-                    .to_owned()
-            })?;
+        for k in 0..S.repair_tries {
+            let v = self.point(&q).ok_or(CertificateError::NotALevel)?;
             match Certified::new(
                 Step::Power,
                 self.lp.clone(),
@@ -753,10 +858,10 @@ impl PowerLp {
             ) {
                 Ok(c) => return Ok((c, q)),
                 Err(e)
-                    if k + 1 == REPAIR_TRIES
+                    if k + 1 == S.repair_tries
                         || self.bins.iter().any(|b| matches!(b, PowerBin::Levels(_))) =>
                 {
-                    return Err(e.to_string())
+                    return Err(e)
                 }
                 Err(_) => {}
             }
@@ -765,20 +870,15 @@ impl PowerLp {
                 *qi = floor + (*qi - floor).max(0.0) * shrink;
             }
         }
-        Err("the power step's answer could not be certified exactly".into())
+        Err(CertificateError::PowerStep)
     }
 }
-
-/// HiGHS's primal feasibility tolerance on the dwell step's program (its
-/// default is 1e-7): the certified program's rows are widened by
-/// `2·DWELL_FEASIBILITY_TOL·(1 + Σ|a|)` ([`LinearProgram::widened`]).
-const DWELL_FEASIBILITY_TOL: f64 = 1e-9;
 
 /// A dwell step's answer: the dwell (s), and its program's exact
 /// certificate or why there is none.
 pub(super) struct DwellStep {
     t: Vec<f64>,
-    cert: Result<Certified, String>,
+    cert: Result<Certified, CertificateError>,
 }
 
 /// Dwell step: power `p` fixed; `current` is the iterate for linearisation.
@@ -787,13 +887,13 @@ pub(super) struct DwellStep {
 /// their limit, found by the power step before) linearised in dwell — the
 /// pulses a cut counts from bin `b` scaled by `t_b/t_b⁰` (a pass over `b`
 /// holds pulses in proportion to its time there), the limits held at the
-/// iterate's — inside a trust region of ±[`TRUST`] on the bins they touch.
+/// iterate's — inside a trust region of ±`settings::trust` on the bins they touch.
 /// Exact at the iterate, first order around it; the bound decides after
 /// (the power step that follows restores certified powers; without one the
 /// move is shortened until the bound certifies, see [`solve`]).
 ///
 /// Certificate (`specs/optimizer.md`, "The dwell step's certificate"):
-/// HiGHS solves the program at [`DWELL_FEASIBILITY_TOL`]; its point, with
+/// HiGHS solves the program at `settings::dwell_feasibility_tol`; its point, with
 /// the columns clamped into their bounds and the binaries rounded, is
 /// checked exactly against the program with every row widened by twice
 /// that tolerance (the frame equality `Σ τ = N` becomes a range of width
@@ -808,165 +908,260 @@ fn dwell_step(
     p: &[f64],
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
-    let mut touched = vec![false; g.n];
-    for c in binding {
-        for &(b, _) in &c.pulses {
-            touched[b] = true;
-        }
-    }
-    let lid = &problem.lidar;
-    let l = &lid.limits;
-    let period = 1.0 / lid.frame_rate_hz;
-    let unit = period / g.n as f64; // τ = t / unit
-    let w_mean = lid.mean_spin_rad_s();
-    let lam = problem.objective.resolution_weight;
+    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current)?;
+    let solved = d.lp.solve_with(
+        "dwell",
+        &SolveOptions {
+            initial: Some(&d.start),
+            primal_feasibility_tolerance: S.dwell_feasibility_tol,
+        },
+    )?;
+    let x = d.lp.clamped(&solved.x);
+    let t = dwell_answer(problem, g, &d, &x);
+    let cert = Certified::new(
+        Step::Dwell,
+        d.lp.widened(2.0 * S.dwell_feasibility_tol),
+        x,
+        solved.y,
+        solved.solver_dual_bound,
+    )
+    .map_err(|e| CertificateError::DwellStep(Box::new(e)));
+    Ok(DwellStep { t, cert })
+}
+
+/// The dwell step's program and how each bin's dwell reads from it.
+struct DwellProgram {
+    lp: LinearProgram,
+    /// `τ_i = t_i / unit` as a linear form over the columns.
+    tau: Vec<Vec<(usize, f64)>>,
+    /// Per bin with set-points, (spin, binary column) per set-point.
+    sp_cols: Vec<Vec<(f64, usize)>>,
+    /// The hot start, one value per column.
+    start: Vec<f64>,
+    /// `T / N`, s.
+    unit: f64,
+}
+
+/// Builds the dwell step's program: per bin its columns and utility (with
+/// set-points: the `levels` family, one binary per set-point and a one-hot
+/// row), then the constraint families in a fixed order — `frame`,
+/// `budget` (time accounting), `accel`, `eye_cuts` (linearised).
+fn dwell_program(
+    problem: &Problem,
+    g: &Grid,
+    binding: &[Cut],
+    pulse_rate_hz: f64,
+    p: &[f64],
+    current: &[f64],
+) -> Result<DwellProgram, OptError> {
+    let l = &problem.lidar.limits;
     let setpoints = &problem.levels.spin_rad_s;
-    let mut lp = LinearProgram::default();
-    // τ_i as a linear form over the columns.
-    let mut tau: Vec<Vec<(usize, f64)>> = Vec::with_capacity(g.n);
-    // Per bin with set-points, (spin, binary column) per set-point.
-    let mut sp_cols: Vec<Vec<(f64, usize)>> = Vec::new();
-    let mut start: Vec<f64> = Vec::new();
-    let mut utility_constant = 0.0;
     let allowed: Vec<f64> = setpoints
         .iter()
         .copied()
         .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
         .collect();
     if !setpoints.is_empty() && allowed.is_empty() {
-        return Err(OptError::Infeasible(
-            "no spin set-point lies within [spin_rad_s_min, spin_rad_s_max]".into(),
-        ));
+        return Err(Infeasible::NoSetPointFits.into());
     }
+    let mut touched = vec![false; g.n];
+    for c in binding {
+        for &(b, _) in &c.pulses {
+            touched[b] = true;
+        }
+    }
+    let mut d = DwellProgram {
+        lp: LinearProgram::default(),
+        tau: Vec::with_capacity(g.n),
+        sp_cols: Vec::new(),
+        start: Vec::new(),
+        unit: 1.0 / problem.lidar.frame_rate_hz / g.n as f64,
+    };
+    let mut utility_constant = 0.0;
     for i in 0..g.n {
-        let th = g.theta[i];
         if setpoints.is_empty() {
-            let lo = th / l.spin_rad_s_max / unit * (1.0 + MARGIN);
-            let hi = if l.spin_rad_s_min > 0.0 {
-                th / l.spin_rad_s_min / unit * (1.0 - MARGIN)
-            } else {
-                1e9
-            };
-            // Where the margins cross (spin limits within 2e-6 of each
-            // other, e.g. equal: a fixed spin), the limits themselves.
-            let (lo, hi) = if lo <= hi {
-                (lo, hi)
-            } else {
-                let bare = |w: f64| th / w / unit;
-                (
-                    bare(l.spin_rad_s_max),
-                    bare(l.spin_rad_s_min).max(bare(l.spin_rad_s_max)),
-                )
-            };
-            let (mut lo, mut hi) = (lo, hi);
             let trust = l.spin_accel_rad_s2_max.is_some() || touched[i];
-            if trust {
-                lo = lo.max(current[i] / unit * (1.0 - TRUST));
-                hi = hi.min(current[i] / unit * (1.0 + TRUST)).max(lo);
-            }
-            let t0 = (current[i] / unit).max(lo).min(hi);
-            let ti = lp.add_col(lo, hi, 0.0, false);
-            start.push(t0);
-            // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
-            let k = unit * TAU / (th * period);
-            let (r_lo, r_hi) = (
-                w_mean / l.spin_rad_s_max,
-                if l.spin_rad_s_min > 0.0 {
-                    w_mean / l.spin_rad_s_min
-                } else {
-                    1e3
-                },
-            );
-            // The utility as boxed segment columns on the densities this
-            // column reaches (its box: the spin limits, and the trust region
-            // where it applies), Σ δ ≤ k·τ − r_0 (see `utility`; its
-            // constant does not move the optimum).
-            let r_0 = r_lo.max(k * lo);
-            let chords = if trust {
-                TRUST_REGION_SEGMENTS
-            } else {
-                super::UTILITY_SEGMENTS
-            };
-            let shape = sqrt_segments_n(r_0, r_hi.min(k * hi).max(r_0), chords);
-            let c = lam * th * g.weight[i];
-            shape.add_to(&mut lp, ti, k, r_0, c);
-            utility_constant += c * shape.base;
-            start.extend(shape.fill(r_0, k * t0));
-            tau.push(vec![(ti, 1.0)]);
+            utility_constant += dwell_column(&mut d, problem, g, i, current[i], trust);
         } else {
-            let ys: Vec<(f64, usize)> = allowed
-                .iter()
-                .map(|&w| {
-                    let cost = lam * th * g.weight[i] * (w_mean / w).sqrt();
-                    start.push(0.0);
-                    (w, lp.add_col(0.0, 1.0, cost, true))
-                })
-                .collect();
-            let one: Vec<(usize, f64)> = ys.iter().map(|&(_, y)| (y, 1.0)).collect();
-            lp.add_row(&one, 1.0, 1.0);
-            tau.push(ys.iter().map(|&(w, y)| (y, th / w / unit)).collect());
-            sp_cols.push(ys);
+            spin_levels(&mut d, problem, g, i, &allowed);
         }
     }
     // The utilities' constants Σ c·√r_0 as one column fixed at 1 (as the
     // power step's), so the program's objective is the chord model's value
     // of the profile, comparable with `exact_objective`.
     if utility_constant != 0.0 {
-        lp.add_col(1.0, 1.0, utility_constant, false);
-        start.push(1.0);
+        d.lp.add_col(1.0, 1.0, utility_constant, false);
+        d.start.push(1.0);
     }
-    let n = g.n as f64;
-    lp.add_row(&tau.concat(), n, n);
-    if lid.power_accounting == PowerAccounting::Time {
-        // No margin here: with uniform P̄ the budget is exactly tight. The
-        // power step that ends every joint solve trims the budget exactly.
-        let spend: Vec<(usize, f64)> = tau
-            .iter()
-            .zip(p)
-            .flat_map(|(form, &pi)| {
-                form.iter()
-                    .map(move |&(j, a)| (j, a * pi / lid.average_power_w))
-            })
-            .collect();
-        lp.add_row(&spend, f64::NEG_INFINITY, n);
+    frame(&mut d, g.n);
+    if problem.lidar.power_accounting == PowerAccounting::Time {
+        dwell_budget(&mut d, p, problem.lidar.average_power_w, g.n);
     }
     if let Some(a_max) = l.spin_accel_rad_s2_max {
-        for i in 0..g.n {
-            let j = next_index(i, g.n);
-            let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
-            let dtheta = 0.5 * (g.theta[i] + g.theta[j]);
-            let ds = ACCEL_SHARE * a_max * dtheta * (1.0 - TRUST).powi(3) / w_cur.powi(3);
-            // s = t/θ = τ·unit/θ.
-            let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
-            let scaled = |form: &[(usize, f64)], k: f64| -> Vec<(usize, f64)> {
-                form.iter().map(|&(c, a)| (c, a * k)).collect()
-            };
-            let diff = [scaled(&tau[j], kj), scaled(&tau[i], -ki)].concat();
-            lp.add_row(&diff, -ds, ds);
-        }
+        accel(&mut d, g, current, a_max);
     }
+    linearised_eye_cuts(&mut d, binding, pulse_rate_hz, p, current);
+    Ok(d)
+}
+
+/// Bin `i`'s continuous dwell column `τ_i` (boxed by the spin limits and,
+/// where `trust`, the trust region around the iterate `current_s`) and its
+/// density utility's segments; returns the utility's constant.
+fn dwell_column(
+    d: &mut DwellProgram,
+    problem: &Problem,
+    g: &Grid,
+    i: usize,
+    current_s: f64,
+    trust: bool,
+) -> f64 {
+    let l = &problem.lidar.limits;
+    let period = 1.0 / problem.lidar.frame_rate_hz;
+    let unit = d.unit;
+    let th = g.theta[i];
+    let (mut lo, mut hi) = dwell_box(l, th, unit);
+    if trust {
+        lo = lo.max(current_s / unit * (1.0 - S.trust));
+        hi = hi.min(current_s / unit * (1.0 + S.trust)).max(lo);
+    }
+    let t0 = (current_s / unit).max(lo).min(hi);
+    let ti = d.lp.add_col(lo, hi, 0.0, false);
+    d.start.push(t0);
+    // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
+    let k = unit * TAU / (th * period);
+    let w_mean = problem.lidar.mean_spin_rad_s();
+    let r_lo = w_mean / l.spin_rad_s_max;
+    let r_hi = if l.spin_rad_s_min > 0.0 {
+        w_mean / l.spin_rad_s_min
+    } else {
+        1e3
+    };
+    // The utility as boxed segment columns on the densities this column
+    // reaches (its box: the spin limits, and the trust region where it
+    // applies), Σ δ ≤ k·τ − r_0 (see `utility`; its constant does not move
+    // the optimum).
+    let r_0 = r_lo.max(k * lo);
+    let chords = if trust {
+        S.trust_region_segments
+    } else {
+        super::UTILITY_SEGMENTS
+    };
+    let shape = sqrt_segments_n(r_0, r_hi.min(k * hi).max(r_0), chords);
+    let c = problem.objective.resolution_weight * th * g.weight[i];
+    shape.add_to(&mut d.lp, ti, k, r_0, c);
+    d.start.extend(shape.fill(r_0, k * t0));
+    d.tau.push(vec![(ti, 1.0)]);
+    c * shape.base
+}
+
+/// The box of a bin's `τ` from the spin limits, with the margin; where the
+/// margins cross (spin limits within 2e-6 of each other, e.g. equal: a
+/// fixed spin), the limits themselves.
+fn dwell_box(l: &crate::model::lidar::Limits, th: f64, unit: f64) -> (f64, f64) {
+    let lo = th / l.spin_rad_s_max / unit * (1.0 + S.margin);
+    let hi = if l.spin_rad_s_min > 0.0 {
+        th / l.spin_rad_s_min / unit * (1.0 - S.margin)
+    } else {
+        1e9
+    };
+    if lo <= hi {
+        (lo, hi)
+    } else {
+        let bare = |w: f64| th / w / unit;
+        (
+            bare(l.spin_rad_s_max),
+            bare(l.spin_rad_s_min).max(bare(l.spin_rad_s_max)),
+        )
+    }
+}
+
+/// `levels` for the spin: one binary per allowed set-point `w` (cost
+/// `c·√(ω̄/w)`) and the one-hot row `Σ y = 1`; `τ_i = Σ (θ_i/w)/unit · y_w`.
+fn spin_levels(d: &mut DwellProgram, problem: &Problem, g: &Grid, i: usize, allowed: &[f64]) {
+    let th = g.theta[i];
+    let w_mean = problem.lidar.mean_spin_rad_s();
+    let lam = problem.objective.resolution_weight;
+    let ys: Vec<(f64, usize)> = allowed
+        .iter()
+        .map(|&w| {
+            let cost = lam * th * g.weight[i] * (w_mean / w).sqrt();
+            d.start.push(0.0);
+            (w, d.lp.add_col(0.0, 1.0, cost, true))
+        })
+        .collect();
+    let one: Vec<(usize, f64)> = ys.iter().map(|&(_, y)| (y, 1.0)).collect();
+    d.lp.add_row(&one, 1.0, 1.0);
+    let unit = d.unit;
+    d.tau
+        .push(ys.iter().map(|&(w, y)| (y, th / w / unit)).collect());
+    d.sp_cols.push(ys);
+}
+
+/// `frame`: `Σ τ_i = N` (one turn per frame period).
+fn frame(d: &mut DwellProgram, n: usize) {
+    let n = n as f64;
+    d.lp.add_row(&d.tau.concat(), n, n);
+}
+
+/// `budget` under time accounting at the fixed powers `p`:
+/// `Σ τ_i·p_i/P̄ ≤ N`. No margin here: with uniform P̄ the budget is exactly
+/// tight. The power step that ends every joint solve trims the budget
+/// exactly.
+fn dwell_budget(d: &mut DwellProgram, p: &[f64], p_mean: f64, n: usize) {
+    let spend: Vec<(usize, f64)> = d
+        .tau
+        .iter()
+        .zip(p)
+        .flat_map(|(form, &pi)| form.iter().map(move |&(j, a)| (j, a * pi / p_mean)))
+        .collect();
+    d.lp.add_row(&spend, f64::NEG_INFINITY, n as f64);
+}
+
+/// `accel`: the change of slowness `s = t/θ` between neighbours,
+/// `|Δs| ≤ accel_share·a·Δθ·(1−trust)³/ω̃³`, linearised at the iterate.
+fn accel(d: &mut DwellProgram, g: &Grid, current: &[f64], a_max: f64) {
+    let unit = d.unit;
+    let scaled = |form: &[(usize, f64)], k: f64| -> Vec<(usize, f64)> {
+        form.iter().map(|&(c, a)| (c, a * k)).collect()
+    };
+    for i in 0..g.n {
+        let j = next_index(i, g.n);
+        let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
+        let dtheta = 0.5 * (g.theta[i] + g.theta[j]);
+        let ds = S.accel_share * a_max * dtheta * (1.0 - S.trust).powi(3) / w_cur.powi(3);
+        // s = t/θ = τ·unit/θ.
+        let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
+        let diff = [scaled(&d.tau[j], kj), scaled(&d.tau[i], -ki)].concat();
+        d.lp.add_row(&diff, -ds, ds);
+    }
+}
+
+/// `eye_cuts` linearised in dwell: the pulses a binding cut counts from bin
+/// `b` scaled by `τ_b/τ_b⁰`, the limits held at the iterate's.
+fn linearised_eye_cuts(
+    d: &mut DwellProgram,
+    binding: &[Cut],
+    pulse_rate_hz: f64,
+    p: &[f64],
+    current: &[f64],
+) {
     for c in binding {
         let mut en: Vec<(usize, f64)> = Vec::new();
         for &(b, cnt) in &c.pulses {
-            let tau0 = current[b] / unit;
+            let tau0 = current[b] / d.unit;
             let k = cnt * p[b] / (pulse_rate_hz * c.limit_j) / tau0;
-            en.extend(tau[b].iter().map(|&(col, a)| (col, a * k)));
+            en.extend(d.tau[b].iter().map(|&(col, a)| (col, a * k)));
         }
-        lp.add_row(&en, f64::NEG_INFINITY, cut_rhs());
+        d.lp.add_row(&en, f64::NEG_INFINITY, cut_rhs());
     }
-    let solved = lp.solve_with(
-        "dwell",
-        &SolveOptions {
-            initial: Some(&start),
-            primal_feasibility_tolerance: DWELL_FEASIBILITY_TOL,
-        },
-    )?;
-    let x = lp.clamped(&solved.x);
-    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * x[j]).sum::<f64>();
-    let mut t: Vec<f64> = if setpoints.is_empty() {
-        tau.iter().map(|form| eval(form) * unit).collect()
-    } else {
-        sp_cols
+}
+
+/// The dwell (s) of the solved point `x`: continuous columns rescaled to
+/// the exact frame period, or each bin's chosen set-point.
+fn dwell_answer(problem: &Problem, g: &Grid, d: &DwellProgram, x: &[f64]) -> Vec<f64> {
+    if !problem.levels.spin_rad_s.is_empty() {
+        return d
+            .sp_cols
             .iter()
             .zip(&g.theta)
             .map(|(ys, th)| {
@@ -976,24 +1171,17 @@ fn dwell_step(
                     .map_or(0.0, |&(w, _)| w);
                 th / w
             })
-            .collect()
-    };
-    if setpoints.is_empty() {
-        // Exact frame period.
-        let s: f64 = t.iter().sum();
-        for ti in &mut t {
-            *ti *= period / s;
-        }
+            .collect();
     }
-    let cert = Certified::new(
-        Step::Dwell,
-        lp.widened(2.0 * DWELL_FEASIBILITY_TOL),
-        x,
-        solved.y,
-        solved.solver_dual_bound,
-    )
-    .map_err(|e| format!("the dwell step's answer could not be certified exactly: {e}"));
-    Ok(DwellStep { t, cert })
+    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * x[j]).sum::<f64>();
+    let mut t: Vec<f64> = d.tau.iter().map(|form| eval(form) * d.unit).collect();
+    // Exact frame period.
+    let period = 1.0 / problem.lidar.frame_rate_hz;
+    let s: f64 = t.iter().sum();
+    for ti in &mut t {
+        *ti *= period / s;
+    }
+    t
 }
 
 /// The spin of dwell `t`: one spin per bin (steps) when `smooth` is
@@ -1032,7 +1220,7 @@ pub(super) struct Solution {
 /// The dwell steps' certificates.
 pub(super) struct DwellCertificates {
     /// The last program's certificate, or the first failure.
-    pub(super) last: Result<Certified, String>,
+    pub(super) last: Result<Certified, CertificateError>,
     /// Programs solved.
     pub(super) programs: usize,
     /// Whether the profile's dwell is the last program's point (rescaled
@@ -1044,7 +1232,7 @@ pub(super) struct DwellCertificates {
 impl DwellCertificates {
     fn push(this: &mut Option<Self>, step: DwellStep) -> Vec<f64> {
         let d = this.get_or_insert(Self {
-            last: Err(String::new()),
+            last: Err(CertificateError::NoProgram),
             programs: 0,
             is_answer: false,
         });
@@ -1056,7 +1244,11 @@ impl DwellCertificates {
     }
 }
 
-/// Solves and builds the (uncertified) profile, with the programs' certificates.
+/// Solves and builds the (uncertified) profile, with the programs'
+/// certificates: block-coordinate ascent from the uniform baseline as named
+/// steps — the mode's rounds ([`range_rounds`], [`resolution_rounds`],
+/// [`joint_rounds`]), the final power step on a smoothed spin, the
+/// eye-safety shortening of a resolution-mode move, the profile.
 pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptError> {
     let g = grid(problem, gaze_deg)?;
     let lid = &problem.lidar;
@@ -1064,127 +1256,221 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
     prechecks(problem, eye.as_ref())?;
     let w_mean = lid.mean_spin_rad_s();
     let t_base: Vec<f64> = g.theta.iter().map(|th| th / w_mean).collect();
-    let mut t = t_base.clone();
     let p_start = lid
         .average_power_w
         .clamp(lid.limits.power_w_min, lid.limits.power_w_max);
-    let mut p: Vec<f64> = vec![p_start; g.n];
-    let mode = problem.objective.mode;
-    let mut last: Option<PowerLp> = None;
-    let smooth_spin = lid.limits.spin_accel_rad_s2_max.is_some();
-    let spin_rounds = if smooth_spin { SLP_ROUNDS } else { 1 };
-    let f_p = lid.pulse_rate_hz;
-    // The cuts of new spins, found at the powers before the step (a warm
-    // start: valid whatever the powers).
-    let warm = |spins: &[(f64, f64)], p: &[f64]| -> Vec<Cut> {
-        eye.as_ref()
-            .map_or_else(Vec::new, |e| e.cuts(&segs(&g, spins, p), &[], BINDING))
+    let mut it = Iterate {
+        p: vec![p_start; g.n],
+        t: t_base.clone(),
+        last: None,
+        dwell: None,
     };
-    let steps = |t: &[f64]| spins_of(&g, t, false, lid.frame_rate_hz);
-    let mut binding: Vec<Cut> = Vec::new();
-    let mut dwell: Option<DwellCertificates> = None;
+    let ctx = Ctx {
+        problem,
+        g: &g,
+        eye: eye.as_ref(),
+    };
+    let mode = problem.objective.mode;
     match mode {
         Mode::Baseline => {}
-        Mode::Range => {
-            let sp = steps(&t);
-            let mut pool = warm(&sp, &p);
-            let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
-            p = pp;
-            last = Some(plp);
-        }
-        Mode::Resolution => {
-            for round in 0..spin_rounds {
-                let step = match dwell_step(problem, &g, &[], f_p, &p, &t) {
-                    // See the joint loop.
-                    Err(OptError::Infeasible(_)) if round > 0 => break,
-                    r => r?,
-                };
-                let next = DwellCertificates::push(&mut dwell, step);
-                let settled = settled(&next, &t);
-                t = next;
-                if settled {
-                    break;
-                }
-            }
-        }
-        Mode::Joint => {
-            let rounds = spin_rounds.max(2);
-            for round in 0..rounds {
-                let step = match dwell_step(problem, &g, &binding, f_p, &p, &t) {
-                    // A later round's program (re-linearised acceleration
-                    // rows, trust region, the budget at the new powers) can
-                    // have no point even though the iterate is a certified
-                    // profile's (found by breaker3 at 10⁴ rad/s²): the
-                    // sequential LP cannot move from it, so it stops there.
-                    Err(OptError::Infeasible(_)) if round > 0 => break,
-                    r => r?,
-                };
-                let next = DwellCertificates::push(&mut dwell, step);
-                if last.is_some() && next == t {
-                    // A fixed point: both steps are deterministic functions
-                    // of (p, t) (the binding cuts are found afresh from
-                    // them), so every further round repeats this one.
-                    break;
-                }
-                let settled = smooth_spin && settled(&next, &t);
-                t = next;
-                if smooth_spin && (settled || round + 1 == rounds) {
-                    // The last dwell of a smoothed spin: the final power
-                    // step below, on the rebuilt spin, replaces this
-                    // round's power step on the step spins.
-                    break;
-                }
-                let sp = steps(&t);
-                let mut pool = warm(&sp, &p);
-                let (pp, plp) = power_step(problem, &g, eye.as_ref(), &sp, &mut pool)?;
-                p = pp;
-                last = Some(plp);
-                // The binding cuts of the new iterate, found afresh (a
-                // function of the iterate alone, not of the loop's path).
-                binding = warm(&sp, &p)
-                    .into_iter()
-                    .filter(|c| c.ratio(&p, f_p) >= BINDING)
-                    .collect();
-            }
-        }
+        Mode::Range => range_rounds(&ctx, &mut it)?,
+        Mode::Resolution => resolution_rounds(&ctx, &mut it)?,
+        Mode::Joint => joint_rounds(&ctx, &mut it)?,
     }
-    let smooth = smooth_spin && mode.controls_resolution();
-    let mut spins = spins_of(&g, &t, smooth, lid.frame_rate_hz);
+    let smooth = lid.limits.spin_accel_rad_s2_max.is_some() && mode.controls_resolution();
+    let mut spins = spins_of(&g, &it.t, smooth, lid.frame_rate_hz);
     if smooth && mode.controls_range() {
         // Final power step on the exact spin of the rebuilt profile.
-        let mut pool = warm(&spins, &p);
-        let (pp, plp) = power_step(problem, &g, eye.as_ref(), &spins, &mut pool)?;
-        p = pp;
-        last = Some(plp);
+        let mut pool = ctx.warm(&spins, &it.p);
+        let (pp, plp) = power_step(problem, &g, ctx.eye, &spins, &mut pool)?;
+        it.p = pp;
+        it.last = Some(plp);
     }
     let mut shortened = false;
-    if let (Some(e), Mode::Resolution) = (eye.as_ref(), mode) {
-        // No power step follows the dwell steps: shorten the move from the
-        // uniform spin until the bound certifies (the uniform spin itself
-        // is the last resort, and the checker has the last word).
-        let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
-            Ok(e.verdict(&segs(&g, sp, &p))?.0 <= 1.0 - EYE_SAFETY_HEADROOM)
-        };
-        let mut alpha = 1.0;
-        while !safe(&spins)? && alpha > 0.0 {
-            shortened = true;
-            alpha = if alpha > 1.0 / 64.0 { alpha / 2.0 } else { 0.0 };
-            let ta: Vec<f64> = t_base
-                .iter()
-                .zip(&t)
-                .map(|(b, x)| b + alpha * (x - b))
-                .collect();
-            spins = spins_of(&g, &ta, smooth, lid.frame_rate_hz);
-        }
-        let (ratio, at) = e.verdict(&segs(&g, &spins, &p))?;
-        if ratio > 1.0 - EYE_SAFETY_HEADROOM {
-            return Err(OptError::Infeasible(format!(
-                "eye safety: the power ({:.4e} W in every bin; resolution mode does not move it) is {:.1} % of the Class 1 limit at {at:.3}° even at the uniform spin",
-                p[0],
-                100.0 * ratio
-            )));
+    if let (Some(e), Mode::Resolution) = (ctx.eye, mode) {
+        (spins, shortened) = shorten_for_eye_safety(&ctx, e, &it, &t_base, spins, smooth)?;
+    }
+    let profile = build_profile(problem, &g, gaze_deg, &it.p, &spins);
+    if let Some(d) = it.dwell.as_mut() {
+        d.is_answer = mode == Mode::Resolution && !smooth && !shortened;
+    }
+    Ok(Solution {
+        profile,
+        power: it.last,
+        dwell: it.dwell,
+    })
+}
+
+/// What every step of [`solve`] reads.
+struct Ctx<'a> {
+    problem: &'a Problem,
+    g: &'a Grid,
+    eye: Option<&'a Eye>,
+}
+
+impl Ctx<'_> {
+    /// The cuts of new spins, found at the powers before the step (a warm
+    /// start: valid whatever the powers).
+    fn warm(&self, spins: &[(f64, f64)], p: &[f64]) -> Vec<Cut> {
+        self.eye.map_or_else(Vec::new, |e| {
+            e.cuts(&segs(self.g, spins, p), &[], S.binding)
+        })
+    }
+
+    /// Step spins of dwell `t` (one spin per bin).
+    fn steps(&self, t: &[f64]) -> Vec<(f64, f64)> {
+        spins_of(self.g, t, false, self.problem.lidar.frame_rate_hz)
+    }
+
+    /// Dwell-step rounds: the sequential LP's with a finite acceleration
+    /// limit, else one.
+    fn spin_rounds(&self) -> usize {
+        if self.problem.lidar.limits.spin_accel_rad_s2_max.is_some() {
+            S.slp_rounds
+        } else {
+            1
         }
     }
+
+    /// A power step on `spins` from the iterate's powers.
+    fn power(&self, it: &mut Iterate, spins: &[(f64, f64)]) -> Result<(), OptError> {
+        let mut pool = self.warm(spins, &it.p);
+        let (pp, plp) = power_step(self.problem, self.g, self.eye, spins, &mut pool)?;
+        it.p = pp;
+        it.last = Some(plp);
+        Ok(())
+    }
+}
+
+/// The block-coordinate iterate: powers (W), dwell (s), the last power
+/// step's program and the dwell steps' certificates.
+struct Iterate {
+    p: Vec<f64>,
+    t: Vec<f64>,
+    last: Option<PowerLp>,
+    dwell: Option<DwellCertificates>,
+}
+
+/// `range`: one power step on the uniform spin.
+fn range_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
+    let sp = ctx.steps(&it.t);
+    ctx.power(it, &sp)
+}
+
+/// `resolution`: dwell steps at the fixed power until settled.
+fn resolution_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
+    let f_p = ctx.problem.lidar.pulse_rate_hz;
+    for round in 0..ctx.spin_rounds() {
+        let step = match dwell_step(ctx.problem, ctx.g, &[], f_p, &it.p, &it.t) {
+            // See `joint_rounds`.
+            Err(OptError::Infeasible(_)) if round > 0 => break,
+            r => r?,
+        };
+        let next = DwellCertificates::push(&mut it.dwell, step);
+        let settled = settled(&next, &it.t);
+        it.t = next;
+        if settled {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// `joint`: alternating dwell and power steps until a fixed point, the
+/// sequential LP settles, or the rounds run out.
+fn joint_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
+    let f_p = ctx.problem.lidar.pulse_rate_hz;
+    let smooth_spin = ctx.problem.lidar.limits.spin_accel_rad_s2_max.is_some();
+    let rounds = ctx.spin_rounds().max(2);
+    let mut binding: Vec<Cut> = Vec::new();
+    for round in 0..rounds {
+        let step = match dwell_step(ctx.problem, ctx.g, &binding, f_p, &it.p, &it.t) {
+            // A later round's program (re-linearised acceleration rows,
+            // trust region, the budget at the new powers) can have no point
+            // even though the iterate is a certified profile's (found by
+            // breaker3 at 10⁴ rad/s²): the sequential LP cannot move from
+            // it, so it stops there.
+            Err(OptError::Infeasible(_)) if round > 0 => break,
+            r => r?,
+        };
+        let next = DwellCertificates::push(&mut it.dwell, step);
+        if it.last.is_some() && next == it.t {
+            // A fixed point: both steps are deterministic functions of
+            // (p, t) (the binding cuts are found afresh from them), so every
+            // further round repeats this one.
+            break;
+        }
+        let settled = smooth_spin && settled(&next, &it.t);
+        it.t = next;
+        if smooth_spin && (settled || round + 1 == rounds) {
+            // The last dwell of a smoothed spin: the final power step in
+            // `solve`, on the rebuilt spin, replaces this round's power
+            // step on the step spins.
+            break;
+        }
+        let sp = ctx.steps(&it.t);
+        ctx.power(it, &sp)?;
+        // The binding cuts of the new iterate, found afresh (a function of
+        // the iterate alone, not of the loop's path).
+        binding = ctx
+            .warm(&sp, &it.p)
+            .into_iter()
+            .filter(|c| c.ratio(&it.p, f_p) >= S.binding)
+            .collect();
+    }
+    Ok(())
+}
+
+/// `resolution` with eye safety: no power step follows the dwell steps, so
+/// the move from the uniform spin is shortened until the bound certifies
+/// (the uniform spin itself is the last resort, and the checker has the
+/// last word). Returns the spins and whether the move was shortened.
+fn shorten_for_eye_safety(
+    ctx: &Ctx<'_>,
+    e: &Eye,
+    it: &Iterate,
+    t_base: &[f64],
+    mut spins: Vec<(f64, f64)>,
+    smooth: bool,
+) -> Result<(Vec<(f64, f64)>, bool), OptError> {
+    let g = ctx.g;
+    let p = &it.p;
+    let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
+        Ok(e.verdict(&segs(g, sp, p))?.0 <= 1.0 - S.eye_safety_headroom)
+    };
+    let mut shortened = false;
+    let mut alpha = 1.0;
+    while !safe(&spins)? && alpha > 0.0 {
+        shortened = true;
+        alpha = if alpha > 1.0 / 64.0 { alpha / 2.0 } else { 0.0 };
+        let ta: Vec<f64> = t_base
+            .iter()
+            .zip(&it.t)
+            .map(|(b, x)| b + alpha * (x - b))
+            .collect();
+        spins = spins_of(g, &ta, smooth, ctx.problem.lidar.frame_rate_hz);
+    }
+    let (ratio, at) = e.verdict(&segs(g, &spins, p))?;
+    if ratio > 1.0 - S.eye_safety_headroom {
+        return Err(Infeasible::EyeAtUniformSpin {
+            power_w: p[0],
+            ratio,
+            at_deg: at,
+        }
+        .into());
+    }
+    Ok((spins, shortened))
+}
+
+/// The (uncertified) profile of powers `p` and `spins`.
+fn build_profile(
+    problem: &Problem,
+    g: &Grid,
+    gaze_deg: f64,
+    p: &[f64],
+    spins: &[(f64, f64)],
+) -> Profile {
+    let lid = &problem.lidar;
     let bins = (0..g.n)
         .map(|i| Bin {
             start_deg: g.start_deg[i],
@@ -1200,7 +1486,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
             dwell_s: Some(2.0 * g.theta[i] / (spins[i].0 + spins[i].1)),
         })
         .collect();
-    let profile = Profile {
+    Profile {
         format: PROFILE_FORMAT.to_owned(),
         frame_rate_hz: lid.frame_rate_hz,
         pulse_rate_hz: lid.pulse_rate_hz,
@@ -1209,16 +1495,8 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
         gaze_deg: Some(wrap_deg(gaze_deg)),
         limits: lid.limits.clone(),
         bins,
-        mode: Some(format!("optimized {}", mode.name())),
+        mode: Some(format!("optimized {}", problem.objective.mode.name())),
         summary: None,
         optimality: None,
-    };
-    if let Some(d) = dwell.as_mut() {
-        d.is_answer = mode == Mode::Resolution && !smooth && !shortened;
     }
-    Ok(Solution {
-        profile,
-        power: last,
-        dwell,
-    })
 }

@@ -43,10 +43,13 @@
 
 pub mod certificate;
 pub mod config;
+pub mod error;
 mod exact;
 pub mod fast;
+pub mod figures;
 pub mod global;
 mod lp;
+pub mod settings;
 mod utility;
 
 use serde::{Deserialize, Serialize};
@@ -55,12 +58,14 @@ use thiserror::Error;
 use crate::checker::{certify, CertifiedProfile, Rejected};
 use crate::model::acuity::FocusModel;
 use crate::model::lidar::{LidarSpec, PowerAccounting};
-use crate::planner::Mode;
+use crate::model::Mode;
 
 pub use config::OptimizerConfig;
+pub use error::{CertificateError, Infeasible, SpinLimit};
+pub use settings::OptimizerSettings;
 
-/// Chords of the piecewise-linear utilities.
-pub const UTILITY_SEGMENTS: usize = 16;
+/// Chords of the piecewise-linear utilities ([`OptimizerSettings::utility_segments`]).
+pub const UTILITY_SEGMENTS: usize = OptimizerSettings::DEFAULT.utility_segments;
 
 /// A static prior: extra weight on a sector (e.g. cross-traffic directions).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -112,13 +117,9 @@ pub struct Levels {
     pub spin_rad_s: Vec<f64>,
 }
 
-/// Most bins the optimizer accepts (0.25° bins). The profile format and
-/// the closed forms go to `model::angle::MAX_BINS` (36,000), but the LP
-/// grows with the bin count and with the eye-safety windows aligned with
-/// every bin edge, and its solve time grows faster than linearly: measured
-/// on a shared 2-core machine, 1,440 bins ≈ 4.5 s of CPU, 3,600 bins
-/// ≈ 22 s, 36,000 bins did not finish in 20 s. 1,440 keeps a solve in seconds.
-pub const MAX_OPTIMIZER_BINS: usize = 1440;
+/// Most bins the optimizer accepts ([`OptimizerSettings::max_bins`], which
+/// gives the reason).
+pub const MAX_OPTIMIZER_BINS: usize = OptimizerSettings::DEFAULT.max_bins;
 
 /// Checks the optimizer's bin count (`field` names it in the error).
 pub fn validate_bins(bins: usize, field: &str) -> Result<(), OptError> {
@@ -163,7 +164,7 @@ pub enum OptError {
     },
     /// The limits cannot all be met (exit 1); says which.
     #[error("infeasible: {0}")]
-    Infeasible(String),
+    Infeasible(#[from] Infeasible),
     /// HiGHS failed.
     #[error("solver: {0}")]
     Solver(String),
@@ -247,7 +248,13 @@ pub(crate) fn optimize_unrated(
 pub fn optimize_with_certificate(
     problem: &Problem,
     gaze_deg: f64,
-) -> Result<(CertifiedProfile, Result<certificate::Certified, String>), OptError> {
+) -> Result<
+    (
+        CertifiedProfile,
+        Result<certificate::Certified, CertificateError>,
+    ),
+    OptError,
+> {
     crate::planner::validate_gaze(gaze_deg).map_err(|e| OptError::Invalid {
         field: "gaze-deg".into(),
         reason: e.to_string(),
@@ -271,7 +278,7 @@ pub fn optimize_with_certificate(
                 Ok(c)
             }
             Some(lp::DwellCertificates { last: Err(e), .. }) => Err(e),
-            _ => Err("this mode has no power step, and the profile's dwell is not the dwell step's answer (smoothed spin, or the move shortened for eye safety)".into()),
+            _ => Err(CertificateError::NoProgram),
         },
         Some(plp) => {
             let p: Vec<f64> = profile.bins.iter().map(|b| b.power_w).collect();

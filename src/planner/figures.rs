@@ -155,39 +155,6 @@ pub fn attach(
     certified
 }
 
-/// The paper's closed forms on `problem`'s sensor and driver model with
-/// `levels` (the preset's the configuration names): what an optimum's
-/// figures are compared with.
-#[cfg(feature = "solver")]
-#[must_use]
-pub fn closed_form_basis(
-    problem: &crate::optimizer::Problem,
-    levels: crate::model::presets::AdaptiveLevels,
-) -> Preset {
-    Preset {
-        lidar: problem.lidar.clone(),
-        focus: problem.focus.clone(),
-        levels,
-    }
-}
-
-/// [`attach`] for an optimum of `problem`: compared with the closed form
-/// of its mode on its sensor, driver model and bin count.
-#[cfg(feature = "solver")]
-#[must_use]
-pub fn attach_to_optimum(
-    certified: CertifiedProfile,
-    problem: &crate::optimizer::Problem,
-    levels: crate::model::presets::AdaptiveLevels,
-) -> CertifiedProfile {
-    attach(
-        certified,
-        &closed_form_basis(problem, levels),
-        problem.objective.mode,
-        problem.bins,
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,7 +4,6 @@
 pub mod closed_form;
 pub mod figures;
 
-use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::checker::Rejected;
@@ -13,48 +12,9 @@ use crate::model::angle::AngleError;
 
 pub use closed_form::closed_form;
 
-/// Which of the paper's controllers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "snake_case")]
-pub enum Mode {
-    /// Uniform power and spin (the non-adaptive LiDAR; also the fail-safe).
-    Baseline,
-    /// Range control: `P_low` in the RoF, `P_high` in the RoI (eq. 3–4).
-    Range,
-    /// Resolution control: `ω_high` in the RoF, `ω_low` in the RoI (eq. 5–6).
-    Resolution,
-    /// Both.
-    Joint,
-}
-
-impl Mode {
-    /// All modes, in the paper's order.
-    pub const ALL: [Mode; 4] = [Mode::Baseline, Mode::Range, Mode::Resolution, Mode::Joint];
-
-    /// Lower-case name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Baseline => "baseline",
-            Self::Range => "range",
-            Self::Resolution => "resolution",
-            Self::Joint => "joint",
-        }
-    }
-
-    /// Whether the power is modulated.
-    #[must_use]
-    pub fn controls_range(self) -> bool {
-        matches!(self, Self::Range | Self::Joint)
-    }
-
-    /// Whether the spin is modulated.
-    #[must_use]
-    pub fn controls_resolution(self) -> bool {
-        matches!(self, Self::Resolution | Self::Joint)
-    }
-}
+/// Which controller (moved to [`crate::model::mode`]; re-exported here so
+/// callers keep `planner::Mode`).
+pub use crate::model::mode::Mode;
 
 /// Why a planner could not produce a certified profile.
 #[derive(Debug, Error)]

@@ -1,0 +1,17 @@
+#!/bin/sh
+# Rewrites tests/data/optimizer_golden/ with BIN (default: the release
+# binary of CARGO_TARGET_DIR or target/): the four shipped configs at gazes
+# 0, 90 and 200, profile + certificate folder. Only for a change meant to
+# move the optimizer's answers (tests/optimizer_golden.rs compares them).
+set -eu
+cd "$(dirname "$0")/.."
+BIN=${BIN:-${CARGO_TARGET_DIR:-target}/release/gaze-lidar}
+D=tests/data/optimizer_golden
+rm -rf "$D"
+mkdir -p "$D"
+for c in paper multi_level smooth vls128_eye; do
+  for g in 0 90 200; do
+    "$BIN" profile --config "examples/configs/$c.toml" --gaze-deg "$g" \
+      --certificate "$D/${c}_g$g" --out "$D/${c}_g$g.json"
+  done
+done

@@ -1,0 +1,202 @@
+//! Every tuning constant of the optimizer in one table, each with its
+//! default and the reason for it (in the manner of Clarabel's
+//! `DefaultSettings`). The programs, the loop and the global bound read
+//! [`OptimizerSettings::DEFAULT`]; nothing else in `src/optimizer` holds a
+//! tuning number. (Fixed-width arithmetic sizes in `exact` and the fill's
+//! rounding bound in `utility` are derived quantities, not tuning.)
+
+/// The optimizer's tuning constants.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OptimizerSettings {
+    // --- The programs' shape -------------------------------------------
+    /// Chords of the piecewise-linear utilities (default 16).
+    pub utility_segments: usize,
+    /// Chords of the density utility on a dwell column inside a trust
+    /// region (default 4): a sequential LP's first-order model, where the
+    /// acceleration rows allow far smaller moves still. Measured on
+    /// `smooth` (360 bins, joint): 16 chords → 4 makes the whole solve 1.8×
+    /// faster (99 → 55 ms) and moves the answer's exact objective by 2e-14
+    /// relative (`optimality.global.objective` 8.864885452179 either way).
+    /// Columns without a trust region keep `utility_segments`.
+    pub trust_region_segments: usize,
+    /// Tie-break added to the weights, growing with signed eccentricity
+    /// (default 1e-3): makes the optimum unique where the acuity is
+    /// symmetric about the gaze, and is itself rotation-equivariant (a
+    /// function of eccentricity only), so a rotated problem has the rotated
+    /// optimum.
+    pub tie_break: f64,
+    /// Most bins the optimizer accepts (default 1,440: 0.25° bins). The
+    /// profile format and the closed forms go to `model::angle::MAX_BINS`
+    /// (36,000), but the LP grows with the bin count and with the
+    /// eye-safety windows aligned with every bin edge, and its solve time
+    /// grows faster than linearly: measured on a shared 2-core machine,
+    /// 1,440 bins ≈ 4.5 s of CPU, 3,600 bins ≈ 22 s, 36,000 bins did not
+    /// finish in 20 s. 1,440 keeps a solve in seconds.
+    pub max_bins: usize,
+
+    // --- Margins (rounding towards safety) ------------------------------
+    /// Relative margin kept from continuous bounds, budget and caps
+    /// (default 1e-6): continuous solutions are clamped and rescaled to
+    /// meet bounds, budget and frame exactly.
+    pub margin: f64,
+    /// Relative slack on the budget row of a level (MILP) power step
+    /// (default 2e-10): HiGHS accepts a MILP's rows to
+    /// `mip_feasibility_tol` (1e-10, absolute, on a row of order one to 2π)
+    /// and a level choice has no continuous part to trim, so the certified
+    /// row allows 2e-10 relative; 5× inside the checker's `REL_TOL` (1e-9).
+    pub level_budget_slack: f64,
+    /// Relative margin every eye-safety cut keeps below its limit (default
+    /// 2e-7): HiGHS's feasibility tolerance (1e-7 on rows normalised to 1)
+    /// beyond the head-room and the bound's own rounding margin
+    /// (`RATIO_MARGIN`).
+    pub cut_margin: f64,
+    /// Head-room the power step leaves under the Class 1 limit of the bound
+    /// (default 1e-9), so that a rotated copy of its answer (the fast path)
+    /// still certifies.
+    pub eye_safety_headroom: f64,
+
+    // --- The loop -------------------------------------------------------
+    /// Rounds of the cutting-plane loop of one power step (default 60).
+    pub cut_rounds: usize,
+    /// Cuts at or above this ratio of the current iterate are binding: the
+    /// dwell step linearises them (default 1 − 1e-3).
+    pub binding: f64,
+    /// Trust region of the sequential LP for acceleration limits (default 0.3).
+    pub trust: f64,
+    /// Share of the acceleration limit the linearised constraint may use
+    /// (default 0.8).
+    pub accel_share: f64,
+    /// Dwell-step iterations when the acceleration limit is finite (at
+    /// most; default 5).
+    pub slp_rounds: usize,
+    /// The sequential LP stops once a dwell step moves no bin's dwell by
+    /// more than this (relative; default 1e-3). On `smooth` (360 bins,
+    /// joint) the five rounds' moves were 2.7e-2, 7.6e-4, 2.4e-5, 3.2e-6,
+    /// 3.7e-6; stopping after the second changes the answer's exact
+    /// objective by −1.4e-7 relative (8.864885070 with five rounds,
+    /// 8.864884199 with two; the global gap is 2.4e-2) and makes the whole
+    /// process 1.24× faster than stopping after the third (1e-4).
+    pub slp_settled: f64,
+    /// Shrink steps tried (towards the power floor) when rounding leaves a
+    /// row of the power step's certificate a few ulps over (default 40).
+    pub repair_tries: usize,
+
+    // --- HiGHS ------------------------------------------------------------
+    /// HiGHS's `primal_feasibility_tolerance` on the power steps and the
+    /// global relaxation (default 1e-7: HiGHS's own default).
+    pub primal_feasibility_tol: f64,
+    /// HiGHS's primal feasibility tolerance on the dwell step's program
+    /// (default 1e-9): the certified program's rows are widened by
+    /// `2·dwell_feasibility_tol·(1 + Σ|a|)` (`LinearProgram::widened`).
+    pub dwell_feasibility_tol: f64,
+    /// Branch-and-bound nodes a MILP may use before its best incumbent is
+    /// taken (default 100). Multiple-choice knapsacks with unequal weights
+    /// (hardware power levels under time accounting once the dwell moves,
+    /// `joint` mode) take HiGHS minutes to close to a zero gap at 90 bins
+    /// (measured: 66–82 s) for an answer the certificate cannot tell apart:
+    /// its bound comes from the LP relaxation's duals, not from the search.
+    /// A node count, unlike a time limit, keeps answers deterministic; the
+    /// exact gap is reported.
+    pub mip_max_nodes: i32,
+    /// The search's second limit when the first ended without a feasible
+    /// point (default 5,000; an equality knapsack: spin set-points meeting
+    /// the frame period); without one there either, the step reports that
+    /// it found none.
+    pub mip_max_nodes_without_incumbent: i32,
+    /// HiGHS's `mip_feasibility_tolerance` for every MILP (default 1e-10,
+    /// its minimum): its default, 1e-6, lets a level choice overspend the
+    /// budget by far more than the checker's relative 1e-9 (found by
+    /// breaker3).
+    pub mip_feasibility_tol: f64,
+    /// Distance from an integer within which a relaxation's value counts as
+    /// integral (default 1e-9; HiGHS's own `mip_feasibility_tolerance` is
+    /// 1e-6).
+    pub relaxation_integrality_tol: f64,
+
+    // --- The global bound -------------------------------------------------
+    /// Tangents per utility and bin in the global relaxation (default 12).
+    pub global_tangents: usize,
+    /// The checker's relative tolerance, by which every row of the global
+    /// relaxation is widened (default 1e-9).
+    pub global_widen: f64,
+    /// τ slices per bin in the coupled Lagrangian's final evaluation
+    /// (default 256).
+    pub lagrangian_slices: usize,
+    /// Relative lowering of the floating-point objective, and raising of
+    /// the bound (rounding cover; default 1e-12).
+    pub objective_margin: f64,
+    /// Pieces of the coarse slicing the multipliers' golden-section search
+    /// uses (default 16), and its rounds (default 1). Measured on `smooth`
+    /// (bound 8.91687 at the LP's multipliers): one round 8.91094 in 4 ms,
+    /// three 8.91085 in 15 ms.
+    pub multiplier_pieces: usize,
+    /// See `multiplier_pieces`.
+    pub multiplier_rounds: usize,
+
+    // --- The fast path ----------------------------------------------------
+    /// Gaze phases per bin of the fast path's canonical solutions (default
+    /// 64: 1/64 of a bin, 0.016° for 360 bins, far below eye-tracker
+    /// noise).
+    pub phase_steps: u32,
+}
+
+impl OptimizerSettings {
+    /// The defaults (each field's documentation gives its reason).
+    pub const DEFAULT: Self = Self {
+        utility_segments: 16,
+        trust_region_segments: 4,
+        tie_break: 1e-3,
+        max_bins: 1440,
+        margin: 1e-6,
+        level_budget_slack: 2e-10,
+        cut_margin: 2e-7,
+        eye_safety_headroom: 1e-9,
+        cut_rounds: 60,
+        binding: 1.0 - 1e-3,
+        trust: 0.3,
+        accel_share: 0.8,
+        slp_rounds: 5,
+        slp_settled: 1e-3,
+        repair_tries: 40,
+        primal_feasibility_tol: 1e-7,
+        dwell_feasibility_tol: 1e-9,
+        mip_max_nodes: 100,
+        mip_max_nodes_without_incumbent: 5000,
+        mip_feasibility_tol: 1e-10,
+        relaxation_integrality_tol: 1e-9,
+        global_tangents: 12,
+        global_widen: 1e-9,
+        lagrangian_slices: 256,
+        objective_margin: 1e-12,
+        multiplier_pieces: 16,
+        multiplier_rounds: 1,
+        phase_steps: 64,
+    };
+}
+
+impl Default for OptimizerSettings {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// The table the optimizer runs with.
+pub(crate) const S: OptimizerSettings = OptimizerSettings::DEFAULT;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The margins keep their order: the level slack inside the checker's
+    /// relative tolerance (1e-9), the cut margin above HiGHS's feasibility
+    /// tolerance, the dwell tolerance covering HiGHS's integrality one.
+    #[test]
+    fn margins_keep_their_reasons() {
+        let s = OptimizerSettings::default();
+        assert!(s.level_budget_slack * 5.0 <= 1e-9 * (1.0 + 1e-12));
+        assert!(s.cut_margin > s.primal_feasibility_tol);
+        assert!(s.mip_feasibility_tol <= s.dwell_feasibility_tol);
+        assert!(s.trust > 0.0 && s.trust < 1.0 && s.accel_share <= 1.0);
+        assert!(s.binding < 1.0 && s.eye_safety_headroom < s.cut_margin);
+    }
+}
