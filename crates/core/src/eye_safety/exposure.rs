@@ -237,9 +237,8 @@ fn evaluate_head(
         0.0,
         0.0,
     ];
-    for (r, &single) in ratios.iter_mut().zip(&b.ratios).skip(1) {
-        *r = w * single;
-    }
+    let energy = head_bound::energy_ratios(&hf, laser, b.ratios, b.pass, frame_s, p_top, spin_max);
+    ratios[1..].copy_from_slice(&energy[1..]);
     let rules = [
         Rule::SinglePulse,
         Rule::PassTrain,

@@ -124,6 +124,9 @@ pub struct Bound {
     /// Window duration where the within-pass rule is worst, and where the
     /// multi-pass rule is, s.
     pub rule_windows_s: [f64; 2],
+    /// The pass figures the multi-pass rules used (largest envelope and
+    /// pulse energy of one pass, longest pass).
+    pub pass: PassFigures,
 }
 
 /// Evaluates the bound for bins `segs` (validated: cover [0, 360) in order,
@@ -221,6 +224,7 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
         },
         rule_azimuths_deg: [best.single.1, best.e_max.1],
         rule_windows_s: [pass_window, multi_window],
+        pass,
     }
 }
 

@@ -66,6 +66,8 @@ pub struct HeadFigures {
     /// `W_sim`: the largest sum of `power_scale` of channels fired together
     /// whose footprints share a point.
     pub weight_simultaneous: f64,
+    /// Channels fired together that share that point.
+    pub count_simultaneous: u32,
     /// `W_g`: the largest `Σ power_scale × pulses` one position receives
     /// within one grouping window (`group_window_s`), footprints widened by
     /// the head's turn over it at the fastest spin.
@@ -87,6 +89,8 @@ pub struct HeadFigures {
     pub weight_stalled_group: f64,
     /// `W_sim` with the head stopped.
     pub weight_stalled_simultaneous: f64,
+    /// Channels fired together sharing one point, the head stopped.
+    pub count_stalled_simultaneous: u32,
     /// Whether a stopped head puts pulses of two times in one position
     /// within one grouping window.
     pub stalled_group_spans_time: bool,
@@ -97,6 +101,115 @@ pub struct HeadFigures {
     pub pass_angle_deg: f64,
     /// The largest `power_scale`.
     pub power_scale_max: f64,
+    /// Azimuth separations of the channels' passes (see [`energy_ratios`]):
+    /// for a head turn of at most `angle_rad` within a window, the most
+    /// weight of channels whose passes over one aperture position such a
+    /// turn can reach.
+    pub separations: Vec<Separation>,
+}
+
+/// One head-turn bound of the channels a window can reach.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Separation {
+    /// Head turn, rad (just below a gap between two channels' passes).
+    pub angle_rad: f64,
+    /// `W(L)`: the largest `Σ power_scale` of channels meeting one height
+    /// whose passes over one position a turn of `angle_rad` reaches.
+    pub weight: f64,
+    /// Channels there.
+    pub count: u32,
+}
+
+/// Most separations evaluated (the largest gaps, evenly sampled).
+pub const SEPARATIONS_MAX: usize = 8;
+
+fn separations(fps: &[Footprint], scales: &[f64], r_mm: f64, cycle_s: f64) -> Vec<Separation> {
+    let circ = core::f64::consts::TAU * r_mm;
+    let x = |f: &Footprint| f.psi_rad * r_mm;
+    let mut gaps: Vec<f64> = Vec::new();
+    for c in fps {
+        for d in fps {
+            let z_meet = (c.z_mm - d.z_mm).abs() <= c.half_height_mm + d.half_height_mm;
+            let g = (x(d) - d.half_arc_mm) - (x(c) + c.half_arc_mm);
+            if z_meet && g > 0.0 {
+                gaps.push(g / r_mm);
+            }
+        }
+    }
+    gaps.sort_by(f64::total_cmp);
+    gaps.dedup();
+    let picked: Vec<f64> = if gaps.len() <= SEPARATIONS_MAX {
+        gaps
+    } else {
+        (0..SEPARATIONS_MAX)
+            .map(|k| gaps[(k * (gaps.len() - 1)) / (SEPARATIONS_MAX - 1)])
+            .collect()
+    };
+    let zeros = vec![0.0; fps.len()];
+    picked
+        .into_iter()
+        .map(|g| {
+            let angle_rad = g * (1.0 - 1e-9);
+            let smear = r_mm * angle_rad * (1.0 + overlap::SUM_MARGIN);
+            let (m, _) = overlap::group(fps, scales, &zeros, cycle_s, 0.0, smear, circ);
+            Separation {
+                angle_rad,
+                weight: m.weight,
+                count: m.count,
+            }
+        })
+        .collect()
+}
+
+/// The head's energy-rule ratios (within a pass, several passes, the time
+/// base; indices 1–3 of the rule order), from the single-channel ratios
+/// `single` (margin applied) at the head's widest pass.
+///
+/// Every window holds at most the channels meeting one height, each at
+/// most its single-channel energy: `W_v ×` each figure. Tighter, for a head
+/// turn `L` ([`Separation`]): a window no longer than `L/ω_max` turns the
+/// head by at most `L`, so only the channels whose passes a turn of `L`
+/// reaches contribute (`W(L) ×` each single-channel figure), and every
+/// longer window is bounded by `W_v ×` the multi-pass bounds from
+/// `L/ω_max` on ([`Laser::windows_from_ratio`]). The smallest of these
+/// maxima over the separations is returned, with the longer windows'
+/// figure reported under the rule of its duration.
+#[must_use]
+pub fn energy_ratios(
+    h: &HeadFigures,
+    laser: &Laser,
+    single: [f64; 4],
+    pass: crate::eye_safety::bound::PassFigures,
+    frame_s: f64,
+    power_max_w: f64,
+    spin_max_rad_s: f64,
+) -> [f64; 4] {
+    let w = h.weight_vertical;
+    let mut best = [0.0, w * single[1], w * single[2], w * single[3]];
+    let peak = |r: &[f64; 4]| r[1].max(r[2]).max(r[3]);
+    for sep in &h.separations {
+        if sep.weight >= w || spin_max_rad_s <= 0.0 {
+            continue;
+        }
+        let t_sep = sep.angle_rad / spin_max_rad_s * (1.0 - 1e-12);
+        let (r_long, t_long) = laser.windows_from_ratio(frame_s, pass, power_max_w, t_sep);
+        let mut cand = [
+            0.0,
+            sep.weight * single[1],
+            sep.weight * single[2],
+            sep.weight * single[3],
+        ];
+        let k = match crate::eye_safety::Rule::for_duration(t_long, frame_s) {
+            crate::eye_safety::Rule::PassTrain | crate::eye_safety::Rule::SinglePulse => 1,
+            crate::eye_safety::Rule::T2Train => 2,
+            crate::eye_safety::Rule::TimeBase => 3,
+        };
+        cand[k] = cand[k].max(w * r_long * (1.0 + RATIO_MARGIN));
+        if peak(&cand) < peak(&best) {
+            best = cand;
+        }
+    }
+    best
 }
 
 /// The head's overlap figures for `params` (band from `laser`) at spins up
@@ -110,12 +223,8 @@ pub fn head_figures(
     head.validate()?;
     let _ = params;
     let f_p = laser.pulse_rate_hz;
-    if (f_p * head.cycle_s - 1.0)
-        .abs()
-        .partial_cmp(&RATE_CYCLE_TOLERANCE)
-        != Some(core::cmp::Ordering::Less)
-        && (f_p * head.cycle_s - 1.0).abs() != RATE_CYCLE_TOLERANCE
-    {
+    let off = (f_p * head.cycle_s - 1.0).abs();
+    if off.is_nan() || off > RATE_CYCLE_TOLERANCE {
         return Err(EyeSafetyError::Param {
             field: "pulse_rate_hz",
             value: f_p,
@@ -146,6 +255,7 @@ pub fn head_figures(
         weight_vertical: v.weight,
         count_vertical: v.count,
         weight_simultaneous: sim.weight,
+        count_simultaneous: sim.count,
         weight_group: g.weight,
         count_group: g.count,
         group_spans_time: spans,
@@ -154,10 +264,16 @@ pub fn head_figures(
         count_stalled: disc.count,
         weight_stalled_group: g0.weight,
         weight_stalled_simultaneous: sim.weight,
+        count_stalled_simultaneous: sim.count,
         stalled_group_spans_time: spans0,
         footprint_max_mm: fold(|f| f.width_mm),
         pass_angle_deg: fold(|f| f.pass_angle_deg),
         power_scale_max: scales.iter().copied().fold(0.0, f64::max),
+        separations: if v.count > 1 {
+            separations(&fps, &scales, r, head.cycle_s)
+        } else {
+            Vec::new()
+        },
     })
 }
 
@@ -199,6 +315,7 @@ pub fn single_pulse_ratio(h: &HeadFigures, laser: &Laser, s: SingleFigures) -> f
         s.single_pulse_ratio,
         Weights {
             simultaneous: h.weight_simultaneous,
+            simultaneous_count: h.count_simultaneous,
             group: h.weight_group,
             spans_time: h.group_spans_time,
             window_s: h.group_window_s,
@@ -211,6 +328,7 @@ pub fn single_pulse_ratio(h: &HeadFigures, laser: &Laser, s: SingleFigures) -> f
 
 struct Weights {
     simultaneous: f64,
+    simultaneous_count: u32,
     group: f64,
     spans_time: bool,
     window_s: f64,
@@ -232,9 +350,17 @@ fn rule1(
     }
     let c5 = laser.c5(n_head);
     let tp = laser.pulse_duration_s;
-    let a = w.simultaneous * pulse_energy_j / (c5 * laser.ael_j(tp));
+    // Pulses of several channels fired together are one pulse of the
+    // pulse's duration; compared, conservatively, with the smallest AEL up
+    // to the grouping window (they may also be read as a group).
+    let group_ael = laser.ael_inf_j(tp, w.window_s + tp);
+    let a = if w.simultaneous_count <= 1 {
+        w.simultaneous * pulse_energy_j / (c5 * laser.ael_j(tp))
+    } else {
+        w.simultaneous * pulse_energy_j / (c5 * group_ael)
+    };
     let b = if w.spans_time {
-        w.group * pulse_energy_j / (c5 * laser.ael_inf_j(tp, w.window_s + tp))
+        w.group * pulse_energy_j / (c5 * group_ael)
     } else {
         0.0
     };
@@ -259,6 +385,7 @@ pub fn stalled_ratio(h: &HeadFigures, laser: &Laser, power_w: f64) -> f64 {
         one,
         Weights {
             simultaneous: h.weight_stalled_simultaneous,
+            simultaneous_count: h.count_stalled_simultaneous,
             group: h.weight_stalled_group,
             spans_time: h.stalled_group_spans_time,
             window_s: h.group_window_s,
