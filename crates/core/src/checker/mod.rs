@@ -735,6 +735,12 @@ fn check_eye_safety(
         }
         return None;
     };
+    if let Err(e) = params.check_pulse_rate(p.pulse_rate_hz) {
+        v.push(Violation::EyeSafetyParams {
+            reason: e.to_string(),
+        });
+        return None;
+    }
     match eye_safety::evaluate_profile(p, params) {
         Ok(report) => {
             v.extend(eye_safety_violation(&report));

@@ -66,6 +66,18 @@ pub enum EyeSafetyError {
     /// The head is invalid.
     #[error("eye_safety.{0}")]
     Head(#[from] head::HeadError),
+    /// With a head, the pulse rate is not the head's `1/cycle_s`.
+    #[error(
+        "pulse_rate_hz = {}: with limits.eye_safety.head it must equal 1/head.cycle_s = {} (every channel fires once per cycle)",
+        crate::text::Num(*.pulse_rate_hz),
+        crate::text::Num(*.expected_hz)
+    )]
+    PulseRate {
+        /// The rate found, Hz.
+        pulse_rate_hz: f64,
+        /// `1/cycle_s`, Hz.
+        expected_hz: f64,
+    },
     /// A parameter is invalid.
     #[error("eye_safety.{field} = {}: {reason}", crate::text::Num(*.value))]
     Param {
@@ -103,5 +115,21 @@ impl EyeSafetyParams {
             head.validate()?;
         }
         Ok(band)
+    }
+
+    /// With a head, every channel fires once per firing cycle, so the
+    /// per-channel `pulse_rate_hz` of the profile, sensor or table carrying
+    /// these parameters must be exactly `1/cycle_s` (as computed in f64, the
+    /// way every preset writes it): two clocks for one laser would let the
+    /// head bound and the single-channel figures count different trains.
+    /// Without a head there is nothing to compare.
+    pub fn check_pulse_rate(&self, pulse_rate_hz: f64) -> Result<(), EyeSafetyError> {
+        match &self.head {
+            Some(h) if pulse_rate_hz != 1.0 / h.cycle_s => Err(EyeSafetyError::PulseRate {
+                pulse_rate_hz,
+                expected_hz: 1.0 / h.cycle_s,
+            }),
+            _ => Ok(()),
+        }
     }
 }
