@@ -35,7 +35,7 @@ __version__: str
 """The package version (the Rust crate's)."""
 
 PRESETS: list[str]
-"""Preset names accepted by `preset=` ("paper", "vls128")."""
+"""Preset names accepted by `preset=` ("paper", "vls128", "vlp16", "os1-128")."""
 
 class Infeasible(Exception):
     """The request is well-formed but cannot be met; the message names the limit."""

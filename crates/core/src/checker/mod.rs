@@ -399,6 +399,9 @@ pub fn summarize_list<T: fmt::Display>(items: &[T]) -> String {
 pub struct Rejected {
     /// Every violation found, in the order checked.
     pub violations: Vec<Violation>,
+    /// The eye-safety evaluation the verdict rests on, when it ran (what
+    /// the head met and how far the powers must come down).
+    pub eye_safety: Option<ExposureReport>,
 }
 
 /// A profile that has passed [`certify`]. Only the checker can build one.
@@ -967,7 +970,10 @@ pub fn certify_with(
 ) -> Result<CertifiedProfile, Rejected> {
     let (violations, eye_safety, summary) = check_and_evaluate(&profile, opts);
     if !violations.is_empty() {
-        return Err(Rejected { violations });
+        return Err(Rejected {
+            violations,
+            eye_safety,
+        });
     }
     // No violation: the bins were checked, so the summary was computed (of
     // this very profile; `summarize` is a function of the bins).
