@@ -180,8 +180,18 @@ const VLS128_CYCLE_S: f64 = 53.3e-6;
 ///   meeting the aperture); the crossing point at the reference height
 ///   (the aperture height is searched anyway); 3 ns pulses; every channel
 ///   at the same power.
-/// - Laser power (assumed, per channel): 1.5 mW mean (80 nJ per pulse);
-///   `beam_diameter_mm` (the one-channel figure) is the exit beam grown by
+/// - Laser power (assumed, per channel): 18 µW mean (0.96 nJ per pulse).
+///   **Rescaled for the head**: this preset carried 1.5 mW per channel
+///   (80 nJ) when it was certified as one channel; as a head, a uniform
+///   profile at `power_w_max` (1.3 × the mean, the hottest profile of the
+///   preset's limits at the mean spin) reaches 74.2 × the Class 1 limit at
+///   1.5 mW (123 beams can cross one aperture height over a sweep, 8 of
+///   one firing group at once), so every power is scaled by 0.012 (÷ 83):
+///   that uniform profile is at 0.89 of the limit (10 % head-room for the
+///   bound's rounding and later tightening). The rated range stays the
+///   vendor's (it is the range at the preset's mean power, whatever that
+///   unpublished power is).
+/// - `beam_diameter_mm` (the one-channel figure) is the exit beam grown by
 ///   the divergence over the 41.37 mm to the aperture, rounded up.
 ///   Rated range 245 m at 10 % reflectivity (vendor figure for the VLS-128
 ///   class).
@@ -193,7 +203,7 @@ const VLS128_CYCLE_S: f64 = 53.3e-6;
 ///   the paper's controllers and the Levi E2 acuity model at a 60° RoF.
 #[must_use]
 pub fn vls128() -> Preset {
-    let average_power_w = 1.5e-3;
+    let average_power_w = 18e-6;
     let head = Head {
         cycle_s: VLS128_CYCLE_S,
         origin_radius_mm: 58.63,
@@ -272,11 +282,15 @@ const VLP16_CYCLE_S: f64 = 55.296e-6;
 ///   Velodyne's HDL-64E material); every channel at the same power;
 ///   100 m range at 10 % reflectivity (datasheet "up to 100 m"; the
 ///   reflectivity is not stated there).
-/// - Laser power (assumed, per channel): 1.5 mW mean (83 nJ per pulse).
+/// - Laser power (assumed, per channel): 240 µW mean (13 nJ per pulse).
+///   Scaled for the head from 1.5 mW by 0.16 (÷ 6.25): at 1.5 mW a uniform
+///   profile at `power_w_max` (1.3 × the mean) reaches 5.61 × the Class 1
+///   limit as a head (9 beams can cross one aperture height over a sweep,
+///   3 within one `T_i`); at 240 µW it is at 0.90.
 /// - Motor, accounting, focus and levels as `vls128`.
 #[must_use]
 pub fn vlp16() -> Preset {
-    let average_power_w = 1.5e-3;
+    let average_power_w = 240e-6;
     let head = Head {
         cycle_s: VLP16_CYCLE_S,
         origin_radius_mm: 41.91,
@@ -376,11 +390,16 @@ const OS1_128_CYCLE_S: f64 = 1.0 / 10_240.0;
 ///   every spin; 5 ns pulses; every channel at the same power; 45 m range
 ///   at 10 % reflectivity; spin 5–20 Hz for the 2D model (the product runs
 ///   at 10 or 20 Hz).
-/// - Laser power (assumed, per channel): 1.5 mW mean (146 nJ per pulse).
+/// - Laser power (assumed, per channel): 13 µW mean (1.3 nJ per pulse).
+///   Scaled for the head from 1.5 mW by 0.0087 (÷ 115): at 1.5 mW a uniform
+///   profile at `power_w_max` (1.3 × the mean) reaches 104 × the Class 1
+///   limit as a head (36 beams of one column, fired at once, share one
+///   aperture position; one channel alone would already be at 1.70); at
+///   13 µW it is at 0.90.
 /// - Motor, accounting, focus and levels as `vls128`.
 #[must_use]
 pub fn os1_128() -> Preset {
-    let average_power_w = 1.5e-3;
+    let average_power_w = 13e-6;
     let head = Head {
         cycle_s: OS1_128_CYCLE_S,
         origin_radius_mm: 15.806,

@@ -493,8 +493,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
                         reason: e.to_string(),
                     }
                 })?;
-            let half = 0.5 * crate::eye_safety::exposure::pass_angle_deg(params, &laser);
-            let cap = crate::eye_safety::cuts::rule_one_cap_w(&laser, half, w_hi, period);
+            let cap = crate::eye_safety::cuts::rule_one_cap_for(params, &laser, w_hi, period);
             x_hi.min(cap / p_mean).max(x_lo)
         }
         _ => x_hi,
