@@ -519,16 +519,21 @@ pub fn rule_one_cap_w(laser: &Laser, half_deg: f64, spin_max_rad_s: f64, frame_s
     f_p / per_j
 }
 
-/// How the head's bound scales the single-channel figures: the head's
-/// ratio of every rule is `a·r₁ + b·E` with `r₁` the single-channel figure
-/// of that rule and `E` the largest pulse energy (J); only one of `a`, `b`
-/// is nonzero for Rule 1 (`head::bound::single_pulse_ratio` is linear in
-/// the single-channel Rule 1 ratio when no two channels share an aperture
-/// position, else linear in the largest pulse energy), and the energy rules
-/// are `W_v·r₁` (`b = 0`).
+/// How the head's bound scales the single-channel figures. Rule 1 is
+/// `a·r₁ + b·E` with `r₁` the single-channel Rule 1 figure and `E` the
+/// largest pulse energy (J); only one of `a`, `b` is nonzero
+/// (`head::bound::single_pulse_ratio` is linear in the single-channel
+/// Rule 1 ratio when no two channels share an aperture position, else
+/// linear in the largest pulse energy). Each energy rule of the head is
+/// at least `W·r` with `r` the single-channel figure of that rule and `W`
+/// the smallest channel weight any of its candidates takes
+/// (`head::bound::energy_ratios`: `W_v`, or a separation's `W(L)`, times
+/// the single-channel figure, the larger of that and a multi-pass figure).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeadScale {
-    /// `W_v`: the energy rules' factor on the single-channel figures.
+    /// `W`: the energy rules' factor on the single-channel figures (a
+    /// lower bound of the head's: its cuts stay below the head's figure
+    /// whichever candidate the head bound takes).
     pub energy: f64,
     /// Rule 1's factor on the single-channel Rule 1 figure.
     pub rule_one_single: f64,
@@ -567,8 +572,13 @@ impl HeadScale {
                 },
             )
         };
+        let energy = hf
+            .separations
+            .iter()
+            .map(|sep| sep.weight)
+            .fold(hf.weight_vertical, f64::min);
         Ok(Some(Self {
-            energy: hf.weight_vertical,
+            energy,
             rule_one_single: rule_one(1.0, 0.0),
             // Power `f_p` W is a pulse of 1 J.
             rule_one_per_j: rule_one(0.0, laser.pulse_rate_hz),
@@ -579,11 +589,12 @@ impl HeadScale {
 
 /// [`cuts_with`] for the bound `params` describe: the single-channel cuts
 /// without a head; with one, the cuts of the head's bound (still linear in
-/// the bin powers): every energy cut's limit divided by `W_v`, and Rule 1
+/// the bin powers): every energy cut's limit divided by `W`
+/// ([`HeadScale::energy`]), and Rule 1
 /// either the single-channel Rule 1 cuts divided by its factor or, where
 /// channels share an aperture position, one cut per bin against the head's
 /// Rule 1 per joule. Each is at most the head bound's figure of its rule
-/// (the energy rules are `W_v` times the single-channel figures the
+/// (the energy rules are at least `W` times the single-channel figures the
 /// single-channel cuts never exceed; the head's Rule 1 takes the largest
 /// bin power), so the cuts stay a relaxation of "the head bound certifies".
 pub fn cuts_for(

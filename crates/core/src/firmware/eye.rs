@@ -858,7 +858,10 @@ mod derive {
                     rule_one(1.0, 0.0) * per_code_one + rule_one(0.0, step)
                 }
             };
-            // The energy rules: `W_v` times the single-channel figures.
+            // The energy rules: `W_v` times the single-channel figures, the
+            // head bound's first candidate (`head::bound::energy_ratios`);
+            // the float bound may take a tighter one (a separation's), so
+            // this check is at least as strict as the float checker's.
             let w_v = head.as_ref().map_or(1.0, |hf| hf.weight_vertical);
             let to_quanta = |energy_j: f64| to_quanta(energy_j / w_v);
             let pulse_code_max = if per_code > 0.0 {
