@@ -331,3 +331,52 @@ fn shipped_configs_and_optimize_certify_the_head() {
         assert!(c.eye_safety().unwrap().head.is_some());
     }
 }
+
+/// The integer firmware checker evaluates the head: every real head's
+/// closed-form range profile builds into a table the integer check
+/// certifies (within 15 % of the float head bound's figure), the table
+/// round-trips through the binary codec with its head, and the same table
+/// with its codes scaled past the head's limit is rejected by the integer
+/// check while one channel alone would still pass it.
+#[test]
+fn firmware_tables_are_checked_as_the_head() {
+    use gaze_lidar::firmware::{binary, check_table_evaluated, FirmwareConfig, FirmwareTable};
+    for (name, _) in HEADS {
+        let c =
+            certify(build_profile(&preset(name).unwrap(), Mode::Range, Some(90.0), 360).unwrap())
+                .unwrap();
+        let float = c.eye_safety().unwrap().worst_ratio;
+        let table = FirmwareTable::from_certified(&c, &FirmwareConfig::default()).unwrap();
+        assert!(table.eye_safety.as_ref().unwrap().head.is_some());
+        let (v, report) = check_table_evaluated(&table);
+        assert!(v.is_empty(), "{name}: {v:?}");
+        let int = report.unwrap().worst_ratio_ppm as f64 / 1e6;
+        eprintln!("{name}: integer head ratio {int:.6}, float head ratio {float:.6}");
+        // Two sound upper bounds of one model (the integer one on the
+        // quantized table, with exact pass counts): close, not equal.
+        assert!((int / float - 1.0).abs() < 0.15, "{name}: {int} vs {float}");
+        // The binary codec carries the head.
+        let back = binary::decode(&binary::encode(&table)).unwrap();
+        assert_eq!(back.eye_safety, table.eye_safety);
+        // Codes scaled until the head's integer check fails.
+        let mut hot = table.clone();
+        let k = (1.2 / int).ceil() as u32;
+        hot.limits.power_code_max = u32::MAX;
+        hot.limits.energy_budget = u64::MAX;
+        hot.limits.window_energy_max = u64::MAX;
+        for b in &mut hot.bins {
+            b.power_code = b.power_code.saturating_mul(k);
+            b.power_code_cap = u32::MAX;
+        }
+        let (v, _) = check_table_evaluated(&hot);
+        assert!(
+            v.iter().any(|x| x.limit_key() == "eye_safety"),
+            "{name} ×{k}: {v:?}"
+        );
+        let mut one = hot.clone();
+        one.eye_safety.as_mut().unwrap().head = None;
+        let (_, r1) = check_table_evaluated(&one);
+        let r1 = r1.unwrap().worst_ratio_ppm as f64 / 1e6;
+        eprintln!("{name} ×{k}: one channel alone {r1:.4}");
+    }
+}
