@@ -680,7 +680,7 @@ fn check(profile_json: &str, preset: Option<&str>, no_eye_safety: bool) -> PyRes
                     } => Some((*ratio, rule.clone(), *azimuth_deg)),
                     _ => None,
                 });
-                let report = rej.eye_safety.as_ref();
+                let report = rej.eye_safety.as_deref();
                 Verdict {
                     head_channels: report.and_then(|r| r.head.as_ref()).map(|h| h.channels),
                     power_scale_to_certify: report.map(|r| power_scale_to_certify(r.worst_ratio)),

@@ -203,7 +203,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                             "limit": v.limit_key(), "message": v.to_string(), "detail": v,
                         })).collect::<Vec<_>>(),
                         "summary": summary,
-                        "eye_safety": rej.eye_safety.as_ref().map(eye_json),
+                        "eye_safety": rej.eye_safety.as_deref().map(eye_json),
                     });
                     out.line(v)?;
                 }
@@ -211,7 +211,11 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                     for v in &rej.violations {
                         out.line(format_args!("violation: {v}"))?;
                     }
-                    if let Some(r) = rej.eye_safety.as_ref().filter(|r| !(r.worst_ratio <= 1.0)) {
+                    if let Some(r) = rej
+                        .eye_safety
+                        .as_deref()
+                        .filter(|r| r.worst_ratio > 1.0 || r.worst_ratio.is_nan())
+                    {
                         out.line(head_line(r))?;
                         out.line(format_args!(
                             "to certify: scale every bin power by at most {:.6} (the largest uniform power scale at which the {} certifies)",

@@ -130,6 +130,8 @@ fn channels(table: impl Iterator<Item = (u32, f64, f64, f64)>) -> Vec<Channel> {
 /// there; same in valgur/velodyne_decoder `src/calib_db.cpp`, "AlphaPrime",
 /// and tier4/nebula `calibration/VLS128.yaml`), as tabulated in HEADS.md
 /// Appendix A.
+// Laser 26's −6.280° is a calibration value that happens to read like −τ.
+#[allow(clippy::approx_constant)]
 const VLS128_ELEVATION_DEG: [f64; 128] = [
     -11.742, -1.990, 3.400, -5.290, -0.780, 4.610, -4.080, 1.310, //
     -6.500, -1.110, 4.280, -4.410, 0.100, 6.480, -3.200, 2.190, //

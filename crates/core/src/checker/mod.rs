@@ -401,7 +401,7 @@ pub struct Rejected {
     pub violations: Vec<Violation>,
     /// The eye-safety evaluation the verdict rests on, when it ran (what
     /// the head met and how far the powers must come down).
-    pub eye_safety: Option<ExposureReport>,
+    pub eye_safety: Option<Box<ExposureReport>>,
 }
 
 /// A profile that has passed [`certify`]. Only the checker can build one.
@@ -972,7 +972,7 @@ pub fn certify_with(
     if !violations.is_empty() {
         return Err(Rejected {
             violations,
-            eye_safety,
+            eye_safety: eye_safety.map(Box::new),
         });
     }
     // No violation: the bins were checked, so the summary was computed (of
