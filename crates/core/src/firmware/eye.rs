@@ -770,7 +770,6 @@ mod derive {
             let params = table.eye_safety.as_ref().ok_or(DeriveError::Missing)?;
             let f_p = table.pulse_rate_hz;
             let laser = laser(params, f_p)?;
-            params.check_pulse_rate(f_p)?;
             let millihz = millihz_ceil(f_p).ok_or(DeriveError::Range {
                 field: "pulse_rate_hz",
                 reason: "must be finite and > 0",

@@ -199,7 +199,7 @@ impl LidarSpec {
                     "pulse_rate_hz",
                     self.pulse_rate_hz,
                     &format!(
-                        "must equal 1/limits.eye_safety.head.cycle_s = {} with a head (every channel fires once per cycle)",
+                        "must be 1/limits.eye_safety.head.cycle_s = {} within 1e-9 with a head (every channel fires once per cycle)",
                         crate::text::Num(expected_hz)
                     ),
                 ),
