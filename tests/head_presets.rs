@@ -172,6 +172,7 @@ fn check_output_names_the_head_and_the_scale_that_certifies() {
             "{}",
             stdout(&o)
         );
+        assert!(stdout(&o).lines().all(|l| l.starts_with("violation: ")));
         // The stated scale certifies; 1 % more does not.
         for (k, ok) in [(scale, true), (scale * 1.01, false)] {
             let mut p = hot.clone();

@@ -3,7 +3,7 @@
 use clap::ValueEnum;
 use std::path::PathBuf;
 
-use gaze_lidar::checker::{certify_with, summarize, CheckOptions};
+use gaze_lidar::checker::{certify_with, summarize, CheckOptions, Violation};
 use gaze_lidar::eye_safety::exposure::{ExposureReport, Rule};
 use gaze_lidar::eye_safety::head::bound::power_scale_to_certify;
 use gaze_lidar::eye_safety::head::HeadFigures;
@@ -208,20 +208,19 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                     out.line(v)?;
                 }
                 Format::Text => {
+                    // One line per violation; the eye-safety one also names
+                    // what was evaluated and the power scale that certifies.
+                    let eye = rej.eye_safety.as_deref();
                     for v in &rej.violations {
-                        out.line(format_args!("violation: {v}"))?;
-                    }
-                    if let Some(r) = rej
-                        .eye_safety
-                        .as_deref()
-                        .filter(|r| r.worst_ratio > 1.0 || r.worst_ratio.is_nan())
-                    {
-                        out.line(head_line(r))?;
-                        out.line(format_args!(
-                            "to certify: scale every bin power by at most {:.6} (the largest uniform power scale at which the {} certifies)",
-                            power_scale_to_certify(r.worst_ratio),
-                            if r.head.is_some() { "head" } else { "channel" }
-                        ))?;
+                        match eye.filter(|_| matches!(v, Violation::EyeSafety { .. })) {
+                            Some(r) => out.line(format_args!(
+                                "violation: {v}; {}; to certify: scale every bin power by at most {:.6} (the largest uniform power scale at which the {} certifies)",
+                                head_line(r),
+                                power_scale_to_certify(r.worst_ratio),
+                                if r.head.is_some() { "head" } else { "channel" }
+                            ))?,
+                            None => out.line(format_args!("violation: {v}"))?,
+                        }
                     }
                 }
             }
