@@ -80,6 +80,10 @@ pub struct HeadFigures {
     /// The grouping window, s: `T_i` in 700–1050 nm (pulses up to `T_i`
     /// long), else the pulse duration.
     pub group_window_s: f64,
+    /// `W_inst`: the largest `Σ power_scale` of channels in their pass at
+    /// one instant (boxes widened by the head's turn over one pulse
+    /// spacing): the head's received power is at most `W_inst·P̂`.
+    pub weight_instant: f64,
     /// `W_disc`: the largest sum of `power_scale` of channels whose
     /// footprints share a point (a stalled rotor: every channel's pulses).
     pub weight_stalled: f64,
@@ -209,6 +213,44 @@ pub fn energy_ratios(
             best = cand;
         }
     }
+    // The head's received power is at most `W_inst·P̂` at any instant, so a
+    // window of `T` holds at most `W_inst·P̂·(T + Δ)` (each pulse's energy
+    // in the pulse spacing after it, disjoint per channel); windows up to
+    // `T*` by that, longer ones by `W_v ×` the multi-pass bounds from `T*`.
+    if h.count_vertical > 1 && power_max_w > 0.0 {
+        let delta = 1.0 / laser.pulse_rate_hz;
+        let tau = pass.duration_s.max(delta);
+        for m in [0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 64.0] {
+            let t_star = m * tau;
+            if t_star >= frame_s {
+                break;
+            }
+            // sup over T ≤ T* of (T + Δ)/AEL(T): on a row `c·T^p`
+            // (0 ≤ p ≤ 1) `(T + Δ)/T^p` has no interior maximum, so the
+            // row ends below T*, the pulse duration and T* are every
+            // candidate (the AEL at an edge is the smaller row's).
+            let mut short = (t_star + delta) / laser.ael_j(t_star);
+            for row in laser.rows() {
+                for t in [row.t_lo_s, row.t_hi_s, laser.pulse_duration_s] {
+                    if t > 0.0 && t < t_star {
+                        short = short.max((t + delta) / laser.ael_j(t));
+                    }
+                }
+            }
+            let short = h.weight_instant * power_max_w * short * (1.0 + RATIO_MARGIN);
+            let (r_long, t_long) = laser.windows_from_ratio(frame_s, pass, power_max_w, t_star);
+            let mut cand = [0.0, short, 0.0, 0.0];
+            let k = match crate::eye_safety::Rule::for_duration(t_long, frame_s) {
+                crate::eye_safety::Rule::PassTrain | crate::eye_safety::Rule::SinglePulse => 1,
+                crate::eye_safety::Rule::T2Train => 2,
+                crate::eye_safety::Rule::TimeBase => 3,
+            };
+            cand[k] = cand[k].max(w * r_long * (1.0 + RATIO_MARGIN));
+            if peak(&cand) < peak(&best) {
+                best = cand;
+            }
+        }
+    }
     best
 }
 
@@ -244,6 +286,16 @@ pub fn head_figures(
     let (sim, _) = overlap::group(&fps, &scales, &slots, head.cycle_s, 0.0, 0.0, circ);
     let (g, spans) = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, smear, circ);
     let (disc, _) = overlap::group(&fps, &scales, &zeros, head.cycle_s, 0.0, 0.0, circ);
+    let turn_per_pulse = r * spin_max_rad_s * head.cycle_s * (1.0 + overlap::SUM_MARGIN);
+    let (inst, _) = overlap::group(
+        &fps,
+        &scales,
+        &zeros,
+        head.cycle_s,
+        0.0,
+        turn_per_pulse,
+        circ,
+    );
     let (g0, spans0) = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, 0.0, circ);
     let fold = |f: fn(&Footprint) -> f64| fps.iter().map(f).fold(0.0, f64::max);
     Ok(HeadFigures {
@@ -260,6 +312,7 @@ pub fn head_figures(
         count_group: g.count,
         group_spans_time: spans,
         group_window_s: t_g,
+        weight_instant: inst.weight,
         weight_stalled: disc.weight,
         count_stalled: disc.count,
         weight_stalled_group: g0.weight,
