@@ -529,6 +529,14 @@ pub fn rule_one_cap_w(laser: &Laser, half_deg: f64, spin_max_rad_s: f64, frame_s
 /// the smallest channel weight any of its candidates takes
 /// (`head::bound::energy_ratios`: `W_v`, or a separation's `W(L)`, times
 /// the single-channel figure, the larger of that and a multi-pass figure).
+///
+/// Not covered: the head bound's instantaneous-overlap candidate
+/// (`W_inst · P̂` per unit time up to `T*`, added after these cuts were
+/// written) is not of the form `W · r`; where it is the smallest, a cut
+/// scaled by `W` may exceed the head's figure, which can only make the
+/// optimizer conservative (every answer is still decided by the checker),
+/// never unsafe. `tests/eye_cuts.rs::cuts_never_exceed_the_bound_on_optimized_profiles`
+/// holds on the shipped configs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeadScale {
     /// `W`: the energy rules' factor on the single-channel figures (a
