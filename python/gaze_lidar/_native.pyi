@@ -35,7 +35,7 @@ __version__: str
 """The package version (the Rust crate's)."""
 
 PRESETS: list[str]
-"""Preset names accepted by `preset=` ("paper", "vls128")."""
+"""Preset names accepted by `preset=` ("paper", "vls128", "vlp16", "os1-128")."""
 
 class Infeasible(Exception):
     """The request is well-formed but cannot be met; the message names the limit."""
@@ -201,6 +201,10 @@ class Verdict:
     """The IEC 60825-1 rule that binds at the worst azimuth."""
     worst_azimuth_deg: float | None
     """Azimuth of the worst eye-safety exposure."""
+    head_channels: int | None
+    """Channels of the head eye safety was evaluated for; None for one channel (no head given) or when not evaluated."""
+    power_scale_to_certify: float | None
+    """The largest uniform power scale (every bin power times it) at which eye safety certifies; None when not evaluated."""
     def __bool__(self) -> bool: ...
 
 def check(profile_json: str, preset: str | None = None, *, no_eye_safety: bool = False) -> Verdict:

@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyDict, PyList};
 
 use gaze_lidar::checker::{certify_with, CertifiedProfile, CheckOptions, Violation};
-use gaze_lidar::eye_safety::evaluate_profile;
+use gaze_lidar::eye_safety::head::bound::power_scale_to_certify;
 use gaze_lidar::firmware::{FirmwareConfig, FirmwareError, FirmwareTable};
 use gaze_lidar::gaze::{
     ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeError, GazeSample, Notice,
@@ -619,6 +619,14 @@ pub struct Verdict {
     /// Azimuth of the worst eye-safety exposure, degrees.
     #[pyo3(get)]
     worst_azimuth_deg: Option<f64>,
+    /// Channels of the head eye safety was evaluated for; None for one
+    /// channel (no head given) or when not evaluated.
+    #[pyo3(get)]
+    head_channels: Option<u32>,
+    /// The largest uniform power scale (every bin power times it) at which
+    /// the profile's eye safety certifies; None when not evaluated.
+    #[pyo3(get)]
+    power_scale_to_certify: Option<f64>,
 }
 
 #[pymethods]
@@ -649,19 +657,18 @@ fn check(profile_json: &str, preset: Option<&str>, no_eye_safety: bool) -> PyRes
         }
         .allow_missing_eye_safety(no_eye_safety);
         Ok(match certify_with(profile.clone(), &opts) {
-            Ok(_) => {
-                let eye = profile
-                    .limits
-                    .eye_safety
-                    .as_ref()
-                    .and_then(|p| evaluate_profile(&profile, p).ok());
+            Ok(c) => {
+                // The evaluation the checker certified with (not a second run).
+                let eye = c.eye_safety();
                 Verdict {
+                    head_channels: eye.and_then(|r| r.head.as_ref()).map(|h| h.channels),
+                    power_scale_to_certify: eye.map(|r| power_scale_to_certify(r.worst_ratio)),
                     certified: true,
                     violations: Vec::new(),
                     limits: Vec::new(),
-                    worst_ratio: eye.as_ref().map(|r| r.worst_ratio),
-                    binding_rule: eye.as_ref().map(|r| r.binding_rule.to_string()),
-                    worst_azimuth_deg: eye.as_ref().map(|r| r.worst_azimuth_deg),
+                    worst_ratio: eye.map(|r| r.worst_ratio),
+                    binding_rule: eye.map(|r| r.binding_rule.to_string()),
+                    worst_azimuth_deg: eye.map(|r| r.worst_azimuth_deg),
                 }
             }
             Err(rej) => {
@@ -673,7 +680,10 @@ fn check(profile_json: &str, preset: Option<&str>, no_eye_safety: bool) -> PyRes
                     } => Some((*ratio, rule.clone(), *azimuth_deg)),
                     _ => None,
                 });
+                let report = rej.eye_safety.as_deref();
                 Verdict {
+                    head_channels: report.and_then(|r| r.head.as_ref()).map(|h| h.channels),
+                    power_scale_to_certify: report.map(|r| power_scale_to_certify(r.worst_ratio)),
                     certified: false,
                     violations: rej.violations.iter().map(ToString::to_string).collect(),
                     limits: rej

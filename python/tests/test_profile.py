@@ -185,3 +185,17 @@ def test_optimized_profile_reports_range_and_density_per_region(repo: pathlib.Pa
     # The closed forms carry no optimality block; JSON keeps the figures.
     assert gl.profile(mode="joint", gaze_deg=90.0).figures is None
     assert gl.Profile.from_json(p.to_json()).figures == f
+
+
+def test_check_certifies_heads_and_names_them() -> None:
+    # A real head's closed-form profile is certified for the whole head
+    # (every channel that can meet the aperture, summed), and says so; the
+    # paper preset has no head: one channel.
+    for name, channels in [("vls128", 128), ("vlp16", 16), ("os1-128", 128)]:
+        p = gl.profile(preset=name, mode="range", gaze_deg=90.0)
+        v = gl.check(p.to_json(), preset=name)
+        assert v.certified, v.violations
+        assert v.head_channels == channels
+        assert v.power_scale_to_certify is not None and v.power_scale_to_certify >= 1.0
+    v = gl.check(gl.profile(preset="paper", mode="range", gaze_deg=90.0).to_json())
+    assert v.certified and v.head_channels is None

@@ -131,3 +131,14 @@ def test_same_frames_as_the_cli_stream(repo: pathlib.Path) -> None:
     got += s.push(*samples[-1])
     assert [(round(f.t_s, 9), f.state, f.gaze_deg) for f in got] == want
     assert {f[1] for f in want} == {"adaptive", "fail_safe"}
+
+
+def test_stream_certifies_the_head() -> None:
+    # Every frame a head's stream hands out went through the checker, which
+    # evaluates the whole head: its JSON re-checks certified for the head.
+    s = gl.GazeStream(preset="vlp16", mode="range", timeout_ms=100)
+    frames = fixations(s, 0.3)
+    assert any(f.state == "adaptive" for f in frames)
+    for f in frames:
+        v = gl.check(f.profile.to_json(), preset="vlp16")
+        assert v.certified and v.head_channels == 16

@@ -19,14 +19,29 @@ pub enum Format {
     Table,
 }
 
+/// The laser the figures are for: the options, else the preset's.
+struct Resolved {
+    wavelength_nm: f64,
+    pulse_duration_s: f64,
+    pulse_rate_hz: Option<f64>,
+    beam_diameter_mm: Option<f64>,
+    format: Format,
+}
+
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Wavelength, nm (700–1050 or 1400–1800).
-    #[arg(long, allow_hyphen_values = true)]
-    wavelength_nm: f64,
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "preset")]
+    wavelength_nm: Option<f64>,
     /// Pulse duration, s.
-    #[arg(long, allow_hyphen_values = true)]
-    pulse_duration_s: f64,
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "preset")]
+    pulse_duration_s: Option<f64>,
+    /// Take the laser (wavelength, pulse duration, pulse rate, beam) from
+    /// this preset's sensor, and show its head: the channels, the optics
+    /// and the overlap figures the head's bound multiplies by. Options given
+    /// with it replace the preset's values (and then no head is shown).
+    #[arg(long)]
+    preset: Option<String>,
     /// Pulse rate, Hz: adds the figures for a stationary (stalled) beam.
     #[arg(long, allow_hyphen_values = true)]
     pulse_rate_hz: Option<f64>,
@@ -39,6 +54,59 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
+    let sensor = match &a.preset {
+        Some(name) => Some(
+            gaze_lidar::model::presets::preset(name)
+                .map_err(|e| CliError::input(format!("--preset: {e}")))?
+                .lidar,
+        ),
+        None => None,
+    };
+    let es = sensor.as_ref().and_then(|s| s.limits.eye_safety.clone());
+    let given = a.wavelength_nm.is_some()
+        || a.pulse_duration_s.is_some()
+        || a.pulse_rate_hz.is_some()
+        || a.beam_diameter_mm.is_some();
+    // Both are required by clap unless --preset is given, and every preset
+    // has eye-safety parameters.
+    let wavelength_nm = a
+        .wavelength_nm
+        .or(es.as_ref().map(|e| e.wavelength_nm))
+        .unwrap_or(f64::NAN);
+    let pulse_duration_s = a
+        .pulse_duration_s
+        .or(es.as_ref().map(|e| e.pulse_duration_s))
+        .unwrap_or(f64::NAN);
+    let pulse_rate_hz = a.pulse_rate_hz.or(sensor.as_ref().map(|s| s.pulse_rate_hz));
+    let beam_diameter_mm = a
+        .beam_diameter_mm
+        .or(es.as_ref().map(|e| e.beam_diameter_mm));
+    // The head of the preset, with its figures at the preset's fastest spin.
+    let head = match (&sensor, &es) {
+        (Some(s), Some(params)) if !given => match &params.head {
+            Some(h) => {
+                let laser = gaze_lidar::eye_safety::exposure::laser(params, s.pulse_rate_hz)
+                    .map_err(|e| CliError::input(format!("--preset: {e}")))?;
+                let f = gaze_lidar::eye_safety::head::bound::head_figures(
+                    h,
+                    params,
+                    &laser,
+                    s.limits.spin_rad_s_max,
+                )
+                .map_err(|e| CliError::input(format!("--preset: {e}")))?;
+                Some((h.clone(), f, s.limits.spin_rad_s_max))
+            }
+            None => None,
+        },
+        _ => None,
+    };
+    let a = &Resolved {
+        wavelength_nm,
+        pulse_duration_s,
+        pulse_rate_hz,
+        beam_diameter_mm,
+        format: a.format,
+    };
     finite("--wavelength-nm", a.wavelength_nm)?;
     finite_positive("--pulse-duration-s", a.pulse_duration_s)?;
     if let Some(r) = a.pulse_rate_hz {
@@ -93,6 +161,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             if let (Some(p), Some(obj)) = (pass, v.as_object_mut()) {
                 obj.insert("scan_pass_angle_deg".into(), serde_json::json!(p));
             }
+            if let (Some((h, f, spin)), Some(obj)) = (&head, v.as_object_mut()) {
+                obj.insert(
+                    "head".into(),
+                    serde_json::json!({"description": h, "figures": f, "spin_rad_s_max": spin}),
+                );
+            }
             o!("{v}");
         }
         Format::Table => {
@@ -121,6 +195,26 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             }
             if let Some(p) = pass {
                 o!("scan pass angle         {p:.3}°");
+            }
+            match &head {
+                Some((h, f, spin)) => {
+                    o!(
+                        "head                    {} channels, cycle {:e} s, crossing point {} mm from the axis, exit beam {} mm, divergence {:.3} mrad, aperture at {} mm",
+                        h.channels.len(), h.cycle_s, h.origin_radius_mm, h.exit_diameter_mm, h.divergence_mrad, h.aperture_distance_mm
+                    );
+                    o!(
+                        "head overlap            {} channels can meet one height (W_v = {:.3}, worst at {:.2} mm); a grouping window of {:e} s puts {} beam(s) in one position (W_g = {:.3}, W_sim = {:.3}) at up to {:.1} rad/s; stalled: {} beam(s) share one position",
+                        f.count_vertical, f.weight_vertical, f.worst_height_mm, f.group_window_s, f.count_group, f.weight_group, f.weight_simultaneous, spin, f.count_stalled
+                    );
+                    o!(
+                        "head pass angle         {:.3}° (the widest of its channels)",
+                        f.pass_angle_deg
+                    );
+                }
+                None if sensor.is_some() && !given => {
+                    o!("head                    none: one channel");
+                }
+                None => {}
             }
             o!("note: figures from public re-implementations of the 2014 tables; verify against the standard");
         }

@@ -3,7 +3,10 @@
 use clap::ValueEnum;
 use std::path::PathBuf;
 
-use gaze_lidar::checker::{certify_with, summarize, CheckOptions};
+use gaze_lidar::checker::{certify_with, summarize, CheckOptions, Violation};
+use gaze_lidar::eye_safety::exposure::{ExposureReport, Rule};
+use gaze_lidar::eye_safety::head::bound::power_scale_to_certify;
+use gaze_lidar::eye_safety::head::HeadFigures;
 use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::profile::Profile;
 
@@ -55,6 +58,55 @@ fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
     Ok(None)
 }
 
+/// The eye-safety evaluation as JSON: the figures, the head's (`null`
+/// for one channel), and the largest uniform power scale that certifies.
+fn eye_json(r: &ExposureReport) -> serde_json::Value {
+    serde_json::json!({
+        "worst_azimuth_deg": r.worst_azimuth_deg, "binding_rule": r.binding_rule,
+        "worst_ratio": r.worst_ratio, "margin": r.margin,
+        "stalled_rotor_ratio": r.stalled_rotor_ratio,
+        "evaluated_for": if r.head.is_some() { "head" } else { "one channel" },
+        "head": r.head.as_ref().map(|h| {
+            let (height_mm, beams) = worst_position(r, h);
+            serde_json::json!({
+                "channels_evaluated": h.channels,
+                "worst_azimuth_deg": r.worst_azimuth_deg,
+                "worst_height_mm": height_mm,
+                "beams_meeting_worst": beams,
+                "binding_rule": r.binding_rule,
+                "figures": h,
+            })
+        }),
+        "power_scale_to_certify": power_scale_to_certify(r.worst_ratio),
+    })
+}
+
+/// The worst aperture position's height and the beams meeting it, for the
+/// binding rule: Rule 1's largest group, else the energy rules' height.
+fn worst_position(r: &ExposureReport, h: &HeadFigures) -> (f64, u32) {
+    if r.binding_rule == Rule::SinglePulse {
+        (h.group_height_mm, h.count_group)
+    } else {
+        (h.worst_height_mm, h.channels_at_worst)
+    }
+}
+
+/// One line naming what was evaluated: the head (channels, the worst
+/// aperture position, the beams meeting it, the binding rule) or one
+/// channel.
+fn head_line(r: &ExposureReport) -> String {
+    match &r.head {
+        Some(h) => {
+            let (height_mm, beams) = worst_position(r, h);
+            format!(
+                "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height; {} beam(s) meet it; binding rule: {}",
+                h.channels, r.worst_azimuth_deg, height_mm, beams, r.binding_rule
+            )
+        }
+        None => "head: none given, evaluated for one channel (limits.eye_safety.head absent: the sensor's other channels are not counted)".to_owned(),
+    }
+}
+
 pub fn run(a: &Args) -> Result<u8, CliError> {
     let bytes = read_bytes(&a.file, MAX_PROFILE_BYTES)?;
     let origin = a.file.display().to_string();
@@ -103,11 +155,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                         "certified": true, "violations": [], "summary": c.summary(),
                         "eye_safety_evaluated": eye.is_some(),
                         "sensor": sensor.as_ref().map(|s| s.name.clone()),
-                        "eye_safety": eye.map(|r| serde_json::json!({
-                            "worst_azimuth_deg": r.worst_azimuth_deg, "binding_rule": r.binding_rule,
-                            "worst_ratio": r.worst_ratio, "margin": r.margin,
-                            "stalled_rotor_ratio": r.stalled_rotor_ratio,
-                        })),
+                        "eye_safety": eye.map(eye_json),
                     });
                     out.line(v)?;
                 }
@@ -119,10 +167,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                         profile.average_power_w, profile.power_accounting, s.frame_period_s, s.max_spin_accel_rad_s2.map_or("∞ (steps)".to_owned(), |a| format!("{a:.4e}"))
                     ))?;
                     match eye {
-                        Some(r) => out.line(format_args!(
-                            "eye safety: Class 1 at every azimuth; worst {:.3}° ({}), {:.1} % of the limit (margin {:.2}×)",
-                            r.worst_azimuth_deg, r.binding_rule, 100.0 * r.worst_ratio, r.margin
-                        ))?,
+                        Some(r) => {
+                            out.line(format_args!(
+                                "eye safety: Class 1 at every azimuth; worst {:.3}° ({}), {:.1} % of the limit (margin {:.2}×)",
+                                r.worst_azimuth_deg, r.binding_rule, 100.0 * r.worst_ratio, r.margin
+                            ))?;
+                            out.line(head_line(r))?;
+                        }
                         None => out.line("eye safety: NOT evaluated (--no-eye-safety; limits.eye_safety is null): this verdict is not Class 1 evidence")?,
                     }
                 }
@@ -152,12 +203,24 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                             "limit": v.limit_key(), "message": v.to_string(), "detail": v,
                         })).collect::<Vec<_>>(),
                         "summary": summary,
+                        "eye_safety": rej.eye_safety.as_deref().map(eye_json),
                     });
                     out.line(v)?;
                 }
                 Format::Text => {
+                    // One line per violation; the eye-safety one also names
+                    // what was evaluated and the power scale that certifies.
+                    let eye = rej.eye_safety.as_deref();
                     for v in &rej.violations {
-                        out.line(format_args!("violation: {v}"))?;
+                        match eye.filter(|_| matches!(v, Violation::EyeSafety { .. })) {
+                            Some(r) => out.line(format_args!(
+                                "violation: {v}; {}; to certify: scale every bin power by at most {:.6} (the largest uniform power scale at which the {} certifies)",
+                                head_line(r),
+                                power_scale_to_certify(r.worst_ratio),
+                                if r.head.is_some() { "head" } else { "channel" }
+                            ))?,
+                            None => out.line(format_args!("violation: {v}"))?,
+                        }
                     }
                 }
             }

@@ -48,7 +48,7 @@ pub enum Accounting {
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// LiDAR preset: paper, vls128 [default: paper]; with --config, replaces
+    /// LiDAR preset: paper, vls128, vlp16, os1-128 [default: paper]; with --config, replaces
     /// the file's `[lidar] preset`.
     #[arg(long)]
     preset: Option<String>,

@@ -13,7 +13,7 @@ use super::CliError;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The preset to write: paper, vls128.
+    /// The preset to write: paper, vls128, vlp16, os1-128.
     #[arg(long)]
     preset: String,
     /// Write to this file (atomically) instead of stdout (`-`: stdout).

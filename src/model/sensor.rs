@@ -24,10 +24,27 @@
 //! wavelength_nm = 905.0
 //! pulse_duration_s = 5e-9
 //! beam_diameter_mm = 8.0
+//!
+//! [limits.eye_safety.head]            # optional: absent means one channel
+//! cycle_s = 5.5296e-5                 # every channel fires once a cycle
+//! origin_radius_mm = 41.91            # (pulse_rate_hz must be 1/cycle_s,
+//! origin_height_mm = 0.0              #  channels the head's count)
+//! exit_diameter_mm = 10.0
+//! divergence_mrad = 3.0
+//! aperture_distance_mm = 100.0
+//!
+//! [[limits.eye_safety.head.channels]] # one table per channel
+//! id = 0
+//! elevation_deg = -15.0
+//! azimuth_offset_deg = 0.0
+//! slot_s = 0.0
+//! power_scale = 1.0
 //! ```
 //!
 //! "Unlimited" is spelled as in the optimizer's configuration files (TOML
-//! has no `null`); every key is required, none may be added. Numbers are
+//! has no `null`); every key is required (but the head's defaults:
+//! `origin_height_mm` 0, `aperture_distance_mm` 100, `power_scale` 1),
+//! none may be added. Numbers are
 //! written with Rust's shortest round-trip formatting, so a preset written
 //! out and read back is the same sensor, bit for bit.
 

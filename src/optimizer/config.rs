@@ -4,7 +4,7 @@
 //! bins = 360                       # equal bins (4..=1440, MAX_OPTIMIZER_BINS)
 //!
 //! [lidar]                          # a preset, then overrides of its fields
-//! preset = "paper"                 # "paper" or "vls128"
+//! preset = "paper"                 # "paper", "vls128", "vlp16" or "os1-128"
 //! average_power_w = 1.0e-3
 //! power_accounting = "time"        # or "angle"
 //!

@@ -579,8 +579,7 @@ fn eye_capped(
                         reason: e.to_string(),
                     }
                 })?;
-            let half = 0.5 * crate::eye_safety::exposure::pass_angle_deg(params, &laser);
-            let cap = crate::eye_safety::cuts::rule_one_cap_w(&laser, half, w_hi, period);
+            let cap = crate::eye_safety::cuts::rule_one_cap_for(params, &laser, w_hi, period);
             Ok(x_hi.min(cap / lid.average_power_w).max(x_lo))
         }
         _ => Ok(x_hi),

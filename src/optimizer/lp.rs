@@ -18,7 +18,7 @@ use super::error::{CertificateError, Infeasible, SpinLimit};
 use super::settings::S;
 use super::{OptError, Problem};
 use crate::eye_safety::bound::{Laser, Rule, Seg, RATIO_MARGIN};
-use crate::eye_safety::cuts::{cuts_with, Cut};
+use crate::eye_safety::cuts::{cuts_for, Cut};
 use crate::eye_safety::{exposure, EyeSafetyParams};
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning};
 use crate::model::lidar::PowerAccounting;
@@ -113,7 +113,6 @@ pub(super) fn grid(problem: &Problem, gaze_deg: f64) -> Result<Grid, OptError> {
 struct Eye {
     params: EyeSafetyParams,
     laser: Laser,
-    half_deg: f64,
     pulse_rate_hz: f64,
 }
 
@@ -128,7 +127,6 @@ fn eye(problem: &Problem) -> Result<Option<Eye>, OptError> {
         })?;
     Ok(Some(Eye {
         params: params.clone(),
-        half_deg: 0.5 * exposure::pass_angle_deg(params, &laser),
         laser,
         pulse_rate_hz: problem.lidar.pulse_rate_hz,
     }))
@@ -160,17 +158,13 @@ impl Eye {
             .map_err(|e| Infeasible::EyeSafety(e.to_string()).into())
     }
 
-    /// The concrete exposures at or above `threshold` for these bins.
-    /// Every Rule 1 cut on one bin comes too (a column bound, free).
+    /// The concrete exposures at or above `threshold` for these bins, of
+    /// the head's bound when the sensor has a head.
+    /// Every Rule 1 cut on one bin comes too (a column bound, free). An
+    /// error of the head's evaluation gives no cuts: the bound's own
+    /// evaluation ([`Self::report`]) reports it before any answer stands.
     fn cuts(&self, segs: &[Seg], witness_deg: &[f64], threshold: f64) -> Vec<Cut> {
-        cuts_with(
-            segs,
-            self.half_deg,
-            &self.laser,
-            witness_deg,
-            threshold,
-            0.0,
-        )
+        cuts_for(segs, &self.params, &self.laser, witness_deg, threshold, 0.0).unwrap_or_default()
     }
 }
 

@@ -197,13 +197,14 @@ mod tests {
         );
         // Range at 1.1 P̄ on the paper's 100 m rating, clear air: 104.8054 m
         // (worked in `model::range`'s tests); at P̄ the rated 100 m; VLS-128
-        // (245 m at 1.5 mW) at 0.75 mW: 245·√0.5 = 173.24 m, and clear air
+        // (245 m at its mean power) at half of it: 245·√0.5 = 173.24 m, and clear air
         // (α₀ = 1.498e-4 /m) lengthens it: R = 173.2412·e^(−α₀(R − 245)):
         // e^(α₀·71.759) = 1.010808 → 175.113; e^(α₀·69.887) = 1.010524 →
         // 175.064; e^(α₀·69.936) = 1.010532 → 175.066 m.
         assert_relative_eq!(range_m(&p.lidar, 1.1e-3), 104.8054, epsilon = 1e-3);
         assert_eq!(range_m(&p.lidar, 1.0e-3), 100.0);
-        assert_relative_eq!(range_m(&vls128().lidar, 0.75e-3), 175.066, epsilon = 2e-3);
+        let half = 0.5 * vls128().lidar.average_power_w;
+        assert_relative_eq!(range_m(&vls128().lidar, half), 175.066, epsilon = 2e-3);
     }
 
     #[test]

@@ -275,7 +275,15 @@ fn decode_errors_at_their_edges() {
         with(6, &[0]).map(|t| t.power_accounting),
         Ok(PowerAccounting::Time)
     );
-    assert_eq!(with(7, &[2]), Err(DecodeError::Reserved(2)));
+    // Flag 2 announces a head section after the records: none here.
+    assert_eq!(
+        with(7, &[2]),
+        Err(DecodeError::Length {
+            found: 132,
+            expected: 132 + 64
+        })
+    );
+    assert_eq!(with(7, &[3]), Err(DecodeError::Reserved(3)));
     // Flag clear but parameter bytes present.
     assert_eq!(with(7, &[0]), Err(DecodeError::Reserved(0)));
     for step in [0.0f64, -0.0, -1.0, f64::NAN, f64::INFINITY] {

@@ -399,6 +399,9 @@ pub fn summarize_list<T: fmt::Display>(items: &[T]) -> String {
 pub struct Rejected {
     /// Every violation found, in the order checked.
     pub violations: Vec<Violation>,
+    /// The eye-safety evaluation the verdict rests on, when it ran (what
+    /// the head met and how far the powers must come down).
+    pub eye_safety: Option<Box<ExposureReport>>,
 }
 
 /// A profile that has passed [`certify`]. Only the checker can build one.
@@ -735,6 +738,12 @@ fn check_eye_safety(
         }
         return None;
     };
+    if let Err(e) = params.check_pulse_rate(p.pulse_rate_hz) {
+        v.push(Violation::EyeSafetyParams {
+            reason: e.to_string(),
+        });
+        return None;
+    }
     match eye_safety::evaluate_profile(p, params) {
         Ok(report) => {
             v.extend(eye_safety_violation(&report));
@@ -961,7 +970,10 @@ pub fn certify_with(
 ) -> Result<CertifiedProfile, Rejected> {
     let (violations, eye_safety, summary) = check_and_evaluate(&profile, opts);
     if !violations.is_empty() {
-        return Err(Rejected { violations });
+        return Err(Rejected {
+            violations,
+            eye_safety: eye_safety.map(Box::new),
+        });
     }
     // No violation: the bins were checked, so the summary was computed (of
     // this very profile; `summarize` is a function of the bins).

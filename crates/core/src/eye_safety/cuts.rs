@@ -518,3 +518,178 @@ pub fn rule_one_cap_w(laser: &Laser, half_deg: f64, spin_max_rad_s: f64, frame_s
     );
     f_p / per_j
 }
+
+/// How the head's bound scales the single-channel figures. Rule 1 is
+/// `a·r₁ + b·E` with `r₁` the single-channel Rule 1 figure and `E` the
+/// largest pulse energy (J); only one of `a`, `b` is nonzero
+/// (`head::bound::single_pulse_ratio` is linear in the single-channel
+/// Rule 1 ratio when no two channels share an aperture position, else
+/// linear in the largest pulse energy). Each energy rule of the head is
+/// at least `W·r` with `r` the single-channel figure of that rule and `W`
+/// the smallest channel weight any of its candidates takes
+/// (`head::bound::energy_ratios`: `W_v`, or a separation's `W(L)`, times
+/// the single-channel figure, the larger of that and a multi-pass figure).
+///
+/// Not covered: the head bound's instantaneous-overlap candidate
+/// (`W_inst · P̂` per unit time up to `T*`, added after these cuts were
+/// written) is not of the form `W · r`; where it is the smallest, a cut
+/// scaled by `W` may exceed the head's figure, which can only make the
+/// optimizer conservative (every answer is still decided by the checker),
+/// never unsafe. `tests/eye_cuts.rs::cuts_never_exceed_the_bound_on_optimized_profiles`
+/// holds on the shipped configs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadScale {
+    /// `W`: the energy rules' factor on the single-channel figures (a
+    /// lower bound of the head's: its cuts stay below the head's figure
+    /// whichever candidate the head bound takes).
+    pub energy: f64,
+    /// Rule 1's factor on the single-channel Rule 1 figure.
+    pub rule_one_single: f64,
+    /// Rule 1's ratio per joule of the largest pulse energy.
+    pub rule_one_per_j: f64,
+    /// Half the head's widest pass angle, deg (the bound's `half_deg`).
+    pub half_deg: f64,
+}
+
+impl HeadScale {
+    /// The scales of the head bound for the spins of `segs` (the head's
+    /// figures at their fastest spin, Rule 1's counts at their longest pass,
+    /// both as the checker takes them: [`super::exposure::evaluate_segments`]).
+    pub fn of(
+        segs: &[Seg],
+        params: &super::EyeSafetyParams,
+        laser: &Laser,
+    ) -> Result<Option<Self>, super::EyeSafetyError> {
+        if params.head.is_none() {
+            return Ok(None);
+        }
+        let report = super::exposure::evaluate_segments(segs, params, laser.pulse_rate_hz)?;
+        let Some(hf) = report.head else {
+            return Ok(None);
+        };
+        let frame_s = Timeline::from_bins(segs).period_s();
+        let rule_one = |single_pulse_ratio: f64, power_max_w: f64| {
+            super::head::bound::single_pulse_ratio(
+                &hf,
+                laser,
+                super::head::bound::SingleFigures {
+                    single_pulse_ratio,
+                    pass_duration_s: report.max_pass_duration_s,
+                    frame_s,
+                    power_max_w,
+                },
+            )
+        };
+        let energy = hf
+            .separations
+            .iter()
+            .map(|sep| sep.weight)
+            .fold(hf.weight_vertical, f64::min);
+        Ok(Some(Self {
+            energy,
+            rule_one_single: rule_one(1.0, 0.0),
+            // Power `f_p` W is a pulse of 1 J.
+            rule_one_per_j: rule_one(0.0, laser.pulse_rate_hz),
+            half_deg: 0.5 * report.pass_angle_deg,
+        }))
+    }
+}
+
+/// [`cuts_with`] for the bound `params` describe: the single-channel cuts
+/// without a head; with one, the cuts of the head's bound (still linear in
+/// the bin powers): every energy cut's limit divided by `W`
+/// ([`HeadScale::energy`]), and Rule 1
+/// either the single-channel Rule 1 cuts divided by its factor or, where
+/// channels share an aperture position, one cut per bin against the head's
+/// Rule 1 per joule. Each is at most the head bound's figure of its rule
+/// (the energy rules are at least `W` times the single-channel figures the
+/// single-channel cuts never exceed; the head's Rule 1 takes the largest
+/// bin power), so the cuts stay a relaxation of "the head bound certifies".
+pub fn cuts_for(
+    segs: &[Seg],
+    params: &super::EyeSafetyParams,
+    laser: &Laser,
+    extra_azimuths_deg: &[f64],
+    threshold: f64,
+    rule_one_threshold: f64,
+) -> Result<Vec<Cut>, super::EyeSafetyError> {
+    let Some(s) = HeadScale::of(segs, params, laser)? else {
+        let half = 0.5 * super::exposure::pass_angle_deg(params, laser);
+        return Ok(cuts_with(
+            segs,
+            half,
+            laser,
+            extra_azimuths_deg,
+            threshold,
+            rule_one_threshold,
+        ));
+    };
+    // A cut's head ratio is its single-channel ratio times the factor, so
+    // a head threshold `t` is a single-channel threshold `t / factor` (a
+    // zero factor: the rule cannot bind, no cut).
+    let below = |t: f64, factor: f64| {
+        if factor > 0.0 {
+            t / factor
+        } else {
+            f64::INFINITY
+        }
+    };
+    let rule_one_factor = if s.rule_one_per_j > 0.0 {
+        0.0
+    } else {
+        s.rule_one_single
+    };
+    let mut found = cuts_with(
+        segs,
+        s.half_deg,
+        laser,
+        extra_azimuths_deg,
+        below(threshold, s.energy),
+        below(rule_one_threshold, rule_one_factor),
+    );
+    found.retain_mut(|c| {
+        let factor = if c.rule == Rule::SinglePulse {
+            rule_one_factor
+        } else {
+            s.energy
+        };
+        c.limit_j /= factor;
+        factor > 0.0
+    });
+    if s.rule_one_per_j > 0.0 {
+        let f_p = laser.pulse_rate_hz;
+        let limit_j = 1.0 / s.rule_one_per_j;
+        for (b, seg) in segs.iter().enumerate() {
+            if seg.power_w / f_p / limit_j >= rule_one_threshold {
+                found.push(Cut {
+                    rule: Rule::SinglePulse,
+                    azimuth_deg: seg.start_deg + 0.5 * seg.width_deg,
+                    window_s: (laser.pulse_duration_s, laser.pulse_duration_s),
+                    pulses: vec![(b, 1.0)],
+                    limit_j,
+                });
+            }
+        }
+    }
+    Ok(found)
+}
+
+/// [`rule_one_cap_w`] for the bound `params` describe. With a head, no cap
+/// (`+∞`): the head's Rule 1 takes its weights at each profile's fastest
+/// spin and changes form where channels start to share a position, so no
+/// single figure is proved to hold for every spin profile of a box; an
+/// absent column bound only weakens the relaxation, never cuts a
+/// certifiable profile.
+#[must_use]
+pub fn rule_one_cap_for(
+    params: &super::EyeSafetyParams,
+    laser: &Laser,
+    spin_max_rad_s: f64,
+    frame_s: f64,
+) -> f64 {
+    if params.head.is_some() {
+        return f64::INFINITY;
+    }
+    let half = 0.5 * super::exposure::pass_angle_deg(params, laser);
+    rule_one_cap_w(laser, half, spin_max_rad_s, frame_s)
+}

@@ -66,6 +66,18 @@ pub enum EyeSafetyError {
     /// The head is invalid.
     #[error("eye_safety.{0}")]
     Head(#[from] head::HeadError),
+    /// With a head, the pulse rate is not the head's `1/cycle_s`.
+    #[error(
+        "pulse_rate_hz = {}: with limits.eye_safety.head it must be 1/head.cycle_s = {} within 1e-9 (every channel fires once per cycle)",
+        crate::text::Num(*.pulse_rate_hz),
+        crate::text::Num(*.expected_hz)
+    )]
+    PulseRate {
+        /// The rate found, Hz.
+        pulse_rate_hz: f64,
+        /// `1/cycle_s`, Hz.
+        expected_hz: f64,
+    },
     /// A parameter is invalid.
     #[error("eye_safety.{field} = {}: {reason}", crate::text::Num(*.value))]
     Param {
@@ -103,5 +115,26 @@ impl EyeSafetyParams {
             head.validate()?;
         }
         Ok(band)
+    }
+
+    /// With a head, every channel fires once per firing cycle, so the
+    /// per-channel `pulse_rate_hz` of the profile, sensor or table carrying
+    /// these parameters must be `1/cycle_s`: the head bound's own rule
+    /// (`|pulse_rate_hz · cycle_s − 1| ≤` [`head::bound::RATE_CYCLE_TOLERANCE`],
+    /// NaN failing), checked here at the boundary so a sensor file or a
+    /// profile is refused by name before any evaluation. Without a head
+    /// there is nothing to compare.
+    pub fn check_pulse_rate(&self, pulse_rate_hz: f64) -> Result<(), EyeSafetyError> {
+        let Some(h) = &self.head else {
+            return Ok(());
+        };
+        let off = (pulse_rate_hz * h.cycle_s - 1.0).abs();
+        if off.is_nan() || off > head::bound::RATE_CYCLE_TOLERANCE {
+            return Err(EyeSafetyError::PulseRate {
+                pulse_rate_hz,
+                expected_hz: 1.0 / h.cycle_s,
+            });
+        }
+        Ok(())
     }
 }

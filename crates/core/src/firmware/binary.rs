@@ -6,7 +6,7 @@
 //! | 0 | 4 | magic `GLFW` |
 //! | 4 | 2 | version = 2 |
 //! | 6 | 1 | accounting: 0 time, 1 angle |
-//! | 7 | 1 | eye-safety parameters: 0 absent (fields at 72–95 zero), 1 present |
+//! | 7 | 1 | eye-safety parameters: 0 absent (fields at 72–95 zero), 1 present without a head (one channel), 2 present with a head (the head section follows the records) |
 //! | 8 | 8 | tick_hz |
 //! | 16 | 8 | frame_ticks |
 //! | 24 | 8 | power_w_per_code (IEEE-754 f64) |
@@ -22,7 +22,34 @@
 //! | 88 | 8 | eye_safety.beam_diameter_mm (f64) |
 //! | 96 | 36·n | records: width_mdeg u32, dwell_ticks u64, power_code u32, dwell_ticks_min u64, dwell_ticks_max u64, power_code_cap u32 |
 //!
-//! [`decode`] never panics and rejects anything that is not exactly this layout.
+//!
+//! The head section (only when byte 7 is 2; `m` channels), at `h = 96 + 36·n`:
+//!
+//! | offset | size | field |
+//! |---:|---:|---|
+//! | h + 0 | 4 | section magic `HEAD` |
+//! | h + 4 | 2 | section version = 1 |
+//! | h + 6 | 2 | reserved = 0 |
+//! | h + 8 | 4 | channel count m (1..=512) |
+//! | h + 12 | 4 | reserved = 0 |
+//! | h + 16 | 8 | head.cycle_s (f64) |
+//! | h + 24 | 8 | head.origin_radius_mm (f64) |
+//! | h + 32 | 8 | head.origin_height_mm (f64) |
+//! | h + 40 | 8 | head.exit_diameter_mm (f64) |
+//! | h + 48 | 8 | head.divergence_mrad (f64) |
+//! | h + 56 | 8 | head.aperture_distance_mm (f64) |
+//! | h + 64 | 40·m | channels, in the table's order: id u32, reserved u32 = 0, elevation_deg f64, azimuth_offset_deg f64, slot_s f64, power_scale f64 |
+//!
+//! A table without a head encodes exactly as before heads existed (byte 7
+//! is 0 or 1, nothing after the records), so every earlier binary decodes
+//! unchanged; a decoder that predates heads refuses byte 7 = 2 instead of
+//! silently dropping the head. The section carries its own version so it
+//! can grow without touching the table's.
+//!
+//! [`decode`] never panics and rejects anything that is not exactly this
+//! layout (so whatever decodes re-encodes to the same bytes). The numbers
+//! themselves are validated where every table's are, by the checker
+//! (`EyeSafetyParams::validate`, `head::Head::validate`).
 
 use alloc::borrow::ToOwned;
 use alloc::vec::Vec;
@@ -39,6 +66,13 @@ pub const RECORD_LEN: usize = 36;
 /// The first four bytes of every encoded table.
 pub const MAGIC: &[u8; 4] = b"GLFW";
 const VERSION: u16 = 2;
+/// Head section: fixed part, bytes.
+pub const HEAD_LEN: usize = 64;
+/// Head section: one channel record, bytes.
+pub const CHANNEL_LEN: usize = 40;
+/// The first four bytes of the head section.
+pub const HEAD_MAGIC: &[u8; 4] = b"HEAD";
+const HEAD_VERSION: u16 = 1;
 
 /// Why bytes are not a table.
 #[derive(Debug, Error, Clone, PartialEq, Eq)]
@@ -72,6 +106,9 @@ pub enum DecodeError {
     /// The DAC step is not a positive finite number.
     #[error("power_w_per_code is not finite and > 0")]
     Step,
+    /// The head section is malformed.
+    #[error("head section: {0}")]
+    Head(&'static str),
 }
 
 fn u16_at(b: &[u8], at: usize) -> Option<u16> {
@@ -94,7 +131,12 @@ pub fn encode(t: &FirmwareTable) -> Vec<u8> {
         PowerAccounting::Time => 0,
         PowerAccounting::Angle => 1,
     });
-    out.push(u8::from(t.eye_safety.is_some()));
+    let head = t.eye_safety.as_ref().and_then(|e| e.head.as_ref());
+    out.push(match (&t.eye_safety, head) {
+        (None, _) => 0,
+        (Some(_), None) => 1,
+        (Some(_), Some(_)) => 2,
+    });
     out.extend_from_slice(&t.tick_hz.to_le_bytes());
     out.extend_from_slice(&t.frame_ticks.to_le_bytes());
     out.extend_from_slice(&t.power_w_per_code.to_le_bytes());
@@ -121,7 +163,97 @@ pub fn encode(t: &FirmwareTable) -> Vec<u8> {
         out.extend_from_slice(&b.dwell_ticks_max.to_le_bytes());
         out.extend_from_slice(&b.power_code_cap.to_le_bytes());
     }
+    if let Some(h) = head {
+        out.extend_from_slice(HEAD_MAGIC);
+        out.extend_from_slice(&HEAD_VERSION.to_le_bytes());
+        out.extend_from_slice(&0u16.to_le_bytes());
+        // More than u32::MAX channels cannot be validated (at most 512), so
+        // the saturation never decodes: the decoder refuses the count.
+        out.extend_from_slice(
+            &u32::try_from(h.channels.len())
+                .unwrap_or(u32::MAX)
+                .to_le_bytes(),
+        );
+        out.extend_from_slice(&0u32.to_le_bytes());
+        for x in [
+            h.cycle_s,
+            h.origin_radius_mm,
+            h.origin_height_mm,
+            h.exit_diameter_mm,
+            h.divergence_mrad,
+            h.aperture_distance_mm,
+        ] {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+        for c in &h.channels {
+            out.extend_from_slice(&c.id.to_le_bytes());
+            out.extend_from_slice(&0u32.to_le_bytes());
+            for x in [
+                c.elevation_deg,
+                c.azimuth_offset_deg,
+                c.slot_s,
+                c.power_scale,
+            ] {
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+    }
     out
+}
+
+/// Decodes the head section at `at`, which must run exactly to the end of
+/// `bytes`.
+fn decode_head(bytes: &[u8], at: usize) -> Result<crate::eye_safety::head::Head, DecodeError> {
+    use crate::eye_safety::head::{Channel, Head, CHANNELS_MAX};
+    let length = |expected: usize| DecodeError::Length {
+        found: bytes.len(),
+        expected,
+    };
+    let fixed_end = at + HEAD_LEN;
+    if bytes.len() < fixed_end {
+        return Err(length(fixed_end));
+    }
+    if bytes.get(at..at + 4) != Some(&HEAD_MAGIC[..]) {
+        return Err(DecodeError::Head("bad magic (expected HEAD)"));
+    }
+    if u16_at(bytes, at + 4) != Some(HEAD_VERSION) {
+        return Err(DecodeError::Head("unsupported section version"));
+    }
+    if u16_at(bytes, at + 6) != Some(0) || u32_at(bytes, at + 12) != Some(0) {
+        return Err(DecodeError::Head("reserved bytes must be 0"));
+    }
+    let m = u32_at(bytes, at + 8).ok_or(length(fixed_end))? as usize;
+    if m == 0 || m > CHANNELS_MAX {
+        return Err(DecodeError::Head("channel count outside 1..=512"));
+    }
+    let expected = fixed_end + CHANNEL_LEN * m;
+    if bytes.len() != expected {
+        return Err(length(expected));
+    }
+    let f = |k: usize| u64_at(bytes, k).map(f64::from_bits).ok_or(length(expected));
+    let mut channels = Vec::with_capacity(m);
+    for k in 0..m {
+        let c = fixed_end + CHANNEL_LEN * k;
+        if u32_at(bytes, c + 4) != Some(0) {
+            return Err(DecodeError::Head("reserved bytes must be 0"));
+        }
+        channels.push(Channel {
+            id: u32_at(bytes, c).ok_or(length(expected))?,
+            elevation_deg: f(c + 8)?,
+            azimuth_offset_deg: f(c + 16)?,
+            slot_s: f(c + 24)?,
+            power_scale: f(c + 32)?,
+        });
+    }
+    Ok(Head {
+        cycle_s: f(at + 16)?,
+        origin_radius_mm: f(at + 24)?,
+        origin_height_mm: f(at + 32)?,
+        exit_diameter_mm: f(at + 40)?,
+        divergence_mrad: f(at + 48)?,
+        aperture_distance_mm: f(at + 56)?,
+        channels,
+    })
 }
 
 /// Decodes a table; never panics. Bin start azimuths are rebuilt from the widths.
@@ -142,15 +274,16 @@ pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
         1 => PowerAccounting::Angle,
         other => return Err(DecodeError::Accounting(other)),
     };
-    let has_eye_safety = match bytes.get(7).copied().ok_or_else(short)? {
-        0 => false,
-        1 => true,
+    let (has_eye_safety, has_head) = match bytes.get(7).copied().ok_or_else(short)? {
+        0 => (false, false),
+        1 => (true, false),
+        2 => (true, true),
         other => return Err(DecodeError::Reserved(other)),
     };
     let f64_at = |at: usize| u64_at(bytes, at).map(f64::from_bits);
     let pulse_rate_hz = f64_at(64).ok_or_else(short)?;
     let es = [f64_at(72), f64_at(80), f64_at(88)];
-    let eye_safety = if has_eye_safety {
+    let mut eye_safety = if has_eye_safety {
         Some(crate::eye_safety::EyeSafetyParams {
             wavelength_nm: es[0].ok_or_else(short)?,
             pulse_duration_s: es[1].ok_or_else(short)?,
@@ -174,7 +307,12 @@ pub fn decode(bytes: &[u8]) -> Result<FirmwareTable, DecodeError> {
         return Err(DecodeError::Count(n));
     }
     let expected = HEADER_LEN + RECORD_LEN * n as usize;
-    if bytes.len() != expected {
+    if has_head {
+        let head = decode_head(bytes, expected)?;
+        if let Some(e) = eye_safety.as_mut() {
+            e.head = Some(head);
+        }
+    } else if bytes.len() != expected {
         return Err(DecodeError::Length {
             found: bytes.len(),
             expected,
@@ -325,6 +463,149 @@ mod verification {
         });
         #[cfg(not(kani))]
         crate::verification::assert_covered(&["three records"]);
+    }
+
+    /// A table with a head, three channels, every head field distinct.
+    #[cfg(not(kani))]
+    fn table_with_head() -> FirmwareTable {
+        use crate::eye_safety::head::{Channel, Head};
+        let channels = (0..3u32)
+            .map(|k| Channel {
+                id: 7 + 2 * k,
+                elevation_deg: -11.742 + f64::from(k),
+                azimuth_offset_deg: -6.354 + 1.5 * f64::from(k),
+                slot_s: 2.665e-6 * f64::from(k),
+                power_scale: 1.0 - 0.25 * f64::from(k),
+            })
+            .collect();
+        FirmwareTable {
+            format: FIRMWARE_FORMAT.to_owned(),
+            tick_hz: 80_000_000,
+            frame_ticks: 8_000_000,
+            power_w_per_code: 1e-6,
+            power_accounting: PowerAccounting::Time,
+            pulse_rate_hz: 1.0 / 53.3e-6,
+            eye_safety: Some(crate::eye_safety::EyeSafetyParams {
+                wavelength_nm: 903.0,
+                pulse_duration_s: 3e-9,
+                beam_diameter_mm: 8.0,
+                head: Some(Head {
+                    cycle_s: 53.3e-6,
+                    origin_radius_mm: 58.63,
+                    origin_height_mm: -1.5,
+                    exit_diameter_mm: 8.0,
+                    divergence_mrad: 3.0,
+                    aperture_distance_mm: 100.0,
+                    channels,
+                }),
+            }),
+            limits: IntLimits {
+                power_code_min: 1,
+                power_code_max: 4095,
+                energy_budget: 1 << 40,
+                window_bins: 2,
+                window_energy_max: 7,
+            },
+            bins: (0..2)
+                .map(|k| FwBin {
+                    start_deg: 180.0 * f64::from(k),
+                    width_mdeg: 180_000,
+                    dwell_ticks: 4_000_000,
+                    power_code: 1500,
+                    dwell_ticks_min: 3_000_000,
+                    dwell_ticks_max: 5_000_000,
+                    power_code_cap: 2000,
+                })
+                .collect(),
+        }
+    }
+
+    /// The head section round-trips field for field, and a table without a
+    /// head encodes exactly as before (nothing after the records).
+    #[cfg(not(kani))]
+    #[test]
+    fn head_section_round_trips() {
+        let t = table_with_head();
+        let bytes = encode(&t);
+        assert_eq!(bytes[7], 2);
+        assert_eq!(
+            bytes.len(),
+            HEADER_LEN + 2 * RECORD_LEN + HEAD_LEN + 3 * CHANNEL_LEN
+        );
+        let back = decode(&bytes).unwrap();
+        assert_eq!(back, t);
+        assert_eq!(encode(&back), bytes);
+        let mut one = t.clone();
+        one.eye_safety.as_mut().unwrap().head = None;
+        let plain = encode(&one);
+        assert_eq!(plain[7], 1);
+        assert_eq!(plain.len(), HEADER_LEN + 2 * RECORD_LEN);
+        assert_eq!(plain[..7], bytes[..7]);
+        assert_eq!(plain[8..], bytes[8..plain.len()]);
+        assert_eq!(decode(&plain).unwrap(), one);
+    }
+
+    /// Decoding the head section is strict: every truncation, any extra
+    /// byte, and every field outside the layout is refused.
+    #[cfg(not(kani))]
+    #[test]
+    fn head_section_is_decoded_strictly() {
+        let bytes = encode(&table_with_head());
+        let h = HEADER_LEN + 2 * RECORD_LEN;
+        for len in 0..bytes.len() {
+            assert!(decode(&bytes[..len]).is_err(), "truncated to {len}");
+        }
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(matches!(decode(&longer), Err(DecodeError::Length { .. })));
+        let patched = |at: usize, with: &[u8]| {
+            let mut b = bytes.clone();
+            b[at..at + with.len()].copy_from_slice(with);
+            decode(&b)
+        };
+        assert_eq!(
+            patched(h, b"HEAX"),
+            Err(DecodeError::Head("bad magic (expected HEAD)"))
+        );
+        assert_eq!(
+            patched(h + 4, &2u16.to_le_bytes()),
+            Err(DecodeError::Head("unsupported section version"))
+        );
+        assert_eq!(
+            patched(h + 6, &[1]),
+            Err(DecodeError::Head("reserved bytes must be 0"))
+        );
+        assert_eq!(
+            patched(h + 12, &[1]),
+            Err(DecodeError::Head("reserved bytes must be 0"))
+        );
+        assert_eq!(
+            patched(h + HEAD_LEN + 4, &[1]),
+            Err(DecodeError::Head("reserved bytes must be 0"))
+        );
+        assert_eq!(
+            patched(h + 8, &0u32.to_le_bytes()),
+            Err(DecodeError::Head("channel count outside 1..=512"))
+        );
+        assert_eq!(
+            patched(h + 8, &513u32.to_le_bytes()),
+            Err(DecodeError::Head("channel count outside 1..=512"))
+        );
+        assert!(matches!(
+            patched(h + 8, &2u32.to_le_bytes()),
+            Err(DecodeError::Length { .. })
+        ));
+        assert!(matches!(
+            patched(h + 8, &4u32.to_le_bytes()),
+            Err(DecodeError::Length { .. })
+        ));
+        // Flag 1 with a section after the records: the length is wrong.
+        assert!(matches!(patched(7, &[1]), Err(DecodeError::Length { .. })));
+        // Flag 2 without a section; flag 3 is reserved.
+        let mut plain = bytes[..h].to_vec();
+        assert!(matches!(decode(&plain), Err(DecodeError::Length { .. })));
+        plain[7] = 3;
+        assert_eq!(decode(&plain), Err(DecodeError::Reserved(3)));
     }
 
     /// Found by the fuzz smoke: with the eye-safety flag clear, a -0.0 in

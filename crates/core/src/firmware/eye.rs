@@ -699,6 +699,9 @@ mod derive {
     use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
     use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
+    use crate::eye_safety::head::bound::{
+        head_figures, single_pulse_ratio as single_pulse_ratio_head, SingleFigures,
+    };
     use crate::eye_safety::EyeSafetyError;
     use crate::firmware::FirmwareTable;
 
@@ -771,7 +774,32 @@ mod derive {
                 field: "pulse_rate_hz",
                 reason: "must be finite and > 0",
             })?;
-            let arc = (pass_angle_deg(params, &laser) * 1000.0 * (1.0 + WIDEN)).ceil();
+            // The head (absent: one channel): its figures at the table's
+            // fastest spin (rounded up: a faster spin only widens the
+            // grouping footprints), its widest pass, and the factors its
+            // bound puts on the single-channel figures.
+            let tick_hz_f = table.tick_hz as f64;
+            let head = match &params.head {
+                None => None,
+                Some(h) => {
+                    let spin_max = table
+                        .bins
+                        .iter()
+                        .filter(|b| b.width_mdeg > 0 && b.dwell_ticks > 0)
+                        .map(|b| {
+                            (f64::from(b.width_mdeg) / 1000.0).to_radians() * tick_hz_f
+                                / b.dwell_ticks as f64
+                        })
+                        .fold(0.0, f64::max)
+                        * (1.0 + WIDEN);
+                    Some(head_figures(h, params, &laser, spin_max)?)
+                }
+            };
+            let pass_deg = head.as_ref().map_or_else(
+                || pass_angle_deg(params, &laser),
+                |hf| hf.pass_angle_deg.min(360.0),
+            );
+            let arc = (pass_deg * 1000.0 * (1.0 + WIDEN)).ceil();
             if !(arc >= 1.0 && arc < f64::from(u32::MAX)) {
                 return Err(DeriveError::Range {
                     field: "pass arc",
@@ -804,7 +832,37 @@ mod derive {
             let t2_ticks = (T2_S * tick_hz).ceil() as u128;
             let passes_t2 =
                 (t2_ticks + u128::from(timing.pass_ticks_max)) / u128::from(table.frame_ticks) + 1;
-            let per_code = laser.single_pulse_ratio(quantum_j, k_max as f64, passes_t2 as f64);
+            let per_code_one = laser.single_pulse_ratio(quantum_j, k_max as f64, passes_t2 as f64);
+            // The head's Rule 1 is `a·r₁ + b·E` (`cuts::HeadScale`): `a`
+            // on the single-channel figure, `b` per joule of the hottest
+            // pulse, at counts of the longest pass (widened) and the frame
+            // (shortened): more pulses, a smaller C5, a larger figure.
+            let per_code = match &head {
+                None => per_code_one,
+                Some(hf) => {
+                    let rule_one = |single_pulse_ratio: f64, power_max_w: f64| {
+                        single_pulse_ratio_head(
+                            hf,
+                            &laser,
+                            SingleFigures {
+                                single_pulse_ratio,
+                                pass_duration_s: timing.pass_ticks_max as f64 / tick_hz
+                                    * (1.0 + WIDEN),
+                                frame_s: table.frame_ticks as f64 / tick_hz * (1.0 - WIDEN),
+                                power_max_w,
+                            },
+                        )
+                    };
+                    // A pulse of one quantum is `step` W at `f_p`.
+                    rule_one(1.0, 0.0) * per_code_one + rule_one(0.0, step)
+                }
+            };
+            // The energy rules: `W_v` times the single-channel figures, the
+            // head bound's first candidate (`head::bound::energy_ratios`);
+            // the float bound may take a tighter one (a separation's), so
+            // this check is at least as strict as the float checker's.
+            let w_v = head.as_ref().map_or(1.0, |hf| hf.weight_vertical);
+            let to_quanta = |energy_j: f64| to_quanta(energy_j / w_v);
             let pulse_code_max = if per_code > 0.0 {
                 let x = (1.0 - LIMIT_MARGIN) / per_code;
                 if x >= 1.8e19 {

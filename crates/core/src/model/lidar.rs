@@ -162,13 +162,29 @@ impl LidarSpec {
                 "is above limits.spin_rad_s_max",
             ));
         }
+        if let Some(head) = l.eye_safety.as_ref().and_then(|e| e.head.as_ref()) {
+            if self.channels as usize != head.channels.len() {
+                return Err(err(
+                    "channels",
+                    f64::from(self.channels),
+                    &format!(
+                        "must equal the number of channels of limits.eye_safety.head ({})",
+                        head.channels.len()
+                    ),
+                ));
+            }
+        }
         match &l.eye_safety {
             None => Err(err(
                 "limits.eye_safety",
                 f64::NAN,
                 "missing: a sensor's laser and optics parameters are needed for Class 1",
             )),
-            Some(params) => params.validate().map(drop).map_err(|e| match e {
+            Some(params) => params
+                .validate()
+                .map(drop)
+                .and_then(|()| params.check_pulse_rate(self.pulse_rate_hz))
+                .map_err(|e| match e {
                 crate::eye_safety::EyeSafetyError::Param {
                     field,
                     value,
@@ -178,6 +194,14 @@ impl LidarSpec {
                     &format!("limits.eye_safety.head.{}", h.field),
                     f64::NAN,
                     h.reason,
+                ),
+                crate::eye_safety::EyeSafetyError::PulseRate { expected_hz, .. } => err(
+                    "pulse_rate_hz",
+                    self.pulse_rate_hz,
+                    &format!(
+                        "must be 1/limits.eye_safety.head.cycle_s = {} within 1e-9 with a head (every channel fires once per cycle)",
+                        crate::text::Num(expected_hz)
+                    ),
                 ),
                 crate::eye_safety::EyeSafetyError::Ael(_) => err(
                     "limits.eye_safety.wavelength_nm",
