@@ -5,9 +5,12 @@
 mod head_oracle_defs;
 mod reference_defs;
 
+use gaze_lidar_core::eye_safety::evaluate_profile;
 use gaze_lidar_core::eye_safety::head::{Channel, Head};
+use gaze_lidar_core::profile::Profile;
 use head_oracle_defs::{hit, OBin, OScan, Oracle, Pos, Train};
 use reference_defs::{DBin, DScan, DefReference};
+use serde_json::json;
 
 fn channel(id: u32, elevation_deg: f64, azimuth_offset_deg: f64, slot_s: f64) -> Channel {
     Channel {
@@ -533,4 +536,88 @@ fn real_head_shapes() {
             assert!(beams_at_once >= 2);
         }
     }
+}
+
+/// The profile the checker reads for `scan` turned by `head` (pulse rate
+/// `1/cycle_s`; `beam_diameter_mm` the head's footprint at the aperture, as
+/// a single-channel file would state it).
+fn profile_of(s: &OScan, h: &Head) -> Profile {
+    let period: f64 = s
+        .bins
+        .iter()
+        .map(|b| 2.0 * b.width_deg.to_radians() / (b.w0 + b.w1))
+        .sum();
+    let footprint = h.exit_diameter_mm
+        + h.divergence_mrad * 1e-3 * (h.aperture_distance_mm - h.origin_radius_mm);
+    let v = json!({
+        "format": "gaze-lidar/profile@1",
+        "frame_rate_hz": 1.0 / period,
+        "pulse_rate_hz": 1.0 / h.cycle_s,
+        "average_power_w": 1e3,
+        "power_accounting": "time",
+        "gaze_deg": null,
+        "limits": {
+            "power_w_min": 0.0, "power_w_max": 1e3,
+            "spin_rad_s_min": 0.0, "spin_rad_s_max": 1e6,
+            "spin_accel_rad_s2_max": null, "power_slew_w_per_deg_max": null,
+            "eye_safety": {
+                "wavelength_nm": s.lambda_nm,
+                "pulse_duration_s": s.pulse_s,
+                "beam_diameter_mm": footprint,
+                "head": serde_json::to_value(h).unwrap(),
+            }
+        },
+        "bins": s.bins.iter().map(|b| json!({
+            "start_deg": b.start_deg, "width_deg": b.width_deg, "power_w": b.power_w,
+            "spin_start_rad_s": b.w0, "spin_end_rad_s": b.w1
+        })).collect::<Vec<_>>()
+    });
+    Profile::from_json(&v.to_string(), "head oracle").expect("generated profile parses")
+}
+
+/// The checker's figure for the profile.
+fn bound_ratio(p: &Profile) -> f64 {
+    let params = p.limits.eye_safety.clone().unwrap();
+    evaluate_profile(p, &params).expect("evaluates").worst_ratio
+}
+
+/// Harness check on what exists today: a 1-channel head on the axis
+/// (origin 0, elevation 0, no offset) is the single-channel model, and the
+/// certified single-channel bound (reading the footprint at the aperture as
+/// its beam) is never below the oracle.
+#[test]
+fn one_channel_axis_heads_never_above_the_single_channel_bound() {
+    let mut r = Rng(0x4ead_0a11);
+    let mut worst_q = f64::INFINITY;
+    for case in 0..cases(6) {
+        let s = random_scan(&mut r);
+        let mut h = random_head(&mut r, 1);
+        h.origin_radius_mm = 0.0;
+        h.origin_height_mm = 0.0;
+        h.channels[0].elevation_deg = 0.0;
+        h.channels[0].azimuth_offset_deg = 0.0;
+        h.channels[0].power_scale = 1.0;
+        let o = Oracle::new(&h, &s);
+        let positions = case_positions(&o, &[0.0], 4);
+        let effort = head_oracle_defs::Effort {
+            phases: 2,
+            starts_max: 100,
+            top_k: 2,
+            ..Default::default()
+        };
+        let w = o.worst(&positions, &effort);
+        let mut single = h.clone();
+        single.channels.clear();
+        let b = bound_ratio(&profile_of(&s, &h));
+        println!(
+            "case {case}: bound {b:.6}, oracle {w}, bound/oracle {:.4}",
+            b / w.ratio
+        );
+        worst_q = worst_q.min(b / w.ratio);
+        assert!(
+            b >= w.ratio * (1.0 - 1e-12),
+            "case {case}: bound {b} < oracle {w}"
+        );
+    }
+    println!("smallest bound/oracle {worst_q:.6}");
 }
