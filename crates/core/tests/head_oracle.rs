@@ -8,7 +8,7 @@ mod reference_defs;
 use gaze_lidar_core::eye_safety::evaluate_profile;
 use gaze_lidar_core::eye_safety::head::{Channel, Head};
 use gaze_lidar_core::profile::Profile;
-use head_oracle_defs::{hit, OBin, OScan, Oracle, Pos, Train};
+use head_oracle_defs::{hit, Fast, OBin, OScan, Oracle, Pos, Train};
 use reference_defs::{DBin, DScan, DefReference};
 use serde_json::json;
 
@@ -132,6 +132,35 @@ fn forward_geometry_by_hand() {
             .unwrap()
             .overlaps
     );
+}
+
+/// The fast overlap test (trigonometry once per channel and aperture) is
+/// [`hit`]'s, on random heads, positions and head angles.
+#[test]
+fn fast_hit_is_hit() {
+    let mut r = Rng(77);
+    let (mut yes, mut total) = (0usize, 0usize);
+    for _ in 0..200 {
+        let h = random_head(&mut r, 4);
+        let p = pos(r.range(0.0, 360.0), r.range(-6.0, 6.0));
+        for c in 0..h.channels.len() {
+            let f = Fast::new(&h, c, p, 7.0);
+            for _ in 0..200 {
+                // Near the aperture half the time.
+                let th = if r.unit() < 0.5 {
+                    r.range(0.0, std::f64::consts::TAU)
+                } else {
+                    (p.azimuth_deg - h.channels[c].azimuth_offset_deg + r.range(-8.0, 8.0))
+                        .to_radians()
+                };
+                let slow = hit(&h, c, th, p, 7.0).is_some_and(|x| x.overlaps);
+                assert_eq!(f.overlaps(th), slow, "{h:?} {p:?} {th}");
+                yes += usize::from(slow);
+                total += 1;
+            }
+        }
+    }
+    assert!(yes > total / 20, "{yes} of {total}");
 }
 
 /// A 1-channel head on the axis (origin 0, elevation 0, no offset, no
@@ -456,6 +485,11 @@ fn cases(d: usize) -> usize {
         .unwrap_or(d)
 }
 
+/// `HEAD_ORACLE_LONG=1`: full effort (more phases, starts and positions).
+fn long_run() -> bool {
+    std::env::var_os("HEAD_ORACLE_LONG").is_some()
+}
+
 /// Positions for a case: every bin's start, middle and end (± 0.5°) and a
 /// few fixed azimuths, × a height grid plus every channel's edge heights.
 fn case_positions(o: &Oracle, heights: &[f64], extra_az: usize) -> Vec<Pos> {
@@ -501,11 +535,15 @@ fn real_head_shapes() {
         let o = Oracle::new(&h, &s);
         let heights: Vec<f64> = (-4..=4).map(|k| k as f64 * 2.0).collect();
         let positions = o.positions(&[15.0], &heights);
-        let effort = head_oracle_defs::Effort {
-            phases: 2,
-            starts_max: 100,
-            top_k: 2,
-            ..Default::default()
+        let effort = if long_run() {
+            head_oracle_defs::Effort::default()
+        } else {
+            head_oracle_defs::Effort {
+                phases: 1,
+                starts_max: 50,
+                top_k: 1,
+                ..Default::default()
+            }
         };
         let w = o.worst(&positions, &effort);
         // The most beams of one slot in one instant at the worst position.
@@ -517,16 +555,30 @@ fn real_head_shapes() {
                 .map(|e| (e / e1).round() as usize)
                 .max()
                 .unwrap_or(0);
-        // The best single channel at the head's worst position.
-        let single = (0..h.channels.len())
+        // The best single channel at the head's worst position: the three
+        // channels with the most energy there in 1.5 turns, in full.
+        let mut by_energy: Vec<(f64, usize)> = (0..h.channels.len())
             .map(|c| {
+                let oc = Oracle::new(&one_channel_of(&h, c), &s);
+                let ivs = oc.intervals(w.pos.azimuth_deg, 0.05);
+                let tr = oc.train(w.pos, w.t0_s, 1.5 * oc.motion.period_s, &ivs);
+                (tr.e.iter().sum::<f64>(), c)
+            })
+            .collect();
+        by_energy.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let reaching = by_energy.iter().filter(|x| x.0 > 0.0).count();
+        let single = by_energy
+            .iter()
+            .take(3)
+            .map(|&(_, c)| {
                 let oc = Oracle::new(&one_channel_of(&h, c), &s);
                 oc.worst(&[w.pos], &effort).ratio
             })
             .fold(0.0, f64::max);
         println!(
             "{name}: head {w}\n  single channel at that position {single:.6}, quotient {:.3}, \
-             {beams_at_once} beams in one instant there; {} positions, {:?}",
+             {beams_at_once} beams in one instant there, {reaching} channels reach it; \
+             {} positions, {:?}",
             w.ratio / single,
             positions.len(),
             t.elapsed()

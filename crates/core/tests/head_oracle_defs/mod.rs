@@ -25,7 +25,7 @@
 //!   that does not overlap.)
 //! - **Rules** on the explicit train (pulses at one instant summed): each
 //!   single pulse against `C5·AEL(t_pulse)`; (pulses no longer than `T_i`)
-//!   each group in a half-open window `[t_i, t_i + T_i)` against
+//!   each group of pulses wholly inside `[t_i, t_i + T_i]` against
 //!   `C5·AEL(T_i)`; each window holding exactly pulses `i..=j` against the
 //!   smallest AEL over the lengths that hold exactly them
 //!   (`ael::ael_inf_j` over `[t_j − t_i + t_pulse, t_{j+1} − t_i]`, capped
@@ -208,6 +208,77 @@ pub struct Hit {
     pub along_mm: f64,
     /// The beam overlaps the disc.
     pub overlaps: bool,
+}
+
+/// [`hit`]'s overlap test with the trigonometry of the channel and of the
+/// aperture computed once (the same formulas by the angle-addition
+/// identities; `fast_hit_is_hit` checks them against [`hit`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Fast {
+    r0: f64,
+    z0: f64,
+    cos_e: f64,
+    sin_e: f64,
+    cos_a: f64,
+    sin_a: f64,
+    centre: V3,
+    n: V3,
+    a: f64,
+    exit: f64,
+    div: f64,
+}
+
+impl Fast {
+    pub fn new(head: &Head, c: usize, pos: Pos, aperture_mm: f64) -> Fast {
+        let ch = &head.channels[c];
+        let (sin_e, cos_e) = ch.elevation_deg.to_radians().sin_cos();
+        let (sin_a, cos_a) = ch.azimuth_offset_deg.to_radians().sin_cos();
+        let (sp, cp) = pos.azimuth_deg.to_radians().sin_cos();
+        let big_r = head.aperture_distance_mm;
+        Fast {
+            r0: head.origin_radius_mm,
+            z0: head.origin_height_mm,
+            cos_e,
+            sin_e,
+            cos_a,
+            sin_a,
+            centre: [big_r * cp, big_r * sp, pos.height_mm],
+            n: [cp, sp, 0.0],
+            a: 0.5 * aperture_mm,
+            exit: head.exit_diameter_mm,
+            div: head.divergence_mrad * 1e-3,
+        }
+    }
+
+    /// Whether the beam overlaps the disc with the head at `theta`.
+    pub fn overlaps(&self, theta: f64) -> bool {
+        let (st, ct) = theta.sin_cos();
+        let o: V3 = [self.r0 * ct, self.r0 * st, self.z0];
+        let (cpsi, spsi) = (
+            ct * self.cos_a - st * self.sin_a,
+            st * self.cos_a + ct * self.sin_a,
+        );
+        let d: V3 = [self.cos_e * cpsi, self.cos_e * spsi, self.sin_e];
+        let dn = dot(d, self.n);
+        if dn <= 1e-9 {
+            return false;
+        }
+        let s = dot(sub(self.centre, o), self.n) / dn;
+        if s <= 0.0 {
+            return false;
+        }
+        let p = add(o, mul(d, s));
+        let q = sub(p, self.centre);
+        let qn = norm(q);
+        let x = if qn <= self.a {
+            p
+        } else {
+            add(self.centre, mul(q, self.a / qn))
+        };
+        let sx = dot(sub(x, o), d);
+        let perp = norm(sub(sub(x, o), mul(d, sx)));
+        sx > 0.0 && perp <= 0.5 * (self.exit + self.div * sx.max(0.0))
+    }
 }
 
 /// A worst case found.
@@ -398,6 +469,7 @@ impl Oracle {
             if ch.power_scale == 0.0 {
                 continue;
             }
+            let fast = Fast::new(&self.head, c, pos, self.aperture_mm);
             mine.clear();
             let turns = (horizon_s / tf).ceil() as i64 + 1;
             for iv in &ivs[c] {
@@ -427,9 +499,7 @@ impl Oracle {
                         if p <= 0.0 {
                             continue;
                         }
-                        if hit(&self.head, c, theta, pos, self.aperture_mm)
-                            .is_some_and(|x| x.overlaps)
-                        {
+                        if fast.overlaps(theta) {
                             mine.push((kk, t, ch.power_scale * p * cyc));
                         }
                     }
@@ -500,9 +570,11 @@ impl Oracle {
             }
             let (mut cnt, mut group_end) = (0usize, f64::NEG_INFINITY);
             for &t in tr.t[i..].iter().take_while(|&&t| t < tr.t[i] + ael::T2_S) {
-                if !grouping || t >= group_end {
+                // Groups a hair wider than T_i: never more groups than
+                // any grouping of the standard's (C5 never below it).
+                if !grouping || t > group_end {
                     cnt += 1;
-                    group_end = t + t_i;
+                    group_end = t + t_i * (1.0 + 1e-9);
                 }
             }
             n_max = n_max.max(cnt);
@@ -529,7 +601,8 @@ impl Oracle {
             let mut j = 0usize;
             for i in 0..first_end {
                 j = j.max(i);
-                while j < n && tr.t[j] < tr.t[i] + t_i {
+                // Pulses wholly inside [t_i, t_i + T_i].
+                while j < n && tr.t[j] + pulse_s <= tr.t[i] + t_i {
                     j += 1;
                 }
                 if tr.t[i] + t_i > horizon {
@@ -695,6 +768,8 @@ impl Oracle {
     /// rules at `effort.phases` clock phases on the `top_k` positions of
     /// each proxy (a sample: the result stays a lower bound).
     pub fn worst(&self, positions: &[Pos], effort: &Effort) -> OWorst {
+        let timing = std::env::var_os("HEAD_ORACLE_TIMING").is_some();
+        let clock = std::time::Instant::now();
         let mut cache: Vec<(f64, Vec<Vec<Interval>>)> = Vec::new();
         let mut ivs_of = |phi: f64| -> usize {
             match cache.iter().position(|(a, _)| *a == phi) {
@@ -720,12 +795,25 @@ impl Oracle {
         chosen.sort_unstable();
         chosen.dedup();
         let horizon = self.full_horizon_s();
+        if timing {
+            eprintln!(
+                "  oracle: {} proxies at {:?}",
+                positions.len(),
+                clock.elapsed()
+            );
+        }
         let mut best: Option<OWorst> = None;
         for &pi in &chosen {
             for ph in 0..effort.phases {
                 let t0 = (ph as f64 + 0.31) / effort.phases as f64 * self.head.cycle_s;
                 let tr = self.train(positions[pi], t0, horizon, &cache[idx[pi]].1);
+                if timing {
+                    eprintln!("  oracle: train of {} at {:?}", tr.t.len(), clock.elapsed());
+                }
                 let w = self.evaluate(&tr, positions[pi], t0, effort.starts_max);
+                if timing {
+                    eprintln!("  oracle: evaluated at {:?}", clock.elapsed());
+                }
                 if best.is_none_or(|b| w.ratio > b.ratio) {
                     best = Some(w);
                 }
