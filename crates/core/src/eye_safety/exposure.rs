@@ -16,6 +16,7 @@ use serde::Serialize;
 use super::ael::{self, APERTURE_DISTANCE_MM};
 pub use super::bound::Rule;
 use super::bound::{self, Laser, Search, Seg};
+use super::head::{bound as head_bound, Head};
 use super::{EyeSafetyError, EyeSafetyParams};
 use crate::profile::Profile;
 
@@ -49,6 +50,9 @@ pub struct ExposureReport {
     /// laser still firing (every pulse into one aperture): > 1 means the
     /// product needs a stall interlock.
     pub stalled_rotor_ratio: f64,
+    /// The multi-beam head's overlap figures (absent: one channel).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub head: Option<super::head::HeadFigures>,
 }
 
 /// The laser constants of `params` at `pulse_rate_hz`, validated.
@@ -146,23 +150,15 @@ fn evaluate_segments_with(
     search: Search,
 ) -> Result<ExposureReport, EyeSafetyError> {
     let laser = laser(params, pulse_rate_hz)?;
+    if let Some(head) = &params.head {
+        return evaluate_head(segs, params, head, &laser, search);
+    }
     let pass = pass_angle_deg(params, &laser);
     if segs.is_empty() {
-        return Err(EyeSafetyError::Param {
-            field: "bins",
-            value: 0.0,
-            reason: "a profile needs at least one bin",
-        });
+        return Err(no_bins());
     }
     let b = bound::evaluate_with(segs, 0.5 * pass, &laser, search);
-    if b.max_pass_duration_s > ael::T_MAX_TABLE_S {
-        return Err(ael::AelError::Duration {
-            what: "pass duration",
-            value: b.max_pass_duration_s,
-            reason: "exceeds 3·10⁴ s, beyond Table 3 (the spin is too slow)",
-        }
-        .into());
-    }
+    check_pass_duration(&b)?;
     let p_top = segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
     let (stalled_rotor_ratio, _) = laser.stationary_ratio(p_top);
     Ok(ExposureReport {
@@ -177,5 +173,101 @@ fn evaluate_segments_with(
         max_pass_energy_j: b.max_pass_energy_j,
         worst_window_s: b.worst_window_s,
         stalled_rotor_ratio,
+        head: None,
+    })
+}
+
+fn no_bins() -> EyeSafetyError {
+    EyeSafetyError::Param {
+        field: "bins",
+        value: 0.0,
+        reason: "a profile needs at least one bin",
+    }
+}
+
+fn check_pass_duration(b: &bound::Bound) -> Result<(), EyeSafetyError> {
+    if b.max_pass_duration_s > ael::T_MAX_TABLE_S {
+        return Err(ael::AelError::Duration {
+            what: "pass duration",
+            value: b.max_pass_duration_s,
+            reason: "exceeds 3·10⁴ s, beyond Table 3 (the spin is too slow)",
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// The head's evaluation (`specs/eye_safety.md`, "The head"): the
+/// single-channel bound at the head's widest pass, every energy rule times
+/// `W_v`, Rule 1 from the head's groups ([`head_bound::single_pulse_ratio`])
+/// and the stalled rotor for every channel meeting one aperture.
+fn evaluate_head(
+    segs: &[Seg],
+    params: &EyeSafetyParams,
+    head: &Head,
+    laser: &Laser,
+    search: Search,
+) -> Result<ExposureReport, EyeSafetyError> {
+    if segs.is_empty() {
+        return Err(no_bins());
+    }
+    let spin_max = segs
+        .iter()
+        .map(|s| s.spin_start_rad_s.max(s.spin_end_rad_s))
+        .fold(0.0, f64::max);
+    let hf = head_bound::head_figures(head, params, laser, spin_max)?;
+    let pass = hf.pass_angle_deg.min(360.0);
+    let b = bound::evaluate_with(segs, 0.5 * pass, laser, search);
+    check_pass_duration(&b)?;
+    let p_top = segs.iter().map(|s| s.power_w).fold(0.0, f64::max);
+    let frame_s = crate::profile::kinematics::Timeline::from_bins(segs).period_s();
+    let w = hf.weight_vertical;
+    let mut ratios = [
+        head_bound::single_pulse_ratio(
+            &hf,
+            laser,
+            head_bound::SingleFigures {
+                single_pulse_ratio: b.ratios[0],
+                pass_duration_s: b.max_pass_duration_s,
+                frame_s,
+                power_max_w: p_top,
+            },
+        ),
+        0.0,
+        0.0,
+        0.0,
+    ];
+    let energy = head_bound::energy_ratios(&hf, laser, b.ratios, b.pass, frame_s, p_top, spin_max);
+    ratios[1..].copy_from_slice(&energy[1..]);
+    let rules = [
+        Rule::SinglePulse,
+        Rule::PassTrain,
+        Rule::T2Train,
+        Rule::TimeBase,
+    ];
+    let (mut k_best, mut r_best) = (0, ratios[0]);
+    for (k, &r) in ratios.iter().enumerate().skip(1) {
+        if r > r_best {
+            (k_best, r_best) = (k, r);
+        }
+    }
+    let stalled_rotor_ratio = head_bound::stalled_ratio(&hf, laser, p_top);
+    Ok(ExposureReport {
+        pass_angle_deg: pass,
+        worst_azimuth_deg: b.rule_azimuths_deg[usize::from(k_best > 0)],
+        binding_rule: rules[k_best],
+        worst_ratio: r_best,
+        margin: 1.0 / r_best,
+        rule_ratios: ratios,
+        max_pass_duration_s: b.max_pass_duration_s,
+        max_pulses_per_pass: b.max_pulses_per_pass,
+        max_pass_energy_j: w * b.max_pass_energy_j,
+        worst_window_s: if k_best == 1 {
+            b.rule_windows_s[0]
+        } else {
+            b.rule_windows_s[1]
+        },
+        stalled_rotor_ratio,
+        head: Some(hf),
     })
 }

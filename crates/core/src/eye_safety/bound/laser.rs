@@ -237,6 +237,35 @@ impl Laser {
         }
     }
 
+    /// `sup min(A, C)(T)/AEL(T)` over windows `T ∈ [t_start_s, T_b]` (the
+    /// two multi-pass bounds of [`Self::multi_pass_ratio`], each valid for
+    /// every window length, at the AEL of the window's own length), from
+    /// any start: below `T_f − τ` bound A is `min(E, P̂·(T + Δ))` and bound C
+    /// one pass, whose pieces' ends are among the candidates. Used by the
+    /// head's bound for the windows long enough to reach two azimuth
+    /// columns of channels. Returns (ratio, window duration); 0 when no
+    /// window of the range is within the time base.
+    #[must_use]
+    pub fn windows_from_ratio(
+        &self,
+        frame_s: f64,
+        pass: PassFigures,
+        p_hat_w: f64,
+        t_start_s: f64,
+    ) -> (f64, f64) {
+        let t_start = t_start_s.max(0.0);
+        if pass.envelope_j <= 0.0 || pass.pulses_j <= 0.0 || t_start > ael::TIME_BASE_S {
+            return (0.0, t_start);
+        }
+        let a = self.envelope_family_max(frame_s, pass.envelope_j, p_hat_w, t_start);
+        let c = self.pass_count_max(frame_s, pass, t_start);
+        if a.0 <= c.0 {
+            a
+        } else {
+            c
+        }
+    }
+
     /// The time-base figure: the smaller of the two multi-pass energy
     /// bounds over a window of the time base, over its AEL.
     #[must_use]

@@ -118,6 +118,15 @@ pub struct Bound {
     pub max_pass_energy_j: f64,
     /// Window duration where the worst train rule binds, s.
     pub worst_window_s: f64,
+    /// Azimuth where Rule 1 is worst, and the aperture with the largest
+    /// pass energy (the train rules'), deg.
+    pub rule_azimuths_deg: [f64; 2],
+    /// Window duration where the within-pass rule is worst, and where the
+    /// multi-pass rule is, s.
+    pub rule_windows_s: [f64; 2],
+    /// The pass figures the multi-pass rules used (largest envelope and
+    /// pulse energy of one pass, longest pass).
+    pub pass: PassFigures,
 }
 
 /// Evaluates the bound for bins `segs` (validated: cover [0, 360) in order,
@@ -213,6 +222,9 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
         } else {
             multi_window
         },
+        rule_azimuths_deg: [best.single.1, best.e_max.1],
+        rule_windows_s: [pass_window, multi_window],
+        pass,
     }
 }
 

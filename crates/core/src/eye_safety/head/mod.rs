@@ -27,6 +27,16 @@
 //! - the measurement aperture stands `aperture_distance_mm` from the spin
 //!   axis (default 100 mm).
 
+#[cfg(feature = "std")]
+pub mod bound;
+#[cfg(feature = "std")]
+pub mod geometry;
+#[cfg(feature = "std")]
+pub mod overlap;
+
+#[cfg(feature = "std")]
+pub use bound::{head_figures, power_scale_to_certify, HeadFigures};
+
 use alloc::vec::Vec;
 use serde::{Deserialize, Serialize};
 
@@ -100,6 +110,7 @@ impl Head {
     /// every angle finite, every slot inside the cycle, no duplicate ids,
     /// sizes positive (or zero where zero is a size), the crossing point
     /// inside the aperture's distance.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn validate(&self) -> Result<(), HeadError> {
         use crate::model::valid;
         use alloc::format;

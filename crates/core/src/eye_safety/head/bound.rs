@@ -1,0 +1,413 @@
+//! Step 3 of the head's argument: the head's figures per rule, from the
+//! single-channel bound and the overlap weights (`specs/eye_safety.md`,
+//! "The head").
+//!
+//! Every channel fires once per cycle, so the profile's `pulse_rate_hz` is
+//! the per-channel rate (checked: `|pulse_rate_hz·cycle_s − 1| ≤ 1e-9`) and
+//! one channel's pulses through the aperture are a single-channel train of
+//! pulse energy `s_c·P(θ)/f_p`. The single-channel bound is evaluated once,
+//! with the widest pass of the channels ([`HeadFigures::pass_angle_deg`]):
+//! a narrower pass receives a subset of a wider one's pulses, at every
+//! azimuth, clock phase and window.
+//!
+//! - **Energy rules** (windows within a pass, whole passes, several passes,
+//!   the time base) are sums of pulse energies, linear in each channel's
+//!   energies: at an aperture at height `z` only the channels whose height
+//!   interval holds `z` can contribute, each at most `s_c ×` the
+//!   single-channel energy of the same window, so the head's ratio is at
+//!   most `W_v ×` the single-channel ratio ([`HeadFigures::weight_vertical`]).
+//! - **Rule 1**: an effective pulse at one position is the pulses of the
+//!   channels whose boxes share it, fired together (`W_sim`, compared with
+//!   the AEL at the pulse duration) or within one grouping window (`W_g`,
+//!   compared with the smallest AEL up to the window plus a pulse), each of
+//!   energy at most `s_c·P̂/f_p`, and C5 taken at
+//!   `N_head = K_v × N_single` pulses (the most pulses one channel can put
+//!   into one aperture within `T_max`, times the most channels that can meet
+//!   one height; C5 is nonincreasing in N, so a larger N is conservative).
+//!   When at most one channel can meet any height (`K_v = 1`) and no
+//!   grouping window puts two channels into one position, every effective
+//!   pulse is one channel's: the single-channel Rule 1 figure times the
+//!   largest `s_c`.
+//!
+//! A 1-channel head is the single-channel bound times 1.0: the same bits.
+
+use serde::Serialize;
+
+use super::geometry::{footprints, Footprint};
+use super::overlap;
+use super::Head;
+use crate::eye_safety::ael;
+use crate::eye_safety::bound::{max_pulses_in, passes_in_window, Laser, RATIO_MARGIN};
+use crate::eye_safety::{EyeSafetyError, EyeSafetyParams};
+
+/// Tolerance of `pulse_rate_hz · cycle_s = 1`.
+pub const RATE_CYCLE_TOLERANCE: f64 = 1e-9;
+
+/// The head's overlap figures: how many channels, and how much power, can
+/// meet one aperture position, over a sweep and at once.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HeadFigures {
+    /// Channels of the head.
+    pub channels: u32,
+    /// Channels meeting the worst height (where `weight_vertical` is).
+    pub channels_at_worst: u32,
+    /// Height of the worst aperture position (energy rules), mm.
+    pub worst_height_mm: f64,
+    /// Head-frame azimuth of the worst position for Rule 1 (the largest
+    /// group), deg.
+    pub worst_azimuth_deg: f64,
+    /// Height of that Rule 1 position, mm.
+    pub group_height_mm: f64,
+    /// `W_v`: the largest sum of `power_scale` over the channels that can
+    /// meet one height during a sweep (multiplies the energy rules).
+    pub weight_vertical: f64,
+    /// `K_v`: the most channels that can meet one height.
+    pub count_vertical: u32,
+    /// `W_sim`: the largest sum of `power_scale` of channels fired together
+    /// whose footprints share a point.
+    pub weight_simultaneous: f64,
+    /// Channels fired together that share that point.
+    pub count_simultaneous: u32,
+    /// `W_g`: the largest `Σ power_scale × pulses` one position receives
+    /// within one grouping window (`group_window_s`), footprints widened by
+    /// the head's turn over it at the fastest spin.
+    pub weight_group: f64,
+    /// Channels in that group.
+    pub count_group: u32,
+    /// Whether some position receives pulses fired at two different times
+    /// within one grouping window.
+    pub group_spans_time: bool,
+    /// The grouping window, s: `T_i` in 700–1050 nm (pulses up to `T_i`
+    /// long), else the pulse duration.
+    pub group_window_s: f64,
+    /// `W_disc`: the largest sum of `power_scale` of channels whose
+    /// footprints share a point (a stalled rotor: every channel's pulses).
+    pub weight_stalled: f64,
+    /// Channels sharing that point.
+    pub count_stalled: u32,
+    /// `W_g` with the head stopped (no widening).
+    pub weight_stalled_group: f64,
+    /// `W_sim` with the head stopped.
+    pub weight_stalled_simultaneous: f64,
+    /// Channels fired together sharing one point, the head stopped.
+    pub count_stalled_simultaneous: u32,
+    /// Whether a stopped head puts pulses of two times in one position
+    /// within one grouping window.
+    pub stalled_group_spans_time: bool,
+    /// Widest footprint (beam only) at the aperture, mm.
+    pub footprint_max_mm: f64,
+    /// Widest pass angle of the channels (aperture plus footprint over
+    /// `R·cos β`), deg, not clamped.
+    pub pass_angle_deg: f64,
+    /// The largest `power_scale`.
+    pub power_scale_max: f64,
+    /// Azimuth separations of the channels' passes (see [`energy_ratios`]):
+    /// for a head turn of at most `angle_rad` within a window, the most
+    /// weight of channels whose passes over one aperture position such a
+    /// turn can reach.
+    pub separations: Vec<Separation>,
+}
+
+/// One head-turn bound of the channels a window can reach.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Separation {
+    /// Head turn, rad (just below a gap between two channels' passes).
+    pub angle_rad: f64,
+    /// `W(L)`: the largest `Σ power_scale` of channels meeting one height
+    /// whose passes over one position a turn of `angle_rad` reaches.
+    pub weight: f64,
+    /// Channels there.
+    pub count: u32,
+}
+
+/// Most separations evaluated (the largest gaps, evenly sampled).
+pub const SEPARATIONS_MAX: usize = 8;
+
+fn separations(fps: &[Footprint], scales: &[f64], r_mm: f64, cycle_s: f64) -> Vec<Separation> {
+    let circ = core::f64::consts::TAU * r_mm;
+    let x = |f: &Footprint| f.psi_rad * r_mm;
+    let mut gaps: Vec<f64> = Vec::new();
+    for c in fps {
+        for d in fps {
+            let z_meet = (c.z_mm - d.z_mm).abs() <= c.half_height_mm + d.half_height_mm;
+            let g = (x(d) - d.half_arc_mm) - (x(c) + c.half_arc_mm);
+            if z_meet && g > 0.0 {
+                gaps.push(g / r_mm);
+            }
+        }
+    }
+    gaps.sort_by(f64::total_cmp);
+    gaps.dedup();
+    let picked: Vec<f64> = if gaps.len() <= SEPARATIONS_MAX {
+        gaps
+    } else {
+        (0..SEPARATIONS_MAX)
+            .map(|k| gaps[(k * (gaps.len() - 1)) / (SEPARATIONS_MAX - 1)])
+            .collect()
+    };
+    let zeros = vec![0.0; fps.len()];
+    picked
+        .into_iter()
+        .map(|g| {
+            let angle_rad = g * (1.0 - 1e-9);
+            let smear = r_mm * angle_rad * (1.0 + overlap::SUM_MARGIN);
+            let (m, _) = overlap::group(fps, scales, &zeros, cycle_s, 0.0, smear, circ);
+            Separation {
+                angle_rad,
+                weight: m.weight,
+                count: m.count,
+            }
+        })
+        .collect()
+}
+
+/// The head's energy-rule ratios (within a pass, several passes, the time
+/// base; indices 1–3 of the rule order), from the single-channel ratios
+/// `single` (margin applied) at the head's widest pass.
+///
+/// Every window holds at most the channels meeting one height, each at
+/// most its single-channel energy: `W_v ×` each figure. Tighter, for a head
+/// turn `L` ([`Separation`]): a window no longer than `L/ω_max` turns the
+/// head by at most `L`, so only the channels whose passes a turn of `L`
+/// reaches contribute (`W(L) ×` each single-channel figure), and every
+/// longer window is bounded by `W_v ×` the multi-pass bounds from
+/// `L/ω_max` on ([`Laser::windows_from_ratio`]). The smallest of these
+/// maxima over the separations is returned, with the longer windows'
+/// figure reported under the rule of its duration.
+#[must_use]
+pub fn energy_ratios(
+    h: &HeadFigures,
+    laser: &Laser,
+    single: [f64; 4],
+    pass: crate::eye_safety::bound::PassFigures,
+    frame_s: f64,
+    power_max_w: f64,
+    spin_max_rad_s: f64,
+) -> [f64; 4] {
+    let w = h.weight_vertical;
+    let mut best = [0.0, w * single[1], w * single[2], w * single[3]];
+    let peak = |r: &[f64; 4]| r[1].max(r[2]).max(r[3]);
+    for sep in &h.separations {
+        if sep.weight >= w || spin_max_rad_s <= 0.0 {
+            continue;
+        }
+        let t_sep = sep.angle_rad / spin_max_rad_s * (1.0 - 1e-12);
+        let (r_long, t_long) = laser.windows_from_ratio(frame_s, pass, power_max_w, t_sep);
+        let mut cand = [
+            0.0,
+            sep.weight * single[1],
+            sep.weight * single[2],
+            sep.weight * single[3],
+        ];
+        let k = match crate::eye_safety::Rule::for_duration(t_long, frame_s) {
+            crate::eye_safety::Rule::PassTrain | crate::eye_safety::Rule::SinglePulse => 1,
+            crate::eye_safety::Rule::T2Train => 2,
+            crate::eye_safety::Rule::TimeBase => 3,
+        };
+        cand[k] = cand[k].max(w * r_long * (1.0 + RATIO_MARGIN));
+        if peak(&cand) < peak(&best) {
+            best = cand;
+        }
+    }
+    best
+}
+
+/// The head's overlap figures for `params` (band from `laser`) at spins up
+/// to `spin_max_rad_s`.
+pub fn head_figures(
+    head: &Head,
+    params: &EyeSafetyParams,
+    laser: &Laser,
+    spin_max_rad_s: f64,
+) -> Result<HeadFigures, EyeSafetyError> {
+    head.validate()?;
+    let _ = params;
+    let f_p = laser.pulse_rate_hz;
+    let off = (f_p * head.cycle_s - 1.0).abs();
+    if off.is_nan() || off > RATE_CYCLE_TOLERANCE {
+        return Err(EyeSafetyError::Param {
+            field: "pulse_rate_hz",
+            value: f_p,
+            reason: "must be 1 / head.cycle_s: every channel of the head fires once per cycle",
+        });
+    }
+    let a = laser.band.aperture_mm();
+    let fps = footprints(head, a);
+    let scales: Vec<f64> = head.channels.iter().map(|c| c.power_scale).collect();
+    let slots: Vec<f64> = head.channels.iter().map(|c| c.slot_s).collect();
+    let zeros = vec![0.0; slots.len()];
+    let r = head.aperture_distance_mm;
+    let circ = core::f64::consts::TAU * r;
+    let t_g = group_window_s(laser);
+    let smear = r * spin_max_rad_s * t_g * (1.0 + overlap::SUM_MARGIN);
+    let v = overlap::vertical(&fps, &scales);
+    let (sim, _) = overlap::group(&fps, &scales, &slots, head.cycle_s, 0.0, 0.0, circ);
+    let (g, spans) = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, smear, circ);
+    let (disc, _) = overlap::group(&fps, &scales, &zeros, head.cycle_s, 0.0, 0.0, circ);
+    let (g0, spans0) = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, 0.0, circ);
+    let fold = |f: fn(&Footprint) -> f64| fps.iter().map(f).fold(0.0, f64::max);
+    Ok(HeadFigures {
+        channels: head.channels.len() as u32,
+        channels_at_worst: v.count_at_worst,
+        worst_height_mm: v.height_mm,
+        worst_azimuth_deg: (g.arc_mm / r).to_degrees(),
+        group_height_mm: g.height_mm,
+        weight_vertical: v.weight,
+        count_vertical: v.count,
+        weight_simultaneous: sim.weight,
+        count_simultaneous: sim.count,
+        weight_group: g.weight,
+        count_group: g.count,
+        group_spans_time: spans,
+        group_window_s: t_g,
+        weight_stalled: disc.weight,
+        count_stalled: disc.count,
+        weight_stalled_group: g0.weight,
+        weight_stalled_simultaneous: sim.weight,
+        count_stalled_simultaneous: sim.count,
+        stalled_group_spans_time: spans0,
+        footprint_max_mm: fold(|f| f.width_mm),
+        pass_angle_deg: fold(|f| f.pass_angle_deg),
+        power_scale_max: scales.iter().copied().fold(0.0, f64::max),
+        separations: if v.count > 1 {
+            separations(&fps, &scales, r, head.cycle_s)
+        } else {
+            Vec::new()
+        },
+    })
+}
+
+/// The window within which pulses are one effective pulse for Rule 1:
+/// `T_i` in 700–1050 nm for pulses up to `T_i` (as the single-channel
+/// grouping), else the pulse duration (pulses that overlap in time).
+#[must_use]
+pub fn group_window_s(laser: &Laser) -> f64 {
+    if laser.band == ael::Band::RetinalNir && laser.pulse_duration_s <= laser.band.t_i_s() {
+        laser.band.t_i_s()
+    } else {
+        laser.pulse_duration_s
+    }
+}
+
+/// What the single-channel bound found that the head's Rule 1 needs.
+#[derive(Debug, Clone, Copy)]
+pub struct SingleFigures {
+    /// The single-channel Rule 1 ratio (margin applied).
+    pub single_pulse_ratio: f64,
+    /// Longest pass, s.
+    pub pass_duration_s: f64,
+    /// Frame period, s.
+    pub frame_s: f64,
+    /// Largest bin power, W.
+    pub power_max_w: f64,
+}
+
+/// The head's Rule 1 ratio (margin applied).
+#[must_use]
+pub fn single_pulse_ratio(h: &HeadFigures, laser: &Laser, s: SingleFigures) -> f64 {
+    let t2 = ael::T2_S.min(ael::TIME_BASE_S);
+    let n1 = max_pulses_in(s.pass_duration_s, laser.pulse_rate_hz)
+        * passes_in_window(t2, s.pass_duration_s, s.frame_s);
+    rule1(
+        h.count_vertical,
+        h.count_group,
+        h.weight_vertical,
+        s.single_pulse_ratio,
+        Weights {
+            simultaneous: h.weight_simultaneous,
+            simultaneous_count: h.count_simultaneous,
+            group: h.weight_group,
+            spans_time: h.group_spans_time,
+            window_s: h.group_window_s,
+        },
+        f64::from(h.count_vertical) * n1,
+        s.power_max_w / laser.pulse_rate_hz,
+        laser,
+    )
+}
+
+struct Weights {
+    simultaneous: f64,
+    simultaneous_count: u32,
+    group: f64,
+    spans_time: bool,
+    window_s: f64,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn rule1(
+    count_vertical: u32,
+    count_group: u32,
+    weight_single: f64,
+    single_ratio: f64,
+    w: Weights,
+    n_head: f64,
+    pulse_energy_j: f64,
+    laser: &Laser,
+) -> f64 {
+    if count_vertical <= 1 && count_group <= 1 {
+        return weight_single * single_ratio;
+    }
+    let c5 = laser.c5(n_head);
+    let tp = laser.pulse_duration_s;
+    // Pulses of several channels fired together are one pulse of the
+    // pulse's duration; compared, conservatively, with the smallest AEL up
+    // to the grouping window (they may also be read as a group).
+    let group_ael = laser.ael_inf_j(tp, w.window_s + tp);
+    let a = if w.simultaneous_count <= 1 {
+        w.simultaneous * pulse_energy_j / (c5 * laser.ael_j(tp))
+    } else {
+        w.simultaneous * pulse_energy_j / (c5 * group_ael)
+    };
+    let b = if w.spans_time {
+        w.group * pulse_energy_j / (c5 * group_ael)
+    } else {
+        0.0
+    };
+    a.max(b) * (1.0 + RATIO_MARGIN)
+}
+
+/// The head's stalled-rotor ratio: every pulse of every channel whose
+/// footprint meets one aperture, the head stopped at the highest-power
+/// azimuth (`power_w`).
+#[must_use]
+pub fn stalled_ratio(h: &HeadFigures, laser: &Laser, power_w: f64) -> f64 {
+    let (one, _) = laser.stationary_ratio(power_w);
+    if h.count_stalled <= 1 {
+        return h.weight_stalled * one;
+    }
+    let t2 = ael::T2_S.min(ael::TIME_BASE_S);
+    let n = f64::from(h.count_stalled) * max_pulses_in(t2, laser.pulse_rate_hz);
+    let r1 = rule1(
+        h.count_stalled,
+        h.count_stalled,
+        h.weight_stalled,
+        one,
+        Weights {
+            simultaneous: h.weight_stalled_simultaneous,
+            simultaneous_count: h.count_stalled_simultaneous,
+            group: h.weight_stalled_group,
+            spans_time: h.stalled_group_spans_time,
+            window_s: h.group_window_s,
+        },
+        n,
+        power_w / laser.pulse_rate_hz,
+        laser,
+    );
+    (h.weight_stalled * one * (1.0 + RATIO_MARGIN)).max(r1)
+}
+
+/// The largest uniform power scale (every bin power times it) at which a
+/// profile whose bound is `worst_ratio` certifies: every figure is
+/// positively homogeneous of degree 1 in the bin powers (energies are
+/// linear in them; the counts and C5 depend on the spins and the pulse
+/// rate only), so the bound at `λ·P` is `λ` times the bound at `P`; the
+/// quotient is rounded down by 1e-9 for the floating-point evaluation.
+#[must_use]
+pub fn power_scale_to_certify(worst_ratio: f64) -> f64 {
+    if worst_ratio > 0.0 {
+        (1.0 - 1e-9) / worst_ratio
+    } else {
+        f64::INFINITY
+    }
+}

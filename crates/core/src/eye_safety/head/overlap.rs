@@ -1,0 +1,315 @@
+//! Step 2 of the head's argument: which channels can meet one aperture
+//! position, found exactly by enumeration (`specs/eye_safety.md`, "The
+//! head").
+//!
+//! - **Over a sweep** ([`vertical`]): the aperture at height `z` meets
+//!   channel `c` at some head angle iff `|z_c − z| ≤ h_c` (the footprint
+//!   box's half-height): closed intervals in `z`. The set of channels
+//!   containing `z` changes only at interval ends, and a maximum of a sum of
+//!   positive weights over closed intervals is attained at some interval's
+//!   lower end: every lower end is evaluated.
+//! - **At once** ([`group`]): the pulses fired within one window of
+//!   `window_s` (channels fire at `slot_c + k·cycle`) whose footprint boxes,
+//!   widened along the arc by the head's turn during the window
+//!   (`smear_mm`), share a point. A maximum over points of a sum of positive
+//!   weights of closed boxes is attained at a point whose arc coordinate is
+//!   some box's left end and whose height is some box's lower end; a window
+//!   can be slid later until it starts at a pulse without losing one, so
+//!   windows starting at every distinct slot are every candidate.
+//!
+//! Sums are of positive weights and rounded up by [`SUM_MARGIN`] when they
+//! hold more than one term (one term is exact).
+
+use super::geometry::Footprint;
+
+/// Relative rounding-up of a sum of more than one weight (`n` terms of a
+/// float sum err by at most `n·2⁻⁵³` relative: 1e-12 covers 512 terms).
+pub const SUM_MARGIN: f64 = 1e-12;
+
+/// Absolute widening, mm, of every interval and box end: positions that
+/// touch in exact arithmetic but miss by a rounding error still meet.
+pub const TOUCH_MM: f64 = 1e-9;
+
+/// The largest weight of channels meeting one position, and where.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Meet {
+    /// Largest `Σ weight` over the channels (or pulses) that meet one
+    /// position.
+    pub weight: f64,
+    /// Most channels meeting one position (not necessarily where the
+    /// weight is largest).
+    pub count: u32,
+    /// Channels meeting the position of the largest weight.
+    pub count_at_worst: u32,
+    /// Height of that position, mm.
+    pub height_mm: f64,
+    /// Head-frame arc position of that position, mm (0 for [`vertical`]).
+    pub arc_mm: f64,
+}
+
+fn round_sum(sum: f64, terms: u32) -> f64 {
+    if terms > 1 {
+        sum * (1.0 + SUM_MARGIN)
+    } else {
+        sum
+    }
+}
+
+/// The most weight (`weights[i]` for footprint `i`) of channels whose height
+/// intervals share a point: exact over every height.
+#[must_use]
+pub fn vertical(fps: &[Footprint], weights: &[f64]) -> Meet {
+    let iv: Vec<(f64, f64)> = fps
+        .iter()
+        .map(|f| {
+            (
+                f.z_mm - f.half_height_mm - TOUCH_MM,
+                f.z_mm + f.half_height_mm + TOUCH_MM,
+            )
+        })
+        .collect();
+    let mut best = Meet {
+        weight: 0.0,
+        count: 0,
+        count_at_worst: 0,
+        height_mm: 0.0,
+        arc_mm: 0.0,
+    };
+    for &(z, _) in &iv {
+        let (mut w, mut n) = (0.0, 0u32);
+        for (i, &(lo, hi)) in iv.iter().enumerate() {
+            if lo <= z && z <= hi {
+                w += weights[i];
+                n += 1;
+            }
+        }
+        let w = round_sum(w, n);
+        best.count = best.count.max(n);
+        if w > best.weight {
+            best.weight = w;
+            best.count_at_worst = n;
+            best.height_mm = z;
+        }
+    }
+    best
+}
+
+/// Pulses of a clock of period `cycle_s` at phase `slot_s` inside the
+/// closed window `[t0_s, t0_s + window_s]` (`0 ≤ t0_s, slot_s < cycle_s`),
+/// rounded up at touching ends.
+#[must_use]
+pub fn pulses_in(slot_s: f64, t0_s: f64, window_s: f64, cycle_s: f64) -> u32 {
+    let eps = 1e-9 * cycle_s;
+    let first = if slot_s + eps >= t0_s {
+        slot_s - t0_s
+    } else {
+        slot_s + cycle_s - t0_s
+    };
+    let first = first.max(0.0);
+    if first > window_s + eps {
+        return 0;
+    }
+    let more = crate::eye_safety::bound::floor_up((window_s - first).max(0.0) / cycle_s);
+    // Counts of a window of at most 1 s at a cycle of at least 1e-12 s fit.
+    (more as u32).saturating_add(1)
+}
+
+/// Boxes: `(x_lo, x_hi, z_lo, z_hi, weight)`; the most weight sharing a
+/// point, exactly (candidate points: every box's left end × lower end).
+fn boxes_max(boxes: &[(f64, f64, f64, f64, f64)]) -> Meet {
+    let mut best = Meet {
+        weight: 0.0,
+        count: 0,
+        count_at_worst: 0,
+        height_mm: 0.0,
+        arc_mm: 0.0,
+    };
+    let mut active: Vec<(f64, f64, f64)> = Vec::with_capacity(boxes.len());
+    for &(x, ..) in boxes {
+        active.clear();
+        active.extend(
+            boxes
+                .iter()
+                .filter(|b| b.0 <= x && x <= b.1)
+                .map(|b| (b.2, b.3, b.4)),
+        );
+        for &(z, _, _) in &active {
+            let (mut w, mut n) = (0.0, 0u32);
+            for &(lo, hi, wi) in &active {
+                if lo <= z && z <= hi {
+                    w += wi;
+                    n += 1;
+                }
+            }
+            let w = round_sum(w, n);
+            best.count = best.count.max(n);
+            if w > best.weight {
+                best.weight = w;
+                best.count_at_worst = n;
+                best.height_mm = z;
+                best.arc_mm = x;
+            }
+        }
+    }
+    best
+}
+
+/// The most weight of pulses one aperture position can receive within one
+/// window of `window_s`: channel `c` contributes `weights[c]` per pulse it
+/// fires in the window (slots `slots_s`, period `cycle_s`); its footprint box
+/// is widened along the arc by `smear_mm` (the head's turn during the
+/// window, at the aperture radius). `count` is the most channels.
+///
+/// Also returns whether some position can receive pulses fired at two
+/// different times within one window (a channel firing twice, or two
+/// channels with different slots).
+#[must_use]
+pub fn group(
+    fps: &[Footprint],
+    weights: &[f64],
+    slots_s: &[f64],
+    cycle_s: f64,
+    window_s: f64,
+    smear_mm: f64,
+    circumference_mm: f64,
+) -> (Meet, bool) {
+    let mut starts: Vec<f64> = slots_s.to_vec();
+    starts.sort_by(f64::total_cmp);
+    starts.dedup();
+    let wraps = smear_mm >= 0.5 * circumference_mm;
+    let mut best = Meet {
+        weight: 0.0,
+        count: 0,
+        count_at_worst: 0,
+        height_mm: 0.0,
+        arc_mm: 0.0,
+    };
+    let mut multi_time = false;
+    let mut boxes = Vec::with_capacity(fps.len());
+    let mut slot_of = Vec::with_capacity(fps.len());
+    for &t0 in &starts {
+        boxes.clear();
+        slot_of.clear();
+        for (i, f) in fps.iter().enumerate() {
+            let k = pulses_in(slots_s[i], t0, window_s, cycle_s);
+            if k == 0 {
+                continue;
+            }
+            let x = f.psi_rad * (circumference_mm / core::f64::consts::TAU);
+            let (x_lo, x_hi) = if wraps {
+                (f64::NEG_INFINITY, f64::INFINITY)
+            } else {
+                (
+                    x - f.half_arc_mm - TOUCH_MM,
+                    x + f.half_arc_mm + smear_mm + TOUCH_MM,
+                )
+            };
+            boxes.push((
+                x_lo,
+                x_hi,
+                f.z_mm - f.half_height_mm - TOUCH_MM,
+                f.z_mm + f.half_height_mm + TOUCH_MM,
+                weights[i] * f64::from(k),
+            ));
+            slot_of.push((slots_s[i], k));
+        }
+        if boxes.is_empty() {
+            continue;
+        }
+        let m = boxes_max(&boxes);
+        if !multi_time {
+            multi_time = multi_time_overlap(&boxes, &slot_of);
+        }
+        best.count = best.count.max(m.count);
+        if m.weight > best.weight {
+            best = Meet {
+                count: best.count,
+                ..m
+            };
+        }
+    }
+    (best, multi_time)
+}
+
+/// Whether two boxes of pulses fired at different times share a point, or a
+/// box holds two pulses (a channel firing twice in the window).
+fn multi_time_overlap(boxes: &[(f64, f64, f64, f64, f64)], slot_of: &[(f64, u32)]) -> bool {
+    if slot_of.iter().any(|&(_, k)| k > 1) {
+        return true;
+    }
+    for i in 0..boxes.len() {
+        for j in i + 1..boxes.len() {
+            if slot_of[i].0 != slot_of[j].0 {
+                let (a, b) = (boxes[i], boxes[j]);
+                if a.0 <= b.1 && b.0 <= a.1 && a.2 <= b.3 && b.2 <= a.3 {
+                    return true;
+                }
+            }
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fp(psi_deg: f64, z: f64, half: f64) -> Footprint {
+        Footprint {
+            index: 0,
+            psi_rad: psi_deg.to_radians(),
+            z_mm: z,
+            slant_mm: 100.0,
+            width_mm: 2.0 * half - 7.0,
+            cos_beta: 1.0,
+            half_arc_mm: half,
+            half_height_mm: half,
+            pass_angle_deg: (2.0 * half / 100.0).to_degrees(),
+        }
+    }
+
+    /// Intervals [−5, 5], [3, 13], [12, 22] (half-height 5): at most two
+    /// share a point (z ∈ [3, 5] or [12, 13]); weights 1, 2, 4: the worst is
+    /// 6 at z = 12.
+    #[test]
+    fn vertical_by_hand() {
+        let f = [fp(0.0, 0.0, 5.0), fp(0.0, 8.0, 5.0), fp(0.0, 17.0, 5.0)];
+        let m = vertical(&f, &[1.0, 2.0, 4.0]);
+        assert_eq!(m.count, 2);
+        assert!((m.weight - 6.0).abs() < 1e-9);
+        assert!((m.height_mm - 12.0).abs() < 1e-6);
+        // Touching intervals meet.
+        let f = [fp(0.0, 0.0, 5.0), fp(0.0, 10.0, 5.0)];
+        assert_eq!(vertical(&f, &[1.0, 1.0]).count, 2);
+        let f = [fp(0.0, 0.0, 5.0), fp(0.0, 10.001, 5.0)];
+        assert_eq!(vertical(&f, &[1.0, 1.0]).count, 1);
+    }
+
+    /// Pulse counts in closed windows: cycle 10, slot 3, window [0, 5]: one
+    /// (t = 3); window [4, 14]: one (13) — touching ends count: [3, 13] two.
+    #[test]
+    fn pulses_in_by_hand() {
+        assert_eq!(pulses_in(3.0, 0.0, 5.0, 10.0), 1);
+        assert_eq!(pulses_in(3.0, 4.0, 10.0, 10.0), 1);
+        assert_eq!(pulses_in(3.0, 4.0, 8.0, 10.0), 0);
+        assert_eq!(pulses_in(3.0, 3.0, 10.0, 10.0), 2);
+        assert_eq!(pulses_in(3.0, 3.0, 25.0, 10.0), 3);
+    }
+
+    /// Two channels at one slot whose boxes overlap, a third 20° away at
+    /// another slot: the group is the first two; with a window holding both
+    /// slots and a smear reaching the third, all three.
+    #[test]
+    fn group_by_hand() {
+        let f = [fp(0.0, 0.0, 6.0), fp(1.0, 0.0, 6.0), fp(20.0, 0.0, 6.0)];
+        let w = [1.0, 1.0, 1.0];
+        let circ = core::f64::consts::TAU * 100.0;
+        let (m, multi) = group(&f, &w, &[0.0, 0.0, 1.0], 10.0, 0.5, 0.0, circ);
+        assert_eq!(m.count, 2);
+        assert!(!multi);
+        assert!((m.weight - 2.0).abs() < 1e-9);
+        let (m, multi) = group(&f, &w, &[0.0, 0.0, 1.0], 10.0, 1.0, 40.0, circ);
+        assert_eq!(m.count, 3);
+        assert!(multi);
+    }
+}
