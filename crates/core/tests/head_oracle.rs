@@ -493,6 +493,17 @@ fn long_run() -> bool {
 /// Positions for a case: every bin's start, middle and end (± 0.5°) and a
 /// few fixed azimuths, × a height grid plus every channel's edge heights.
 fn case_positions(o: &Oracle, heights: &[f64], extra_az: usize) -> Vec<Pos> {
+    case_positions_max(o, heights, extra_az, usize::MAX)
+}
+
+/// [`case_positions`] with the edge heights of at most `edge_channels`
+/// channels (evenly chosen).
+fn case_positions_max(
+    o: &Oracle,
+    heights: &[f64],
+    extra_az: usize,
+    edge_channels: usize,
+) -> Vec<Pos> {
     let mut az: Vec<f64> = Vec::new();
     for b in &o.scan.bins {
         az.push(b.start_deg + 0.5);
@@ -500,7 +511,21 @@ fn case_positions(o: &Oracle, heights: &[f64], extra_az: usize) -> Vec<Pos> {
         az.push((b.start_deg + b.width_deg - 0.5).rem_euclid(360.0));
     }
     az.extend((0..extra_az).map(|k| 360.0 * (k as f64 + 0.5) / extra_az as f64));
-    o.positions(&az, heights)
+    let n = o.head.channels.len();
+    if n <= edge_channels {
+        return o.positions(&az, heights);
+    }
+    let mut out = Vec::new();
+    for &phi in &az {
+        let mut hs: Vec<f64> = heights.to_vec();
+        for k in 0..edge_channels {
+            hs.extend(o.edge_heights(k * n / edge_channels, phi, 1e-6));
+        }
+        hs.sort_by(f64::total_cmp);
+        hs.dedup();
+        out.extend(hs.into_iter().map(|h| pos(phi, h)));
+    }
+    out
 }
 
 fn one_channel_of(h: &Head, c: usize) -> Head {
@@ -672,4 +697,141 @@ fn one_channel_axis_heads_never_above_the_single_channel_bound() {
         );
     }
     println!("smallest bound/oracle {worst_q:.6}");
+}
+
+/// Statistics of bound / oracle.
+#[derive(Debug, Default)]
+struct Quot {
+    n: usize,
+    min: f64,
+    max: f64,
+    min_case: String,
+    max_case: String,
+}
+
+impl Quot {
+    fn add(&mut self, q: f64, label: String) {
+        if self.n == 0 {
+            (self.min, self.max) = (f64::INFINITY, 0.0);
+        }
+        self.n += 1;
+        if q < self.min {
+            self.min = q;
+            self.min_case = label.clone();
+        }
+        if q > self.max {
+            self.max = q;
+            self.max_case = label;
+        }
+    }
+}
+
+/// One differential case: the head bound against the oracle; returns
+/// bound / oracle (∞ when the oracle sees nothing).
+fn differential(
+    label: &str,
+    s: &OScan,
+    h: &Head,
+    effort: &head_oracle_defs::Effort,
+    edge_channels: usize,
+) -> (f64, f64, String) {
+    let o = Oracle::new(h, s);
+    let heights: Vec<f64> = (-3..=3)
+        .map(|k| h.origin_height_mm + k as f64 * 2.5)
+        .collect();
+    let positions = case_positions_max(&o, &heights, 4, edge_channels);
+    let w = o.worst(&positions, effort);
+    let b = bound_ratio(&profile_of(s, h));
+    let line = format!(
+        "{label}: {} channels, {} nm, bound {b:.6}, oracle {w}, bound/oracle {:.4}",
+        h.channels.len(),
+        s.lambda_nm,
+        b / w.ratio
+    );
+    if w.ratio > 0.0 && b < w.ratio * (1.0 - 1e-12) {
+        println!(
+            "BELOW: {line}\nhead = {}\nscan = {s:?}",
+            serde_json::to_string(h).unwrap()
+        );
+    }
+    (b, w.ratio, line)
+}
+
+/// The head bound is never below the oracle: random heads (1–128 channels,
+/// random slots, offsets, origins, beam sizes, power scales, 905/1550 nm,
+/// profiles with steps and in-bin acceleration). `HEAD_ORACLE_CASES` for
+/// long runs (default 12); `HEAD_ORACLE_SEED` another stream.
+#[test]
+fn head_bound_is_never_below_the_oracle_on_random_heads() {
+    let seed = std::env::var("HEAD_ORACLE_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0x0ac1_e5u64);
+    let mut r = Rng(seed);
+    let effort = head_oracle_defs::Effort {
+        phases: 2,
+        starts_max: 60,
+        top_k: 2,
+        scan_step_deg: 0.05,
+    };
+    let mut q = Quot::default();
+    let mut below = Vec::new();
+    for case in 0..cases(12) {
+        let max_ch = if r.unit() < 0.15 { 128 } else { 12 };
+        let h = random_head(&mut r, max_ch);
+        let s = random_scan(&mut r);
+        let (b, o, line) = differential(&format!("seed {seed} case {case}"), &s, &h, &effort, 12);
+        println!("{line}");
+        if o > 0.0 {
+            q.add(b / o, line.clone());
+        }
+        if b < o * (1.0 - 1e-12) {
+            below.push(line);
+        }
+    }
+    println!(
+        "{} cases: bound/oracle min {:.6} ({}), max {:.4} ({})",
+        q.n, q.min, q.min_case, q.max, q.max_case
+    );
+    assert!(
+        below.is_empty(),
+        "bound below the oracle:\n{}",
+        below.join("\n")
+    );
+}
+
+/// The same on the real-head shapes, on the 4-bin scan at 905/865 nm and
+/// at 1550 nm.
+#[test]
+fn head_bound_is_never_below_the_oracle_on_real_heads() {
+    let effort = head_oracle_defs::Effort {
+        phases: 1,
+        starts_max: 40,
+        top_k: 1,
+        scan_step_deg: 0.05,
+    };
+    let mut below = Vec::new();
+    for (name, h, lambda) in [
+        ("vlp16-like", vlp16_like(), 905.0),
+        ("vls128-like", vls128_like(), 905.0),
+        ("os1-128-like", os1_128_like(), 865.0),
+        ("vlp16-like", vlp16_like(), 1550.0),
+        ("os1-128-like", os1_128_like(), 1550.0),
+    ] {
+        let p = if lambda > 1000.0 { 2e-3 } else { 0.05e-3 };
+        let s = OScan {
+            lambda_nm: lambda,
+            ..scan(lambda, 10.0, p)
+        };
+        let (b, o, line) = differential(name, &s, &h, &effort, 24);
+        println!("{line}");
+        if b < o * (1.0 - 1e-12) {
+            below.push(line);
+        }
+    }
+    assert!(
+        below.is_empty(),
+        "bound below the oracle:\n{}",
+        below.join("\n")
+    );
 }
