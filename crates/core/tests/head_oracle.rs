@@ -835,3 +835,117 @@ fn head_bound_is_never_below_the_oracle_on_real_heads() {
         below.join("\n")
     );
 }
+
+/// A head at the edges of the description: crossing point close to the
+/// aperture (parallax), large offsets and elevations, pencil or very
+/// divergent beams, cycles that put 1–3 of one channel's pulses in `T_i`,
+/// slots at the cycle's end, large power scales, one shared slot for many.
+fn wild_head(r: &mut Rng, max_channels: usize) -> Head {
+    let n = 1 + r.below(max_channels);
+    let cycle_s = match r.below(4) {
+        0 => 5e-6,
+        1 => 2.5e-6 * r.range(0.9, 1.1),
+        2 => r.range(1e-6, 20e-6),
+        _ => r.range(20e-6, 300e-6),
+    };
+    let origin_radius_mm = match r.below(3) {
+        0 => r.range(80.0, 99.0),
+        1 => 0.0,
+        _ => r.range(0.0, 80.0),
+    };
+    let big_offsets = r.unit() < 0.4;
+    let shared = r.unit() < 0.4;
+    let el0 = r.range(-30.0, 30.0);
+    let channels = (0..n)
+        .map(|k| Channel {
+            id: 1000 - k as u32,
+            elevation_deg: el0 + r.range(-1.0, 1.0) * r.range(0.0, 4.0),
+            azimuth_offset_deg: if big_offsets {
+                r.range(-45.0, 45.0)
+            } else {
+                r.range(-3.0, 3.0)
+            },
+            slot_s: if shared {
+                0.0
+            } else if r.unit() < 0.3 {
+                cycle_s * (1.0 - 1e-9)
+            } else {
+                r.range(0.0, cycle_s)
+            },
+            power_scale: match r.below(4) {
+                0 => 0.0,
+                1 => r.range(1.0, 10.0),
+                _ => r.range(0.1, 1.0),
+            },
+        })
+        .collect();
+    let h = Head {
+        cycle_s,
+        origin_radius_mm,
+        origin_height_mm: r.range(-20.0, 20.0),
+        exit_diameter_mm: if r.unit() < 0.3 {
+            r.range(0.01, 0.2)
+        } else {
+            r.range(0.2, 20.0)
+        },
+        divergence_mrad: if r.unit() < 0.2 {
+            r.range(10.0, 200.0)
+        } else {
+            r.range(0.0, 3.0)
+        },
+        aperture_distance_mm: 100.0,
+        channels,
+    };
+    h.validate().expect("valid wild head");
+    h
+}
+
+/// The head bound against the oracle on [`wild_head`]s (default 4 cases;
+/// `HEAD_ORACLE_WILD_CASES` for long runs).
+#[test]
+fn head_bound_is_never_below_the_oracle_on_wild_heads() {
+    let n_cases = std::env::var("HEAD_ORACLE_WILD_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(4usize);
+    let seed = std::env::var("HEAD_ORACLE_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0x0_3111_du64);
+    let mut r = Rng(seed);
+    let effort = head_oracle_defs::Effort {
+        phases: 2,
+        starts_max: 60,
+        top_k: 2,
+        scan_step_deg: 0.02,
+    };
+    let mut q = Quot::default();
+    let mut below = Vec::new();
+    for case in 0..n_cases {
+        let h = wild_head(&mut r, 12);
+        let s = random_scan(&mut r);
+        let (b, o, line) = differential(
+            &format!("wild seed {seed} case {case}"),
+            &s,
+            &h,
+            &effort,
+            12,
+        );
+        println!("{line}");
+        if o > 0.0 {
+            q.add(b / o, line.clone());
+        }
+        if b < o * (1.0 - 1e-12) {
+            below.push(line);
+        }
+    }
+    println!(
+        "{} wild cases: bound/oracle min {:.6} ({}), max {:.4} ({})",
+        q.n, q.min, q.min_case, q.max, q.max_case
+    );
+    assert!(
+        below.is_empty(),
+        "bound below the oracle:\n{}",
+        below.join("\n")
+    );
+}
