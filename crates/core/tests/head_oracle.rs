@@ -312,6 +312,7 @@ fn a_channel_at_power_scale_zero_contributes_nothing() {
 /// VLS-128 elevations (HEADS.md Appendix A, from ros-drivers/velodyne
 /// `velodyne_pointcloud/params/VLS128.yaml`); the azimuth offset is set by
 /// `id mod 8`, each row of 8 is one firing group.
+#[allow(clippy::approx_constant)] // vendor data (6.280°), not τ
 const VLS128_ELEVATION_DEG: [f64; 128] = [
     -11.742, -1.990, 3.400, -5.290, -0.780, 4.610, -4.080, 1.310, -6.500, -1.110, 4.280, -4.410,
     0.100, 6.480, -3.200, 2.190, -3.860, 1.530, -9.244, -1.770, 2.740, -5.950, -0.560, 4.830,
@@ -355,6 +356,7 @@ fn vls128_like() -> Head {
 /// −4.22), origin 15.806 mm (ouster-sdk metadata, HEADS.md §1/§3), 10 mm
 /// exit beam and 0.18° (3.14 mrad) divergence (OS1 datasheet, §3), column
 /// period 97.7 µs (1024 × 10 Hz).
+#[allow(clippy::approx_constant)] // 3.14 mrad = 0.18°, not π
 fn os1_128_like() -> Head {
     let cols = [4.21, 1.41, -1.40, -4.22];
     let channels = (0..128u32)
@@ -767,7 +769,7 @@ fn head_bound_is_never_below_the_oracle_on_random_heads() {
     let seed = std::env::var("HEAD_ORACLE_SEED")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(0x0ac1_e5u64);
+        .unwrap_or(0x000a_c1e5_u64);
     let mut r = Rng(seed);
     let effort = head_oracle_defs::Effort {
         phases: 2,
@@ -919,7 +921,7 @@ fn head_bound_is_never_below_the_oracle_on_wild_heads() {
     let seed = std::env::var("HEAD_ORACLE_SEED")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(0x0_3111_du64);
+        .unwrap_or(0x0003_111d_u64);
     let mut r = Rng(seed);
     let effort = head_oracle_defs::Effort {
         phases: 2,

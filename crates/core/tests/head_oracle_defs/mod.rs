@@ -787,9 +787,13 @@ impl Oracle {
             .map(|(&p, &k)| self.proxy(p, &cache[k].1))
             .collect();
         let mut chosen: Vec<usize> = Vec::new();
-        for k in 0..3 {
+        for key in [
+            |x: &[f64; 3]| x[0],
+            |x: &[f64; 3]| x[1],
+            |x: &[f64; 3]| x[2],
+        ] {
             let mut idx: Vec<usize> = (0..positions.len()).collect();
-            idx.sort_by(|&a, &b| proxies[b][k].total_cmp(&proxies[a][k]));
+            idx.sort_by(|&a, &b| key(&proxies[b]).total_cmp(&key(&proxies[a])));
             chosen.extend(idx.into_iter().take(effort.top_k));
         }
         chosen.sort_unstable();
