@@ -117,6 +117,20 @@ fn forward_geometry_by_hand() {
     let x = hit(&ha, 0, th, pos(0.0, 0.0), 7.0).unwrap();
     let y = 40.0 * th.sin() + (100.0 - 40.0 * th.cos()) * (th + 10f64.to_radians()).tan();
     assert!((x.lateral_mm - y).abs() < 1e-9);
+    // Where a channel passes: offset 10° from 40 mm out, head at 0°: the
+    // ray (40, 0) + s (cos 10°, sin 10°) meets the 100 mm circle at
+    // s = −40 cos 10° + √(1600 cos² 10° − 1600 + 10⁴).
+    let oa = Oracle::new(&ha, &scan(905.0, 10.0, 1e-3));
+    let c10 = 10f64.to_radians().cos();
+    let s10 = -40.0 * c10 + (1600.0 * c10 * c10 - 1600.0 + 1e4).sqrt();
+    let want = (s10 * 10f64.to_radians().sin())
+        .atan2(40.0 + s10 * c10)
+        .to_degrees();
+    assert!((oa.pass_azimuth_deg(0, 0.0) - want).abs() < 1e-9);
+    assert!((oa.pass_azimuth_deg(0, 30.0) - want - 30.0).abs() < 1e-9);
+    // The beam centre is there: the ray meets that aperture on its axis.
+    let x = hit(&ha, 0, 0.0, pos(want, 0.0), 7.0).unwrap();
+    assert!(x.miss_mm < 1e-9, "{x:?}");
     // Divergence: 10 mrad over 60 mm adds 0.6 mm of diameter.
     let mut hd = h0.clone();
     hd.divergence_mrad = 10.0;
@@ -514,6 +528,24 @@ fn case_positions_max(
     }
     az.extend((0..extra_az).map(|k| 360.0 * (k as f64 + 0.5) / extra_az as f64));
     let n = o.head.channels.len();
+    // Where (up to 6) channels pass while the head is in the hottest bin:
+    // its start, middle and end.
+    let hot = o
+        .scan
+        .bins
+        .iter()
+        .max_by(|a, b| a.power_w.total_cmp(&b.power_w))
+        .unwrap();
+    for k in 0..n.min(6) {
+        let c = k * n / n.min(6);
+        for th in [
+            hot.start_deg + 0.3,
+            hot.start_deg + 0.5 * hot.width_deg,
+            hot.start_deg + hot.width_deg - 0.3,
+        ] {
+            az.push(o.pass_azimuth_deg(c, th));
+        }
+    }
     if n <= edge_channels {
         return o.positions(&az, heights);
     }
@@ -950,7 +982,7 @@ fn head_bound_is_never_below_the_oracle_on_wild_heads() {
         }
     }
     println!(
-        "{} wild cases: bound/oracle min {:.6} ({}), max {:.4} ({})",
+        "{} wild cases: bound/oracle min {:.12} ({}), max {:.4} ({})",
         q.n, q.min, q.min_case, q.max, q.max_case
     );
     assert!(

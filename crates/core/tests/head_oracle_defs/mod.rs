@@ -737,6 +737,28 @@ impl Oracle {
         ]
     }
 
+    /// The aperture azimuth (deg) at which channel `c`'s ray crosses the
+    /// cylinder of radius `aperture_distance_mm` (horizontally) with the head
+    /// at `theta_deg`: where the channel passes when the head is there
+    /// (azimuth offset and the parallax of the crossing point).
+    pub fn pass_azimuth_deg(&self, c: usize, theta_deg: f64) -> f64 {
+        let th = theta_deg.to_radians();
+        let psi = th + self.head.channels[c].azimuth_offset_deg.to_radians();
+        let o = [
+            self.head.origin_radius_mm * th.cos(),
+            self.head.origin_radius_mm * th.sin(),
+        ];
+        let d = [psi.cos(), psi.sin()];
+        let od = o[0] * d[0] + o[1] * d[1];
+        let oo = o[0] * o[0] + o[1] * o[1];
+        let r = self.head.aperture_distance_mm;
+        let s = -od + (od * od - oo + r * r).sqrt();
+        (o[1] + s * d[1])
+            .atan2(o[0] + s * d[0])
+            .to_degrees()
+            .rem_euclid(360.0)
+    }
+
     /// A cheap proxy of a position (one turn's train at phase 0): the
     /// largest instant energy, the largest `T_i` group energy, the largest
     /// energy within half a turn.
