@@ -879,7 +879,7 @@ fn head_bound_is_never_below_the_oracle_on_real_heads() {
 }
 
 /// A head at the edges of the description: crossing point close to the
-/// aperture (parallax), large offsets and elevations, pencil or very
+/// aperture (parallax), an aperture distance other than 100 mm, large offsets and elevations, pencil or very
 /// divergent beams, cycles that put 1–3 of one channel's pulses in `T_i`,
 /// slots at the cycle's end, large power scales, one shared slot for many.
 fn wild_head(r: &mut Rng, max_channels: usize) -> Head {
@@ -935,7 +935,11 @@ fn wild_head(r: &mut Rng, max_channels: usize) -> Head {
         } else {
             r.range(0.0, 3.0)
         },
-        aperture_distance_mm: 100.0,
+        aperture_distance_mm: if r.unit() < 0.3 {
+            origin_radius_mm + r.range(5.0, 200.0)
+        } else {
+            100.0
+        },
         channels,
     };
     h.validate().expect("valid wild head");
