@@ -314,6 +314,7 @@ pub fn single_pulse_ratio(h: &HeadFigures, laser: &Laser, s: SingleFigures) -> f
         h.weight_vertical,
         s.single_pulse_ratio,
         Weights {
+            single_max: h.power_scale_max,
             simultaneous: h.weight_simultaneous,
             simultaneous_count: h.count_simultaneous,
             group: h.weight_group,
@@ -327,6 +328,7 @@ pub fn single_pulse_ratio(h: &HeadFigures, laser: &Laser, s: SingleFigures) -> f
 }
 
 struct Weights {
+    single_max: f64,
     simultaneous: f64,
     simultaneous_count: u32,
     group: f64,
@@ -355,7 +357,8 @@ fn rule1(
     // to the grouping window (they may also be read as a group).
     let group_ael = laser.ael_inf_j(tp, w.window_s + tp);
     let a = if w.simultaneous_count <= 1 {
-        w.simultaneous * pulse_energy_j / (c5 * laser.ael_j(tp))
+        // At most one channel at any point: its own weight, exactly.
+        w.single_max * pulse_energy_j / (c5 * laser.ael_j(tp))
     } else {
         w.simultaneous * pulse_energy_j / (c5 * group_ael)
     };
@@ -384,6 +387,7 @@ pub fn stalled_ratio(h: &HeadFigures, laser: &Laser, power_w: f64) -> f64 {
         h.weight_stalled,
         one,
         Weights {
+            single_max: h.power_scale_max,
             simultaneous: h.weight_stalled_simultaneous,
             simultaneous_count: h.count_stalled_simultaneous,
             group: h.weight_stalled_group,
