@@ -825,7 +825,7 @@ fn head_bound_is_never_below_the_oracle_on_random_heads() {
         }
     }
     println!(
-        "{} cases: bound/oracle min {:.6} ({}), max {:.4} ({})",
+        "{} cases: bound/oracle min {:.12} ({}), max {:.4} ({})",
         q.n, q.min, q.min_case, q.max, q.max_case
     );
     assert!(
