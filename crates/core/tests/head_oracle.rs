@@ -778,7 +778,7 @@ fn differential(
     let w = o.worst(&positions, effort);
     let b = bound_ratio(&profile_of(s, h));
     let line = format!(
-        "{label}: {} channels, {} nm, bound {b:.6}, oracle {w}, bound/oracle {:.4}",
+        "{label}: {} channels, {} nm, bound {b:.6}, oracle {w}, bound/oracle {:.12}",
         h.channels.len(),
         s.lambda_nm,
         b / w.ratio
@@ -1085,7 +1085,7 @@ fn head_bound_is_never_below_the_oracle_on_separated_pairs() {
         }
     }
     println!(
-        "{} pairs: bound/oracle min {:.6} ({})",
+        "{} pairs: bound/oracle min {:.12} ({})",
         q.n, q.min, q.min_case
     );
     assert!(
