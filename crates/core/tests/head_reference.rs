@@ -474,3 +474,119 @@ fn head_bound_is_never_below_the_definitions_reference() {
     println!("head reference: {evaluated} cases, bound/reference in [{lo:.6}, {hi:.3}]");
     assert!(evaluated >= cases * 9 / 10);
 }
+
+/// Heads of the shapes of the presets (`../shared/HEADS.md` §2, §3): an
+/// OS1-128-like column head (128 channels fired together, four azimuth
+/// columns, origin 15.806 mm, 10 mm exit beam), a VLS-128-like head (16
+/// groups of 8 every 2.665 µs in 53.3 µs, eight azimuth columns, 58.63 mm)
+/// and a VLP-16-like head (16 channels 2.304 µs apart in 55.296 µs,
+/// 2° apart, 41.91 mm). On a uniform 10 Hz, 360-bin-free profile: the bound
+/// is never below the reference; prints the head's ratio over the
+/// single-channel ratio and over the reference.
+#[test]
+fn preset_shaped_heads_are_never_below_the_reference() {
+    let shapes: Vec<(&str, Head)> = vec![
+        ("os1-128-like", {
+            let cycle = 1.0 / (1024.0 * 10.0);
+            Head {
+                cycle_s: cycle,
+                origin_radius_mm: 15.806,
+                origin_height_mm: 0.0,
+                exit_diameter_mm: 10.0,
+                divergence_mrad: 3.1,
+                aperture_distance_mm: 100.0,
+                channels: (0..128u32)
+                    .map(|i| Channel {
+                        id: i,
+                        elevation_deg: 22.5 - 0.354 * f64::from(i),
+                        azimuth_offset_deg: [4.2, 1.4, -1.4, -4.2][(i % 4) as usize],
+                        slot_s: 0.0,
+                        power_scale: 1.0,
+                    })
+                    .collect(),
+            }
+        }),
+        ("vls-128-like", {
+            Head {
+                cycle_s: 53.3e-6,
+                origin_radius_mm: 58.63,
+                origin_height_mm: 0.0,
+                exit_diameter_mm: 5.0,
+                divergence_mrad: 3.0,
+                aperture_distance_mm: 100.0,
+                channels: (0..128u32)
+                    .map(|i| Channel {
+                        id: i,
+                        elevation_deg: -25.0 + 0.11 * f64::from((i * 37) % 128) + 0.1,
+                        azimuth_offset_deg: [-6.35, -4.5, -2.7, -0.9, 0.9, 2.7, 4.5, 6.35]
+                            [(i % 8) as usize],
+                        slot_s: f64::from(i / 8) * 2.665e-6,
+                        power_scale: 1.0,
+                    })
+                    .collect(),
+            }
+        }),
+        ("vlp-16-like", {
+            Head {
+                cycle_s: 55.296e-6,
+                origin_radius_mm: 41.91,
+                origin_height_mm: 0.0,
+                exit_diameter_mm: 5.0,
+                divergence_mrad: 3.0,
+                aperture_distance_mm: 100.0,
+                channels: (0..16u32)
+                    .map(|i| Channel {
+                        id: i,
+                        elevation_deg: if i % 2 == 0 {
+                            -15.0 + f64::from(i)
+                        } else {
+                            f64::from(i)
+                        },
+                        azimuth_offset_deg: 0.0,
+                        slot_s: f64::from(i) * 2.304e-6,
+                        power_scale: 1.0,
+                    })
+                    .collect(),
+            }
+        }),
+    ];
+    let mut rng = Rng(7);
+    for (name, head) in shapes {
+        let f_p = 1.0 / head.cycle_s;
+        let segs = vec![Seg {
+            start_deg: 0.0,
+            width_deg: 360.0,
+            power_w: 0.002,
+            spin_start_rad_s: 62.8,
+            spin_end_rad_s: 62.8,
+        }];
+        let single = EyeSafetyParams {
+            wavelength_nm: 905.0,
+            pulse_duration_s: 5e-9,
+            beam_diameter_mm: head.exit_diameter_mm,
+            head: None,
+        };
+        let one = evaluate_segments(&segs, &single, f_p).unwrap();
+        let params = EyeSafetyParams {
+            head: Some(head),
+            ..single
+        };
+        let b = evaluate_segments(&segs, &params, f_p).unwrap();
+        let case = Case { segs, params, f_p };
+        let r = reference(&case, 1, &mut rng);
+        let hf = b.head.as_ref().unwrap();
+        println!(
+            "{name}: head {:.4} ({:?}), single {:.4}, head/single {:.2}, reference {r:.4}, bound/reference {:.3}; K_v {}, W_v {:.2}, group {} ch, W_g {:.2}",
+            b.worst_ratio,
+            b.binding_rule,
+            one.worst_ratio,
+            b.worst_ratio / one.worst_ratio,
+            b.worst_ratio / r,
+            hf.count_vertical,
+            hf.weight_vertical,
+            hf.count_group,
+            hf.weight_group
+        );
+        assert!(b.worst_ratio >= r * (1.0 - 1e-12), "{name}");
+    }
+}
