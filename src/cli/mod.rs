@@ -13,6 +13,7 @@ mod ael;
 mod args;
 mod check;
 mod config;
+mod gaze_args;
 pub mod io;
 pub mod output;
 mod profile;

@@ -8,20 +8,11 @@
 
 use std::path::{Path, PathBuf};
 
-#[cfg(feature = "solver")]
-use gaze_lidar::gaze::GazeError;
-use gaze_lidar::gaze::{
-    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, StreamConfig,
-};
-use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
-use gaze_lidar::model::presets;
-use gaze_lidar::planner::Mode;
-use gaze_lidar::replay::{
-    replay, Compression, GazeKind, PipelineConfig, ReplayError, ReplayOptions,
-};
+use gaze_lidar::replay::{replay, Compression, GazeKind, ReplayError, ReplayOptions};
 use gaze_lidar::sim::returns::ModelKind;
 
-use super::args::{finite_between, int_in};
+use super::args::finite_between;
+use super::gaze_args::{FilterArgs, PlanArgs};
 use super::CliError;
 
 /// Output chunk compression.
@@ -52,20 +43,8 @@ pub struct Args {
     /// Output MCAP (replaced only when the replay succeeds).
     #[arg(long)]
     out: PathBuf,
-    /// LiDAR preset (closed-form controllers) [default: paper]; with
-    /// --config, replaces the file's `[lidar] preset`.
-    #[arg(long)]
-    preset: Option<String>,
-    /// Controller for the closed form (default range); with --config, replaces the file's objective mode.
-    #[arg(long, value_enum)]
-    mode: Option<Mode>,
-    /// Equal bins (4..=36000; with --config 4..=1440) [default: 360, or the
-    /// --config file's].
-    #[arg(long, allow_hyphen_values = true)]
-    bins: Option<i64>,
-    /// Optimizer configuration (TOML): plan with the optimizer's fast path.
-    #[arg(long)]
-    config: Option<PathBuf>,
+    #[command(flatten)]
+    plan: PlanArgs,
     /// The cloud frame's x axis, degrees counter-clockwise (ISO 8855) from
     /// the vehicle's: a point at azimuth β in the cloud is at β + yaw in the
     /// vehicle frame of the gaze and the profile.
@@ -88,19 +67,8 @@ pub struct Args {
     /// uniform spin, 2π × frame rate].
     #[arg(long, allow_hyphen_values = true)]
     cloud_spin_rad_s: Option<f64>,
-    /// A fixation older than this when a frame is decided is stale (fail-safe), ms (0 < T < 1e7).
-    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
-    timeout_ms: f64,
-    /// Consecutive valid samples needed to leave fail-safe (1..=100000).
-    #[arg(long, default_value_t = 4, allow_hyphen_values = true)]
-    recover_samples: i64,
-    /// I-VT saccade threshold, °/s (0 < v < 1e6).
-    #[arg(long, default_value_t = 30.0, allow_hyphen_values = true)]
-    saccade_deg_s: f64,
-    /// A gaze timestamp jump making more than this many frames due at once
-    /// emits one fail-safe frame and restarts the frame clock (0..=1000000).
-    #[arg(long, default_value_t = 200, allow_hyphen_values = true)]
-    max_gap_frames: i64,
+    #[command(flatten)]
+    filter: FilterArgs,
     /// Messages are put in log-time order within this window, ms (0..=60000).
     #[arg(long, default_value_t = 200.0, allow_hyphen_values = true)]
     reorder_window_ms: f64,
@@ -116,60 +84,6 @@ pub struct Args {
     /// Output chunk compression.
     #[arg(long, value_enum, default_value_t = CompressionArg::None)]
     compression: CompressionArg,
-}
-
-#[cfg(feature = "solver")]
-fn gaze_error(e: GazeError) -> CliError {
-    if e.is_input_error() {
-        CliError::input(e.to_string())
-    } else {
-        CliError::infeasible(e.to_string())
-    }
-}
-
-/// The planner and the rated range of its sensor.
-fn planner(a: &Args, bins: Option<usize>) -> Result<(Box<dyn FramePlanner>, f64), CliError> {
-    if let Some(path) = &a.config {
-        return optimizer_planner(a, bins, path);
-    }
-    let preset = presets::preset(a.preset.as_deref().unwrap_or("paper"))
-        .map_err(|e| CliError::input(format!("--preset: {e}")))?;
-    let rated = preset.lidar.rated_range_m;
-    Ok((
-        Box::new(ClosedFormPlanner {
-            preset,
-            mode: a.mode.unwrap_or(Mode::Range),
-            bins: bins.unwrap_or(360),
-        }),
-        rated,
-    ))
-}
-
-#[cfg(feature = "solver")]
-fn optimizer_planner(
-    a: &Args,
-    bins: Option<usize>,
-    path: &Path,
-) -> Result<(Box<dyn FramePlanner>, f64), CliError> {
-    let overrides = super::config::Overrides {
-        preset: a.preset.as_deref(),
-        bins,
-        accounting: None,
-        mode: a.mode,
-    };
-    let problem = super::config::optimizer_problem(path, &overrides)?;
-    let rated = problem.lidar.rated_range_m;
-    let p = gaze_lidar::gaze::OptimizerPlanner::new(problem).map_err(gaze_error)?;
-    Ok((Box::new(p), rated))
-}
-
-#[cfg(not(feature = "solver"))]
-fn optimizer_planner(
-    _a: &Args,
-    _bins: Option<usize>,
-    _path: &Path,
-) -> Result<(Box<dyn FramePlanner>, f64), CliError> {
-    Err(super::config::no_solver("--config"))
 }
 
 fn replay_error(e: ReplayError) -> CliError {
@@ -190,25 +104,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
-    let bins = match a.bins {
-        Some(b) if a.config.is_some() => Some(int_in("--bins", b, 0, i64::MAX)?),
-        Some(b) => Some(int_in("--bins", b, MIN_BINS as i64, MAX_BINS as i64)?),
-        None => None,
-    };
-    let timeout_ms = finite_between("--timeout-ms", a.timeout_ms, 0.0, 1e7)?;
-    let pipeline = PipelineConfig {
-        filter: FilterConfig {
-            saccade_deg_s: finite_between("--saccade-deg-s", a.saccade_deg_s, 0.0, 1e6)?,
-            ..FilterConfig::default()
-        },
-        failsafe: FailSafeConfig {
-            timeout_us: (timeout_ms * 1000.0).round().max(1.0) as u64,
-            recover_samples: int_in("--recover-samples", a.recover_samples, 1, 100_000)?,
-        },
-        stream: StreamConfig {
-            max_gap_frames: int_in("--max-gap-frames", a.max_gap_frames, 0, 1_000_000)?,
-        },
-    };
+    let pipeline = a.filter.settings()?;
     if !(a.reorder_window_ms.is_finite() && (0.0..=60_000.0).contains(&a.reorder_window_ms)) {
         return Err(CliError::input(format!(
             "--reorder-window-ms: {} must lie in 0..=60000",
@@ -221,7 +117,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             a.sensor_yaw_deg
         )));
     }
-    let (planner, preset_range_m) = planner(a, bins)?;
+    let (planner, preset_range_m) = a.plan.planner()?;
     let rated_range_m = match a.rated_range_m {
         Some(r) => finite_between("--rated-range-m", r, 0.0, 1e7)?,
         None => preset_range_m,

@@ -13,34 +13,18 @@ use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
 use gaze_lidar::gaze::{
-    ClosedFormPlanner, FailSafeConfig, FilterConfig, Format, Frame, FramePlanner, GazeError,
-    GazeStream, Input, LineError, Notice, Parser, StreamConfig,
+    Format, Frame, FramePlanner, GazeError, GazeStream, Input, LineError, Notice, Parser,
+    PipelineConfig,
 };
-use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
-use gaze_lidar::model::presets;
-use gaze_lidar::planner::Mode;
 use gaze_lidar::text::Num;
 
-use super::args::{finite_between, int_in};
+use super::gaze_args::{gaze_error, FilterArgs, PlanArgs};
 use super::CliError;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// LiDAR preset (closed-form controllers) [default: paper]; with
-    /// --config, replaces the file's `[lidar] preset`.
-    #[arg(long)]
-    preset: Option<String>,
-    /// Controller for the closed form (default range); with --config, replaces the file's objective mode.
-    #[arg(long, value_enum)]
-    mode: Option<Mode>,
-    /// Equal bins (4..=36000; with --config 4..=1440) [default: 360, or the
-    /// --config file's].
-    #[arg(long, allow_hyphen_values = true)]
-    bins: Option<i64>,
-    /// Optimizer configuration (TOML): plan with the optimizer's fast path.
-    /// --preset, --bins and --mode given with it replace the file's values.
-    #[arg(long)]
-    config: Option<PathBuf>,
+    #[command(flatten)]
+    plan: PlanArgs,
     /// Input format.
     #[arg(long, value_enum, default_value_t = Format::Jsonl)]
     format: Format,
@@ -48,99 +32,13 @@ pub struct Args {
     /// error; on stdin it is reported with its number and skipped).
     #[arg(long)]
     input: Option<PathBuf>,
-    /// A fixation older than this when a frame is decided is stale (fail-safe), ms (0 < T < 1e7).
-    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
-    timeout_ms: f64,
-    /// Consecutive valid samples needed to leave fail-safe (1..=100000).
-    #[arg(long, default_value_t = 4, allow_hyphen_values = true)]
-    recover_samples: i64,
-    /// I-VT saccade threshold, °/s (0 < v < 1e6).
-    #[arg(long, default_value_t = 30.0, allow_hyphen_values = true)]
-    saccade_deg_s: f64,
-    /// Replay: a timestamp jump making more than this many frames (plus the
-    /// one at the sample) due at once emits one fail-safe frame, a warning,
-    /// and restarts the frame clock (0..=1000000). --realtime --input: a
-    /// gap longer than this many frames (plus one) in the file is not waited for.
-    #[arg(long, default_value_t = 200, allow_hyphen_values = true)]
-    max_gap_frames: i64,
+    #[command(flatten)]
+    filter: FilterArgs,
     /// Live: frames on the wall clock (t_s = seconds since start), fail-safe
     /// frames while no fresh gaze arrives, one flushed line per frame. With
     /// --input, the file is fed at the pace of its timestamps.
     #[arg(long)]
     realtime: bool,
-}
-
-/// The options, range-checked.
-struct Settings {
-    bins: Option<usize>,
-    timeout_us: u64,
-    recover_samples: u32,
-    saccade_deg_s: f64,
-    max_gap_frames: u64,
-}
-
-fn settings(a: &Args) -> Result<Settings, CliError> {
-    let timeout_ms = finite_between("--timeout-ms", a.timeout_ms, 0.0, 1e7)?;
-    let bins = match a.bins {
-        // With --config the optimizer's range applies (checked with the file).
-        Some(b) if a.config.is_some() => Some(int_in("--bins", b, 0, i64::MAX)?),
-        Some(b) => Some(int_in("--bins", b, MIN_BINS as i64, MAX_BINS as i64)?),
-        None => None,
-    };
-    Ok(Settings {
-        bins,
-        timeout_us: (timeout_ms * 1000.0).round().max(1.0) as u64,
-        recover_samples: int_in("--recover-samples", a.recover_samples, 1, 100_000)?,
-        saccade_deg_s: finite_between("--saccade-deg-s", a.saccade_deg_s, 0.0, 1e6)?,
-        max_gap_frames: int_in("--max-gap-frames", a.max_gap_frames, 0, 1_000_000)?,
-    })
-}
-
-fn planner(a: &Args, s: &Settings) -> Result<Box<dyn FramePlanner>, CliError> {
-    if let Some(path) = &a.config {
-        return optimizer_planner(a, s, path);
-    }
-    let preset = presets::preset(a.preset.as_deref().unwrap_or("paper"))
-        .map_err(|e| CliError::input(format!("--preset: {e}")))?;
-    Ok(Box::new(ClosedFormPlanner {
-        preset,
-        mode: a.mode.unwrap_or(Mode::Range),
-        bins: s.bins.unwrap_or(360),
-    }))
-}
-
-fn cli_error(e: GazeError) -> CliError {
-    if e.is_input_error() {
-        CliError::input(e.to_string())
-    } else {
-        CliError::infeasible(e.to_string())
-    }
-}
-
-#[cfg(feature = "solver")]
-fn optimizer_planner(
-    a: &Args,
-    s: &Settings,
-    path: &std::path::Path,
-) -> Result<Box<dyn FramePlanner>, CliError> {
-    let overrides = super::config::Overrides {
-        preset: a.preset.as_deref(),
-        bins: s.bins,
-        accounting: None,
-        mode: a.mode,
-    };
-    let problem = super::config::optimizer_problem(path, &overrides)?;
-    let p = gaze_lidar::gaze::OptimizerPlanner::new(problem).map_err(cli_error)?;
-    Ok(Box::new(p))
-}
-
-#[cfg(not(feature = "solver"))]
-fn optimizer_planner(
-    _a: &Args,
-    _s: &Settings,
-    _path: &std::path::Path,
-) -> Result<Box<dyn FramePlanner>, CliError> {
-    Err(super::config::no_solver("--config"))
 }
 
 /// One line on stderr; a failing stderr is not worth dying for.
@@ -198,20 +96,10 @@ fn write_frame(out: &mut dyn Write, f: &Frame, flush: bool) -> Result<(), GazeEr
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
-    let settings = settings(a)?;
-    let planner = planner(a, &settings)?;
-    let filter = FilterConfig {
-        saccade_deg_s: settings.saccade_deg_s,
-        ..FilterConfig::default()
-    };
-    let failsafe = FailSafeConfig {
-        timeout_us: settings.timeout_us,
-        recover_samples: settings.recover_samples,
-    };
-    let config = StreamConfig {
-        max_gap_frames: settings.max_gap_frames,
-    };
-    let stream = GazeStream::with_config(planner, filter, failsafe, config);
+    let settings = a.filter.settings()?;
+    let (planner, _) = a.plan.planner()?;
+    let stream =
+        GazeStream::with_config(planner, settings.filter, settings.failsafe, settings.stream);
     let (reader, origin, strict): (Box<dyn BufRead + Send>, String, bool) = match &a.input {
         Some(path) => {
             let f = std::fs::File::open(path)
@@ -269,7 +157,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         // Downstream closed the pipe (`| head`): stop quietly.
         Err(GazeError::Output(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(0),
         Err(GazeError::Output(e)) => Err(CliError::output(format!("stdout: {e}"))),
-        Err(e) => Err(cli_error(e)),
+        Err(e) => Err(gaze_error(e)),
     }
 }
 
@@ -397,7 +285,7 @@ impl Source {
 type Stats = gaze_lidar::gaze::StreamStats;
 
 fn replay(
-    s: &Settings,
+    s: &PipelineConfig,
     mut stream: GazeStream<Box<dyn FramePlanner>>,
     mut source: Source,
 ) -> Result<Stats, GazeError> {
@@ -405,7 +293,7 @@ fn replay(
     let mut emit = |f: Frame| write_frame(&mut out, &f, false);
     while let Some(sample) = source.next()? {
         let r = stream.push_each(&sample, &mut emit);
-        report(stream.take_notices(), s.max_gap_frames, false);
+        report(stream.take_notices(), s.stream.max_gap_frames, false);
         r?;
     }
     out.flush().map_err(GazeError::Output)?;
@@ -414,7 +302,7 @@ fn replay(
 
 fn live(
     a: &Args,
-    s: &Settings,
+    s: &PipelineConfig,
     mut stream: GazeStream<Box<dyn FramePlanner>>,
     mut source: Source,
 ) -> Result<Stats, GazeError> {
@@ -427,7 +315,7 @@ fn live(
     let max_wait = Duration::from_micros(
         stream
             .period_us()
-            .saturating_mul(s.max_gap_frames.saturating_add(1)),
+            .saturating_mul(s.stream.max_gap_frames.saturating_add(1)),
     );
     let start = Instant::now();
     // The reader thread blocks on the input; it ends with the input (closing
@@ -463,7 +351,7 @@ fn live(
         }
     });
     let mut out = std::io::stdout().lock();
-    let max_gap = s.max_gap_frames;
+    let max_gap = s.stream.max_gap_frames;
     stream.run_live(
         &rx,
         start,

@@ -10,7 +10,9 @@ pub mod stream;
 pub use failsafe::{Due, FailSafe, FailSafeConfig, FrameClock, SampleKind, State};
 pub use filter::{FilterConfig, GazeFilter};
 pub use formats::{Format, GazeSample, LineError, Parser};
-pub use stream::{Frame, FramePlanner, GazeStream, Input, Notice, StreamConfig, StreamStats};
+pub use stream::{
+    Frame, FramePlanner, GazeStream, Input, Notice, PipelineConfig, StreamConfig, StreamStats,
+};
 
 use crate::checker::CertifiedProfile;
 use crate::model::presets::Preset;

@@ -77,6 +77,18 @@ pub struct StreamConfig {
     pub max_gap_frames: u64,
 }
 
+/// The gaze pipeline's settings: the filter, the fail-safe and the frame
+/// clock (`stream` and `replay` alike).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PipelineConfig {
+    /// Gaze filter.
+    pub filter: crate::gaze::FilterConfig,
+    /// Fail-safe machine.
+    pub failsafe: crate::gaze::FailSafeConfig,
+    /// Stream settings.
+    pub stream: StreamConfig,
+}
+
 impl Default for StreamConfig {
     fn default() -> Self {
         Self {

@@ -207,16 +207,7 @@ impl ReplayOptions {
     }
 }
 
-/// The gaze pipeline's settings (as `stream`'s).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct PipelineConfig {
-    /// Gaze filter.
-    pub filter: FilterConfig,
-    /// Fail-safe machine.
-    pub failsafe: FailSafeConfig,
-    /// Stream settings.
-    pub stream: StreamConfig,
-}
+pub use crate::gaze::PipelineConfig;
 
 /// What a replay did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
