@@ -48,10 +48,7 @@ use mcap::sans_io::{LinearReaderOptions, MessageReadEvent, MessageReader};
 use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
-use crate::gaze::{
-    FailSafeConfig, FilterConfig, Frame, FramePlanner, GazeError, GazeSample, GazeStream, State,
-    StreamConfig, StreamStats,
-};
+use crate::gaze::{Frame, FramePlanner, GazeError, GazeSample, GazeStream, State, StreamStats};
 use crate::pointcloud::{keep_mask, CloudError, CloudFrame, CloudOptions};
 
 /// Why a replay stopped.
