@@ -590,8 +590,9 @@ fn optimize(py: Python<'_>, config_text: &str, gaze_deg: f64, json: bool) -> PyR
             .and_then(|c| Ok((c.problem()?, c.preset()?)))
             .map_err(|e| opt_error(py, e))?;
         detached(py, || {
-            gaze_lidar::optimizer::optimize(&problem, gaze_deg)
-                .map(|c| gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels))
+            gaze_lidar::optimizer::optimize(&problem, gaze_deg).map(|c| {
+                gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels)
+            })
         })?
         .map(|inner| PyProfile { inner })
         .map_err(|e| opt_error(py, e))
