@@ -239,23 +239,12 @@ fn evaluate_head(
     ];
     let energy = head_bound::energy_ratios(&hf, laser, b.ratios, b.pass, frame_s, p_top, spin_max);
     ratios[1..].copy_from_slice(&energy[1..]);
-    let rules = [
-        Rule::SinglePulse,
-        Rule::PassTrain,
-        Rule::T2Train,
-        Rule::TimeBase,
-    ];
-    let (mut k_best, mut r_best) = (0, ratios[0]);
-    for (k, &r) in ratios.iter().enumerate().skip(1) {
-        if r > r_best {
-            (k_best, r_best) = (k, r);
-        }
-    }
+    let (k_best, r_best) = crate::eye_safety::bound::binding(&ratios);
     let stalled_rotor_ratio = head_bound::stalled_ratio(&hf, laser, p_top);
     Ok(ExposureReport {
         pass_angle_deg: pass,
         worst_azimuth_deg: b.rule_azimuths_deg[usize::from(k_best > 0)],
-        binding_rule: rules[k_best],
+        binding_rule: crate::eye_safety::bound::RULES[k_best],
         worst_ratio: r_best,
         margin: 1.0 / r_best,
         rule_ratios: ratios,

@@ -131,6 +131,26 @@ pub struct Bound {
     pub pass: PassFigures,
 }
 
+/// The rules in the order of [`Bound::ratios`].
+pub(crate) const RULES: [Rule; 4] = [
+    Rule::SinglePulse,
+    Rule::PassTrain,
+    Rule::T2Train,
+    Rule::TimeBase,
+];
+
+/// The binding rule: the index and value of the largest ratio (the first
+/// on a tie), over the rules in [`RULES`] order.
+pub(crate) fn binding(ratios: &[f64; 4]) -> (usize, f64) {
+    let (mut k_best, mut r_best) = (0, ratios[0]);
+    for (k, &r) in ratios.iter().enumerate().skip(1) {
+        if r > r_best {
+            (k_best, r_best) = (k, r);
+        }
+    }
+    (k_best, r_best)
+}
+
 /// Evaluates the bound for bins `segs` (validated: cover [0, 360) in order,
 /// positive spins), half pass angle `half_deg`, and `laser`.
 #[must_use]
@@ -206,21 +226,10 @@ pub fn evaluate_with(segs: &[Seg], half_deg: f64, laser: &Laser, search: Search)
     for r in &mut ratios {
         *r *= 1.0 + RATIO_MARGIN;
     }
-    let rules = [
-        Rule::SinglePulse,
-        Rule::PassTrain,
-        Rule::T2Train,
-        Rule::TimeBase,
-    ];
-    let (mut k_best, mut r_best) = (0, ratios[0]);
-    for (k, &r) in ratios.iter().enumerate().skip(1) {
-        if r > r_best {
-            (k_best, r_best) = (k, r);
-        }
-    }
+    let (k_best, r_best) = binding(&ratios);
     Bound {
         worst_ratio: r_best,
-        binding_rule: rules[k_best],
+        binding_rule: RULES[k_best],
         worst_azimuth_deg: if k_best == 0 {
             best.single.1
         } else {
