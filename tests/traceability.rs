@@ -754,3 +754,83 @@ fn req_id_scanner_finds_ids() {
         vec![bogus, "REQ-FW-3".into(), "REQ-IN-1".into()]
     );
 }
+
+/// The backticked names of a Markdown table row's cell that look like paths
+/// (contain `/` or end in a file extension we keep in the tree).
+fn path_like(cell: &str) -> Vec<String> {
+    cell.split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|t| !t.contains(' ') && !t.contains("::"))
+        .filter(|t| {
+            t.contains('/')
+                || [".rs", ".md", ".toml", ".py", ".sh"]
+                    .iter()
+                    .any(|e| t.ends_with(e))
+        })
+        .map(str::to_owned)
+        .collect()
+}
+
+/// Every path the README's layout table names, checked against the tree: the
+/// folders of the first column from the repository root, the names inside a
+/// row's description from that row's folder (or its `src/`) or the root.
+/// Returns the names that resolve nowhere.
+fn missing_layout_paths(readme: &str, root: &Path) -> Vec<String> {
+    let section = readme
+        .split("\n## Layout")
+        .nth(1)
+        .and_then(|s| s.split("\n## ").next())
+        .unwrap_or("");
+    let mut missing = Vec::new();
+    for row in section.lines().filter(|l| l.starts_with("| `")) {
+        let cells: Vec<&str> = row.split(" | ").collect();
+        let folders = path_like(cells[0]);
+        for folder in &folders {
+            if !root.join(folder).exists() {
+                missing.push(folder.clone());
+            }
+        }
+        for name in cells.iter().skip(1).flat_map(|c| path_like(c)) {
+            let found = std::iter::once(root.to_path_buf())
+                .chain(folders.iter().flat_map(|f| {
+                    let base = if f.ends_with('/') {
+                        root.join(f)
+                    } else {
+                        root.join(f).parent().unwrap_or(root).to_path_buf()
+                    };
+                    [base.clone(), base.join("src")]
+                }))
+                .any(|b| b.join(&name).exists());
+            if !found {
+                missing.push(name);
+            }
+        }
+    }
+    missing
+}
+
+#[test]
+fn readme_layout_names_only_paths_that_exist() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    assert!(
+        readme.contains("\n## Layout"),
+        "README has a Layout section"
+    );
+    let missing = missing_layout_paths(&readme, &root());
+    assert!(
+        missing.is_empty(),
+        "README's layout table names paths that do not exist: {missing:?}"
+    );
+}
+
+#[test]
+fn layout_check_flags_a_path_that_does_not_exist() {
+    let table = "intro\n## Layout\n\n| folder | what |\n|---|---|\n\
+                 | `src/sim/` | the simulator: `plots.rs`, `nowhere/gone.rs` |\n\
+                 | `src/not_a_folder/` | nothing |\n\n## Next\n| `src/zzz/` | outside |\n";
+    assert_eq!(
+        missing_layout_paths(table, &root()),
+        vec!["nowhere/gone.rs".to_owned(), "src/not_a_folder/".to_owned()]
+    );
+}

@@ -19,6 +19,17 @@
 //! the `json` feature). The planner, optimizer, gaze pipeline, simulator and
 //! CLI live in the `gaze-lidar` crate, which depends on this one.
 //!
+//! ## Start here
+//!
+//! A vendor needs the names re-exported at this root: read a profile
+//! ([`Profile`], e.g. `Profile::from_json` with the `json` feature), describe
+//! the sensor ([`LidarSpec`]), and certify: [`certify`] against the
+//! profile's own declared limits, [`certify_for_sensor`] against a sensor's
+//! limits, [`certify_with`] with [`CheckOptions`]. Success is a
+//! [`CertifiedProfile`] (only the checker can build one); failure is
+//! [`Rejected`], listing every [`Violation`] and, for eye safety, the
+//! binding [`Rule`] and the [`ExposureReport`] it rests on.
+//!
 //! Proofs: Kani harnesses live beside the code they verify (`mod
 //! verification` in each module); every harness body also runs as a test.
 //! They are machine-checked only where Kani is installed (see
@@ -40,3 +51,15 @@ pub mod profile;
 pub mod text;
 #[doc(hidden)]
 pub mod verification;
+
+#[cfg(feature = "std")]
+pub use checker::{
+    certify, certify_for_sensor, certify_with, CertifiedProfile, CheckOptions, Rejected, Violation,
+};
+pub use eye_safety::rule::Rule;
+#[cfg(feature = "std")]
+pub use eye_safety::ExposureReport;
+#[cfg(feature = "std")]
+pub use model::lidar::LidarSpec;
+#[cfg(feature = "std")]
+pub use profile::Profile;
