@@ -834,3 +834,114 @@ fn layout_check_flags_a_path_that_does_not_exist() {
         vec!["nowhere/gone.rs".to_owned(), "src/not_a_folder/".to_owned()]
     );
 }
+
+/// Every text file of the repository the citation check reads (sources,
+/// specs, docs, scripts), skipping build output and virtual environments.
+fn text_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if p.is_dir() {
+            if !name.starts_with('.') && !["target", "node_modules", "venv"].contains(&name) {
+                text_files(&p, out);
+            }
+        } else if ["rs", "py", "pyi", "md", "toml", "sh"]
+            .iter()
+            .any(|x| p.extension().is_some_and(|e| e == *x))
+        {
+            out.push(p);
+        }
+    }
+}
+
+/// The documents a text cites: tokens ending in `.md` that name a project
+/// document — an upper-case file name (`README.md`, `CHANGELOG.md`) or a
+/// path under `specs/` or `docs/`, or any path leaving the repository
+/// (`../`). Output file names in examples (`report.md`) are not citations.
+fn cited_documents(text: &str) -> Vec<String> {
+    let ok = |c: char| c.is_ascii_alphanumeric() || "_./-".contains(c);
+    let mut out = Vec::new();
+    for (at, _) in text.match_indices(".md") {
+        if text[at + 3..]
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphanumeric())
+        {
+            continue;
+        }
+        let start = text[..at]
+            .char_indices()
+            .rev()
+            .take_while(|&(_, c)| ok(c))
+            .last()
+            .map_or(at, |(i, _)| i);
+        let token = &text[start..at + 3];
+        if text[..start].ends_with("//") || token.contains("//") {
+            continue;
+        }
+        let base = token.rsplit('/').next().unwrap_or(token);
+        let stem = &base[..base.len() - 3];
+        let upper = !stem.is_empty()
+            && stem
+                .chars()
+                .all(|c| c.is_ascii_uppercase() || c == '_' || c.is_ascii_digit());
+        if upper
+            || token.starts_with("specs/")
+            || token.starts_with("docs/")
+            || token.starts_with("../")
+        {
+            out.push(token.to_owned());
+        }
+    }
+    out
+}
+
+#[test]
+fn every_cited_document_exists_in_the_repository() {
+    let root = root();
+    let mut files = Vec::new();
+    text_files(&root, &mut files);
+    let mut missing = Vec::new();
+    for f in files {
+        let Ok(text) = std::fs::read_to_string(&f) else {
+            continue;
+        };
+        let dir = f.parent().unwrap_or(&root);
+        for cited in cited_documents(&text) {
+            let inside = |p: PathBuf| {
+                p.canonicalize()
+                    .is_ok_and(|c| c.starts_with(root.canonicalize().unwrap()))
+            };
+            let rooted = cited.trim_start_matches('/');
+            let found = inside(root.join(rooted)) || inside(dir.join(&cited));
+            if !found {
+                let rel = f.strip_prefix(&root).unwrap_or(&f).display().to_string();
+                missing.push(format!("{rel}: {cited}"));
+            }
+        }
+    }
+    missing.sort();
+    missing.dedup();
+    assert!(
+        missing.is_empty(),
+        "documents cited but not in the repository: {missing:#?}"
+    );
+}
+
+#[test]
+fn citation_scanner_finds_design_style_citations() {
+    // Built at run time so that this file does not cite what it tests.
+    let (design, heads) = (["DESIGN", "md"].join("."), ["HEADS", "md"].join("."));
+    let text = format!(
+        "see {design} §5, `../shared/{heads}` and specs/eye_safety.md; \
+         writes report.md; https://github.com/x/y/blob/main/CONTRIBUTING.md"
+    );
+    assert_eq!(
+        cited_documents(&text),
+        vec![
+            design,
+            format!("../shared/{heads}"),
+            "specs/eye_safety.md".to_owned()
+        ]
+    );
+}

@@ -90,7 +90,7 @@ def test_range_control_keeps_farther_points_outside_the_region_of_focus() -> Non
     argus = gl.apply_profile(p, pts, rated_range_m=100.0, model="argus")
     assert r[argus].max() <= 100.0
     argus_fog = gl.apply_profile(p, pts, rated_range_m=100.0, model="argus", fog_mor_m=200.0)
-    # DESIGN.md: ≈ 74 m at 1.1 × P̄ in its fog 50; at half power nothing
+    # The paper code's model (`docs/reproduction.md`): ≈ 74 m at 1.1 × P̄ in its fog 50; at half power nothing
     # clears the intensity threshold.
     assert 70.0 < r[roi & argus_fog].max() < 76.0
     assert not argus_fog[rof].any()

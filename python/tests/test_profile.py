@@ -143,7 +143,7 @@ def test_optimizer_from_a_toml_config(repo: pathlib.Path) -> None:
     p = gl.optimize(cfg, 90.0)
     closed = gl.profile(mode="joint", gaze_deg=90.0)
     assert gl.check(p.to_json()).certified
-    # The paper's problem: the optimum is the closed form (DESIGN.md).
+    # The paper's problem: the optimum is the closed form (`specs/optimizer.md`).
     np.testing.assert_allclose(np.sort(p.power_w), np.sort(closed.power_w), rtol=1e-6)
     with pytest.raises(ValueError, match="^config: "):
         gl.optimize("[lidar]\nfoo = 1\n", 90.0)

@@ -128,7 +128,7 @@ fn channels(table: impl Iterator<Item = (u32, f64, f64, f64)>) -> Vec<Channel> {
 /// VLS-128 / Alpha Prime laser elevations by laser id, deg: ros-drivers/velodyne
 /// `velodyne_pointcloud/params/VLS128.yaml` (`vert_correction`, in rad
 /// there; same in valgur/velodyne_decoder `src/calib_db.cpp`, "AlphaPrime",
-/// and tier4/nebula `calibration/VLS128.yaml`), as tabulated in HEADS.md
+/// and tier4/nebula `calibration/VLS128.yaml`), as tabulated in docs/heads.md
 /// Appendix A.
 // Laser 26's −6.280° is a calibration value that happens to read like −τ.
 #[allow(clippy::approx_constant)]
@@ -152,7 +152,7 @@ const VLS128_ELEVATION_DEG: [f64; 128] = [
 ];
 
 /// VLS-128 azimuth offset of laser `id`, by `id mod 8`, deg
-/// (`rot_correction` of `VLS128.yaml`, HEADS.md §1): eight columns, one
+/// (`rot_correction` of `VLS128.yaml`, docs/heads.md §1): eight columns, one
 /// laser of each firing group in each.
 const VLS128_AZIMUTH_DEG: [f64; 8] = [-6.354, -4.548, -2.732, -0.911, 0.911, 2.732, 4.548, 6.354];
 
@@ -171,14 +171,14 @@ const VLS128_CYCLE_S: f64 = 53.3e-6;
 ///   channel, 2.4 M points/s in all), 5–20 Hz in 60 RPM steps (datasheet),
 ///   10 Hz here.
 /// - Head (public): elevations per laser id and the eight azimuth columns
-///   (`id mod 8`) from `VLS128.yaml` (HEADS.md Appendix A); groups of eight
+///   (`id mod 8`) from `VLS128.yaml` (docs/heads.md Appendix A); groups of eight
 ///   (`id / 8`) fire together, group `g` at `2.665·g` µs for `g < 8` and
 ///   `2.665·(g + 1)` µs after the first maintenance period (manual p.49);
 ///   the beams cross 58.63 mm from the axis (valgur `calib_db.cpp`);
 ///   divergence 3.0 mrad, the larger (horizontal) axis (manual p.115).
 /// - Not public, assumed: the exit beam diameter, 10 mm (the only stated
 ///   exit diameter of a comparable head, Ouster OS1's; the upper end of
-///   the 5–10 mm bracket of HEADS.md §6, which counts more beams as
+///   the 5–10 mm bracket of docs/heads.md §6, which counts more beams as
 ///   meeting the aperture); the crossing point at the reference height
 ///   (the aperture height is searched anyway); 3 ns pulses; every channel
 ///   at the same power.
@@ -256,7 +256,7 @@ pub fn vls128() -> Preset {
 
 /// VLP-16 laser elevations by laser id, deg (ros-drivers/velodyne
 /// `velodyne_pointcloud/params/VLP16db.yaml`; valgur `calib_db.cpp`;
-/// HEADS.md Appendix A): −15, 1, −13, 3, …, −1, 15 (interleaved).
+/// docs/heads.md Appendix A): −15, 1, −13, 3, …, −1, 15 (interleaved).
 const VLP16_ELEVATION_DEG: [f64; 16] = [
     -15.0, 1.0, -13.0, 3.0, -11.0, 5.0, -9.0, 7.0, -7.0, 9.0, -5.0, 11.0, -3.0, 13.0, -1.0, 15.0,
 ];
@@ -270,7 +270,7 @@ const VLP16_CYCLE_S: f64 = 55.296e-6;
 /// A sensor resembling the Velodyne VLP-16 run at 10 Hz, with its real
 /// 16-channel head.
 ///
-/// - 903 nm (VLP-16 manual's channel definition, HEADS.md §4), 16 lasers
+/// - 903 nm (VLP-16 manual's channel definition, docs/heads.md §4), 16 lasers
 ///   each firing once per 55.296 µs cycle (18,084 Hz per channel), 10 Hz
 ///   (5–20 Hz, 300–1200 RPM, datasheet).
 /// - Head (public): the elevations of `VLP16db.yaml`, no azimuth offsets;
@@ -370,13 +370,13 @@ const OS1_128_AZIMUTH_DEG: [f64; 128] = [
 ];
 /// One OS1 column period in 1024×10 mode, s: 1/(1024 columns · 10 Hz)
 /// (ouster-sdk `using-the-api.rst`, "each column contains measurements
-/// taken at a single timestamp"; HEADS.md §2).
+/// taken at a single timestamp"; docs/heads.md §2).
 const OS1_128_CYCLE_S: f64 = 1.0 / 10_240.0;
 
 /// A sensor resembling the Ouster OS1-128 (Rev 6/7) in 1024×10 mode, with
 /// its real 128-channel head.
 ///
-/// - 865 nm ("operate in the 865nm band", OS0/OS1 manual; HEADS.md §4);
+/// - 865 nm ("operate in the 865nm band", OS0/OS1 manual; docs/heads.md §4);
 ///   all 128 beams of a column flash at one timestamp, once per 97.656 µs
 ///   column period (10,240 Hz per channel, 1.3 M points/s in all).
 /// - Head (public): elevations and the four azimuth columns of ouster-sdk
@@ -384,7 +384,7 @@ const OS1_128_CYCLE_S: f64 = 1.0 / 10_240.0;
 ///   origin `lidar_origin_to_beam_origin_mm` = 15.806 mm from the axis
 ///   (same file); 10 mm exit beam ("Beam Diameter Exiting Sensor 10 mm")
 ///   and 0.18° divergence (128-channel, FWHM) from the OS1 datasheet
-///   (HEADS.md §3). The head takes 1/e² sizes: the FWHM angle is widened
+///   (docs/heads.md §3). The head takes 1/e² sizes: the FWHM angle is widened
 ///   by `1/√(ln 2 / 2)` ≈ 1.699 (a Gaussian beam's 1/e² to FWHM ratio) to
 ///   5.34 mrad; the 10 mm exit diameter is taken as 1/e² (not stated).
 /// - Assumed: the head fires on the encoder (1024 columns a turn); the
@@ -466,7 +466,7 @@ mod tests {
     }
 
     /// The heads carry the public tables: channel counts, firing groups,
-    /// cycles, crossing points (HEADS.md §1–3), and `paper` stays one channel.
+    /// cycles, crossing points (docs/heads.md §1–3), and `paper` stays one channel.
     #[test]
     fn heads_carry_the_public_tables() {
         let head = |name: &str| preset(name).unwrap().lidar.limits.eye_safety.unwrap().head;

@@ -3,7 +3,7 @@
 //! ([`crate::sim::returns::ReturnModel`]) and the profile figures
 //! ([`crate::planner::figures`]) both call it.
 //!
-//! Extended Lambertian target (DESIGN.md §4): the received signal is
+//! Extended Lambertian target (a target wider than the beam): the received signal is
 //! `P_r ∝ P·ρ·cos θ·e^(−2αR)/R²`. Calibrated on the sensor's rating — a pulse
 //! at the average power `P̄` reaches its rated range `R₀` on the reference
 //! reflectivity `ρ₀` in clear air (extinction `α₀`), i.e. there the signal

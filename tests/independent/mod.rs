@@ -2,7 +2,7 @@
 //! would otherwise re-run `checker::certify` on a profile the same checker
 //! has just accepted (an assertion that cannot fail).
 //!
-//! Written from the profile@1 definition (DESIGN.md §2, `specs/`), sharing no
+//! Written from the profile@1 definition (README, "The profile format"; `specs/`), sharing no
 //! code with `gaze_lidar::checker`: its own kinematics (constant angular
 //! acceleration inside a bin: dwell = 2·Δθ/(ω₀+ω₁), α = (ω₁²−ω₀²)/(2·Δθ)),
 //! its own sums and its own tolerance. Eye safety is the business of the

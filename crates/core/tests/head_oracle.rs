@@ -320,10 +320,10 @@ fn a_channel_at_power_scale_zero_contributes_nothing() {
 }
 
 // ---------------------------------------------------------------------------
-// Head shapes: real heads from public data (`../shared/HEADS.md`) and random
+// Head shapes: real heads from public data (`docs/heads.md`) and random
 // heads.
 
-/// VLS-128 elevations (HEADS.md Appendix A, from ros-drivers/velodyne
+/// VLS-128 elevations (docs/heads.md Appendix A, from ros-drivers/velodyne
 /// `velodyne_pointcloud/params/VLS128.yaml`); the azimuth offset is set by
 /// `id mod 8`, each row of 8 is one firing group.
 #[allow(clippy::approx_constant)] // vendor data (6.280°), not τ
@@ -343,7 +343,7 @@ const VLS128_ELEVATION_DEG: [f64; 128] = [
 const VLS128_COLUMN_DEG: [f64; 8] = [-6.354, -4.548, -2.732, -0.911, 0.911, 2.732, 4.548, 6.354];
 
 /// VLS-128-like: groups of 8 (`id / 8`) every 2.665 µs, a 2.665 µs pause
-/// after the 8th group, 53.3 µs cycle (VLS-128 manual p.49 via HEADS.md §2);
+/// after the 8th group, 53.3 µs cycle (VLS-128 manual p.49 via docs/heads.md §2);
 /// crossing point 58.63 mm (valgur/velodyne_decoder `calib_db.cpp`, §3);
 /// divergence 3 mrad (manual p.115, the larger axis); exit diameter not
 /// public: 8 mm assumed.
@@ -367,7 +367,7 @@ fn vls128_like() -> Head {
 
 /// OS1-128-like: the whole column at once, rows from +20.95° down by
 /// 0.3387° to −21.82°, azimuth offsets by `row mod 4` (+4.21, +1.41, −1.40,
-/// −4.22), origin 15.806 mm (ouster-sdk metadata, HEADS.md §1/§3), 10 mm
+/// −4.22), origin 15.806 mm (ouster-sdk metadata, docs/heads.md §1/§3), 10 mm
 /// exit beam and 0.18° (3.14 mrad) divergence (OS1 datasheet, §3), column
 /// period 97.7 µs (1024 × 10 Hz).
 #[allow(clippy::approx_constant)] // 3.14 mrad = 0.18°, not π
@@ -385,7 +385,7 @@ fn os1_128_like() -> Head {
 }
 
 /// VLP-16-like: sequential firing 2.304 µs apart, 55.296 µs cycle, 2°
-/// interleaved elevations, no offsets, crossing point 41.91 mm (HEADS.md
+/// interleaved elevations, no offsets, crossing point 41.91 mm (docs/heads.md
 /// §1–§3); exit diameter not public: 8 mm assumed, 3 mrad.
 fn vlp16_like() -> Head {
     let el = [

@@ -475,7 +475,7 @@ fn head_bound_is_never_below_the_definitions_reference() {
     assert!(evaluated >= cases * 9 / 10);
 }
 
-/// Heads of the shapes of the presets (`../shared/HEADS.md` §2, §3): an
+/// Heads of the shapes of the presets (`docs/heads.md` §2, §3): an
 /// OS1-128-like column head (128 channels fired together, four azimuth
 /// columns, origin 15.806 mm, 10 mm exit beam), a VLS-128-like head (16
 /// groups of 8 every 2.665 µs in 53.3 µs, eight azimuth columns, 58.63 mm)

@@ -89,7 +89,7 @@ pub struct Summary {
     pub spin_rad_s_range: [f64; 2],
 }
 
-/// A scan profile in the `gaze-lidar/profile@1` layout (DESIGN.md §3).
+/// A scan profile in the `gaze-lidar/profile@1` layout (README, "The profile format").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Profile {
     /// Always [`PROFILE_FORMAT`].

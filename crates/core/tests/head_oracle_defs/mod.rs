@@ -1,6 +1,6 @@
 //! A brute-force reference for the eye safety of a whole multi-beam head,
-//! written from the definitions (IEC 60825-1:2014 as DESIGN.md §5 and
-//! `specs/eye_safety.md` quote them; the head's conventions as
+//! written from the definitions (IEC 60825-1:2014, as
+//! `specs/eye_safety.md` quotes it; the head's conventions as
 //! `eye_safety::head` documents them). It shares no code with the head bound:
 //! only the AEL tables (`eye_safety::ael`, the project's one model of them)
 //! and the head description (`eye_safety::head::Head`).

@@ -1,5 +1,6 @@
 //! Brute-force reference evaluator for the Class 1 eye-safety rules of a
-//! scanned, pulsed beam (DESIGN.md §2 "Spin with finite acceleration", §5).
+//! scanned, pulsed beam (the profile@1 kinematics, constant angular acceleration within a
+//! bin, as README's "The profile format" states them; IEC 60825-1:2014).
 //!
 //! Written independently of `gaze_lidar_core::eye_safety`: it shares no code with
 //! the crate (own kinematics, own AEL table, own pulse clock). It is slow and
@@ -37,7 +38,7 @@
 
 use std::fmt;
 
-/// Spectral band (rows of Table 3 as DESIGN.md §5 gives them).
+/// Spectral band (the columns of IEC 60825-1:2014 Table 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Band {
     /// 700–1050 nm.
