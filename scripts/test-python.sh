@@ -23,7 +23,7 @@ echo "== python: pip install ./python into a fresh venv ($venv)"
 "$PY" -m venv "$venv"
 "$venv/bin/pip" install -q ./python   # exactly what a user runs
 "$venv/bin/python" -m pip install -q pytest hypothesis mypy
-# An independent MCAP writer and reader for the replay test (issue 33).
+# An independent MCAP writer and reader for the replay test.
 "$venv/bin/python" -m pip install -q mcap mcap-ros2-support
 
 echo "== python: pytest"

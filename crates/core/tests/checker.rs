@@ -661,7 +661,7 @@ fn the_sensor_requires_eye_safety_even_with_the_opt_out() {
     assert_eq!(check_with(&p, &opts), vec![]);
 }
 
-/// Issue 21, item 2, at the library: a NaN in the sensor's limits must not
+/// At the library: a NaN in the sensor's limits must not
 /// let a profile through `certify_for_sensor` (the comparison used to be
 /// `x > y`, false against NaN). Every comparison with a NaN sensor limit is
 /// "looser", for upper and lower limits alike. (The CLI refuses such a
@@ -704,9 +704,9 @@ fn nan_sensor_limits_never_pass() {
     }
 }
 
-/// Issue 21, item 3: subnormal rates were certified (`frame_rate_hz:
-/// 5e-324` gave an infinite expected period, which matched any dwell sum
-/// within a relative tolerance). Every rate outside 1e-9..=1e12 Hz and every
+/// Subnormal rates must not certify (`frame_rate_hz: 5e-324` would give an
+/// infinite expected period, which matches any dwell sum within a relative
+/// tolerance). Every rate outside 1e-9..=1e12 Hz and every
 /// subnormal number of the header, limits and bins is a violation naming
 /// its key; 1e-9 and 1e12 themselves are only judged by the other rules.
 #[test]

@@ -969,7 +969,7 @@ fn rule_one_counts_a_pulse_on_a_hot_bin_s_first_instant() {
 }
 
 // ---------------------------------------------------------------------------
-// Issue 21: windows longer than the pulses they hold, across a step-down of
+// Windows longer than the pulses they hold, across a step-down of
 // Table 3 (`eye_cases::ael_step_cases`, true ratios by hand there).
 
 /// Both profiles are rejected naming eye safety, the checker's figure at

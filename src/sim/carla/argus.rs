@@ -371,8 +371,8 @@ mod tests {
 
     #[test]
     fn fine_long_range_mask_is_sparse_and_small() {
-        // Issue 22 item 14: 0.05 m cells over a 1 km trace were a dense
-        // 1.6 GB mask per detector.
+        // 0.05 m cells over a 1 km trace must not make a dense 1.6 GB mask
+        // per detector.
         let p = CarlaParams {
             argus_cell_m: 0.05,
             range_m: 1000.0,

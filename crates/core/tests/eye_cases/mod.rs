@@ -163,7 +163,7 @@ pub fn constructed() -> Vec<Constructed> {
 }
 
 // ---------------------------------------------------------------------------
-// The two profiles of issue 21, over Class 1 only in a window *longer* than
+// Two profiles over Class 1 only in a window *longer* than
 // the pulses it holds, across a row edge where Table 3 steps down: a
 // checker that takes the AEL at the pulses' span (a monotone-AEL reading)
 // certified both. True ratios by hand from the files' numbers.

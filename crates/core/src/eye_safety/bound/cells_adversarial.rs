@@ -1,4 +1,4 @@
-//! Adversarial review (breaker4) of the sweep's curved-cell bounds
+//! Adversarial tests of the sweep's curved-cell bounds
 //! (`cells.rs`): a generator aimed at what the midpoint fix touched —
 //! many bins, spins near 0 at one edge (extreme acceleration), `h` equal
 //! to (or half of, or a hair off) a bin width so that cuts coincide,
