@@ -189,7 +189,7 @@ impl Behaviour {
                 if !(rate_hz > 0.0 && rate_hz <= 10.0) {
                     return bad("rate_hz", rate_hz, "must lie in (0, 10]");
                 }
-                if !(step_deg >= 1.0 && step_deg <= 360.0) {
+                if !(1.0..=360.0).contains(&step_deg) {
                     return bad("step_deg", step_deg, "must lie in [1, 360]");
                 }
                 Ok(())
