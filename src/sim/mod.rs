@@ -6,6 +6,7 @@
 //! - [`scene`]: the intersection and its geometry;
 //! - [`returns`]: the `argus` and `physical` return models and the fog table;
 //! - [`trial`]: one trial, every pulse ray-cast at its firing time;
+//! - [`stats`]: bootstrap intervals, modes and paired tests;
 //! - [`plots`] and [`report`]: figures and the reproduction report.
 //!
 //! Trials are independent and seeded by `(seed, trial index)` only, so every
@@ -19,6 +20,7 @@ pub mod plots;
 pub mod report;
 pub mod returns;
 pub mod scene;
+pub mod stats;
 pub mod table;
 pub mod trial;
 
