@@ -59,13 +59,26 @@ fn every_scenario_file_runs() {
 fn pedestrian_is_a_small_slow_target() {
     let sc = scenario("pedestrian.toml");
     assert_eq!((sc.vehicle_width_m, sc.speed_kmh), (0.5, 5.0));
-    let r = sim::run(&config(sc, 3), &|| {}).unwrap();
+    let c = SimConfig {
+        fog_pcts: vec![0, 50],
+        ..config(sc, 3)
+    };
+    let r = sim::run(&c, &|| {}).unwrap();
     for row in &r.rows {
-        assert!(row.detected > 0, "{row:?}");
-        // Seen at most from the corner 25 m away (+3 m offset) at 1.39 m/s.
+        assert_eq!(row.detected, 3, "{row:?}");
+        // Seen at most from the corner 60 m away (+3 m offset) at 1.39 m/s.
         let tta = row.tta_median_s.unwrap();
-        assert!(tta > 1.0 && tta < 28.0 / (5.0 / 3.6), "{tta}");
+        assert!(tta > 1.0 && tta < 63.0 / (5.0 / 3.6), "{tta}");
     }
+    // Far and small: in clear air seen as it comes into view, in fog much later.
+    let at = |variant: &str, fog: u32| {
+        r.row(ModelKind::Physical, variant, fog)
+            .unwrap()
+            .tta_median_s
+            .unwrap()
+    };
+    assert!(at("baseline", 0) > 40.0, "{}", at("baseline", 0));
+    assert!(at("baseline", 50) < at("baseline", 0) - 5.0);
 }
 
 #[test]
