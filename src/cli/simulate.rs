@@ -98,6 +98,21 @@ pub struct Args {
     /// Disable ray culling (reference path; results are identical).
     #[arg(long, hide = true)]
     brute_force: bool,
+    /// Drive the sensor's profile frame by frame from this recorded gaze
+    /// file (format: --gaze-format) through `stream`'s filter and fail-safe.
+    #[arg(long, conflicts_with = "gaze_behaviour")]
+    gaze: Option<PathBuf>,
+    /// Format of --gaze.
+    #[arg(long, value_enum, default_value_t = gaze_lidar::gaze::Format::Jsonl)]
+    gaze_format: gaze_lidar::gaze::Format,
+    /// Drive the profile from a named gaze behaviour, seeded per trial:
+    /// `fixate[:gaze_deg=G]`, `scan[:left_deg=L,right_deg=R,rate_hz=F,step_deg=S]`,
+    /// `mirror[:gaze_deg=G,mirror_deg=M,every_s=P,glance_s=D]`,
+    /// `blink[:gaze_deg=G,every_s=P,blink_s=D]`.
+    #[arg(long)]
+    gaze_behaviour: Option<String>,
+    #[command(flatten)]
+    filter: super::gaze_args::FilterArgs,
 }
 
 fn parse_k_of_n(s: &str) -> Result<KOfN, CliError> {
@@ -119,6 +134,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     let mut outputs = Outputs::default();
     outputs
         .input_opt("--scenario", a.scenario.as_deref())
+        .input_opt("--gaze", a.gaze.as_deref())
         .input_opt("--optimizer-config", a.optimizer_config.as_deref());
     let scenario = match &a.scenario {
         Some(path) => {
@@ -177,9 +193,14 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     if a.optimizer_config.is_some() {
         return Err(super::config::no_solver("--optimizer-config"));
     }
+    let gaze = gaze_drive(a, &scenario)?;
     let config = SimConfig {
         models: if a.model.is_empty() {
-            vec![ModelKind::Argus, ModelKind::Physical]
+            if gaze.is_some() {
+                vec![ModelKind::Physical]
+            } else {
+                vec![ModelKind::Argus, ModelKind::Physical]
+            }
         } else {
             a.model.clone()
         },
@@ -232,7 +253,11 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     } else {
         ProgressBar::hidden()
     };
-    let result = sim::run(&config, &|| bar.inc(1)).map_err(|e| {
+    let result = match &gaze {
+        Some(g) => sim::gaze_drive::run(&config, g, &|| bar.inc(1)),
+        None => sim::run(&config, &|| bar.inc(1)),
+    }
+    .map_err(|e| {
         if e.is_input_error() {
             CliError::input(e.to_string())
         } else {
@@ -344,6 +369,37 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
     }
     Ok(0)
+}
+
+/// The gaze drive of `--gaze` / `--gaze-behaviour`, if either is given.
+fn gaze_drive(
+    a: &Args,
+    scenario: &Scenario,
+) -> Result<Option<sim::gaze_drive::GazeDrive>, CliError> {
+    use sim::gaze_drive::{Behaviour, GazeDrive, GazeSource, Trace};
+    let source = match (&a.gaze, &a.gaze_behaviour) {
+        (Some(path), _) => {
+            // Recordings are larger than configurations: 256 MiB.
+            let text = read_text(path, 256 << 20)?;
+            GazeSource::Trace(
+                Trace::parse(&text, a.gaze_format, &path.display().to_string())
+                    .map_err(super::gaze_args::gaze_error)?,
+            )
+        }
+        (None, Some(spec)) => GazeSource::Behaviour(
+            Behaviour::parse(spec, scenario.gaze_deg).map_err(CliError::input)?,
+        ),
+        (None, None) => return Ok(None),
+    };
+    if a.report.is_some() || a.plots.is_some() {
+        return Err(CliError::input(
+            "--gaze/--gaze-behaviour: --report and --plots describe the paper's grid; use --format, --export-json/--export-csv or --trials-csv",
+        ));
+    }
+    Ok(Some(GazeDrive {
+        source,
+        pipeline: a.filter.settings()?,
+    }))
 }
 
 /// Renders the plots (in a private temporary folder) and returns their

@@ -6,6 +6,7 @@
 //! - [`scene`]: the intersection and its geometry;
 //! - [`returns`]: the `argus` and `physical` return models and the fog table;
 //! - [`trial`]: one trial, every pulse ray-cast at its firing time;
+//! - [`stats`]: bootstrap intervals, modes and paired tests;
 //! - [`plots`] and [`report`]: figures and the reproduction report.
 //!
 //! Trials are independent and seeded by `(seed, trial index)` only, so every
@@ -13,11 +14,13 @@
 //! results are bit-identical whatever the number of threads.
 
 pub mod carla;
+pub mod gaze_drive;
 #[cfg(feature = "cli")]
 pub mod plots;
 pub mod report;
 pub mod returns;
 pub mod scene;
+pub mod stats;
 pub mod table;
 pub mod trial;
 
@@ -474,6 +477,13 @@ pub struct Row {
     /// azimuths below gaze − 30° (all channels, ground included; planar:
     /// the simulated channel × channels); median.
     pub argus_density_points: f64,
+    /// False detections per frame over the cell's trials (scenario
+    /// `false_alarms_per_frame`; 0 without).
+    pub false_alarms_per_frame: f64,
+    /// Trials whose right-car TTA was "early false" (a false detection first).
+    pub early_false: usize,
+    /// Share of frames the sensor ran in fail-safe (`simulate --gaze`; 0 otherwise).
+    pub fail_safe_frame_share: f64,
 }
 
 /// All rows and per-trial records.
@@ -648,6 +658,12 @@ pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, S
     if config.detector == Detector::Argus && config.geometry != Geometry::Carla {
         return Err(SimError::Argument(
             "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)"
+                .into(),
+        ));
+    }
+    if config.geometry == Geometry::Carla && config.scenario.false_alarms_per_frame > 0.0 {
+        return Err(SimError::Argument(
+            "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)"
                 .into(),
         ));
     }
@@ -1056,6 +1072,14 @@ fn rows_of<'s>(
             .map(|r| r.outcome.argus_roi_points as f64 * scale)
             .collect();
         let q = quartiles(&right);
+        let frames: u64 = chunk.iter().map(|r| r.outcome.frames).sum();
+        let per_frame = |n: u64| {
+            if frames > 0 {
+                n as f64 / frames as f64
+            } else {
+                0.0
+            }
+        };
         rows.push(Row {
             model: first.model,
             variant: first.variant,
@@ -1076,6 +1100,14 @@ fn rows_of<'s>(
             hybrid_tta_median_s: quartiles(&hybrid_r).map(|q| q[1]),
             left_hybrid_tta_median_s: quartiles(&hybrid_l).map(|q| q[1]),
             argus_density_points: quartiles(&argus_dens).map_or(0.0, |q| q[1]),
+            false_alarms_per_frame: per_frame(chunk.iter().map(|r| r.outcome.false_alarms).sum()),
+            early_false: chunk
+                .iter()
+                .filter(|r| r.outcome.early_false_tta_s.is_some())
+                .count(),
+            fail_safe_frame_share: per_frame(
+                chunk.iter().map(|r| r.outcome.fail_safe_frames).sum(),
+            ),
         });
     }
     rows

@@ -85,6 +85,9 @@ pub struct Scenario {
     pub vehicle_reflectivity: f64,
     /// Lambertian reflectivity of the buildings.
     pub building_reflectivity: f64,
+    /// The detector's false detections per frame: in each frame, one with
+    /// this probability (`[0, 1]`; planar geometry only; default 0).
+    pub false_alarms_per_frame: f64,
     /// The `carla` geometry's parameters (table `[carla]`; ignored by `planar`).
     pub carla: CarlaParams,
 }
@@ -107,6 +110,7 @@ impl Default for Scenario {
             gaze_jitter_deg: 2.0,
             vehicle_reflectivity: 0.1,
             building_reflectivity: 0.3,
+            false_alarms_per_frame: 0.0,
             carla: CarlaParams::default(),
         }
     }
@@ -234,6 +238,13 @@ impl Scenario {
                 "vehicle_reflectivity",
                 self.vehicle_reflectivity.max(self.building_reflectivity),
                 "reflectivities must be <= 1",
+            );
+        }
+        if !(0.0..=1.0).contains(&self.false_alarms_per_frame) {
+            return bad(
+                "false_alarms_per_frame",
+                self.false_alarms_per_frame,
+                "must be a probability per frame in [0, 1]",
             );
         }
         if self.vehicle_width_m >= self.lane_width_m {

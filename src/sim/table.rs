@@ -95,6 +95,10 @@ pub fn render_trials_csv(r: &GridResult) -> Result<String, csv::Error> {
         roi_pulses: u64,
         duration_s: f64,
         density_pts_per_deg_s: f64,
+        fail_safe_frames: u64,
+        detected_in_fail_safe: Option<bool>,
+        false_alarms: u64,
+        early_false_tta_s: Option<f64>,
     }
     let mut w = csv::Writer::from_writer(Vec::new());
     for t in &r.trials {
@@ -112,6 +116,10 @@ pub fn render_trials_csv(r: &GridResult) -> Result<String, csv::Error> {
             roi_pulses: o.roi_pulses,
             duration_s: o.duration_s,
             density_pts_per_deg_s: o.density_pts_per_deg_s(),
+            fail_safe_frames: o.fail_safe_frames,
+            detected_in_fail_safe: o.detected_in_fail_safe[1],
+            false_alarms: o.false_alarms,
+            early_false_tta_s: o.early_false_tta_s,
         })?;
     }
     let bytes = w

@@ -109,6 +109,17 @@ pub struct TrialOutcome {
     pub argus_roi_points: u64,
     /// Channels the simulation cast (planar: 1, standing for all).
     pub channels_simulated: u32,
+    /// Frames the sensor ran in fail-safe (`simulate --gaze`; 0 otherwise).
+    pub fail_safe_frames: u64,
+    /// Whether each car was detected in a fail-safe frame (`simulate
+    /// --gaze`; `None`: not detected, or no gaze drive).
+    pub detected_in_fail_safe: [Option<bool>; 2],
+    /// False detections over the trial (scenario `false_alarms_per_frame`).
+    pub false_alarms: u64,
+    /// "Early false": the TTA of the first false detection when it comes
+    /// before the right car's true detection (or there is none) and before
+    /// its arrival, s.
+    pub early_false_tta_s: Option<f64>,
 }
 
 impl TrialOutcome {
@@ -132,6 +143,52 @@ pub fn mix64(mut z: u64) -> u64 {
 /// Uniform in `[0, 1)` from a key.
 fn unit(key: u64) -> f64 {
     (mix64(key) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// A detector's false detections: in each frame of the trial, one with
+/// probability `p_per_frame` at a uniform time in the frame (both drawn
+/// from `noise_seed` and the frame index, so every variant of a trial sees
+/// the same false alarms). Frame `f` spans `[f·T − phase, (f+1)·T − phase)`
+/// clipped to `[0, t_end_s)`. Returns the count and the early-false TTA of
+/// the right car: `t_arrive_s − t` of the first false detection at `t` if it
+/// comes no later than the arrival and before the true detection (at
+/// `t_arrive_s − tta_s`; `None`: never detected).
+#[must_use]
+#[allow(clippy::too_many_arguments)]
+pub fn false_alarms(
+    noise_seed: u64,
+    p_per_frame: f64,
+    frames: u64,
+    period_s: f64,
+    phase_s: f64,
+    t_end_s: f64,
+    t_arrive_s: f64,
+    tta_s: Option<f64>,
+) -> (u64, Option<f64>) {
+    if p_per_frame <= 0.0 {
+        return (0, None);
+    }
+    let mut count = 0u64;
+    let mut first: Option<f64> = None;
+    for f in 0..frames {
+        let key = noise_seed ^ mix64(f ^ 0xFA15_E000_0000_0000);
+        if unit(key) >= p_per_frame {
+            continue;
+        }
+        let start = (f as f64 * period_s - phase_s).max(0.0);
+        let end = ((f + 1) as f64 * period_s - phase_s).min(t_end_s);
+        if end <= start {
+            continue;
+        }
+        let t = start + unit(key ^ 0x5EED) * (end - start);
+        count += 1;
+        first.get_or_insert(t);
+    }
+    let detected_at = tta_s.map(|x| t_arrive_s - x);
+    let early = first
+        .filter(|&t| t <= t_arrive_s && detected_at.is_none_or(|d| t < d))
+        .map(|t| t_arrive_s - t);
+    (count, early)
 }
 
 /// The smallest arc containing the directions to `points` (none may be the origin).
@@ -195,14 +252,51 @@ pub struct TrialSetup<'a> {
     pub gaze_deg: f64,
 }
 
+/// What the sensor runs in one frame and what the driver sees then.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameView<'a> {
+    /// The certified profile of the frame.
+    pub profile: &'a Profile,
+    /// Its timeline (`Timeline::new(profile)`).
+    pub timeline: &'a Timeline<'a>,
+    /// The profile's regions (RoI point count, RoF decimation).
+    pub regions: &'a Regions,
+    /// The driver's regions at the frame start (`None`: eyes closed or gaze unknown: the driver sees nothing).
+    pub driver: Option<&'a Regions>,
+    /// Gaze of ARGUS's density region, degrees.
+    pub gaze_deg: f64,
+}
+
 /// Runs one trial.
 #[must_use]
 pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
-    let sc = setup.scenario;
     let tl = Timeline::new(setup.profile);
-    let period = tl.period_s();
-    let pulse_rate = setup.profile.pulse_rate_hz;
-    let p_mean = setup.profile.average_power_w;
+    let view = FrameView {
+        profile: setup.profile,
+        timeline: &tl,
+        regions: setup.regions,
+        driver: Some(setup.regions),
+        gaze_deg: setup.gaze_deg,
+    };
+    run_trial_frames(setup, draw, &|_| view).0
+}
+
+/// [`run_trial`] with the profile chosen per frame: `view_of(frame)` is
+/// what the sensor runs in frame `frame` (numbered from the trial's first,
+/// 0, which starts `phase_frac` of a period before t = 0). Every view's
+/// timeline must have the period of `view_of(0)`'s; `setup.profile`,
+/// `setup.regions` and `setup.gaze_deg` are ignored. Also returns the frame
+/// in which each car was detected.
+#[must_use]
+pub fn run_trial_frames<'v>(
+    setup: &TrialSetup<'_>,
+    draw: &TrialDraw,
+    view_of: &dyn Fn(u64) -> FrameView<'v>,
+) -> (TrialOutcome, [Option<u64>; 2]) {
+    let sc = setup.scenario;
+    let mut view = view_of(0);
+    let period = view.timeline.period_s();
+    let pulse_rate = view.profile.pulse_rate_hz;
     let v = sc.speed_m_s();
     let lane_x = sc.lane_x_m();
     let half_w = 0.5 * sc.vehicle_width_m;
@@ -232,6 +326,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
     let phase = draw.phase_frac * period;
 
     let mut detected_at: [Option<f64>; 2] = [None, None];
+    let mut detected_frame: [Option<u64>; 2] = [None, None];
     let mut driver_at: [Option<f64>; 2] = [None, None];
     let mut hit_frames: [Vec<u64>; 2] = [Vec::new(), Vec::new()];
     let mut roi_points = 0u64;
@@ -282,6 +377,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
             current_frame = frame;
             frames += 1;
             bin_hint = 0;
+            view = view_of(frame);
             let t0 = (frame as f64 * period - phase).max(0.0);
             let t1 = (frame + 1) as f64 * period - phase;
             for (j, arc) in car_arcs.iter_mut().enumerate() {
@@ -293,7 +389,9 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
                     let (x, y) = (lane_x[j], front0[j] + dir[j] * v * t0);
                     let az = y.atan2(x).to_degrees();
                     let dist = x.hypot(y);
-                    if setup.regions.rof.contains(az) && dist <= setup.driver_range_m {
+                    if view.driver.is_some_and(|r| r.rof.contains(az))
+                        && dist <= setup.driver_range_m
+                    {
                         let (c, s) = (x / dist, y / dist);
                         let all = [
                             Arc {
@@ -314,16 +412,16 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
                 }
             }
         }
-        let (az, bin) = tl.azimuth_at_from(tau, bin_hint);
+        let (az, bin) = view.timeline.azimuth_at_from(tau, bin_hint);
         bin_hint = bin;
-        let in_roi = setup.regions.roi.contains(az);
+        let in_roi = view.regions.roi.contains(az);
         roi_pulses += u64::from(in_roi);
         let rad = az.to_radians();
         let (s, c) = rad.sin_cos();
         let Some((range, cos_i, refl, car)) = cast(c, s, az, t, &car_arcs) else {
             continue;
         };
-        let power_ratio = setup.profile.bins[bin].power_w / p_mean;
+        let power_ratio = view.profile.bins[bin].power_w / view.profile.average_power_w;
         let p_d = setup
             .model
             .detection_probability(power_ratio, refl, cos_i, range);
@@ -332,7 +430,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
         if !returned {
             continue;
         }
-        if setup.rof_keep < 1.0 && setup.regions.rof.contains(az) {
+        if setup.rof_keep < 1.0 && view.regions.rof.contains(az) {
             keep_acc += setup.rof_keep;
             if keep_acc < 1.0 {
                 continue;
@@ -342,7 +440,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
         roi_points += u64::from(in_roi);
         argus_roi_points += u64::from(super::carla::argus::in_density_region(
             az,
-            setup.gaze_deg,
+            view.gaze_deg,
             setup.ego_yaw_deg,
         ));
         if let Some(j) = car {
@@ -359,6 +457,7 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
                     .count();
                 if recent as u32 >= setup.detection.k {
                     detected_at[j] = Some(t);
+                    detected_frame[j] = Some(frame);
                 }
             }
         }
@@ -366,22 +465,37 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
 
     let tta = |j: usize, t: Option<f64>| t.map(|t| t_conflict[j] - t).filter(|x| *x >= 0.0);
     let tta_s = [tta(0, detected_at[0]), tta(1, detected_at[1])];
+    let (false_alarms, early_false_tta_s) = false_alarms(
+        draw.noise_seed,
+        sc.false_alarms_per_frame,
+        frames,
+        period,
+        phase,
+        n_pulses as f64 / pulse_rate,
+        t_conflict[1],
+        tta_s[1],
+    );
     let driver_tta = [tta(0, driver_at[0]), tta(1, driver_at[1])];
     let hybrid = |j: usize| match (tta_s[j], driver_tta[j]) {
         (Some(a), Some(b)) => Some(a.max(b)),
         (a, b) => a.or(b),
     };
-    TrialOutcome {
+    let outcome = TrialOutcome {
         tta_s,
         hybrid_tta_s: [hybrid(0), hybrid(1)],
         roi_points,
         roi_pulses,
-        roi_width_deg: setup.regions.roi.measure_deg(),
+        roi_width_deg: view.regions.roi.measure_deg(),
         duration_s: n_pulses as f64 / pulse_rate,
         frames,
         argus_roi_points,
         channels_simulated: 1,
-    }
+        fail_safe_frames: 0,
+        detected_in_fail_safe: [None, None],
+        false_alarms,
+        early_false_tta_s,
+    };
+    (outcome, detected_frame)
 }
 
 /// Margin of [`BinFacts`], degrees: far above the rounding of a bin's
@@ -762,6 +876,16 @@ pub fn run_group(
         .iter()
         .map(|st| {
             let tta_s = [tta(0, st.detected_at[0]), tta(1, st.detected_at[1])];
+            let (false_alarms, early_false_tta_s) = false_alarms(
+                draw.noise_seed,
+                sc.false_alarms_per_frame,
+                frames,
+                period,
+                phase,
+                n_pulses as f64 / pulse_rate,
+                t_conflict[1],
+                tta_s[1],
+            );
             let driver_tta = [tta(0, st.driver_at[0]), tta(1, st.driver_at[1])];
             let hybrid = |j: usize| match (tta_s[j], driver_tta[j]) {
                 (Some(a), Some(b)) => Some(a.max(b)),
@@ -777,6 +901,10 @@ pub fn run_group(
                 frames,
                 argus_roi_points: st.argus_roi_points,
                 channels_simulated: 1,
+                fail_safe_frames: 0,
+                detected_in_fail_safe: [None, None],
+                false_alarms,
+                early_false_tta_s,
             }
         })
         .collect()

@@ -1009,6 +1009,10 @@ fn run<const W: usize>(
                 frames,
                 argus_roi_points: st.argus_roi_points,
                 channels_simulated: channels as u32,
+                fail_safe_frames: 0,
+                detected_in_fail_safe: [None, None],
+                false_alarms: 0,
+                early_false_tta_s: None,
             }
         })
         .collect()
