@@ -643,8 +643,9 @@ fn optimize(py: Python<'_>, config_text: &str, gaze_deg: f64, json: bool) -> PyR
         let (problem, named) = config
             .and_then(|c| Ok((c.problem()?, c.preset()?)))
             .map_err(|e| opt_error(py, e))?;
-        // Ctrl-C returns at once (the solve finishes in the background).
-        runtime::interruptible(py, move |_| {
+        // Ctrl-C returns at once (the solve finishes in the background); a
+        // pool of its own should the solver's path ever use rayon.
+        runtime::interruptible(py, true, move |_| {
             gaze_lidar::optimizer::optimize(&problem, gaze_deg).map(|c| {
                 gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels)
             })
@@ -818,9 +819,9 @@ fn check(
         let profile = CoreProfile::from_json(profile_json, "profile_json")
             .map_err(|e| value_error(e.to_string()))?;
         let sensor = preset.map(preset_of).transpose()?;
-        // A many-channel head's eye safety takes seconds: Ctrl-C returns at
-        // once (the checker finishes in the background, its verdict dropped).
-        runtime::interruptible(py, move |_| {
+        // A many-bin, many-channel check: Ctrl-C returns at once (the
+        // checker finishes in the background, its verdict dropped).
+        runtime::interruptible(py, false, move |_| {
             let opts = match &sensor {
                 Some(s) => CheckOptions::for_sensor(&s.lidar),
                 None => CheckOptions::declared(),
@@ -1616,15 +1617,16 @@ fn simulate<'py>(
             ));
         }
         // On a pool of its own (fork-safe), Ctrl-C stopping it within a trial.
-        let result =
-            runtime::interruptible(py, move |cancel| sim::run(&config, &|| cancel.check()))?
-                .map_err(|e| {
-                    if e.is_input_error() {
-                        value_error(e.to_string())
-                    } else {
-                        Infeasible::new_err(e.to_string())
-                    }
-                })?;
+        let result = runtime::interruptible(py, true, move |cancel| {
+            sim::run(&config, &|| cancel.check())
+        })?
+        .map_err(|e| {
+            if e.is_input_error() {
+                value_error(e.to_string())
+            } else {
+                Infeasible::new_err(e.to_string())
+            }
+        })?;
         let json = sim::table::render_json(&result).map_err(|e| value_error(e.to_string()))?;
         // The CLI's --trials-csv records, column for column.
         let trials = sim::table::render_trials_csv(&result)

@@ -53,12 +53,14 @@ fn wait<T: Send>(py: Python<'_>, rx: Receiver<T>) -> (Receiver<T>, Result<T, Rec
     })
 }
 
-/// Runs `f` on a fresh rayon pool on a worker thread and waits for it,
-/// checking for signals every [`POLL`]. On a signal (KeyboardInterrupt),
-/// sets the [`Cancel`] flag and raises the signal's exception at once. A
-/// panic in `f` is an [`InternalError`].
+/// Runs `f` on a worker thread (with `parallel`, on a fresh rayon pool:
+/// work that uses rayon) and waits for it, checking for signals every
+/// [`POLL`]. On a signal (KeyboardInterrupt), sets the [`Cancel`] flag and
+/// raises the signal's exception at once. A panic in `f` is an
+/// [`InternalError`].
 pub fn interruptible<T: Send + 'static>(
     py: Python<'_>,
+    parallel: bool,
     f: impl FnOnce(&Cancel) -> T + Send + 'static,
 ) -> PyResult<T> {
     let cancel = Arc::new(Cancel::default());
@@ -68,6 +70,9 @@ pub fn interruptible<T: Send + 'static>(
         .name("gaze-lidar-call".into())
         .spawn(move || {
             let out = catch_unwind(AssertUnwindSafe(|| {
+                if !parallel {
+                    return Ok(f(&flag));
+                }
                 rayon::ThreadPoolBuilder::new()
                     .thread_name(|i| format!("gaze-lidar-{i}"))
                     .build()
