@@ -28,9 +28,10 @@ limit), :class:`Rejected` for a profile that fails the checker (its
 
 Processes and signals: long calls (:func:`simulate`, :func:`check`,
 :func:`optimize`) check for signals every 50 ms, so Ctrl-C (a
-``KeyboardInterrupt``) stops them at once (``simulate`` stops its trials;
-``check`` and ``optimize`` return at once and let the checker or solver
-finish in the background). Parallel work runs on a thread pool made for the
+``KeyboardInterrupt``) stops them at once (``simulate`` starts no further
+trial, its threads left parked, idle, until the process exits; ``check``
+and ``optimize`` return at once and let the checker or solver finish in the
+background). Parallel work runs on a thread pool made for the
 call, never a global one, so a process ``fork``ed after a call (the default
 start method of ``multiprocessing`` on Linux up to Python 3.13) can call
 anything again. :class:`Profile`, :class:`Frame`, :class:`Verdict` and the

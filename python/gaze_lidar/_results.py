@@ -7,6 +7,7 @@ when it is missing.
 from __future__ import annotations
 
 import csv
+import importlib
 import io
 from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any, List, Dict, Literal
@@ -19,14 +20,15 @@ DataFrame = Any
 
 
 def _pandas(what: str) -> Any:
+    # import_module, not `import pandas`: type-checking this package must
+    # not need pandas' stubs.
     try:
-        import pandas as pd
+        return importlib.import_module("pandas")
     except ImportError:
         raise ImportError(
             f"{what} needs pandas, which is not installed: `pip install pandas` "
             "(to_dict() gives the same data without it)"
         ) from None
-    return pd
 
 
 def _value(text: str) -> int | float | str | None:
