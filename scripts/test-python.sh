@@ -5,12 +5,13 @@
 # the tests and examples, and print the apply_profile benchmark. The wheel's
 # Rust build shares the workspace's target/ (python/.cargo/config.toml; the
 # python crate uses the root's release profile), so HiGHS is not rebuilt
-# and nothing lands in python/target/. Also keeps the binding crate fmt-
-# and clippy-clean (it is its own workspace, outside `cargo … --workspace`).
+# and nothing lands in python/target/; a CARGO_TARGET_DIR already set is
+# used instead. Also keeps the binding crate fmt- and clippy-clean (it is
+# its own workspace, outside `cargo … --workspace`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-export CARGO_TARGET_DIR="$PWD/target"
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}"
 PY=${PYTHON:-python3}
 
 echo "== python: fmt + clippy (binding crate)"
@@ -23,6 +24,10 @@ echo "== python: pip install ./python into a fresh venv ($venv)"
 "$PY" -m venv "$venv"
 "$venv/bin/pip" install -q ./python   # exactly what a user runs
 "$venv/bin/python" -m pip install -q pytest hypothesis mypy
+# pandas (optional for users): the to_pandas() tests and push_many's
+# nullable-type cases (pandas "boolean", "Float64") run with it.
+"$venv/bin/python" -m pip install -q pandas
+# An independent MCAP writer and reader for the replay test (issue 33).
 # An independent MCAP writer and reader for the replay test.
 "$venv/bin/python" -m pip install -q mcap mcap-ros2-support
 

@@ -25,6 +25,44 @@ field), :class:`Infeasible` for a request that cannot be met (it names the
 limit), :class:`Rejected` for a profile that fails the checker (its
 ``violations`` attribute lists every violated limit), :class:`InternalError`
 (a ``RuntimeError``) for a bug caught at the Rust edge.
+
+Processes and signals: long calls (:func:`simulate`, :func:`check`,
+:func:`optimize`) check for signals every 50 ms, so Ctrl-C (a
+``KeyboardInterrupt``) stops them at once (``simulate`` starts no further
+trial, its threads left parked, idle, until the process exits; ``check``
+and ``optimize`` return at once and let the checker or solver finish in the
+background). Parallel work runs on a thread pool made for the
+call, never a global one, so a process ``fork``ed after a call (the default
+start method of ``multiprocessing`` on Linux up to Python 3.13) can call
+anything again. :class:`Profile`, :class:`Frame`, :class:`Verdict` and the
+results of :func:`simulate` pickle (and compare equal after the round trip).
+
+Terms (as the code uses them):
+
+- *rated range*: the distance at which the sensor's uniform (baseline)
+  profile, at its average power P̄, detects a target of the reference
+  reflectivity at normal incidence with probability ½, in clear air.
+- *reference reflectivity*: the diffuse (Lambertian) reflectivity the
+  sensor's range is rated on, the preset's (10 % for every preset).
+- *clear air*: a meteorological optical range (MOR) of 20 km, i.e. an
+  extinction of 2.996 / 20 km (``gaze_lidar::model::range::CLEAR_AIR_MOR_M``);
+  the simulator's fog 0 % level.
+- *fog* (``fog_pct`` 0, 25, 50: the paper's labels): MORs of 20 km (clear
+  air), 200 m and 100 m (the ARGUS code's fog_density 0, 50 and 100);
+  extinction α = 2.996 / MOR.
+- *range* of a bin: the distance R at which a pulse of the bin's power P
+  still detects the reference reflectivity in clear air: the range
+  equation ``(P/P̄)·(R₀/R)²·e^(−2α₀(R−R₀)) = 1`` (R₀ the rated range, α₀ =
+  2.996 / 20 km), close to ``R₀·√(P/P̄)``.
+- *points per degree*: per channel and revolution, the pulse rate times the
+  bin's dwell time over its width.
+- *region of focus* (RoF, ``in_rof``): the azimuths the driver covers
+  around the gaze (the preset's driver model); *region of interest* (RoI):
+  the rest of the circle, where an adaptive profile puts its range or
+  density.
+- *TTA* (time to arrival): seconds left before the crossing car reaches
+  the ego lane when it is first detected; larger is earlier.
+- *fail-safe*: the uniform baseline profile, run whenever gaze is stale.
 """
 
 from __future__ import annotations
@@ -52,6 +90,10 @@ from ._native import (
     profile,
 )
 from ._points import as_points, rotate_yaw
+from ._results import SimulationResult, frames_to_pandas, parse_trials_csv
+
+#: The formats :func:`read_gaze` reads (``gaze-lidar stream --format``).
+GAZE_FORMATS: list[str] = list(_native.GAZE_FORMATS)
 
 #: What :func:`check` accepts: a Profile, a profile@1 dict, a path, or JSON text.
 ProfileSource = Union[Profile, Mapping[str, Any], os.PathLike[str], str]
@@ -211,7 +253,7 @@ def simulate(
     trials: int = 10,
     seed: int | None = 1,
     **options: Any,
-) -> list[dict[str, Any]]:
+) -> SimulationResult:
     """The paper's T-intersection experiment (``gaze-lidar simulate``): one
     row per model × variant × fog level, as a dict (model, variant, fog_pct,
     trials, detected, tta_median_s, tta_q1_s, tta_q3_s,
@@ -220,15 +262,43 @@ def simulate(
     left_hybrid_tta_median_s). Same seed, same rows; seed=None draws a
     fresh seed from the OS.
 
+    The result is a list of those rows (a :class:`SimulationResult`) whose
+    ``trials`` holds one record per trial and cell, as ``--trials-csv``
+    writes them; ``to_dict()`` and ``to_pandas()`` (``"rows"`` or
+    ``"trials"``) give both.
+
     options: variants (list of "baseline", "range", "resolution", "joint",
     "optimized"), fog_pct (list of 0, 25, 50), detect ("k/n"), bins,
     preset, scenario_toml (TOML text), optimizer_toml (TOML text, with the
-    "optimized" variant). Releases the GIL while it runs.
+    "optimized" variant). Releases the GIL while it runs, runs on a thread
+    pool of its own (fork-safe) and stops at Ctrl-C.
     """
-    return _native.simulate(model, trials, _fresh_seed(seed), **options)
+    out = _native.simulate(model, trials, _fresh_seed(seed), **options)
+    return SimulationResult(out["rows"], parse_trials_csv(out["trials_csv"]))
+
+
+def read_gaze(
+    path: os.PathLike[str] | str,
+    format: Literal["jsonl", "csv", "varjo", "neon"] = "jsonl",
+) -> dict[str, npt.NDArray[Any]]:
+    """A recorded gaze file, read by the same parsers as ``gaze-lidar stream
+    --input PATH --format FORMAT`` (the Rust ones; no second parser here):
+    ``jsonl`` and ``csv`` (``t_s``, ``gaze_deg``, optional ``valid``), Varjo
+    Base gaze CSV (``varjo``), Pupil Neon ``gaze.csv`` (``neon``); see
+    :data:`GAZE_FORMATS`.
+
+    Returns the samples as numpy columns: ``t_s`` (float64, s), ``gaze_deg``
+    (float64, degrees, ISO 8855: 90 looks left) and ``valid`` (bool: the
+    tracker had the eyes and the azimuth is usable) — the keyword arguments
+    of :meth:`GazeStream.push_many` (``stream.push_many(**track)``), and
+    ``pandas.DataFrame(track)`` tabulates them. A malformed line raises
+    ValueError naming the file, the line and the field, as the CLI does.
+    """
+    return _native.read_gaze(os.fspath(path), format)
 
 
 __all__ = [
+    "GAZE_FORMATS",
     "PRESETS",
     "ConfigSource",
     "Frame",
@@ -238,12 +308,20 @@ __all__ = [
     "Profile",
     "ProfileSource",
     "Rejected",
+    "SimulationResult",
     "Verdict",
     "__version__",
     "apply_profile",
     "azimuth_deg",
+    "carla",
     "check",
+    "frames_to_pandas",
     "optimize",
     "profile",
+    "read_gaze",
     "simulate",
 ]
+
+# Last: gaze_lidar.carla imports from this module.
+from . import carla  # noqa: E402
+

@@ -16,6 +16,7 @@ import numpy.typing as npt
 
 __all__ = [
     "Frame",
+    "GAZE_FORMATS",
     "GazeStream",
     "Infeasible",
     "InternalError",
@@ -29,6 +30,7 @@ __all__ = [
     "check",
     "optimize",
     "profile",
+    "read_gaze",
     "simulate",
 ]
 __version__: str
@@ -36,6 +38,9 @@ __version__: str
 
 PRESETS: list[str]
 """Preset names accepted by `preset=` ("paper", "vls128", "vlp16", "os1-128")."""
+
+GAZE_FORMATS: list[str]
+"""The formats read_gaze reads, as `gaze-lidar stream --format` names them."""
 
 class Infeasible(Exception):
     """The request is well-formed but cannot be met; the message names the limit."""
@@ -60,13 +65,15 @@ class Profile:
     power slew, Class 1 eye safety). Arrays are read-only float64, one
     entry per bin, bins in azimuth order tiling [0, 360). Immutable:
     compares and hashes by value (its profile@1 JSON), pickles and
-    deep-copies through that JSON. Profile(text) is Profile.from_json(text).
+    deep-copies through that JSON and its preset. Profile(text) is
+    Profile.from_json(text); Profile(text, preset) also names the preset
+    whose sensor and driver model give its `figures`.
     """
 
-    def __new__(cls, text: str) -> Profile: ...
+    def __new__(cls, text: str, preset: str | None = None) -> Profile: ...
     def __eq__(self, value: object, /) -> bool: ...
     def __hash__(self) -> int: ...
-    def __reduce__(self) -> tuple[type[Profile], tuple[str]]: ...
+    def __reduce__(self) -> tuple[type[Profile], tuple[str, str | None]]: ...
     def __copy__(self) -> Self: ...
     def __deepcopy__(self, _memo: Any) -> Profile: ...
     def power_w_at(self, azimuth_deg: npt.ArrayLike) -> npt.NDArray[np.float64]:
@@ -129,15 +136,28 @@ class Profile:
         eye_safety_tightening when the power step had to tighten its
         eye-safety cuts; None for the closed forms."""
     @property
+    def preset(self) -> str | None:
+        """The preset it was planned on (closed forms, closed-form stream
+        frames); None when unknown (optimizer output, JSON read alone)."""
+    @property
     def figures(self) -> dict[str, Any] | None:
         """Range and point density in units people use (profile@1
         `optimality.figures`): {"profile": {"rof", "roi"}, "closed_form":
         {"rof", "roi"} or absent, "closed_form_rejected": reason or absent};
-        each region {"width_deg", "range_m", "points_per_deg"}, each figure
-        {"mean" (angle-weighted over the region's bins), "min", "max"}. Range
-        on the reference reflectivity in clear air from the range equation at
-        the sensor's rated range; points per degree per channel and
-        revolution. None where the profile has none (the closed forms)."""
+        each region {"width_deg", "range_m", "points_per_deg"} (None when no
+        bin lies in it), each figure {"mean" (angle-weighted over the
+        region's bins), "min", "max"}. Range on the reference reflectivity in
+        clear air (MOR 20 km) from the range equation at the sensor's rated
+        range; points per degree per channel and revolution. A closed form
+        (a profile that knows its `preset`) has {"profile"} only; None for a
+        profile with neither (JSON read without a preset)."""
+    def to_dict(self) -> dict[str, npt.NDArray[Any]]:
+        """The bins as numpy columns: start_deg, width_deg, power_w,
+        spin_start_rad_s, spin_end_rad_s, dwell_s, in_rof, and, when the
+        preset is known, range_m and points_per_deg per bin."""
+    def to_pandas(self) -> Any:
+        """to_dict() as a pandas.DataFrame, one row per bin (ImportError
+        naming pandas when it is not installed)."""
     def to_json(self) -> str:
         """The profile as `gaze-lidar/profile@1` JSON (what `gaze-lidar check` reads)."""
     @staticmethod
@@ -205,21 +225,56 @@ class Verdict:
     """Channels of the head eye safety was evaluated for; None for one channel (no head given) or when not evaluated."""
     power_scale_to_certify: float | None
     """The largest uniform power scale (every bin power times it) at which eye safety certifies; None when not evaluated."""
+    def __new__(
+        cls,
+        certified: bool,
+        violations: list[str],
+        limits: list[str],
+        worst_ratio: float | None = None,
+        binding_rule: str | None = None,
+        worst_azimuth_deg: float | None = None,
+        head_channels: int | None = None,
+        power_scale_to_certify: float | None = None,
+    ) -> Verdict:
+        """A verdict from its fields (what pickle calls; check() makes them)."""
+    def __reduce__(
+        self,
+    ) -> tuple[
+        type[Verdict],
+        tuple[bool, list[str], list[str], float | None, str | None, float | None, int | None, float | None],
+    ]: ...
+    def __eq__(self, other: object, /) -> bool: ...
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a dict."""
+    def to_pandas(self) -> Any:
+        """A pandas.DataFrame, one row per violation (limit, violation and
+        the scalars; one row for a certified verdict). Needs pandas."""
     def __bool__(self) -> bool: ...
 
 def check(profile_json: str, preset: str | None = None, *, no_eye_safety: bool = False) -> Verdict:
     """Verifies profile@1 JSON against its declared limits; with preset, also
     against that sensor (a declared limit looser than the sensor's is a
     violation). A file without eye-safety parameters is rejected unless
-    no_eye_safety=True. Raises ValueError when the JSON does not parse."""
+    no_eye_safety=True. Raises ValueError when the JSON does not parse.
+    Ctrl-C returns at once (KeyboardInterrupt)."""
 
 @final
 class Frame:
-    """One LiDAR frame of a GazeStream."""
+    """One LiDAR frame of a GazeStream. Pickles; equal when t_s, state and
+    the profile are."""
 
     t_s: float
     """Frame start on the gaze clock, s."""
     state: Literal["adaptive", "fail_safe"]
+    def __new__(cls, t_s: float, state: Literal["adaptive", "fail_safe"], profile: Profile) -> Frame:
+        """A frame from its fields (what pickle calls; streams make them)."""
+    def __reduce__(self) -> tuple[type[Frame], tuple[float, str, Profile]]: ...
+    def __eq__(self, other: object, /) -> bool: ...
+    def to_dict(self) -> dict[str, Any]:
+        """t_s, state, gaze_deg and the profile's mode."""
+    def to_pandas(self) -> Any:
+        """The frame's profile as a pandas.DataFrame, one row per bin
+        (Profile.to_pandas), with t_s, state and gaze_deg on every row."""
     @property
     def profile(self) -> Profile:
         """The certified profile the LiDAR runs during this frame."""
@@ -266,7 +321,13 @@ class GazeStream:
         valid: npt.ArrayLike | None = None,
     ) -> list[Frame]:
         """Feeds a recorded gaze track (1-D arrays of one length) in order, as
-        many push calls would; returns all the frames they emit."""
+        many push calls would; returns all the frames they emit.
+
+        t_s and gaze_deg: real numbers (numpy dtype kinds f, i, u; a
+        NaN gaze is an invalid sample, a non-finite time an error); valid:
+        booleans (dtype bool) or None for all valid. Anything else (dates,
+        timedeltas, strings, objects such as a pandas "boolean" column with
+        NA, floats for valid) raises ValueError naming the argument."""
     def tick(self, now_s: float) -> list[Frame]:
         """Runs the frame clock to now_s without a sample: the frames due by
         then, fail-safe once the last fixation is older than the timeout.
@@ -322,18 +383,23 @@ def azimuth_deg(
     """Azimuth of each point in the crate's convention, degrees in [0, 360),
     exactly as apply_profile maps the frame (atan2(-y, x) for CARLA)."""
 
+def read_gaze(path: str, format: str = "jsonl") -> dict[str, npt.NDArray[Any]]:
+    """A recorded gaze file by the CLI's parsers: {"t_s", "gaze_deg", "valid"} as numpy columns."""
+
 def simulate(
     model: Literal["argus", "physical"] | Sequence[str] = "argus",
     trials: int = 10,
     seed: int = 1,
     **options: Any,
-) -> list[dict[str, Any]]:
-    """The paper's T-intersection experiment (`gaze-lidar simulate`): one
-    row per model × variant × fog level, as a dict (model, variant, fog_pct,
-    trials, detected, tta_median_s, tta_q1_s, tta_q3_s,
+) -> dict[str, Any]:
+    """The paper's T-intersection experiment (`gaze-lidar simulate`):
+    {"rows": one dict per model × variant × fog level (model, variant,
+    fog_pct, trials, detected, tta_median_s, tta_q1_s, tta_q3_s,
     density_median_pts_per_deg, density_median_pts_per_deg_s,
     left_tta_median_s, left_detected, hybrid_tta_median_s,
-    left_hybrid_tta_median_s). Same seed, same rows.
+    left_hybrid_tta_median_s), "trials_csv": the CLI's --trials-csv text}.
+    Same seed, same rows. Runs on a thread pool of its own (fork-safe) and
+    stops at Ctrl-C (KeyboardInterrupt).
 
     options: variants (list of "baseline", "range", "resolution", "joint",
     "optimized"), fog_pct (list of 0, 25, 50), detect ("k/n"), bins,

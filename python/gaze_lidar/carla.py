@@ -191,11 +191,30 @@ def _attribute(blueprint: Any, name: str) -> float | None:
     return float(as_float()) if as_float is not None else float(str(attr))
 
 
+#: CARLA's default ``range`` of ``sensor.lidar.ray_cast``, m.
+CARLA_DEFAULT_RANGE_M = 10.0
+
+
+def profile_range_m(profile: Profile, rated_range_m: float | None = None) -> float | None:
+    """The farthest a sensor running `profile` sees, m: the largest per-bin
+    range of ``profile.figures`` (range on the reference reflectivity in
+    clear air, MOR 20 km) and `rated_range_m` (the uniform baseline's), the
+    larger of those known; None when neither is."""
+    known: list[float] = [] if rated_range_m is None else [float(rated_range_m)]
+    figures = profile.figures
+    if figures is not None:
+        for region in figures["profile"].values():
+            if region is not None:
+                known.append(float(region["range_m"]["max"]))
+    return max(known) if known else None
+
+
 def check_blueprint(
     blueprint: Any,
     profile: Profile,
     *,
     fixed_delta_seconds: float | None = None,
+    rated_range_m: float | None = None,
     warn: bool = True,
 ) -> list[str]:
     """Checks a CARLA LiDAR blueprint against `profile`; returns one line per
@@ -210,7 +229,11 @@ def check_blueprint(
     ``dropoff_zero_intensity``) already thins the cloud at random, on top
     of the profile; with `fixed_delta_seconds` (synchronous mode), a tick
     that is not one whole turn (each measurement then holds a partial or a
-    repeated sweep).
+    repeated sweep); ``range`` (CARLA's default: 10 m) shorter than the
+    farthest the profile sees (:func:`profile_range_m`: its figures' largest
+    per-bin range, at least the sensor's rated range; `rated_range_m` gives
+    the rated range for a profile whose preset is unknown), so CARLA drops
+    the far points the profile's range control is about.
     """
     problems: list[str] = []
     hz = _attribute(blueprint, "rotation_frequency")
@@ -227,6 +250,16 @@ def check_blueprint(
                 f"{name}: {rate:g} > 0: CARLA already drops points at random, on top of the "
                 f"profile's thinning; set it to 0"
             )
+    sensor_range = _attribute(blueprint, "range")
+    needed = profile_range_m(profile, rated_range_m)
+    if sensor_range is not None and needed is not None and sensor_range < needed:
+        default = " (CARLA's default)" if sensor_range == CARLA_DEFAULT_RANGE_M else ""
+        problems.append(
+            f"range: {sensor_range:g} m{default} is shorter than the {needed:.4g} m the profile "
+            f"reaches (rated range on the reference reflectivity in clear air, more where "
+            f"range control raises the power): CARLA drops every point beyond it; set range "
+            f"to at least {math.ceil(needed):d}"
+        )
     if fixed_delta_seconds is not None and hz is not None and hz > 0:
         turns = fixed_delta_seconds * hz
         if not math.isclose(turns, 1.0, rel_tol=1e-6):
@@ -242,6 +275,7 @@ def check_blueprint(
 
 
 __all__ = [
+    "CARLA_DEFAULT_RANGE_M",
     "DROPOFF_ATTRIBUTES",
     "LIDAR_DTYPE",
     "SEMANTIC_LIDAR_DTYPE",
@@ -250,5 +284,6 @@ __all__ = [
     "apply_to_measurement",
     "check_blueprint",
     "points_from_measurement",
+    "profile_range_m",
     "sensor_yaw_deg",
 ]

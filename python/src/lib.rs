@@ -32,6 +32,10 @@ use gaze_lidar::profile::kinematics::{BinMotion, Timeline};
 use gaze_lidar::profile::{Profile as CoreProfile, Region};
 use gaze_lidar::sim::{self, KOfN, ModelKind, Scenario, SimConfig, Variant, FOG_LEVELS_PCT};
 
+mod gaze_io;
+mod records;
+mod runtime;
+
 create_exception!(
     gaze_lidar,
     Infeasible,
@@ -166,6 +170,9 @@ fn finite(field: &str, v: f64) -> PyResult<f64> {
 #[pyclass(frozen, module = "gaze_lidar", name = "Profile")]
 pub struct PyProfile {
     inner: CertifiedProfile,
+    /// The preset it was planned on (closed forms), whose sensor and driver
+    /// model give its figures; None when unknown (read from JSON alone).
+    basis: Option<String>,
 }
 
 impl PyProfile {
@@ -217,10 +224,16 @@ impl PyProfile {
             .map_err(|e| value_error(e.to_string()))
     }
 
-    fn parse(py: Python<'_>, text: &str) -> PyResult<Self> {
+    fn parse(py: Python<'_>, text: &str, basis: Option<&str>) -> PyResult<Self> {
+        if let Some(name) = basis {
+            preset_of(name)?;
+        }
         let p = CoreProfile::from_json(text, "<json>").map_err(|e| value_error(e.to_string()))?;
         certify_with(p, &CheckOptions::declared())
-            .map(|inner| Self { inner })
+            .map(|inner| Self {
+                inner,
+                basis: basis.map(str::to_owned),
+            })
             .map_err(|r| rejected(py, r.to_string(), &r.violations))
     }
 
@@ -345,18 +358,44 @@ impl PyProfile {
     /// ("rof") and outside it ("roi"), each {"mean", "min", "max"} over the
     /// region's bins (angle-weighted mean), and the closed form's for the
     /// same gaze ("closed_form", or "closed_form_rejected" saying why
-    /// there is none): profile@1 `optimality.figures`, as a dict; None
-    /// where the profile has none.
+    /// there is none): profile@1 `optimality.figures`, as a dict. A profile
+    /// without them that knows its preset (a closed form, a stream frame)
+    /// gets its own ("profile" only: it is the closed form), from the same
+    /// `planner::figures::region_figures`; None otherwise.
     #[getter]
     fn figures<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         guard(|| {
-            self.inner
-                .profile()
-                .optimality
-                .as_ref()
-                .and_then(|o| o.figures.as_ref())
-                .map(|f| to_py_json(py, f))
-                .transpose()
+            let p = self.inner.profile();
+            if let Some(f) = p.optimality.as_ref().and_then(|o| o.figures.as_ref()) {
+                return to_py_json(py, f).map(Some);
+            }
+            let Some(name) = &self.basis else {
+                return Ok(None);
+            };
+            let preset = preset_of(name)?;
+            let own = gaze_lidar::planner::figures::region_figures(p, &preset.lidar, &preset.focus);
+            let f = gaze_lidar::profile::UnitFigures {
+                profile: own,
+                closed_form: None,
+                closed_form_rejected: None,
+            };
+            to_py_json(py, &f).map(Some)
+        })
+    }
+    /// The bins as columns (start_deg, width_deg, power_w,
+    /// spin_start_rad_s, spin_end_rad_s, dwell_s, in_rof: numpy arrays)
+    /// plus range_m and points_per_deg per bin when the profile knows its
+    /// preset.
+    fn to_dict<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
+        guard(|| records::profile_columns(slf.py(), slf.get()))
+    }
+    /// `to_dict()` as a DataFrame, one row per bin. Needs pandas.
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            records::pandas(slf.py(), "Profile.to_pandas")?.call_method1(
+                "DataFrame",
+                (records::profile_columns(slf.py(), slf.get())?,),
+            )
         })
     }
     /// The profile as `gaze-lidar/profile@1` JSON.
@@ -374,11 +413,20 @@ impl PyProfile {
     /// and Rejected when a limit is violated.
     #[staticmethod]
     fn from_json(py: Python<'_>, text: &str) -> PyResult<Self> {
-        guard(|| Self::parse(py, text))
+        guard(|| Self::parse(py, text, None))
     }
+    /// `Profile(text, preset=None)`: `from_json`, and with `preset` the
+    /// preset whose sensor and driver model give its `figures`.
     #[new]
-    fn new(py: Python<'_>, text: &str) -> PyResult<Self> {
-        guard(|| Self::parse(py, text))
+    #[pyo3(signature = (text, preset=None))]
+    fn new(py: Python<'_>, text: &str, preset: Option<&str>) -> PyResult<Self> {
+        guard(|| Self::parse(py, text, preset))
+    }
+    /// The preset the profile was planned on (closed forms and stream
+    /// frames), None when unknown (a profile read from JSON alone).
+    #[getter]
+    fn preset(&self) -> Option<String> {
+        self.basis.clone()
     }
     /// Laser power at each azimuth (degrees, any shape; wrapped into
     /// [0, 360)), W: the power of the bin holding it, as the checker and the
@@ -416,18 +464,20 @@ impl PyProfile {
             Ok(h.finish())
         })
     }
-    /// Pickles through its profile@1 JSON (re-certified when loaded).
+    /// Pickles through its profile@1 JSON (re-certified when loaded) and
+    /// its preset.
+    #[allow(clippy::type_complexity)]
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, pyo3::types::PyType>, (String,))> {
-        guard(|| Ok((slf.get_type(), (slf.get().json()?,))))
+    ) -> PyResult<(Bound<'py, pyo3::types::PyType>, (String, Option<String>))> {
+        guard(|| Ok((slf.get_type(), (slf.get().json()?, slf.get().basis.clone()))))
     }
     fn __copy__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
         slf
     }
     /// A new Profile from this one's JSON (it is immutable, so equal to it).
     fn __deepcopy__(&self, py: Python<'_>, _memo: &Bound<'_, PyAny>) -> PyResult<Self> {
-        guard(|| Self::parse(py, &self.json()?))
+        guard(|| Self::parse(py, &self.json()?, self.basis.as_deref()))
     }
     /// Integer firmware tables: a dict of scalars and numpy integer arrays.
     #[pyo3(signature = (tick_hz=80_000_000, power_w_per_code=None))]
@@ -532,6 +582,7 @@ fn profile(
     accounting: Option<&str>,
 ) -> PyResult<PyProfile> {
     guard(|| {
+        let preset_name = preset;
         let mut preset = preset_of(preset)?;
         let mode = mode_of(mode)?;
         if let Some(acc) = accounting {
@@ -561,7 +612,10 @@ fn profile(
         let bins = usize::try_from(bins)
             .map_err(|_| value_error(format!("bins: {bins} must lie in [4, 36000]")))?;
         closed_form(&preset, mode, gaze, bins)
-            .map(|inner| PyProfile { inner })
+            .map(|inner| PyProfile {
+                inner,
+                basis: Some(preset_name.to_owned()),
+            })
             .map_err(|e| plan_error(py, e))
     })
 }
@@ -589,18 +643,21 @@ fn optimize(py: Python<'_>, config_text: &str, gaze_deg: f64, json: bool) -> PyR
         let (problem, named) = config
             .and_then(|c| Ok((c.problem()?, c.preset()?)))
             .map_err(|e| opt_error(py, e))?;
-        detached(py, || {
+        // Ctrl-C returns at once (the solve finishes in the background); a
+        // pool of its own should the solver's path ever use rayon.
+        runtime::interruptible(py, true, move |_| {
             gaze_lidar::optimizer::optimize(&problem, gaze_deg).map(|c| {
                 gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels)
             })
         })?
-        .map(|inner| PyProfile { inner })
+        .map(|inner| PyProfile { inner, basis: None })
         .map_err(|e| opt_error(py, e))
     })
 }
 
 /// The checker's verdict on a profile@1 file.
 #[pyclass(frozen, module = "gaze_lidar", name = "Verdict")]
+#[derive(Clone, PartialEq)]
 pub struct Verdict {
     /// Whether every limit holds.
     #[pyo3(get)]
@@ -630,8 +687,113 @@ pub struct Verdict {
     power_scale_to_certify: Option<f64>,
 }
 
+type VerdictArgs = (
+    bool,
+    Vec<String>,
+    Vec<String>,
+    Option<f64>,
+    Option<String>,
+    Option<f64>,
+    Option<u32>,
+    Option<f64>,
+);
+
 #[pymethods]
 impl Verdict {
+    /// A verdict from its fields (what pickle calls; `check` makes them).
+    #[new]
+    #[pyo3(signature = (certified, violations, limits, worst_ratio=None, binding_rule=None, worst_azimuth_deg=None, head_channels=None, power_scale_to_certify=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        certified: bool,
+        violations: Vec<String>,
+        limits: Vec<String>,
+        worst_ratio: Option<f64>,
+        binding_rule: Option<String>,
+        worst_azimuth_deg: Option<f64>,
+        head_channels: Option<u32>,
+        power_scale_to_certify: Option<f64>,
+    ) -> PyResult<Self> {
+        if violations.len() != limits.len() {
+            return Err(value_error(format!(
+                "limits: one per violation, got {} limits for {} violations",
+                limits.len(),
+                violations.len()
+            )));
+        }
+        if certified && !violations.is_empty() {
+            return Err(value_error(
+                "violations: a certified verdict has none".to_owned(),
+            ));
+        }
+        Ok(Self {
+            certified,
+            violations,
+            limits,
+            worst_ratio,
+            binding_rule,
+            worst_azimuth_deg,
+            head_channels,
+            power_scale_to_certify,
+        })
+    }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, pyo3::types::PyType>, VerdictArgs) {
+        let v = slf.get().clone();
+        (
+            slf.get_type(),
+            (
+                v.certified,
+                v.violations,
+                v.limits,
+                v.worst_ratio,
+                v.binding_rule,
+                v.worst_azimuth_deg,
+                v.head_channels,
+                v.power_scale_to_certify,
+            ),
+        )
+    }
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<Self>().is_ok_and(|o| *o.get() == *self)
+    }
+    /// The fields as a dict (what `to_pandas` tabulates).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("certified", self.certified)?;
+        d.set_item("violations", self.violations.clone())?;
+        d.set_item("limits", self.limits.clone())?;
+        d.set_item("worst_ratio", self.worst_ratio)?;
+        d.set_item("binding_rule", self.binding_rule.clone())?;
+        d.set_item("worst_azimuth_deg", self.worst_azimuth_deg)?;
+        d.set_item("head_channels", self.head_channels)?;
+        d.set_item("power_scale_to_certify", self.power_scale_to_certify)?;
+        Ok(d)
+    }
+    /// One row per violation (limit, violation) with the verdict's scalars
+    /// on every row (a certified verdict: one row, limit and violation
+    /// None). Needs pandas.
+    fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pd = records::pandas(py, "Verdict.to_pandas")?;
+        let rows = PyList::empty(py);
+        let pairs: Vec<(Option<&str>, Option<&str>)> = if self.violations.is_empty() {
+            vec![(None, None)]
+        } else {
+            self.limits
+                .iter()
+                .zip(&self.violations)
+                .map(|(l, v)| (Some(l.as_str()), Some(v.as_str())))
+                .collect()
+        };
+        for (limit, violation) in pairs {
+            let d = self.to_dict(py)?;
+            d.del_item("violations")?;
+            d.del_item("limits")?;
+            d.set_item("limit", limit)?;
+            d.set_item("violation", violation)?;
+            rows.append(d)?;
+        }
+        pd.call_method1("DataFrame", (rows,))
+    }
     fn __bool__(&self) -> bool {
         self.certified
     }
@@ -647,54 +809,64 @@ impl Verdict {
 /// Verifies profile@1 JSON against its declared limits (and a preset's sensor).
 #[pyfunction]
 #[pyo3(signature = (profile_json, preset=None, *, no_eye_safety=false))]
-fn check(profile_json: &str, preset: Option<&str>, no_eye_safety: bool) -> PyResult<Verdict> {
+fn check(
+    py: Python<'_>,
+    profile_json: &str,
+    preset: Option<&str>,
+    no_eye_safety: bool,
+) -> PyResult<Verdict> {
     guard(|| {
         let profile = CoreProfile::from_json(profile_json, "profile_json")
             .map_err(|e| value_error(e.to_string()))?;
         let sensor = preset.map(preset_of).transpose()?;
-        let opts = match &sensor {
-            Some(s) => CheckOptions::for_sensor(&s.lidar),
-            None => CheckOptions::declared(),
-        }
-        .allow_missing_eye_safety(no_eye_safety);
-        Ok(match certify_with(profile.clone(), &opts) {
-            Ok(c) => {
-                // The evaluation the checker certified with (not a second run).
-                let eye = c.eye_safety();
-                Verdict {
-                    head_channels: eye.and_then(|r| r.head.as_ref()).map(|h| h.channels),
-                    power_scale_to_certify: eye.map(|r| power_scale_to_certify(r.worst_ratio)),
-                    certified: true,
-                    violations: Vec::new(),
-                    limits: Vec::new(),
-                    worst_ratio: eye.map(|r| r.worst_ratio),
-                    binding_rule: eye.map(|r| r.binding_rule.to_string()),
-                    worst_azimuth_deg: eye.map(|r| r.worst_azimuth_deg),
-                }
+        // A many-bin, many-channel check: Ctrl-C returns at once (the
+        // checker finishes in the background, its verdict dropped).
+        runtime::interruptible(py, false, move |_| {
+            let opts = match &sensor {
+                Some(s) => CheckOptions::for_sensor(&s.lidar),
+                None => CheckOptions::declared(),
             }
-            Err(rej) => {
-                let eye = rej.violations.iter().find_map(|v| match v {
-                    Violation::EyeSafety {
-                        azimuth_deg,
-                        rule,
-                        ratio,
-                    } => Some((*ratio, rule.clone(), *azimuth_deg)),
-                    _ => None,
-                });
-                let report = rej.eye_safety.as_deref();
-                Verdict {
-                    head_channels: report.and_then(|r| r.head.as_ref()).map(|h| h.channels),
-                    power_scale_to_certify: report.map(|r| power_scale_to_certify(r.worst_ratio)),
-                    certified: false,
-                    violations: rej.violations.iter().map(ToString::to_string).collect(),
-                    limits: rej
-                        .violations
-                        .iter()
-                        .map(|v| v.limit_key().to_owned())
-                        .collect(),
-                    worst_ratio: eye.as_ref().map(|e| e.0),
-                    binding_rule: eye.as_ref().map(|e| e.1.clone()),
-                    worst_azimuth_deg: eye.as_ref().map(|e| e.2),
+            .allow_missing_eye_safety(no_eye_safety);
+            match certify_with(profile, &opts) {
+                Ok(c) => {
+                    // The evaluation the checker certified with (not a second run).
+                    let eye = c.eye_safety();
+                    Verdict {
+                        head_channels: eye.and_then(|r| r.head.as_ref()).map(|h| h.channels),
+                        power_scale_to_certify: eye.map(|r| power_scale_to_certify(r.worst_ratio)),
+                        certified: true,
+                        violations: Vec::new(),
+                        limits: Vec::new(),
+                        worst_ratio: eye.map(|r| r.worst_ratio),
+                        binding_rule: eye.map(|r| r.binding_rule.to_string()),
+                        worst_azimuth_deg: eye.map(|r| r.worst_azimuth_deg),
+                    }
+                }
+                Err(rej) => {
+                    let eye = rej.violations.iter().find_map(|v| match v {
+                        Violation::EyeSafety {
+                            azimuth_deg,
+                            rule,
+                            ratio,
+                        } => Some((*ratio, rule.clone(), *azimuth_deg)),
+                        _ => None,
+                    });
+                    let report = rej.eye_safety.as_deref();
+                    Verdict {
+                        head_channels: report.and_then(|r| r.head.as_ref()).map(|h| h.channels),
+                        power_scale_to_certify: report
+                            .map(|r| power_scale_to_certify(r.worst_ratio)),
+                        certified: false,
+                        violations: rej.violations.iter().map(ToString::to_string).collect(),
+                        limits: rej
+                            .violations
+                            .iter()
+                            .map(|v| v.limit_key().to_owned())
+                            .collect(),
+                        worst_ratio: eye.as_ref().map(|e| e.0),
+                        binding_rule: eye.as_ref().map(|e| e.1.clone()),
+                        worst_azimuth_deg: eye.as_ref().map(|e| e.2),
+                    }
                 }
             }
         })
@@ -715,6 +887,70 @@ pub struct PyFrame {
 
 #[pymethods]
 impl PyFrame {
+    /// A frame from its fields (what pickle calls; streams make them).
+    #[new]
+    fn new(t_s: f64, state: &str, profile: Py<PyProfile>) -> PyResult<Self> {
+        let state = match state {
+            "adaptive" => "adaptive",
+            "fail_safe" => "fail_safe",
+            other => {
+                return Err(value_error(format!(
+                    "state: '{other}' is not one of adaptive, fail_safe"
+                )))
+            }
+        };
+        Ok(Self {
+            t_s: finite("t_s", t_s)?,
+            state,
+            profile,
+        })
+    }
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (
+        Bound<'py, pyo3::types::PyType>,
+        (f64, &'static str, Py<PyProfile>),
+    ) {
+        let f = slf.get();
+        (
+            slf.get_type(),
+            (f.t_s, f.state, f.profile.clone_ref(slf.py())),
+        )
+    }
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        guard(|| {
+            let Ok(o) = other.cast::<Self>() else {
+                return Ok(false);
+            };
+            let o = o.get();
+            Ok(self.t_s.to_bits() == o.t_s.to_bits()
+                && self.state == o.state
+                && self.profile.get().json()? == o.profile.get().json()?)
+        })
+    }
+    /// t_s, state, gaze_deg and the profile's mode as a dict (one row of
+    /// `gaze_lidar.frames_to_pandas`).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("t_s", self.t_s)?;
+        d.set_item("state", self.state)?;
+        d.set_item("gaze_deg", self.gaze_deg())?;
+        d.set_item("mode", self.profile.get().inner.profile().mode.clone())?;
+        Ok(d)
+    }
+    /// The frame's profile, one row per bin (`Profile.to_pandas`), with
+    /// t_s, state and gaze_deg on every row. Needs pandas.
+    fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let df = records::pandas(py, "Frame.to_pandas")?.call_method1(
+            "DataFrame",
+            (records::profile_columns(py, self.profile.get())?,),
+        )?;
+        df.call_method1("insert", (0, "t_s", self.t_s))?;
+        df.call_method1("insert", (1, "state", self.state))?;
+        df.call_method1("insert", (2, "gaze_deg", self.gaze_deg()))?;
+        Ok(df)
+    }
     /// The certified profile the LiDAR runs during this frame.
     #[getter]
     fn profile(&self, py: Python<'_>) -> Py<PyProfile> {
@@ -766,6 +1002,8 @@ pub struct PyGazeStream {
     inner: Mutex<Stream>,
     preset: String,
     mode: &'static str,
+    /// The frames' preset (closed-form planning), None with config_toml.
+    basis: Option<String>,
 }
 
 impl PyGazeStream {
@@ -845,6 +1083,7 @@ impl PyGazeStream {
             inner: Mutex::new(gaze_lidar::gaze::GazeStream::with_config(
                 planner, filter, failsafe, config,
             )),
+            basis: config_toml.is_none().then(|| preset_name.clone()),
             preset: preset_name,
             mode: mode.name(),
         })
@@ -868,7 +1107,11 @@ impl PyGazeStream {
     }
 }
 
-fn frames(py: Python<'_>, frames: Vec<gaze_lidar::gaze::Frame>) -> PyResult<Vec<PyFrame>> {
+fn frames(
+    py: Python<'_>,
+    frames: Vec<gaze_lidar::gaze::Frame>,
+    basis: Option<&str>,
+) -> PyResult<Vec<PyFrame>> {
     frames
         .into_iter()
         .map(|f| {
@@ -878,7 +1121,13 @@ fn frames(py: Python<'_>, frames: Vec<gaze_lidar::gaze::Frame>) -> PyResult<Vec<
                     State::Adaptive => "adaptive",
                     State::FailSafe => "fail_safe",
                 },
-                profile: Py::new(py, PyProfile { inner: f.profile })?,
+                profile: Py::new(
+                    py,
+                    PyProfile {
+                        inner: f.profile,
+                        basis: basis.map(str::to_owned),
+                    },
+                )?,
             })
         })
         .collect()
@@ -931,7 +1180,7 @@ impl PyGazeStream {
             let out = self
                 .locked(py, |s| s.push(&sample))?
                 .map_err(|e| gaze_error(py, e))?;
-            frames(py, out)
+            frames(py, out, self.basis.as_deref())
         })
     }
 
@@ -949,9 +1198,27 @@ impl PyGazeStream {
     ) -> PyResult<Vec<PyFrame>> {
         guard(|| {
             let np = py.import("numpy")?;
+            // numpy's dtype kinds each argument may have: numbers for the
+            // times and azimuths (never bools, dates, strings or objects),
+            // bools only for `valid` (never "Invalid", NaN or None).
             let column =
                 |name: &str, a: &Bound<'py, PyAny>, dtype: &str| -> PyResult<Bound<'py, PyAny>> {
-                    let c = np.call_method1("ascontiguousarray", (a, dtype))?;
+                    let (kinds, what) = if dtype == "bool" {
+                        ("b", "booleans (a bool array, or None for all valid)")
+                    } else {
+                        ("fiu", "real numbers")
+                    };
+                    let raw = np
+                        .call_method1("asarray", (a,))
+                        .map_err(|e| value_error(format!("{name}: not an array: {e}")))?;
+                    let dt = raw.getattr("dtype")?;
+                    let kind: String = dt.getattr("kind")?.extract()?;
+                    if !kinds.contains(kind.as_str()) {
+                        return Err(value_error(format!(
+                            "{name}: expected {what}, got dtype {dt}"
+                        )));
+                    }
+                    let c = np.call_method1("ascontiguousarray", (raw, dtype))?;
                     let ndim: usize = c.getattr("ndim")?.extract()?;
                     if ndim != 1 {
                         return Err(value_error(format!(
@@ -998,7 +1265,7 @@ impl PyGazeStream {
                     Ok(out)
                 })?
                 .map_err(|e| gaze_error(py, e))?;
-            frames(py, out)
+            frames(py, out, self.basis.as_deref())
         })
     }
 
@@ -1011,7 +1278,7 @@ impl PyGazeStream {
             let out = self
                 .locked(py, |s| s.tick(now_s))?
                 .map_err(|e| gaze_error(py, e))?;
-            frames(py, out)
+            frames(py, out, self.basis.as_deref())
         })
     }
 
@@ -1349,7 +1616,11 @@ fn simulate<'py>(
                 "optimizer_toml: configures the optimized variant: add 'optimized' to variants",
             ));
         }
-        let result = py.detach(|| sim::run(&config, &|| {})).map_err(|e| {
+        // On a pool of its own (fork-safe), Ctrl-C stopping it within a trial.
+        let result = runtime::interruptible(py, true, move |cancel| {
+            sim::run(&config, &|| cancel.check())
+        })?
+        .map_err(|e| {
             if e.is_input_error() {
                 value_error(e.to_string())
             } else {
@@ -1357,7 +1628,36 @@ fn simulate<'py>(
             }
         })?;
         let json = sim::table::render_json(&result).map_err(|e| value_error(e.to_string()))?;
-        json_value(py, &json)?.get_item("rows")
+        // The CLI's --trials-csv records, column for column.
+        let trials = sim::table::render_trials_csv(&result)
+            .map_err(|e| InternalError::new_err(format!("internal error: trials: {e}")))?;
+        let out = PyDict::new(py);
+        out.set_item("rows", json_value(py, &json)?.get_item("rows")?)?;
+        out.set_item("trials_csv", trials)?;
+        Ok(out.into_any())
+    })
+}
+
+/// A recorded gaze file as columns (`gaze_lidar.read_gaze`).
+#[pyfunction]
+#[pyo3(signature = (path, format="jsonl"))]
+fn read_gaze<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+    format: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let fmt = gaze_io::format_of(format).map_err(value_error)?;
+        let origin = path.display().to_string();
+        let bytes =
+            std::fs::read(&path).map_err(|e| value_error(format!("path: {origin}: {e}")))?;
+        let track = detached(py, || gaze_io::parse(&bytes, fmt, &origin))?
+            .map_err(|e| gaze_error(py, e))?;
+        let d = PyDict::new(py);
+        d.set_item("t_s", PyArray1::from_vec(py, track.t_s))?;
+        d.set_item("gaze_deg", PyArray1::from_vec(py, track.gaze_deg))?;
+        d.set_item("valid", PyArray1::from_vec(py, track.valid))?;
+        Ok(d)
     })
 }
 
@@ -1380,6 +1680,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(apply_profile, m)?)?;
     m.add_function(wrap_pyfunction!(azimuth_deg, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(read_gaze, m)?)?;
+    m.add(
+        "GAZE_FORMATS",
+        PyList::new(py, gaze_io::FORMATS.iter().map(|(n, _)| *n))?,
+    )?;
     m.add(
         "PRESETS",
         PyList::new(py, presets::PRESET_NAMES.iter().copied())?,

@@ -182,8 +182,12 @@ def test_optimized_profile_reports_range_and_density_per_region(repo: pathlib.Pa
     assert float(np.sum(w[inside] * dens[inside]) / np.sum(w[inside])) == pytest.approx(
         rof["points_per_deg"]["mean"], rel=1e-12
     )
-    # The closed forms carry no optimality block; JSON keeps the figures.
-    assert gl.profile(mode="joint", gaze_deg=90.0).figures is None
+    # The closed forms carry no optimality block: their figures are their
+    # own only (no closed form to compare with); JSON keeps the figures.
+    closed = gl.profile(mode="joint", gaze_deg=90.0)
+    assert closed.optimality is None
+    cf = closed.figures
+    assert cf is not None and set(cf) == {"profile"}
     assert gl.Profile.from_json(p.to_json()).figures == f
 
 
