@@ -27,7 +27,6 @@ echo "== python: pip install ./python into a fresh venv ($venv)"
 # pandas (optional for users): the to_pandas() tests and push_many's
 # nullable-type cases (pandas "boolean", "Float64") run with it.
 "$venv/bin/python" -m pip install -q pandas
-# An independent MCAP writer and reader for the replay test (issue 33).
 # An independent MCAP writer and reader for the replay test.
 "$venv/bin/python" -m pip install -q mcap mcap-ros2-support
 
