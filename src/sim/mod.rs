@@ -20,6 +20,7 @@ pub mod report;
 pub mod returns;
 pub mod scene;
 pub mod stats;
+pub mod sweep;
 pub mod table;
 pub mod trial;
 
@@ -476,6 +477,11 @@ pub struct Row {
     /// azimuths below gaze − 30° (all channels, ground included; planar:
     /// the simulated channel × channels); median.
     pub argus_density_points: f64,
+    /// Uncertainty of this cell's numbers (bootstrap intervals, modes,
+    /// the paired test against the baseline): [`stats::CellStats`]. The
+    /// JSON and CSV renderers (`table`) add its fields to the row's.
+    #[serde(skip)]
+    pub stats: stats::CellStats,
 }
 
 /// All rows and per-trial records.
@@ -1023,6 +1029,7 @@ fn rows_of<'s>(
     sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
 ) -> Vec<Row> {
     let mut rows = Vec::new();
+    let mut dens_by_row = Vec::new();
     for chunk in records.chunks(config.trials) {
         let first = &chunk[0];
         let variant = if first.variant == Variant::Optimized.name() {
@@ -1078,8 +1085,11 @@ fn rows_of<'s>(
             hybrid_tta_median_s: quartiles(&hybrid_r).map(|q| q[1]),
             left_hybrid_tta_median_s: quartiles(&hybrid_l).map(|q| q[1]),
             argus_density_points: quartiles(&argus_dens).map_or(0.0, |q| q[1]),
+            stats: stats::CellStats::default(),
         });
+        dens_by_row.push(dens_acc);
     }
+    stats::annotate(config.seed, config.trials, records, &dens_by_row, &mut rows);
     rows
 }
 
