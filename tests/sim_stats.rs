@@ -115,3 +115,108 @@ fn bootstrap_interval_matches_scipy_up_to_one_order_statistic() {
         }
     }
 }
+
+mod grid {
+    use gaze_lidar::sim::{self, ModelKind, SimConfig, Variant};
+
+    fn small() -> sim::GridResult {
+        let config = SimConfig {
+            models: vec![ModelKind::Argus],
+            variants: vec![Variant::Baseline, Variant::Range],
+            fog_pcts: vec![0, 50],
+            trials: 12,
+            seed: 3,
+            ..SimConfig::default()
+        };
+        sim::run(&config, &|| {}).expect("run")
+    }
+
+    #[test]
+    fn rows_carry_intervals_modes_and_paired_tests() {
+        let r = small();
+        for row in &r.rows {
+            let s = &row.stats;
+            let (lo, hi) = (s.tta_ci_lo_s.expect("lo"), s.tta_ci_hi_s.expect("hi"));
+            let med = row.tta_median_s.expect("median");
+            assert!(lo <= med && med <= hi, "{lo} {med} {hi}");
+            assert!(s.tta_mode_count >= 1 && !s.tta_modes.is_empty());
+            if row.variant == "baseline" {
+                assert_eq!(s.vs_baseline_pairs, 0);
+                assert_eq!(s.vs_baseline_wilcoxon_p, None);
+            } else {
+                assert_eq!(s.vs_baseline_pairs, row.detected.min(12));
+                let p = s.vs_baseline_wilcoxon_p.expect("p");
+                assert!((0.0..=1.0).contains(&p));
+            }
+        }
+        // At 50 % fog range control detects the right car earlier (the
+        // paper's effect): a positive paired difference, significant.
+        let range = r.row(ModelKind::Argus, "range", 50).expect("row");
+        assert!(range.stats.vs_baseline_median_diff_s.expect("diff") > 1.0);
+        assert!(range.stats.vs_baseline_sign_p.expect("p") < 0.01);
+    }
+
+    #[test]
+    fn csv_and_json_carry_the_stats_and_are_deterministic() {
+        let (a, b) = (small(), small());
+        let csv = sim::table::render_csv(&a).expect("csv");
+        assert_eq!(csv, sim::table::render_csv(&b).expect("csv"));
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 1 + a.rows.len());
+        for col in [
+            "tta_median_s",
+            "tta_ci_lo_s",
+            "tta_modes",
+            "vs_baseline_wilcoxon_p",
+        ] {
+            assert!(
+                lines[0].split(',').any(|c| c == col),
+                "{col} in {}",
+                lines[0]
+            );
+        }
+        let width = lines[0].split(',').count();
+        assert!(lines.iter().all(|l| l.split(',').count() == width));
+        let json = sim::table::render_json(&a).expect("json");
+        assert_eq!(json, sim::table::render_json(&b).expect("json"));
+        let v: serde_json::Value = serde_json::from_str(&json).expect("json");
+        assert!(v["rows"][2]["vs_baseline_sign_p"].is_number()); // range, fog 0
+        assert!(v["rows"][1]["vs_baseline_sign_p"].is_null()); // baseline
+        assert!(v["rows"][0]["tta_ci_hi_s"].is_number());
+        let table = sim::table::render_table(&a);
+        assert!(table.contains("TTA 95% CI"));
+    }
+
+    #[test]
+    fn a_sweep_changes_the_scenario_key() {
+        let sw = sim::sweep::parse("speed_kmh=30,70").expect("sweep");
+        let base = SimConfig {
+            models: vec![ModelKind::Argus],
+            variants: vec![Variant::Baseline],
+            fog_pcts: vec![0],
+            trials: 5,
+            ..SimConfig::default()
+        };
+        let results: Vec<sim::GridResult> = sw
+            .values
+            .iter()
+            .map(|&v| {
+                let scenario = sim::sweep::apply(&base.scenario, &sw.key, v).expect("apply");
+                sim::run(
+                    &SimConfig {
+                        scenario,
+                        ..base.clone()
+                    },
+                    &|| {},
+                )
+                .expect("run")
+            })
+            .collect();
+        let slow = results[0].rows[0].tta_median_s.expect("tta");
+        let fast = results[1].rows[0].tta_median_s.expect("tta");
+        assert!(slow > fast, "30 km/h TTA {slow} > 70 km/h TTA {fast}");
+        let t = sim::sweep::render_table(&sw, &results);
+        assert!(t.starts_with("sweep of speed_kmh"));
+        assert_eq!(t.lines().count(), 2 + 2);
+    }
+}

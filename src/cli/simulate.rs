@@ -95,6 +95,13 @@ pub struct Args {
     /// Also write the rows as CSV to this file.
     #[arg(long)]
     export_csv: Option<PathBuf>,
+    /// Sensitivity sweep `KEY=V1,V2,…` (repeatable, one table per key): any
+    /// numeric scenario key (`speed_kmh`, `carla.mount_height_m`, …) or the
+    /// aliases `mount_height`, `tick` (`carla.tick_s`), `spawn_distance`;
+    /// the whole grid is run once per value and printed as tables (`--format
+    /// json`: `{"sweeps": [...]}`).
+    #[arg(long)]
+    sweep: Vec<String>,
     /// Disable ray culling (reference path; results are identical).
     #[arg(long, hide = true)]
     brute_force: bool,
@@ -223,6 +230,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         optimizer,
         ..SimConfig::default()
     };
+    if !a.sweep.is_empty() {
+        return run_sweeps(a, &config);
+    }
     // Every output path is checked before the run — against the others
     // (the plots' file names included) and against the inputs: a bad one
     // fails now, and nothing is replaced.
@@ -424,4 +434,84 @@ fn render_plots(
                 .map_err(|e| CliError::output(format!("--plots: {}: {e}", path.display())))
         })
         .collect()
+}
+
+/// `--sweep`: the grid once per value of each key; tables (or JSON) on stdout.
+fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
+    if a.report.is_some()
+        || a.plots.is_some()
+        || a.trials_csv.is_some()
+        || a.export_json.is_some()
+        || a.export_csv.is_some()
+    {
+        return Err(CliError::input(
+            "--sweep prints its tables on stdout: --report, --plots, --trials-csv, --export-json and --export-csv are not available with it",
+        ));
+    }
+    let sweeps = a
+        .sweep
+        .iter()
+        .map(|s| sim::sweep::parse(s))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| CliError::input(e.to_string()))?;
+    // Every value is validated before anything runs.
+    let mut configs = Vec::new();
+    for sw in &sweeps {
+        let mut per_value = Vec::new();
+        for &v in &sw.values {
+            let scenario = sim::sweep::apply(&config.scenario, &sw.key, v)
+                .map_err(|e| CliError::input(e.to_string()))?;
+            per_value.push(SimConfig {
+                scenario,
+                ..config.clone()
+            });
+        }
+        configs.push(per_value);
+    }
+    let mut text = String::new();
+    let mut json = Vec::new();
+    for (sw, per_value) in sweeps.iter().zip(&configs) {
+        let results = per_value
+            .iter()
+            .map(|c| sim::run(c, &|| {}))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| {
+                if e.is_input_error() {
+                    CliError::input(e.to_string())
+                } else {
+                    CliError::infeasible(e.to_string())
+                }
+            })?;
+        match a.format {
+            Format::Json => {
+                let values = sw
+                    .values
+                    .iter()
+                    .zip(&results)
+                    .map(|(v, r)| {
+                        let rows: serde_json::Value =
+                            serde_json::from_str(&sim::table::render_json(r)?)?;
+                        Ok(serde_json::json!({"value": v, "rows": rows["rows"]}))
+                    })
+                    .collect::<Result<Vec<_>, serde_json::Error>>()
+                    .map_err(|e| CliError::input(e.to_string()))?;
+                json.push(serde_json::json!({"key": sw.key, "values": values}));
+            }
+            _ => {
+                text.push_str(&sim::sweep::render_table(sw, &results));
+                text.push('\n');
+            }
+        }
+    }
+    if a.format == Format::Json {
+        text = serde_json::to_string_pretty(&serde_json::json!({ "sweeps": json }))
+            .map_err(|e| CliError::input(e.to_string()))?;
+        text.push('\n');
+    }
+    let mut outputs = Outputs::default();
+    outputs.claim_stdout("the sweep tables");
+    outputs.check()?;
+    outputs.stdout(text);
+    outputs.commit()?;
+    Ok(0)
 }

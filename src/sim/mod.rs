@@ -21,6 +21,7 @@ pub mod report;
 pub mod returns;
 pub mod scene;
 pub mod stats;
+pub mod sweep;
 pub mod table;
 pub mod trial;
 
@@ -484,6 +485,11 @@ pub struct Row {
     pub early_false: usize,
     /// Share of frames the sensor ran in fail-safe (`simulate --gaze`; 0 otherwise).
     pub fail_safe_frame_share: f64,
+    /// Uncertainty of this cell's numbers (bootstrap intervals, modes,
+    /// the paired test against the baseline): [`stats::CellStats`]. The
+    /// JSON and CSV renderers (`table`) add its fields to the row's.
+    #[serde(skip)]
+    pub stats: stats::CellStats,
 }
 
 /// All rows and per-trial records.
@@ -1037,6 +1043,7 @@ fn rows_of<'s>(
     sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
 ) -> Vec<Row> {
     let mut rows = Vec::new();
+    let mut dens_by_row = Vec::new();
     for chunk in records.chunks(config.trials) {
         let first = &chunk[0];
         let variant = if first.variant == Variant::Optimized.name() {
@@ -1108,8 +1115,11 @@ fn rows_of<'s>(
             fail_safe_frame_share: per_frame(
                 chunk.iter().map(|r| r.outcome.fail_safe_frames).sum(),
             ),
+            stats: stats::CellStats::default(),
         });
+        dens_by_row.push(dens_acc);
     }
+    stats::annotate(config.seed, config.trials, records, &dens_by_row, &mut rows);
     rows
 }
 

@@ -121,6 +121,20 @@ where
                     .whisker_width(0.5)
                     .style(color),
             ))?;
+            // The bootstrap 95 % interval of the median, right of the box.
+            if let Some((lo, hi)) = result
+                .row(model, v.name(), fog)
+                .and_then(|row| metric.interval(&row.stats))
+            {
+                let x = i as f32 + 0.3;
+                let (lo, hi) = (lo as f32, hi as f32);
+                let style = BLACK.stroke_width(2);
+                chart.draw_series([
+                    PathElement::new(vec![(x, lo), (x, hi)], style),
+                    PathElement::new(vec![(x - 0.05, lo), (x + 0.05, lo)], style),
+                    PathElement::new(vec![(x - 0.05, hi), (x + 0.05, hi)], style),
+                ])?;
+            }
         }
     }
     Ok(())
@@ -133,6 +147,14 @@ enum Metric {
 }
 
 impl Metric {
+    /// The 95 % interval of the cell's median.
+    fn interval(self, s: &super::stats::CellStats) -> Option<(f64, f64)> {
+        match self {
+            Self::Tta => s.tta_ci_lo_s.zip(s.tta_ci_hi_s),
+            Self::Density => s.density_ci_lo_pts_per_deg.zip(s.density_ci_hi_pts_per_deg),
+        }
+    }
+
     fn title(self) -> &'static str {
         match self {
             Self::Tta => "Time to arrival at detection",

@@ -39,21 +39,64 @@ pub fn render(r: &GridResult, config: &SimConfig) -> String {
     render_with_pipeline(r, config, None)
 }
 
-/// One result cell: median (q1–q3) and detections, or a dash.
+/// One result cell: median [bootstrap 95 % interval] (q1–q3), detections,
+/// the modes when there are several, and the paired test against the
+/// baseline; or a dash.
 fn tta_cell(x: Option<&Row>) -> String {
     x.map_or_else(
         || "—".to_owned(),
         |x| {
-            format!(
-                "{} ({}–{}), {}/{} det.",
+            let st = &x.stats;
+            let mut out = format!(
+                "{} [{}–{}] ({}–{}), {}/{} det.",
                 f2(x.tta_median_s),
+                f2(st.tta_ci_lo_s),
+                f2(st.tta_ci_hi_s),
                 f2(x.tta_q1_s),
                 f2(x.tta_q3_s),
                 x.detected,
                 x.trials
-            )
+            );
+            if st.tta_mode_count > 1 {
+                let modes: Vec<String> = st
+                    .tta_modes
+                    .split(';')
+                    .filter_map(|m| {
+                        let (t, sh) = m.split_once(':')?;
+                        Some(format!(
+                            "{:.2}: {:.0} %",
+                            t.parse::<f64>().ok()?,
+                            sh.parse::<f64>().ok()? * 100.0
+                        ))
+                    })
+                    .collect();
+                let _ = write!(out, "; modes {}", modes.join(", "));
+            }
+            if let (Some(d), Some(pw), Some(ps), Some(rb)) = (
+                st.vs_baseline_median_diff_s,
+                st.vs_baseline_wilcoxon_p,
+                st.vs_baseline_sign_p,
+                st.vs_baseline_rank_biserial,
+            ) {
+                let _ = write!(
+                    out,
+                    "; vs baseline Δ {d:+.2} s, r {rb:+.2}, p {} (W) / {} (sign)",
+                    pfmt(pw),
+                    pfmt(ps)
+                );
+            }
+            out
         },
     )
+}
+
+/// A p-value: 3 decimals, or `< 0.001`.
+fn pfmt(p: f64) -> String {
+    if p < 0.001 {
+        "< 0.001".to_owned()
+    } else {
+        format!("{p:.3}")
+    }
 }
 
 /// The paper's pipeline cell: median (q1–q3) and detections.
@@ -178,12 +221,23 @@ pub fn render_with_pipelines(
             );
         }
     }
+    let _ = writeln!(
+        s,
+        "\nEach cell: median [95 % interval of the median: percentile bootstrap, {} resamples, seeded from the run's seed] \
+         (q1–q3), detections; when the TTAs fall into several groups (sorted TTAs cut at gaps over {} s, e.g. the far ring \
+         or the next one), each group's median and share; for a variant, the paired comparison with the baseline of the \
+         same model and fog on the same trials (both detected): median difference Δ (positive: detected earlier), \
+         matched-pairs rank-biserial r, two-sided Wilcoxon signed-rank p (exact below 51 untied pairs, else normal with \
+         tie and continuity corrections) and sign-test p (`src/sim/stats.rs`; checked against scipy.stats).",
+        super::stats::BOOTSTRAP_RESAMPLES,
+        super::stats::MODE_GAP_S
+    );
     let _ = writeln!(s, "\n## Point density in the LiDAR's region of interest\n");
     let _ = writeln!(
         s,
         "Definition: points returned from pulses inside the RoI, per degree of RoI, accumulated over the trial \
          (from the start until the later car arrives, ≈ {:.1} s) and scaled to the 64 channels of the paper's sensor \
-         (× 64, as if every channel returned like the simulated one); median over trials. \
+         (× 64, as if every channel returned like the simulated one); median over trials [its bootstrap 95 % interval]. \
          The paper reports 16,000–26,000 points per degree, joint highest, then resolution, then range and baseline, \
          little change with fog.\n",
         r.trials.first().map_or(0.0, |t| t.outcome.duration_s)
@@ -195,7 +249,15 @@ pub fn render_with_pipelines(
             let d = |m| {
                 row(r, m, v.name(), fog).map_or_else(
                     || "—".to_owned(),
-                    |x| format!("{:.0}", x.density_median_pts_per_deg),
+                    |x| match (
+                        x.stats.density_ci_lo_pts_per_deg,
+                        x.stats.density_ci_hi_pts_per_deg,
+                    ) {
+                        (Some(lo), Some(hi)) => {
+                            format!("{:.0} [{lo:.0}–{hi:.0}]", x.density_median_pts_per_deg)
+                        }
+                        _ => format!("{:.0}", x.density_median_pts_per_deg),
+                    },
                 )
             };
             let _ = writeln!(

@@ -442,6 +442,152 @@ pub fn paired(variant: &[f64], baseline: &[f64]) -> Option<Paired> {
     })
 }
 
+/// The uncertainty of one (model, variant, fog) cell, flattened into its
+/// row of the results: bootstrap intervals of the medians, the modes of the
+/// right car's TTA, and the paired test of the right car's TTA against the
+/// baseline variant of the same model and fog on the same trials.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct CellStats {
+    /// Bootstrap resamples behind every interval of this row.
+    pub bootstrap_resamples: usize,
+    /// Right car's TTA: lower end of the 95 % interval of the median, s.
+    pub tta_ci_lo_s: Option<f64>,
+    /// Upper end, s.
+    pub tta_ci_hi_s: Option<f64>,
+    /// Modes of the right car's TTA (split at gaps > [`MODE_GAP_S`]).
+    pub tta_mode_count: usize,
+    /// The modes as `median:share` pairs separated by `;`, increasing
+    /// TTA (median to 3 decimals in s, share to 3 decimals).
+    pub tta_modes: String,
+    /// Left car's LiDAR TTA: 95 % interval of the median, s.
+    pub left_tta_ci_lo_s: Option<f64>,
+    /// Upper end, s.
+    pub left_tta_ci_hi_s: Option<f64>,
+    /// Right car's hybrid TTA: 95 % interval of the median, s.
+    pub hybrid_tta_ci_lo_s: Option<f64>,
+    /// Upper end, s.
+    pub hybrid_tta_ci_hi_s: Option<f64>,
+    /// Accumulated RoI density: 95 % interval of the median, points/degree.
+    pub density_ci_lo_pts_per_deg: Option<f64>,
+    /// Upper end, points/degree.
+    pub density_ci_hi_pts_per_deg: Option<f64>,
+    /// Trials where both this variant and the baseline detected the right
+    /// car (the pairs of the tests; 0 for the baseline itself or when the
+    /// baseline was not run).
+    pub vs_baseline_pairs: usize,
+    /// Median of (this − baseline) TTA over the pairs, s (positive: earlier
+    /// detection than the baseline).
+    pub vs_baseline_median_diff_s: Option<f64>,
+    /// Matched-pairs rank-biserial correlation of the differences.
+    pub vs_baseline_rank_biserial: Option<f64>,
+    /// Two-sided Wilcoxon signed-rank p-value.
+    pub vs_baseline_wilcoxon_p: Option<f64>,
+    /// How that p-value was computed.
+    pub vs_baseline_wilcoxon_method: Option<WilcoxonMethod>,
+    /// Two-sided exact sign-test p-value.
+    pub vs_baseline_sign_p: Option<f64>,
+}
+
+/// `median:share;…` of [`modes`].
+#[must_use]
+pub fn format_modes(modes: &[Mode]) -> String {
+    modes
+        .iter()
+        .map(|m| format!("{:.3}:{:.3}", m.median, m.share))
+        .collect::<Vec<_>>()
+        .join(";")
+}
+
+/// Fills every row's [`CellStats`]. `records` are in the rows' order,
+/// `trials` per row; `density[i]` is row i's accumulated density per trial.
+/// The row whose variant is `baseline` with the same model and fog is the
+/// reference of the paired test. Each interval's seed is [`derive_seed`] of
+/// `seed` and the cell's `model/variant/fog/quantity`, so results do not
+/// depend on the cells' order or the threads.
+pub fn annotate(
+    seed: u64,
+    trials: usize,
+    records: &[super::TrialRecord],
+    density: &[Vec<f64>],
+    rows: &mut [super::Row],
+) {
+    use rayon::prelude::*;
+    let chunks: Vec<&[super::TrialRecord]> = records.chunks(trials.max(1)).collect();
+    let baseline_of = |row: &super::Row| {
+        rows.iter().position(|b| {
+            b.model == row.model && b.fog_pct == row.fog_pct && b.variant == "baseline"
+        })
+    };
+    let base: Vec<Option<usize>> = rows.iter().map(baseline_of).collect();
+    let computed: Vec<CellStats> = rows
+        .par_iter()
+        .enumerate()
+        .map(|(i, row)| {
+            let chunk = chunks.get(i).copied().unwrap_or(&[]);
+            let label = format!("{}/{}/{}", row.model.name(), row.variant, row.fog_pct);
+            let ci = |values: &[f64], what: &str| {
+                bootstrap_median(
+                    values,
+                    BOOTSTRAP_RESAMPLES,
+                    derive_seed(seed, &format!("{label}/{what}")),
+                )
+            };
+            let right: Vec<f64> = chunk.iter().filter_map(|r| r.outcome.tta_s[1]).collect();
+            let left: Vec<f64> = chunk.iter().filter_map(|r| r.outcome.tta_s[0]).collect();
+            let hybrid: Vec<f64> = chunk
+                .iter()
+                .filter_map(|r| r.outcome.hybrid_tta_s[1])
+                .collect();
+            let (t, l, h) = (
+                ci(&right, "tta"),
+                ci(&left, "left_tta"),
+                ci(&hybrid, "hybrid"),
+            );
+            let d = density.get(i).and_then(|v| ci(v, "density"));
+            let m = modes(&right, MODE_GAP_S);
+            let mut out = CellStats {
+                bootstrap_resamples: BOOTSTRAP_RESAMPLES,
+                tta_ci_lo_s: t.map(|c| c.lo),
+                tta_ci_hi_s: t.map(|c| c.hi),
+                tta_mode_count: m.len(),
+                tta_modes: format_modes(&m),
+                left_tta_ci_lo_s: l.map(|c| c.lo),
+                left_tta_ci_hi_s: l.map(|c| c.hi),
+                hybrid_tta_ci_lo_s: h.map(|c| c.lo),
+                hybrid_tta_ci_hi_s: h.map(|c| c.hi),
+                density_ci_lo_pts_per_deg: d.map(|c| c.lo),
+                density_ci_hi_pts_per_deg: d.map(|c| c.hi),
+                ..CellStats::default()
+            };
+            if let Some(b) = base[i].filter(|&b| b != i) {
+                let base_chunk = chunks.get(b).copied().unwrap_or(&[]);
+                let (mut v, mut w) = (Vec::new(), Vec::new());
+                for (x, y) in chunk.iter().zip(base_chunk) {
+                    if x.trial != y.trial {
+                        continue;
+                    }
+                    if let (Some(a), Some(c)) = (x.outcome.tta_s[1], y.outcome.tta_s[1]) {
+                        v.push(a);
+                        w.push(c);
+                    }
+                }
+                if let Some(p) = paired(&v, &w) {
+                    out.vs_baseline_pairs = p.pairs;
+                    out.vs_baseline_median_diff_s = Some(p.median_difference);
+                    out.vs_baseline_rank_biserial = Some(p.rank_biserial);
+                    out.vs_baseline_wilcoxon_p = Some(p.wilcoxon.p_value);
+                    out.vs_baseline_wilcoxon_method = Some(p.wilcoxon.method);
+                    out.vs_baseline_sign_p = Some(p.sign.p_value);
+                }
+            }
+            out
+        })
+        .collect();
+    for (row, s) in rows.iter_mut().zip(computed) {
+        row.stats = s;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
