@@ -49,6 +49,8 @@ pub mod fast;
 pub mod figures;
 pub mod global;
 mod lp;
+pub mod program;
+mod setpoints;
 pub mod settings;
 mod utility;
 
@@ -219,6 +221,18 @@ impl Problem {
             },
             bins,
         })
+    }
+}
+
+impl Problem {
+    /// Drops the spin set-points when a finite acceleration limit forbids
+    /// the spin steps between them and the mode moves the spin (the
+    /// optimizer then ramps the spin); returns the set-points dropped.
+    pub fn drop_forbidden_setpoints(&mut self) -> Option<Vec<f64>> {
+        let forbidden = !self.levels.spin_rad_s.is_empty()
+            && self.lidar.limits.spin_accel_rad_s2_max.is_some()
+            && self.objective.mode.controls_resolution();
+        forbidden.then(|| std::mem::take(&mut self.levels.spin_rad_s))
     }
 }
 
