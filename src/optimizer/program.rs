@@ -467,3 +467,52 @@ pub struct Solved {
     /// ran.
     pub solver_dual_bound: Option<f64>,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimizer::certificate::check;
+
+    /// max x + 2y s.t. x + y ≤ 4, x − y ≥ −1, x + 3y = 6 (the names kept),
+    /// 0 ≤ x, y ≤ 10: the view has the rows HiGHS solved (a `≥` row with
+    /// its written coefficients) and HiGHS's duals certify the optimum.
+    #[test]
+    fn the_view_is_the_rows_highs_solved() {
+        let mut p = Program::default();
+        let x = p.column(0.0, 10.0, 1.0, false);
+        let y = p.column(0.0, 10.0, 2.0, false);
+        p.at_most("budget", x + y, 4.0);
+        p.at_least("slew", x - y, -1.0);
+        p.equal("frame", x + 3.0 * y, 6.0);
+        let (hi, lo) = p.between("accel", 2.0 * x - y, -5.0, 5.0);
+        assert_eq!((hi, lo), (3, 4));
+        assert_eq!(p.names(), ["budget", "slew", "frame", "accel", "accel"]);
+        let v = p.view();
+        let rows: Vec<(Vec<(usize, f64)>, f64, f64)> = v
+            .rows
+            .iter()
+            .map(|r| (r.coefs.clone(), r.lo, r.hi))
+            .collect();
+        let inf = f64::INFINITY;
+        assert_eq!(
+            rows,
+            vec![
+                (vec![(0, 1.0), (1, 1.0)], -inf, 4.0),
+                (vec![(0, 1.0), (1, -1.0)], -1.0, inf),
+                (vec![(0, 1.0), (1, 3.0)], 6.0, 6.0),
+                (vec![(0, 2.0), (1, -1.0)], -inf, 5.0),
+                (vec![(0, 2.0), (1, -1.0)], -5.0, inf),
+            ]
+        );
+        let s = p.solve("test").unwrap();
+        // x + 3y = 6 and x + y ≤ 4: x = 3, y = 1 (objective 5).
+        assert_eq!(s.x, vec![3.0, 1.0]);
+        let e = check(&v, &s.x, &s.y);
+        assert!(e.primal_feasible);
+        // HiGHS's duals (½, ½ on `budget` and `frame`) to the last bits.
+        let gap = e.gap().unwrap();
+        let tiny = num_rational::BigRational::new(1.into(), (1_i64 << 50).into());
+        assert!(gap >= num_rational::BigRational::from_integer(0.into()) && gap < tiny);
+        assert_eq!(p.eval(&(x + 3.0 * y), &s.x), 6.0);
+    }
+}
