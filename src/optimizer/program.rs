@@ -488,7 +488,8 @@ mod tests {
         assert_eq!((hi, lo), (3, 4));
         assert_eq!(p.names(), ["budget", "slew", "frame", "accel", "accel"]);
         let v = p.view();
-        let rows: Vec<(Vec<(usize, f64)>, f64, f64)> = v
+        type Side = (Vec<(usize, f64)>, f64, f64);
+        let rows: Vec<Side> = v
             .rows
             .iter()
             .map(|r| (r.coefs.clone(), r.lo, r.hi))
