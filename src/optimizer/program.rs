@@ -117,17 +117,17 @@ impl Program {
 
     /// `e ≤ hi`, named; returns its row.
     pub fn at_most(&mut self, name: &str, e: Expression, hi: f64) -> usize {
-        self.push(name, nonzero(&e).leq(hi), Sense::AtMost)
+        self.push(name, nonzero(e).leq(hi), Sense::AtMost)
     }
 
     /// `e ≥ lo`, named; returns its row.
     pub fn at_least(&mut self, name: &str, e: Expression, lo: f64) -> usize {
-        self.push(name, nonzero(&e).geq(lo), Sense::AtLeast)
+        self.push(name, nonzero(e).geq(lo), Sense::AtLeast)
     }
 
     /// `e = v`, named; returns its row.
     pub fn equal(&mut self, name: &str, e: Expression, v: f64) -> usize {
-        self.push(name, nonzero(&e).eq(v), Sense::Equal)
+        self.push(name, nonzero(e).eq(v), Sense::Equal)
     }
 
     /// `lo ≤ e ≤ hi` as two rows (`≤` then `≥`); returns both.
@@ -424,14 +424,17 @@ impl LinearProgram {
 }
 
 /// `e` without its exact-zero coefficients (HiGHS gets no zero entries).
-fn nonzero(e: &Expression) -> Expression {
+fn nonzero(e: Expression) -> Expression {
+    if (&e).linear_coefficients().all(|(_, a)| a != 0.0) {
+        return e;
+    }
     let mut out = Expression::with_capacity(0);
-    for (v, a) in e.linear_coefficients() {
+    for (v, a) in (&e).linear_coefficients() {
         if a != 0.0 {
             out.add_mul(a, v);
         }
     }
-    out + IntoAffineExpression::constant(e)
+    out + IntoAffineExpression::constant(&e)
 }
 
 /// How HiGHS is run on a program.
