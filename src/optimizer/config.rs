@@ -26,6 +26,15 @@
 //! resolution_weight = 1.0
 //! floor_weight = 0.001
 //! priors = [{ start_deg = 250.0, width_deg = 40.0, weight = 0.5 }]
+//! kind = "detection"               # or "sqrt" (default): the power step's value
+//!
+//! [objective.detection]            # kind = "detection" (super::detection)
+//! models = ["argus", "physical"]   # return models, weighted equally
+//! fog_pct = [0, 25, 50]            # the paper's fog levels
+//! fog_weight = [1.0, 1.0, 1.0]     # their probabilities (omit: equal)
+//! target_width_m = 1.8
+//! reflectivity = 0.1
+//! detect = 1.0                     # expected returns per frame
 //! ```
 
 use serde::Deserialize;
@@ -279,6 +288,7 @@ impl OptimizerConfig {
                 });
             }
         }
+        o.detection.validate()?;
         let bins = self.bins.unwrap_or(360);
         super::validate_bins(bins, "bins")?;
         if o.mode == crate::model::Mode::Baseline {
