@@ -378,8 +378,11 @@ impl ReturnModel {
     /// m; 0 when even 1 cm is short. Both factors fall with the range (the
     /// pulses across the target as `1/R`; `P_D` as the amplitude, or the
     /// `argus` intensity, falls), so the set of ranges that detect is an
-    /// interval from 0 and bisection on `[0.01, 10⁴]` m finds its end
-    /// (80 halvings: far below a micrometre).
+    /// interval from 0 and bisection finds its end, to a relative 1e-12.
+    /// The bracket is `[0.01, R_max]` m, `R_max` the least of 10⁴ m, the
+    /// range where even `P_D = 1` leaves fewer than `detect` pulses on the
+    /// target (`W/(Δφ·detect)`), and `argus`'s 100 m: beyond each, no range
+    /// detects.
     #[must_use]
     pub fn detection_range_m(
         &self,
@@ -392,14 +395,21 @@ impl ReturnModel {
         let ok = |r: f64| {
             self.expected_returns(power_ratio, reflectivity, width_m, spacing_rad, r) >= detect
         };
-        let (mut lo, mut hi) = (0.01, 10_000.0);
-        if !ok(lo) {
+        let mut hi = (width_m / (spacing_rad * detect)).min(10_000.0);
+        if let Self::Argus { .. } = self {
+            hi = hi.min(ARGUS_RANGE_M);
+        }
+        let mut lo = 0.01;
+        if !(hi > lo && ok(lo)) {
             return 0.0;
         }
         if ok(hi) {
             return hi;
         }
-        for _ in 0..80 {
+        for _ in 0..100 {
+            if hi - lo <= 1e-12 * hi {
+                break;
+            }
             let mid = 0.5 * (lo + hi);
             if ok(mid) {
                 lo = mid;

@@ -335,4 +335,52 @@ mod tests {
             .to_string();
         assert!(e.contains("limts"), "{e}");
     }
+
+    #[test]
+    fn detection_objective_parses_and_names_bad_fields() {
+        let p = OptimizerConfig::from_toml(
+            "[objective]\nkind = \"detection\"\n[objective.detection]\nmodels = [\"physical\"]\nfog_pct = [25, 50]\nfog_weight = [3.0, 1.0]\ndetect = 2.0\n",
+            "c.toml",
+        )
+        .unwrap()
+        .problem()
+        .unwrap();
+        assert_eq!(p.objective.kind, super::super::ObjectiveKind::Detection);
+        let d = &p.objective.detection;
+        assert_eq!(d.models, vec![crate::model::returns::ModelKind::Physical]);
+        assert_eq!((d.fog_pct.clone(), d.detect), (vec![25, 50], 2.0));
+        assert_eq!(d.target_width_m, 1.8);
+        // The default stays `sqrt`.
+        let p = OptimizerConfig::from_toml("", "c.toml")
+            .unwrap()
+            .problem()
+            .unwrap();
+        assert_eq!(p.objective.kind, super::super::ObjectiveKind::Sqrt);
+        for (body, field) in [
+            ("fog_pct = [10]", "objective.detection.fog_pct[0]"),
+            ("fog_weight = [1.0]", "objective.detection.fog_weight"),
+            (
+                "fog_weight = [1.0, -1.0, 1.0]",
+                "objective.detection.fog_weight[1]",
+            ),
+            ("models = []", "objective.detection.models"),
+            ("target_width_m = 0.0", "objective.detection.target_width_m"),
+            ("reflectivity = 1.5", "objective.detection.reflectivity"),
+            ("detect = nan", "objective.detection.detect"),
+        ] {
+            let e = OptimizerConfig::from_toml(
+                &format!("[objective]\nkind = \"detection\"\n[objective.detection]\n{body}\n"),
+                "c.toml",
+            )
+            .unwrap()
+            .problem()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains(field), "{body}: {e}");
+        }
+        let e = OptimizerConfig::from_toml("[objective]\nkind = \"closest\"\n", "c.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("kind"), "{e}");
+    }
 }
