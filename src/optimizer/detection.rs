@@ -483,6 +483,36 @@ mod tests {
         }
     }
 
+    /// End to end on continuous power (the paper sensor, range mode): the
+    /// detection objective's optimum certifies, and scores at least as
+    /// high on the detection value as the `√` optimum does (both scored by
+    /// `exact_objective` with `u` itself, not its segments), strictly higher
+    /// at some gaze.
+    #[test]
+    fn the_detection_optimum_beats_the_sqrt_optimum_on_detection() {
+        let mut det = problem();
+        det.levels = crate::optimizer::Levels::default();
+        det.focus = crate::model::acuity::FocusModel::levi_e2_with_width(60.0);
+        let mut sqrt = det.clone();
+        sqrt.objective.kind = ObjectiveKind::Sqrt;
+        let mut strictly = 0;
+        for gaze in [0.0, 90.0, 200.0] {
+            let a = crate::optimizer::optimize(&det, gaze).unwrap();
+            let b = crate::optimizer::optimize(&sqrt, gaze).unwrap();
+            let score = |c: &crate::checker::CertifiedProfile| {
+                crate::optimizer::exact_objective(&det, gaze, c.profile()).unwrap()
+            };
+            let (ja, jb) = (score(&a), score(&b));
+            assert!(
+                ja >= jb * (1.0 - 1e-3),
+                "gaze {gaze}: detection {ja} < sqrt {jb}"
+            );
+            strictly += usize::from(ja > jb * (1.0 + 1e-3));
+        }
+        // And the objective does move the optimum.
+        assert!(strictly > 0, "the detection optimum is the √ one's");
+    }
+
     #[test]
     fn argus_fog_threshold_is_bridged_by_the_envelope() {
         // argus at code fog 50 (paper 25 %): nothing below x ≈ 0.82, then
