@@ -365,6 +365,12 @@ pub(super) fn bound(
     gaze_deg: f64,
     profile: &Profile,
 ) -> Result<GlobalOptimality, OptError> {
+    if problem.objective.kind != super::ObjectiveKind::Sqrt {
+        return Err(OptError::Invalid {
+            field: "objective.kind".into(),
+            reason: "the global bound is derived for the √ utilities only".into(),
+        });
+    }
     let upper_bound = upper_bound(problem, gaze_deg)?;
     let j = model_objective(problem, gaze_deg, profile)?;
     let objective = j - S.objective_margin * j.abs();

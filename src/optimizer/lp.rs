@@ -12,7 +12,7 @@
 
 use super::certificate::{Certified, LinearProgram, Step};
 use super::program::{Program, SolveOptions};
-use super::utility::{sqrt_segments, sqrt_segments_n, SqrtSegments};
+use super::utility::{sqrt_segments_n, SqrtSegments};
 use good_lp::{Expression, IntoAffineExpression, Variable};
 use std::f64::consts::TAU;
 
@@ -500,7 +500,7 @@ fn power_program(
     let mut bins = Vec::with_capacity(g.n);
     let mut utility_constant = 0.0;
     for i in 0..g.n {
-        let (form, bin, constant) = power_bin(&mut lp, problem, g, i, caps[i], bare[i])?;
+        let (form, bin, constant) = power_bin(&mut lp, problem, g, i, t[i], caps[i], bare[i])?;
         x.push(form);
         bins.push(bin);
         utility_constant += constant;
@@ -559,6 +559,7 @@ fn power_bin(
     problem: &Problem,
     g: &Grid,
     i: usize,
+    dwell_s: f64,
     cap_w: f64,
     bare_w: f64,
 ) -> Result<(LinearForm, PowerBin, f64), OptError> {
@@ -576,14 +577,15 @@ fn power_bin(
     let hi = l.power_w_max.min(cap_w.max(l.power_w_min));
     let c = problem.objective.range_weight * g.theta[i] * g.weight[i];
     if !problem.levels.power_w.is_empty() {
-        let (form, bin) = levels(lp, problem, i, hi, c)?;
+        let value = |x: f64| super::detection::level_value(problem, g.theta[i], dwell_s, x);
+        let (form, bin) = levels(lp, problem, i, hi, c, value)?;
         return Ok((form, bin, 0.0));
     }
     let lo_x = l.power_w_min / p_mean;
     let hi_x = (hi / p_mean * (1.0 - S.margin)).max(lo_x);
     let xi = lp.column(lo_x, hi_x, 0.0, false);
     // The utility as boxed segment columns (see `utility`).
-    let shape = sqrt_segments(lo_x, hi_x);
+    let shape = super::detection::range_segments(problem, g.theta[i], dwell_s, lo_x, hi_x);
     let deltas = shape.add_to(lp, xi, 1.0, lo_x, c);
     let constant = c * shape.base;
     let bin = PowerBin::Continuous {
@@ -603,6 +605,7 @@ fn levels(
     i: usize,
     hi_w: f64,
     c: f64,
+    value: impl Fn(f64) -> f64,
 ) -> Result<(LinearForm, PowerBin), OptError> {
     let floor = problem.lidar.limits.power_w_min;
     let p_mean = problem.lidar.average_power_w;
@@ -623,7 +626,7 @@ fn levels(
     }
     let zs: Vec<(f64, Variable)> = allowed
         .iter()
-        .map(|&lv| (lv, lp.column(0.0, 1.0, c * (lv / p_mean).sqrt(), true)))
+        .map(|&lv| (lv, lp.column(0.0, 1.0, c * value(lv / p_mean), true)))
         .collect();
     lp.equal("levels", zs.iter().map(|&(_, z)| z).sum(), 1.0);
     let mut form = Expression::with_capacity(zs.len());

@@ -43,6 +43,7 @@
 
 pub mod certificate;
 pub mod config;
+pub mod detection;
 pub mod error;
 mod exact;
 pub mod fast;
@@ -63,6 +64,7 @@ use crate::model::lidar::{LidarSpec, PowerAccounting};
 use crate::model::Mode;
 
 pub use config::OptimizerConfig;
+pub use detection::{Detection, ObjectiveKind};
 pub use error::{CertificateError, Infeasible, SpinLimit};
 pub use settings::OptimizerSettings;
 
@@ -95,6 +97,10 @@ pub struct Objective {
     pub floor_weight: f64,
     /// Static priors.
     pub priors: Vec<Prior>,
+    /// The power step's per-bin value: `sqrt` (default) or `detection`.
+    pub kind: ObjectiveKind,
+    /// The detection objective's target and conditions (`kind = "detection"`).
+    pub detection: Detection,
 }
 
 impl Default for Objective {
@@ -105,6 +111,8 @@ impl Default for Objective {
             resolution_weight: 1.0,
             floor_weight: 1e-3,
             priors: Vec::new(),
+            kind: ObjectiveKind::Sqrt,
+            detection: Detection::default(),
         }
     }
 }
@@ -342,6 +350,13 @@ pub fn exact_objective(
         .enumerate()
         .map(|(i, b)| {
             let (range, res) = utilities(problem, g.theta[i], b);
+            let range = if o.kind == ObjectiveKind::Detection {
+                let dwell = crate::profile::kinematics::BinMotion::dwell_s(b);
+                let x = b.power_w / problem.lidar.average_power_w;
+                detection::exact_range_utility(problem, g.theta[i], dwell, x)
+            } else {
+                range
+            };
             let range = if o.mode.controls_range() {
                 o.range_weight * range
             } else {
