@@ -295,3 +295,93 @@ fn output_is_deterministic() {
         "JSON round trip"
     );
 }
+
+/// Issue 30, step 4: `profile --preset P --mode M --optimize` answers for
+/// every preset × mode; where a finite acceleration limit forbids the
+/// closed form's spin set-points they are dropped (ramps instead) with one
+/// line on stderr; the text summary labels every gap.
+#[cfg(feature = "solver")]
+#[test]
+fn every_preset_and_mode_optimizes_from_the_command_line() {
+    for preset in gaze_lidar::model::presets::PRESET_NAMES {
+        let accel = gaze_lidar::model::presets::preset(preset)
+            .unwrap()
+            .lidar
+            .limits
+            .spin_accel_rad_s2_max
+            .is_some();
+        for mode in ["range", "resolution", "joint"] {
+            let o = run(
+                &[
+                    "profile",
+                    "--preset",
+                    preset,
+                    "--mode",
+                    mode,
+                    "--gaze-deg",
+                    "90",
+                    "--optimize",
+                    "--format",
+                    "text",
+                ],
+                None,
+            );
+            let err = common::stderr(&o);
+            assert!(o.status.success(), "{preset} {mode}: {err}");
+            let text = stdout(&o);
+            // Every gap labelled; an optimality block wherever a program's
+            // answer is the profile (not yet: resolution mode under an
+            // acceleration limit, whose smoothed spin is no program's answer).
+            for l in text.lines() {
+                assert_eq!(
+                    l.matches(", gap ").count(),
+                    l.matches(" absolute (").count(),
+                    "{preset} {mode}: {l}"
+                );
+            }
+            if !(accel && mode == "resolution") {
+                assert!(
+                    text.contains(" relative to the bound)"),
+                    "{preset} {mode}: {text}"
+                );
+            }
+            let note = err.lines().filter(|l| l.contains("ramps the spin")).count();
+            let dropped = accel && mode != "range";
+            assert_eq!(note, usize::from(dropped), "{preset} {mode}: {err}");
+        }
+    }
+}
+
+/// Issue 30, step 4: a closed form the sensor's limits reject says so in one
+/// line: the first violated limit, the count of the rest, and a command
+/// that works (run here).
+#[cfg(feature = "solver")]
+#[test]
+fn a_rejected_closed_form_names_its_first_violation_and_a_command_that_works() {
+    let o = run(
+        &[
+            "profile",
+            "--preset",
+            "vls128",
+            "--mode",
+            "joint",
+            "--gaze-deg",
+            "90",
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let err = common::stderr(&o);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.len() < 600, "{} characters: {err}", err.len());
+    assert!(err.contains("violates the sensor's limits"), "{err}");
+    let cmd = err
+        .split("the optimizer meets them: ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no command: {err}"))
+        .trim();
+    let args: Vec<&str> = cmd.split_whitespace().skip(1).collect();
+    assert_eq!(args.last(), Some(&"--optimize"), "{cmd}");
+    let o = run(&args, None);
+    assert!(o.status.success(), "{cmd}: {}", common::stderr(&o));
+}

@@ -192,6 +192,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             gaze_lidar::planner::PlanError::InvalidInput { field, reason } => {
                 CliError::input(format!("--{field}: {reason}"))
             }
+            gaze_lidar::planner::PlanError::Rejected(r) => {
+                closed_form_rejected(&r, a, preset_name, mode)
+            }
             other => CliError::from(other),
         })?
     };
@@ -224,6 +227,50 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     }
     outputs.commit()?;
     Ok(0)
+}
+
+/// A closed form the sensor's limits reject: one line naming the first
+/// violated limit, the count of the rest and the command that would work
+/// (the optimizer, which meets the limits by construction).
+fn closed_form_rejected(
+    r: &gaze_lidar::checker::Rejected,
+    a: &Args,
+    preset: &str,
+    mode: Mode,
+) -> CliError {
+    let first = r
+        .violations
+        .first()
+        .map_or_else(String::new, ToString::to_string);
+    let rest = match r.violations.len().saturating_sub(1) {
+        0 => String::new(),
+        n => format!(" (and {n} more)"),
+    };
+    let head = format!(
+        "the {} closed form on --preset {preset} violates the sensor's limits: {first}{rest}",
+        mode.name()
+    );
+    let Some(gaze) = a.gaze_deg.filter(|_| mode != Mode::Baseline) else {
+        return CliError::infeasible(head);
+    };
+    let mut cmd = format!(
+        "gaze-lidar profile --preset {preset} --mode {} --gaze-deg {gaze}",
+        mode.name()
+    );
+    if let Some(b) = a.bins {
+        cmd.push_str(&format!(" --bins {b}"));
+    }
+    if let Some(acc) = a.accounting {
+        cmd.push_str(&format!(
+            " --accounting {}",
+            acc.to_possible_value()
+                .map(|v| v.get_name().to_owned())
+                .unwrap_or_default()
+        ));
+    }
+    CliError::infeasible(format!(
+        "{head}; the optimizer meets them: {cmd} --optimize"
+    ))
 }
 
 /// `DIR/problem.mps` and `DIR/certificate.json` (the directory is created).
@@ -291,6 +338,13 @@ fn optimized(
             if let Some(m) = a.mode {
                 p.objective.mode = m;
             }
+            if let Some(dropped) = p.drop_forbidden_setpoints() {
+                eprintln!(
+                    "note: --preset {}: spin_accel_rad_s2_max {} rad/s² forbids spin steps, so the optimizer ramps the spin instead of using the closed form's set-points {dropped:?} rad/s",
+                    preset_label(a),
+                    p.lidar.limits.spin_accel_rad_s2_max.unwrap_or(f64::INFINITY),
+                );
+            }
             (p, preset.clone())
         }
     };
@@ -325,6 +379,24 @@ struct Basis {
     optimized: bool,
 }
 
+/// The preset's name as given (the default is `paper`).
+#[cfg(feature = "solver")]
+fn preset_label(a: &Args) -> &str {
+    a.preset.as_deref().unwrap_or("paper")
+}
+
+/// A gap labelled: absolute, and relative to the upper bound.
+fn labelled_gap(gap: f64, upper_bound: f64) -> String {
+    if upper_bound.abs() > 0.0 {
+        format!(
+            "{gap:.3e} absolute ({:.3e} relative to the bound)",
+            gap / upper_bound.abs()
+        )
+    } else {
+        format!("{gap:.3e} absolute")
+    }
+}
+
 /// `--format text`: the checker's figures, the optimizer's optimality
 /// figures and the range and point density per region (`planner::figures`).
 fn text_summary(c: &CertifiedProfile, basis: &Basis) -> String {
@@ -347,17 +419,19 @@ fn text_summary(c: &CertifiedProfile, basis: &Basis) -> String {
     if let Some(o) = &p.optimality {
         let _ = write!(
             out,
-            "optimality (final power step): objective {:.9} ≤ upper bound {:.9}, gap {:.3e}{}",
+            "optimality (final power step): objective {:.9} ≤ upper bound {:.9}, gap {}{}",
             o.objective,
             o.upper_bound,
-            o.gap,
+            labelled_gap(o.gap, o.upper_bound),
             if o.exact { " (proven optimal)" } else { "" }
         );
         if let Some(g) = &o.global {
             let _ = write!(
                 out,
-                "; global: objective {:.9} ≤ upper bound {:.9}, gap {:.3e}",
-                g.objective, g.upper_bound, g.gap
+                "; global: objective {:.9} ≤ upper bound {:.9}, gap {}",
+                g.objective,
+                g.upper_bound,
+                labelled_gap(g.gap, g.upper_bound)
             );
         }
         out.push('\n');

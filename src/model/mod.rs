@@ -1,6 +1,6 @@
 //! The model of the paper (sections III–IV): angles and circular sets,
 //! visual acuity and the driver's region of focus, the LiDAR and its limits,
-//! presets, the range equation. Angles and the LiDAR's limits belong to the trusted core
+//! presets, the range equation and the return models. Angles and the LiDAR's limits belong to the trusted core
 //! ([`gaze_lidar_core::model`]) and are re-exported here.
 
 pub mod acuity;
@@ -8,6 +8,7 @@ pub use gaze_lidar_core::model::{angle, lidar, valid};
 pub mod mode;
 pub mod presets;
 pub mod range;
+pub mod returns;
 pub mod sensor;
 
 pub use acuity::{AcuityModel, FocusModel, Regions};

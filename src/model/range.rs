@@ -1,6 +1,6 @@
 //! The range equation: **the one model** of how far a pulse of a given power
 //! reaches. The simulator's `physical` return model
-//! ([`crate::sim::returns::ReturnModel`]) and the profile figures
+//! ([`crate::model::returns::ReturnModel`]) and the profile figures
 //! ([`crate::planner::figures`]) both call it.
 //!
 //! Extended Lambertian target (a target wider than the beam): the received signal is

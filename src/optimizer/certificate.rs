@@ -2,8 +2,10 @@
 //! arithmetic, and their export (free MPS + `certificate.json`).
 //!
 //! A [`LinearProgram`] is `max cᵀx` subject to `r_lo ≤ A x ≤ r_hi` and
-//! `x_lo ≤ x ≤ x_hi` (some columns integral). HiGHS solves it in floating
-//! point; nothing it says is trusted. The certificate is built from:
+//! `x_lo ≤ x ≤ x_hi` (some columns integral): the exact-check view of a
+//! good_lp [`Program`], read back from its constraints
+//! ([`Program::view`]). HiGHS solves the program in floating point; nothing
+//! it says is trusted. The certificate is built from:
 //!
 //! - **a primal point** `x` (HiGHS's, repaired by the caller to meet every
 //!   bound and row): every number is converted *exactly* to a rational and
@@ -32,9 +34,8 @@ use num_traits::{Signed, Zero};
 
 use serde::Serialize;
 
-use super::error::{CertificateError, Infeasible};
-use super::settings::S;
-use super::OptError;
+use super::error::CertificateError;
+pub use super::program::{Program, SolveOptions, Solved};
 
 /// One row: `lo ≤ Σ coef·x ≤ hi` (either side may be infinite).
 #[derive(Debug, Clone, PartialEq)]
@@ -63,7 +64,9 @@ pub struct LinearProgram {
 }
 
 impl LinearProgram {
-    /// Adds a column; returns its index.
+    /// Adds a column to a view built by hand (tests of the checker and of
+    /// the MPS export; the optimizer's views come from [`Program::view`]);
+    /// returns its index.
     pub fn add_col(&mut self, lo: f64, hi: f64, cost: f64, integer: bool) -> usize {
         self.cost.push(cost);
         self.col_lo.push(lo);
@@ -72,20 +75,14 @@ impl LinearProgram {
         self.cost.len() - 1
     }
 
-    /// Adds `lo ≤ Σ coefs ≤ hi`; coefficients on the same column are summed.
+    /// Adds `lo ≤ Σ coefs ≤ hi` to a view built by hand (as
+    /// [`Self::add_col`]); coefficients on one column are summed.
     pub fn add_row(&mut self, coefs: &[(usize, f64)], lo: f64, hi: f64) {
-        // Merged in order of first appearance; the slot of each column
-        // through a map (a budget row has thousands of entries).
         let mut merged: Vec<(usize, f64)> = Vec::with_capacity(coefs.len());
-        let mut slot: std::collections::HashMap<usize, usize> =
-            std::collections::HashMap::with_capacity(coefs.len());
         for &(j, a) in coefs {
-            match slot.entry(j) {
-                std::collections::hash_map::Entry::Occupied(e) => merged[*e.get()].1 += a,
-                std::collections::hash_map::Entry::Vacant(e) => {
-                    e.insert(merged.len());
-                    merged.push((j, a));
-                }
+            match merged.iter_mut().find(|e| e.0 == j) {
+                Some(e) => e.1 += a,
+                None => merged.push((j, a)),
             }
         }
         merged.retain(|e| e.1 != 0.0);
@@ -100,72 +97,6 @@ impl LinearProgram {
     #[must_use]
     pub fn is_mip(&self) -> bool {
         self.integer.iter().any(|&b| b)
-    }
-
-    /// The program as a HiGHS model; HiGHS refusing it (a coefficient or a
-    /// bound it cannot take, e.g. from limits of no physical size) is a
-    /// solver error, never a panic.
-    fn highs_model(
-        &self,
-        relax: bool,
-        nodes: i32,
-        what: &str,
-        opts: &SolveOptions<'_>,
-    ) -> Result<highs::Model, OptError> {
-        let mut pb = highs::RowProblem::default();
-        let cols: Vec<highs::Col> = (0..self.cost.len())
-            .map(|j| {
-                pb.add_column_with_integrality(
-                    self.cost[j],
-                    self.col_lo[j]..=self.col_hi[j],
-                    self.integer[j] && !relax,
-                )
-            })
-            .collect();
-        for r in &self.rows {
-            pb.add_row(r.lo..=r.hi, r.coefs.iter().map(|&(j, a)| (cols[j], a)));
-        }
-        let mut m = pb.try_optimise(highs::Sense::Maximise).map_err(|e| {
-            OptError::Solver(format!("{what} step: HiGHS refused the program ({e:?})"))
-        })?;
-        // Pinned for determinism (one thread, fixed seed); MILPs to optimality.
-        m.set_option("threads", 1);
-        m.set_option("random_seed", 0);
-        m.set_option("mip_rel_gap", 0.0);
-        m.set_option("mip_abs_gap", 1e-12);
-        if !relax && self.is_mip() {
-            // A primal heuristic only (the search still closes the gap to
-            // zero): measured, it costs more than it saves on the power
-            // steps' multiple-choice programs.
-            m.set_option("mip_heuristic_run_feasibility_jump", false);
-            // A deterministic work limit (nodes, not seconds): see
-            // `settings::mip_max_nodes`.
-            m.set_option("mip_max_nodes", nodes);
-            m.set_option("mip_detect_symmetry", false);
-            // HiGHS accepts a MILP's rows (and integrality) to this
-            // tolerance, absolute; its default, 1e-6, lets a level choice
-            // overspend the budget by far more than the checker's relative
-            // 1e-9 (found by breaker3). Its minimum.
-            m.set_option("mip_feasibility_tolerance", S.mip_feasibility_tol);
-        }
-        // Measured on the shipped configs' power steps and global bound
-        // (360 bins): HiGHS's presolve costs more than it saves on these
-        // programs (boxed segment columns, few rows): 1.9× (power) to 3×
-        // (global bound) faster without it; and on the power steps' MILPs
-        // (`multi_level`, one-hot levels and eye-safety column bounds)
-        // 1.45× whole process, same answers (the search still closes the
-        // gap to zero).
-        m.set_option("presolve", "off");
-        m.set_option(
-            "primal_feasibility_tolerance",
-            opts.primal_feasibility_tolerance,
-        );
-        if let Some(x0) = opts.initial {
-            // A hot start (HiGHS's `setSolution`): a wrong length is the
-            // caller's bug, refused by HiGHS, and only costs the hot start.
-            let _ = m.try_set_solution(Some(x0), None, None, None);
-        }
-        Ok(m)
     }
 
     /// This program with every finite row side moved outwards by
@@ -204,99 +135,6 @@ impl LinearProgram {
                 v.clamp(self.col_lo[j], self.col_hi[j])
             })
             .collect()
-    }
-
-    /// Solves with HiGHS; for a MILP also solves the LP relaxation for the
-    /// row multipliers of the certificate.
-    pub fn solve(&self, what: &str) -> Result<Solved, OptError> {
-        self.solve_with(what, &SolveOptions::default())
-    }
-
-    /// [`Self::solve`] with options (a hot start, a feasibility tolerance).
-    pub fn solve_with(&self, what: &str, opts: &SolveOptions<'_>) -> Result<Solved, OptError> {
-        // `Ok(None)`: the node limit came without an incumbent.
-        let run = |relax: bool, nodes: i32| -> Result<Option<highs::SolvedModel>, OptError> {
-            let solved = self
-                .highs_model(relax, nodes, what, opts)?
-                .try_solve()
-                .map_err(|e| OptError::Solver(format!("{what} step: {e:?}")))?;
-            match solved.status() {
-                highs::HighsModelStatus::Optimal => Ok(Some(solved)),
-                // The node limit of a MILP's branch and bound, with an
-                // incumbent: a feasible point (checked exactly like any
-                // other); its gap is stated, not assumed zero. Without one,
-                // the search goes on without the limit.
-                highs::HighsModelStatus::ReachedSolutionLimit if !relax && self.is_mip() => Ok(
-                    (solved.primal_solution_status() == highs::HighsSolutionStatus::Feasible)
-                        .then_some(solved),
-                ),
-                highs::HighsModelStatus::Infeasible => Err(Infeasible::Step {
-                    step: what.to_owned(),
-                }
-                .into()),
-                s => Err(OptError::Solver(format!("{what} step: HiGHS status {s:?}"))),
-            }
-        };
-        let run = |relax: bool| -> Result<highs::SolvedModel, OptError> {
-            match run(relax, S.mip_max_nodes)? {
-                Some(solved) => Ok(solved),
-                None => run(relax, S.mip_max_nodes_without_incumbent)?.ok_or_else(|| {
-                    Infeasible::NoIncumbent {
-                        step: what.to_owned(),
-                        nodes: S.mip_max_nodes_without_incumbent,
-                    }
-                    .into()
-                }),
-            }
-        };
-        if !self.is_mip() {
-            let main = run(false)?;
-            let sol = main.get_solution();
-            return Ok(Solved {
-                x: sol.columns().to_vec(),
-                y: sol.dual_rows().to_vec(),
-                solver_objective: main.objective_value(),
-                solver_dual_bound: None,
-            });
-        }
-        // A MILP: its LP relaxation first (its row duals are the
-        // certificate's multipliers anyway). When the relaxation's optimum
-        // is integral (within 1e-9; HiGHS's own MIP tolerance is 1e-6), it
-        // is the MILP's optimum (the relaxation
-        // bounds the MILP and this point is a MILP point), so the branch
-        // and bound is skipped; the point is still checked exactly by the
-        // certificate. Otherwise HiGHS's MIP solver runs as before.
-        let relaxed = run(true)?;
-        let rsol = relaxed.get_solution();
-        let y = rsol.dual_rows().to_vec();
-        let integral = rsol
-            .columns()
-            .iter()
-            .zip(&self.integer)
-            .all(|(v, &int)| !int || (v - v.round()).abs() <= S.relaxation_integrality_tol);
-        let (x, solver_objective, solver_dual_bound) = if integral {
-            let x = rsol
-                .columns()
-                .iter()
-                .zip(&self.integer)
-                .map(|(&v, &int)| if int { v.round() } else { v })
-                .collect();
-            let obj = relaxed.objective_value();
-            (x, obj, Some(obj))
-        } else {
-            let main = run(false)?;
-            (
-                main.get_solution().columns().to_vec(),
-                main.objective_value(),
-                main.double_info_value(c"mip_dual_bound").ok(),
-            )
-        };
-        Ok(Solved {
-            x,
-            y,
-            solver_objective,
-            solver_dual_bound,
-        })
     }
 
     /// The program in free MPS (shortest round-trip numbers, so HiGHS reads
@@ -397,40 +235,6 @@ fn widen_up(v: f64, w: f64) -> f64 {
     -next_down(-s)
 }
 
-/// How HiGHS is run on a program.
-#[derive(Debug, Clone, Copy)]
-pub struct SolveOptions<'a> {
-    /// A starting point (one value per column), passed as a hot start.
-    pub initial: Option<&'a [f64]>,
-    /// HiGHS's `primal_feasibility_tolerance` (its default is 1e-7).
-    pub primal_feasibility_tolerance: f64,
-}
-
-impl Default for SolveOptions<'_> {
-    fn default() -> Self {
-        Self {
-            initial: None,
-            primal_feasibility_tolerance: S.primal_feasibility_tol,
-        }
-    }
-}
-
-/// HiGHS's floating-point answer (untrusted).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Solved {
-    /// Primal values, column order.
-    pub x: Vec<f64>,
-    /// Row duals in HiGHS's convention (`c − Aᵀy` are its reduced costs),
-    /// of the LP relaxation for a MILP.
-    pub y: Vec<f64>,
-    /// HiGHS's objective value.
-    pub solver_objective: f64,
-    /// HiGHS's MIP dual bound (a MILP only; a float, not checked): the
-    /// relaxation's optimum when that was integral and no branch and bound
-    /// ran.
-    pub solver_dual_bound: Option<f64>,
-}
-
 /// The exact verdict on a primal point and row multipliers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Exact {
@@ -462,8 +266,7 @@ fn q(v: f64) -> BigRational {
 /// products of doubles in a long fixed-point accumulator, [`super::exact`]).
 #[must_use]
 pub fn check(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Exact {
-    use super::exact::{Sum, Wide};
-    use std::cmp::Ordering::{Equal, Greater, Less};
+    use super::exact::Sum;
     let n = lp.cost.len();
     let finite = x.len() == n && x.iter().all(|v| v.is_finite()) && y.iter().all(|v| v.is_finite());
     if !finite {
@@ -474,6 +277,29 @@ pub fn check(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Exact {
             upper_bound: None,
         };
     }
+    let mut violation = primal_violation(lp, x, y);
+    let mut objective = Sum::default();
+    for (&c, &xj) in lp.cost.iter().zip(x) {
+        objective.add_product(c, xj);
+    }
+    let (ub, mut ub_finite) = dual_bound(lp, y);
+    if objective.overflowed() || ub.overflowed() {
+        violation.get_or_insert_with(|| "a sum left the exact accumulator's range".to_owned());
+        ub_finite = false;
+    }
+    Exact {
+        primal_feasible: violation.is_none(),
+        violation,
+        objective: objective.rational(),
+        upper_bound: ub_finite.then(|| ub.rational()),
+    }
+}
+
+/// The first column bound, integrality or row that `x` breaks exactly (or a
+/// `y` of the wrong length).
+fn primal_violation(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Option<String> {
+    use super::exact::Sum;
+    use std::cmp::Ordering::{Greater, Less};
     let mut violation = (y.len() != lp.rows.len()).then(|| "y has the wrong length".to_owned());
     for (j, &xj) in x.iter().enumerate() {
         if xj < lp.col_lo[j] || xj > lp.col_hi[j] || (lp.integer[j] && xj.fract() != 0.0) {
@@ -499,10 +325,13 @@ pub fn check(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Exact {
             });
         }
     }
-    let mut objective = Sum::default();
-    for (&c, &xj) in lp.cost.iter().zip(x) {
-        objective.add_product(c, xj);
-    }
+    violation
+}
+
+/// The dual bound of `y` (module docs), exactly, and whether it is finite.
+fn dual_bound(lp: &LinearProgram, y: &[f64]) -> (super::exact::Wide, bool) {
+    use super::exact::{Sum, Wide};
+    use std::cmp::Ordering::{Equal, Greater, Less};
     // Reduced costs d = c − Aᵀy, exactly, with y repaired to finite sides;
     // the bound Σ_r max(y_r lo_r, y_r hi_r) + Σ_j max(d_j lo_j, d_j hi_j).
     let mut d: Vec<Sum> = lp
@@ -539,16 +368,7 @@ pub fn check(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Exact {
             ub_finite = false;
         }
     }
-    if objective.overflowed() || ub.overflowed() {
-        violation.get_or_insert_with(|| "a sum left the exact accumulator's range".to_owned());
-        ub_finite = false;
-    }
-    Exact {
-        primal_feasible: violation.is_none(),
-        violation,
-        objective: objective.rational(),
-        upper_bound: ub_finite.then(|| ub.rational()),
-    }
+    (ub, ub_finite)
 }
 
 /// The nearest double at or below `v` (a conservative rendering of an

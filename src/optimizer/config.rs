@@ -26,6 +26,15 @@
 //! resolution_weight = 1.0
 //! floor_weight = 0.001
 //! priors = [{ start_deg = 250.0, width_deg = 40.0, weight = 0.5 }]
+//! kind = "detection"               # or "sqrt" (default): the power step's value
+//!
+//! [objective.detection]            # kind = "detection" (super::detection)
+//! models = ["argus", "physical"]   # return models, weighted equally
+//! fog_pct = [0, 25, 50]            # the paper's fog levels
+//! fog_weight = [1.0, 1.0, 1.0]     # their probabilities (omit: equal)
+//! target_width_m = 1.8
+//! reflectivity = 0.1
+//! detect = 1.0                     # expected returns per frame
 //! ```
 
 use serde::Deserialize;
@@ -279,6 +288,7 @@ impl OptimizerConfig {
                 });
             }
         }
+        o.detection.validate()?;
         let bins = self.bins.unwrap_or(360);
         super::validate_bins(bins, "bins")?;
         if o.mode == crate::model::Mode::Baseline {
@@ -324,5 +334,53 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("limts"), "{e}");
+    }
+
+    #[test]
+    fn detection_objective_parses_and_names_bad_fields() {
+        let p = OptimizerConfig::from_toml(
+            "[objective]\nkind = \"detection\"\n[objective.detection]\nmodels = [\"physical\"]\nfog_pct = [25, 50]\nfog_weight = [3.0, 1.0]\ndetect = 2.0\n",
+            "c.toml",
+        )
+        .unwrap()
+        .problem()
+        .unwrap();
+        assert_eq!(p.objective.kind, super::super::ObjectiveKind::Detection);
+        let d = &p.objective.detection;
+        assert_eq!(d.models, vec![crate::model::returns::ModelKind::Physical]);
+        assert_eq!((d.fog_pct.clone(), d.detect), (vec![25, 50], 2.0));
+        assert_eq!(d.target_width_m, 1.8);
+        // The default stays `sqrt`.
+        let p = OptimizerConfig::from_toml("", "c.toml")
+            .unwrap()
+            .problem()
+            .unwrap();
+        assert_eq!(p.objective.kind, super::super::ObjectiveKind::Sqrt);
+        for (body, field) in [
+            ("fog_pct = [10]", "objective.detection.fog_pct[0]"),
+            ("fog_weight = [1.0]", "objective.detection.fog_weight"),
+            (
+                "fog_weight = [1.0, -1.0, 1.0]",
+                "objective.detection.fog_weight[1]",
+            ),
+            ("models = []", "objective.detection.models"),
+            ("target_width_m = 0.0", "objective.detection.target_width_m"),
+            ("reflectivity = 1.5", "objective.detection.reflectivity"),
+            ("detect = nan", "objective.detection.detect"),
+        ] {
+            let e = OptimizerConfig::from_toml(
+                &format!("[objective]\nkind = \"detection\"\n[objective.detection]\n{body}\n"),
+                "c.toml",
+            )
+            .unwrap()
+            .problem()
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains(field), "{body}: {e}");
+        }
+        let e = OptimizerConfig::from_toml("[objective]\nkind = \"closest\"\n", "c.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("kind"), "{e}");
     }
 }

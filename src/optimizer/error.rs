@@ -6,12 +6,25 @@
 use thiserror::Error;
 
 /// Which spin limit cannot meet the frame period.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SpinLimit {
     /// `limits.spin_rad_s_max` is below the mean spin the frame needs.
     Max,
     /// `limits.spin_rad_s_min` is above it.
     Min,
+    /// No choice of the spin set-points (`levels.spin_rad_s`, those within
+    /// the spin limits) on `bins` equal bins makes one turn take the frame
+    /// period (within the checker's 10⁻⁹).
+    SetPoints {
+        /// The bins.
+        bins: usize,
+        /// The set-points within the spin limits.
+        count: usize,
+        /// The nearest frame period below it that a choice reaches, s.
+        below_s: Option<f64>,
+        /// The nearest above it, s.
+        above_s: Option<f64>,
+    },
 }
 
 /// Why the limits cannot all be met.
@@ -140,6 +153,20 @@ fn frame_unreachable(
         SpinLimit::Min => format!(
             "spin_rad_s_min {spin_rad_s:.3} rad/s is above the mean spin {mean_spin_rad_s:.3} rad/s that frame_rate_hz {frame_rate_hz} requires"
         ),
+        SpinLimit::SetPoints {
+            bins,
+            count,
+            below_s,
+            above_s,
+        } => {
+            let side = |v: Option<f64>| v.map_or_else(|| "none".to_owned(), |t| format!("{t:.9} s"));
+            format!(
+                "levels.spin_rad_s: no choice of the {count} spin set-points on {bins} equal bins makes one turn take the frame period 1/frame_rate_hz = {:.9} s (mean spin {mean_spin_rad_s:.3} rad/s); the nearest periods they reach are {} below and {} above; change the set-points, bins or frame_rate_hz",
+                1.0 / frame_rate_hz,
+                side(below_s),
+                side(above_s),
+            )
+        }
     }
 }
 
@@ -192,6 +219,21 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "eye safety: power_w_min 1.0000e-3 W everywhere at the mean spin is 150.0 % of the Class 1 limit (worst at 2.000°) at 905 nm"
+        );
+        let e = Infeasible::FrameUnreachable {
+            limit: SpinLimit::SetPoints {
+                bins: 24,
+                count: 4,
+                below_s: Some(0.099_999),
+                above_s: None,
+            },
+            spin_rad_s: 209.0,
+            mean_spin_rad_s: 62.83185307179586,
+            frame_rate_hz: 10.0,
+        };
+        assert_eq!(
+            e.to_string(),
+            "levels.spin_rad_s: no choice of the 4 spin set-points on 24 equal bins makes one turn take the frame period 1/frame_rate_hz = 0.100000000 s (mean spin 62.832 rad/s); the nearest periods they reach are 0.099999000 s below and none above; change the set-points, bins or frame_rate_hz"
         );
         assert_eq!(
             CertificateError::DwellStep(Box::new(CertificateError::Unbounded)).to_string(),

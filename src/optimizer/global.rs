@@ -92,13 +92,15 @@
 
 use std::f64::consts::TAU;
 
-use super::certificate::{check, next_down, to_f64_up, LinearProgram};
+use super::certificate::{check, next_down, to_f64_up};
 use super::lp::{grid, Grid};
+use super::program::Program;
 use super::settings::S;
 use super::{OptError, Problem};
 use crate::model::angle::next_index;
 use crate::model::lidar::PowerAccounting;
 use crate::profile::{GlobalOptimality, Profile};
+use good_lp::{Expression, Variable};
 
 /// Tangent rows `u ≤ √a + (k·v − a)/(2√a)` of `√(k·v)` for `v ∈ [lo, hi]`,
 /// as (slope in v, intercept) pairs; points spread evenly in `√`.
@@ -160,16 +162,17 @@ fn tangent_segments(k: f64, lo: f64, hi: f64) -> (f64, Vec<(f64, f64)>) {
 /// Adds `√(k·v)`'s over-estimator on column `v ∈ [lo, hi]` with weight
 /// `c ≥ 0`: segment columns (cost `c·slope` rounded up) and the row
 /// `Σ δ − v ≤ −lo`; returns `c·g0` (rounded up), the caller's constant.
-fn add_concave_bound(lp: &mut LinearProgram, v: usize, k: f64, lo: f64, hi: f64, c: f64) -> f64 {
+fn add_concave_bound(lp: &mut Program, v: Variable, k: f64, lo: f64, hi: f64, c: f64) -> f64 {
     let up = |x: f64| -next_down(-x);
     let (g0, segments) = tangent_segments(k, lo, hi);
-    let mut row: Vec<(usize, f64)> = segments
+    let deltas: Vec<Variable> = segments
         .iter()
-        .map(|&(a, len)| (lp.add_col(0.0, len, up(c * a), false), 1.0))
+        .map(|&(a, len)| lp.column(0.0, len, up(c * a), false))
         .collect();
-    if !row.is_empty() {
-        row.push((v, -1.0));
-        lp.add_row(&row, f64::NEG_INFINITY, -lo);
+    if !deltas.is_empty() {
+        let mut row: Expression = deltas.into_iter().sum();
+        row.add_mul(-1.0, v);
+        lp.at_most("utility", row, -lo);
     }
     up(c * g0)
 }
@@ -362,6 +365,12 @@ pub(super) fn bound(
     gaze_deg: f64,
     profile: &Profile,
 ) -> Result<GlobalOptimality, OptError> {
+    if problem.objective.kind != super::ObjectiveKind::Sqrt {
+        return Err(OptError::Invalid {
+            field: "objective.kind".into(),
+            reason: "the global bound is derived for the √ utilities only".into(),
+        });
+    }
     let upper_bound = upper_bound(problem, gaze_deg)?;
     let j = model_objective(problem, gaze_deg, profile)?;
     let objective = j - S.objective_margin * j.abs();
@@ -427,7 +436,7 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     }
     let r = relaxation(problem, &g, &b);
     let solved = r.lp.solve("global bound")?;
-    let exact = check(&r.lp, &solved.x, &solved.y);
+    let exact = check(&r.lp.view(), &solved.x, &solved.y);
     let ub = exact
         .upper_bound
         .ok_or_else(|| OptError::Solver("global bound: no finite dual bound".into()))?;
@@ -631,14 +640,15 @@ fn separable_bound(problem: &Problem, g: &Grid, b: &Boxes) -> Option<f64> {
 
 /// The relaxation's LP and where its rows are.
 struct Relaxation {
-    lp: LinearProgram,
+    lp: Program,
     /// Per bin (column, lo, hi) of `x` and of `τ`.
-    xs: Vec<(usize, f64, f64)>,
-    taus: Vec<(usize, f64, f64)>,
-    frame_row: usize,
+    xs: Vec<(Variable, f64, f64)>,
+    taus: Vec<(Variable, f64, f64)>,
+    /// The frame's two rows (`≤`, `≥`).
+    frame_rows: (usize, usize),
     budget_row: usize,
-    /// (row, i, j, limit) per slew row.
-    slews: Vec<(usize, usize, usize, f64)>,
+    /// ((`≤` row, `≥` row), i, j, limit) per slew pair of rows.
+    slews: Vec<((usize, usize), usize, usize, f64)>,
 }
 
 /// The relaxation's LP: per bin `x`, `τ` and the utilities' concave
@@ -646,15 +656,15 @@ struct Relaxation {
 /// (McCormick envelopes under time accounting), `slew`.
 fn relaxation(problem: &Problem, g: &Grid, b: &Boxes) -> Relaxation {
     let o = &problem.objective;
-    let mut lp = LinearProgram::default();
+    let mut lp = Program::default();
     let mut xs = Vec::with_capacity(g.n);
     let mut taus = Vec::with_capacity(g.n);
     let mut constant = 0.0;
     let (x_lo, x_hi) = (b.x_lo, b.x_hi);
     for i in 0..g.n {
         let (t_lo, t_hi) = b.tau(g.theta[i]);
-        let x = lp.add_col(x_lo, x_hi, 0.0, false);
-        let tau = lp.add_col(t_lo, t_hi, 0.0, false);
+        let x = lp.column(x_lo, x_hi, 0.0, false);
+        let tau = lp.column(t_lo, t_hi, 0.0, false);
         let cw = g.theta[i] * g.weight[i];
         // A fixed block needs no tangents: its utility is a box bound
         // (√ rounded up by a relative 1e-15, above the true root).
@@ -662,13 +672,13 @@ fn relaxation(problem: &Problem, g: &Grid, b: &Boxes) -> Relaxation {
         if x_lo < x_hi {
             constant += add_concave_bound(&mut lp, x, 1.0, x_lo, x_hi, o.range_weight * cw);
         } else {
-            lp.add_col(0.0, up(x_hi), o.range_weight * cw, false);
+            lp.column(0.0, up(x_hi), o.range_weight * cw, false);
         }
         let k = b.k(g.theta[i]);
         if t_lo < t_hi {
             constant += add_concave_bound(&mut lp, tau, k, t_lo, t_hi, o.resolution_weight * cw);
         } else {
-            lp.add_col(0.0, up(k * t_hi), o.resolution_weight * cw, false);
+            lp.column(0.0, up(k * t_hi), o.resolution_weight * cw, false);
         }
         xs.push((x, x_lo, x_hi));
         taus.push((tau, t_lo, t_hi));
@@ -677,13 +687,13 @@ fn relaxation(problem: &Problem, g: &Grid, b: &Boxes) -> Relaxation {
     // most 2N non-negative doubles, each rounded up, raised by a relative
     // 1e-12 (far above the 2N·ε its rounding can lose).
     if constant > 0.0 {
-        lp.add_col(1.0, 1.0, constant * (1.0 + 1e-12), false);
+        lp.column(1.0, 1.0, constant * (1.0 + 1e-12), false);
     }
     let mut r = Relaxation {
         lp,
         xs,
         taus,
-        frame_row: 0,
+        frame_rows: (0, 0),
         budget_row: 0,
         slews: Vec::new(),
     };
@@ -696,16 +706,16 @@ fn relaxation(problem: &Problem, g: &Grid, b: &Boxes) -> Relaxation {
     r
 }
 
-/// `frame`: `N(1−widen) ≤ Σ τ ≤ N(1+widen)`.
+/// `frame`: `N(1−widen) ≤ Σ τ ≤ N(1+widen)` (two rows).
 fn relaxed_frame(r: &mut Relaxation, n: f64) {
-    let frame: Vec<(usize, f64)> = r.taus.iter().map(|&(t, _, _)| (t, 1.0)).collect();
-    r.frame_row = r.lp.rows.len();
-    r.budget_row = r.frame_row;
-    r.lp.add_row(
-        &frame,
+    let frame: Expression = r.taus.iter().map(|&(t, _, _)| t).sum();
+    r.frame_rows = r.lp.between(
+        "frame",
+        frame,
         n * (1.0 - S.global_widen),
         n * (1.0 + S.global_widen),
     );
+    r.budget_row = r.frame_rows.0;
 }
 
 /// `budget`: `Σ θ x ≤ 2π(1+widen)` (angle), or under time accounting
@@ -713,22 +723,24 @@ fn relaxed_frame(r: &mut Relaxation, n: f64) {
 fn relaxed_budget(r: &mut Relaxation, problem: &Problem, g: &Grid, n: f64) {
     match problem.lidar.power_accounting {
         PowerAccounting::Angle => {
-            let spend: Vec<(usize, f64)> = (0..g.n).map(|i| (r.xs[i].0, g.theta[i])).collect();
-            r.lp.add_row(&spend, f64::NEG_INFINITY, TAU * (1.0 + S.global_widen));
+            let mut spend = Expression::with_capacity(g.n);
+            for i in 0..g.n {
+                spend.add_mul(g.theta[i], r.xs[i].0);
+            }
+            r.lp.at_most("budget", spend, TAU * (1.0 + S.global_widen));
         }
         PowerAccounting::Time => {
-            let mut spend = Vec::with_capacity(g.n);
+            let mut spend = Expression::with_capacity(g.n);
             for i in 0..g.n {
                 let (x, xl, xh) = r.xs[i];
                 let (t, tl, th) = r.taus[i];
-                let w = r.lp.add_col(xl * tl, xh * th, 0.0, false);
+                let w = r.lp.column(xl * tl, xh * th, 0.0, false);
                 // w ≥ tl·x + xl·τ − tl·xl and w ≥ th·x + xh·τ − th·xh.
-                r.lp.add_row(&[(w, 1.0), (x, -tl), (t, -xl)], -tl * xl, f64::INFINITY);
-                r.lp.add_row(&[(w, 1.0), (x, -th), (t, -xh)], -th * xh, f64::INFINITY);
-                spend.push((w, 1.0));
+                r.lp.at_least("mccormick", w - tl * x - xl * t, -tl * xl);
+                r.lp.at_least("mccormick", w - th * x - xh * t, -th * xh);
+                spend.add_mul(1.0, w);
             }
-            r.budget_row = r.lp.rows.len();
-            r.lp.add_row(&spend, f64::NEG_INFINITY, n * (1.0 + S.global_widen));
+            r.budget_row = r.lp.at_most("budget", spend, n * (1.0 + S.global_widen));
         }
     }
 }
@@ -738,8 +750,8 @@ fn relaxed_slew(r: &mut Relaxation, g: &Grid, s: f64, p_mean: f64) {
     for i in 0..g.n {
         let j = next_index(i, g.n);
         let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 + S.global_widen);
-        r.slews.push((r.lp.rows.len(), i, j, lim));
-        r.lp.add_row(&[(r.xs[j].0, 1.0), (r.xs[i].0, -1.0)], -lim, lim);
+        let rows = r.lp.between("slew", r.xs[j].0 - r.xs[i].0, -lim, lim);
+        r.slews.push((rows, i, j, lim));
     }
 }
 
@@ -761,8 +773,9 @@ fn coupled_bound(problem: &Problem, g: &Grid, b: &Boxes, r: &Relaxation, y: &[f6
         })
         .collect();
     let duals = Duals {
+        // A two-sided family's multiplier: the sum of its two rows'.
         frame: (
-            y[r.frame_row],
+            y[r.frame_rows.0] + y[r.frame_rows.1],
             n * (1.0 - S.global_widen),
             n * (1.0 + S.global_widen),
         ),
@@ -770,7 +783,7 @@ fn coupled_bound(problem: &Problem, g: &Grid, b: &Boxes, r: &Relaxation, y: &[f6
         slews: r
             .slews
             .iter()
-            .map(|&(row, i, j, lim)| (y[row], i, j, lim))
+            .map(|&((hi, lo), i, j, lim)| (y[hi] + y[lo], i, j, lim))
             .collect(),
     };
     let duals = improve_multipliers(&bins, duals);

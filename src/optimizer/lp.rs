@@ -10,8 +10,10 @@
 // variables); indices read like the formulation.
 #![allow(clippy::needless_range_loop)]
 
-use super::certificate::{Certified, LinearProgram, SolveOptions, Step};
-use super::utility::{sqrt_segments, sqrt_segments_n, SqrtSegments};
+use super::certificate::{Certified, LinearProgram, Step};
+use super::program::{Program, SolveOptions};
+use super::utility::{sqrt_segments_n, SqrtSegments};
+use good_lp::{Expression, IntoAffineExpression, Variable};
 use std::f64::consts::TAU;
 
 use super::error::{CertificateError, Infeasible, SpinLimit};
@@ -232,6 +234,13 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
             reason: "spin set-points step the spin, which a finite limits.spin_accel_rad_s2_max forbids; drop the set-points for smooth spin".into(),
         });
     }
+    levels_valid(problem)?;
+    setpoints_reach_frame(problem)
+}
+
+/// The hardware levels and spin set-points are finite, ≥ 0 (powers) and
+/// > 0 (spins).
+fn levels_valid(problem: &Problem) -> Result<(), OptError> {
     for (k, &lv) in problem.levels.power_w.iter().enumerate() {
         if !(lv.is_finite() && lv >= 0.0) {
             return Err(OptError::Invalid {
@@ -249,6 +258,43 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
         }
     }
     Ok(())
+}
+
+/// With spin set-points on equal bins, some choice of them must make one
+/// turn take the frame period (see [`super::setpoints`]); otherwise the
+/// request is [`SpinLimit::SetPoints`] unreachable.
+fn setpoints_reach_frame(problem: &Problem) -> Result<(), OptError> {
+    use super::setpoints::{reach, Reach};
+    let l = &problem.lidar.limits;
+    let allowed: Vec<f64> = (problem.levels.spin_rad_s.iter().copied())
+        .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
+        .collect();
+    if allowed.is_empty() || !problem.objective.mode.controls_resolution() {
+        return Ok(());
+    }
+    let g = grid(problem, 0.0)?;
+    if g.theta.iter().any(|&th| th != g.theta[0]) {
+        return Ok(());
+    }
+    let w_mean = problem.lidar.mean_spin_rad_s();
+    let r: Vec<f64> = allowed.iter().map(|&w| w_mean / w).collect();
+    let Reach::Misses { below, above } = reach(&r, g.n, S.setpoint_search_steps) else {
+        return Ok(());
+    };
+    let period = 1.0 / problem.lidar.frame_rate_hz;
+    let per = |v: f64| v * period / g.n as f64;
+    Err(Infeasible::FrameUnreachable {
+        limit: SpinLimit::SetPoints {
+            bins: g.n,
+            count: allowed.len(),
+            below_s: below.map(per),
+            above_s: above.map(per),
+        },
+        spin_rad_s: allowed.iter().copied().fold(0.0, f64::max),
+        mean_spin_rad_s: w_mean,
+        frame_rate_hz: problem.lidar.frame_rate_hz,
+    }
+    .into())
 }
 
 /// Dwell of each bin under `spins` (constant acceleration within a bin), s.
@@ -291,7 +337,7 @@ fn power_step(
             }
             (other, _) => other,
         })?;
-        let p = powers(problem, g, t, &program.bins, &program.x, &solved.x);
+        let p = powers(problem, g, t, &program, &solved.x);
         let checkpoint = match eye {
             None => Checkpoint::Certified,
             Some(e) => power_checkpoint(e, g, spins, &p, pool, &factor, round)?,
@@ -302,7 +348,7 @@ fn power_step(
                 return Ok((
                     p,
                     PowerLp {
-                        lp: program.lp,
+                        lp: program.lp.view(),
                         bins: program.bins,
                         one: program.one,
                         tightening: (top > 1.0).then_some(top),
@@ -328,8 +374,8 @@ fn power_step(
     }
 }
 
-/// A linear form over a program's columns: (column, coefficient) pairs.
-type LinearForm = Vec<(usize, f64)>;
+/// A linear form over a program's columns (a good_lp expression).
+type LinearForm = Expression;
 
 /// What one round of the power step's cutting-plane loop decides (in the
 /// manner of Clarabel's `solve()`: each named step returns where to go).
@@ -428,9 +474,9 @@ fn power_checkpoint(
 /// The power step's program for the cuts in `pool` (their limits divided by
 /// `factor`), and how each bin's power reads from its columns.
 struct PowerProgram {
-    lp: LinearProgram,
+    lp: Program,
     /// `x_i = p_i / P̄` as a linear form (a continuous column or Σ levels·z).
-    x: Vec<Vec<(usize, f64)>>,
+    x: Vec<LinearForm>,
     bins: Vec<PowerBin>,
     /// The column fixed at 1 that carries the utilities' constants.
     one: Option<usize>,
@@ -449,18 +495,21 @@ fn power_program(
     factor: &[f64; 2],
 ) -> Result<PowerProgram, OptError> {
     let (caps, bare) = eye_caps(problem, g, eye, pool, factor);
-    let mut lp = LinearProgram::default();
+    let mut lp = Program::default();
     let mut x = Vec::with_capacity(g.n);
     let mut bins = Vec::with_capacity(g.n);
     let mut utility_constant = 0.0;
     for i in 0..g.n {
-        let (form, bin, constant) = power_bin(&mut lp, problem, g, i, caps[i], bare[i])?;
+        let (form, bin, constant) = power_bin(&mut lp, problem, g, i, t[i], caps[i], bare[i])?;
         x.push(form);
         bins.push(bin);
         utility_constant += constant;
     }
     // The utilities' constants Σ c·√lo as one column fixed at 1.
-    let one = (utility_constant != 0.0).then(|| lp.add_col(1.0, 1.0, utility_constant, false));
+    let one = (utility_constant != 0.0).then(|| {
+        let v = lp.column(1.0, 1.0, utility_constant, false);
+        lp.col(v)
+    });
     budget(&mut lp, problem, g, t, &x);
     if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
         slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
@@ -506,10 +555,11 @@ fn eye_caps(
 /// continuous column and its utility's segments). Returns `x_i` as a linear
 /// form, how the bin reads back, and its utility's constant.
 fn power_bin(
-    lp: &mut LinearProgram,
+    lp: &mut Program,
     problem: &Problem,
     g: &Grid,
     i: usize,
+    dwell_s: f64,
     cap_w: f64,
     bare_w: f64,
 ) -> Result<(LinearForm, PowerBin, f64), OptError> {
@@ -527,33 +577,35 @@ fn power_bin(
     let hi = l.power_w_max.min(cap_w.max(l.power_w_min));
     let c = problem.objective.range_weight * g.theta[i] * g.weight[i];
     if !problem.levels.power_w.is_empty() {
-        let (form, bin) = levels(lp, problem, i, hi, c)?;
+        let value = |x: f64| super::detection::level_value(problem, g.theta[i], dwell_s, x);
+        let (form, bin) = levels(lp, problem, i, hi, c, value)?;
         return Ok((form, bin, 0.0));
     }
     let lo_x = l.power_w_min / p_mean;
     let hi_x = (hi / p_mean * (1.0 - S.margin)).max(lo_x);
-    let xi = lp.add_col(lo_x, hi_x, 0.0, false);
+    let xi = lp.column(lo_x, hi_x, 0.0, false);
     // The utility as boxed segment columns (see `utility`).
-    let shape = sqrt_segments(lo_x, hi_x);
+    let shape = super::detection::range_segments(problem, g.theta[i], dwell_s, lo_x, hi_x);
     let deltas = shape.add_to(lp, xi, 1.0, lo_x, c);
     let constant = c * shape.base;
     let bin = PowerBin::Continuous {
-        x: xi,
+        x: lp.col(xi),
         lo: lo_x,
-        deltas,
+        deltas: deltas.into_iter().map(|d| lp.col(d)).collect(),
         shape,
     };
-    Ok((vec![(xi, 1.0)], bin, constant))
+    Ok((xi.into(), bin, constant))
 }
 
 /// `levels`: one binary column per hardware level within
 /// `[power_w_min, hi_w]` (cost `c·√(level/P̄)`) and the one-hot row `Σ z = 1`.
 fn levels(
-    lp: &mut LinearProgram,
+    lp: &mut Program,
     problem: &Problem,
     i: usize,
     hi_w: f64,
     c: f64,
+    value: impl Fn(f64) -> f64,
 ) -> Result<(LinearForm, PowerBin), OptError> {
     let floor = problem.lidar.limits.power_w_min;
     let p_mean = problem.lidar.average_power_w;
@@ -572,19 +624,17 @@ fn levels(
         }
         .into());
     }
-    let zs: Vec<(f64, usize)> = allowed
+    let zs: Vec<(f64, Variable)> = allowed
         .iter()
-        .map(|&lv| (lv, lp.add_col(0.0, 1.0, c * (lv / p_mean).sqrt(), true)))
+        .map(|&lv| (lv, lp.column(0.0, 1.0, c * value(lv / p_mean), true)))
         .collect();
-    let one: Vec<(usize, f64)> = zs.iter().map(|&(_, z)| (z, 1.0)).collect();
-    lp.add_row(&one, 1.0, 1.0);
-    let form = zs.iter().map(|&(lv, z)| (z, lv / p_mean)).collect();
-    Ok((form, PowerBin::Levels(zs)))
-}
-
-/// `k·form` appended to `out`.
-fn scaled(k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>) {
-    out.extend(form.iter().map(|&(j, a)| (j, k * a)));
+    lp.equal("levels", zs.iter().map(|&(_, z)| z).sum(), 1.0);
+    let mut form = Expression::with_capacity(zs.len());
+    for &(lv, z) in &zs {
+        form.add_mul(lv / p_mean, z);
+    }
+    let cols = zs.iter().map(|&(lv, z)| (lv, lp.col(z))).collect();
+    Ok((form, PowerBin::Levels(cols)))
 }
 
 /// `budget`: `Σ θ_i x_i ≤ 2π` (angle accounting) or `Σ (t_i/T) x_i ≤ 1`
@@ -592,44 +642,44 @@ fn scaled(k: f64, form: &[(usize, f64)], out: &mut Vec<(usize, f64)>) {
 /// plus `level_budget_slack` (far inside the checker's REL_TOL) so that a
 /// level choice that meets it in floating point (the closed form's does, to
 /// the last bit) also meets it in the exact arithmetic of the certificate.
-fn budget(lp: &mut LinearProgram, problem: &Problem, g: &Grid, t: &[f64], x: &[Vec<(usize, f64)>]) {
+fn budget(lp: &mut Program, problem: &Problem, g: &Grid, t: &[f64], x: &[LinearForm]) {
     let budget_margin = if problem.levels.power_w.is_empty() {
         1.0 - S.margin
     } else {
         1.0 + S.level_budget_slack
     };
     let period: f64 = t.iter().sum();
-    let mut spend = Vec::new();
+    let mut spend = Expression::default();
     let budget = match problem.lidar.power_accounting {
         PowerAccounting::Angle => {
             for i in 0..g.n {
-                scaled(g.theta[i], &x[i], &mut spend);
+                spend.add_mul(g.theta[i], &x[i]);
             }
             TAU * budget_margin
         }
         PowerAccounting::Time => {
             for i in 0..g.n {
-                scaled(t[i] / period, &x[i], &mut spend);
+                spend.add_mul(t[i] / period, &x[i]);
             }
             budget_margin
         }
     };
     // A floor that spends the whole budget (power_w_min = P̄) keeps its own
     // spend: the margin must not make the all-floor answer infeasible.
-    let floor_spend: f64 = spend.iter().map(|&(j, a)| a * lp.col_lo[j]).sum();
-    lp.add_row(&spend, f64::NEG_INFINITY, budget.max(floor_spend));
+    let floor: Vec<f64> = (0..lp.len()).map(|j| lp.bounds(j).0).collect();
+    let floor_spend = lp.eval(&spend, &floor);
+    lp.at_most("budget", spend, budget.max(floor_spend));
 }
 
 /// `slew`: `|x_{i+1} − x_i| ≤ s·(Δ_i + Δ_{i+1})/2·(1 − margin)` around the
 /// circle (`s` in W per degree, `x` in units of `p_mean`).
-fn slew(lp: &mut LinearProgram, g: &Grid, x: &[Vec<(usize, f64)>], s: f64, p_mean: f64) {
+fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
     for i in 0..g.n {
         let j = next_index(i, g.n);
         let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
-        let mut d = Vec::new();
-        scaled(1.0, &x[j], &mut d);
-        scaled(-1.0, &x[i], &mut d);
-        lp.add_row(&d, -lim, lim);
+        let mut d = x[j].clone();
+        d.add_mul(-1.0, &x[i]);
+        lp.between("slew", d, -lim, lim);
     }
 }
 
@@ -637,21 +687,21 @@ fn slew(lp: &mut LinearProgram, g: &Grid, x: &[Vec<(usize, f64)>], s: f64, p_mea
 /// `Σ n_b·x_b·P̄ / (f_p·limit) ≤ cut_rhs` (single-bin cuts are column
 /// bounds, see [`eye_caps`]).
 fn eye_cuts(
-    lp: &mut LinearProgram,
+    lp: &mut Program,
     problem: &Problem,
     e: &Eye,
     pool: &[Cut],
     factor: &[f64; 2],
-    x: &[Vec<(usize, f64)>],
+    x: &[LinearForm],
 ) -> Result<(), OptError> {
     let l = &problem.lidar.limits;
     let p_mean = problem.lidar.average_power_w;
     for c in pool.iter().filter(|c| c.pulses.len() > 1) {
-        let mut row = Vec::new();
+        let mut row = Expression::default();
         let f = factor[cut_class(c)];
         let limit = c.limit_j / f;
         for &(b, n) in &c.pulses {
-            scaled(n * p_mean / (e.pulse_rate_hz * limit), &x[b], &mut row);
+            row.add_mul(n * p_mean / (e.pulse_rate_hz * limit), &x[b]);
         }
         // A floor alone at more than the row's side (but within the bare
         // limit: checked below) keeps its own value.
@@ -667,11 +717,7 @@ fn eye_cuts(
             }
             .into());
         }
-        lp.add_row(
-            &row,
-            f64::NEG_INFINITY,
-            cut_rhs().max(at_floor * (1.0 + 1e-12)),
-        );
+        lp.at_most("eye_cuts", row, cut_rhs().max(at_floor * (1.0 + 1e-12)));
     }
     Ok(())
 }
@@ -680,19 +726,13 @@ fn eye_cuts(
 /// powers clamped into their bounds and trimmed to the budget exactly
 /// (lower powers never break a cut: every cut has nonnegative
 /// coefficients).
-fn powers(
-    problem: &Problem,
-    g: &Grid,
-    t: &[f64],
-    bins: &[PowerBin],
-    x: &[Vec<(usize, f64)>],
-    sol: &[f64],
-) -> Vec<f64> {
+fn powers(problem: &Problem, g: &Grid, t: &[f64], program: &PowerProgram, sol: &[f64]) -> Vec<f64> {
+    let (bins, x) = (&program.bins, &program.x);
     let lid = &problem.lidar;
     let l = &lid.limits;
     let p_mean = lid.average_power_w;
     let period: f64 = t.iter().sum();
-    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * sol[j]).sum::<f64>();
+    let eval = |form: &LinearForm| program.lp.eval(form, sol);
     let mut p: Vec<f64> = bins
         .iter()
         .zip(x)
@@ -910,11 +950,12 @@ fn dwell_step(
             primal_feasibility_tolerance: S.dwell_feasibility_tol,
         },
     )?;
-    let x = d.lp.clamped(&solved.x);
+    let view = d.lp.view();
+    let x = view.clamped(&solved.x);
     let t = dwell_answer(problem, g, &d, &x);
     let cert = Certified::new(
         Step::Dwell,
-        d.lp.widened(2.0 * S.dwell_feasibility_tol),
+        view.widened(2.0 * S.dwell_feasibility_tol),
         x,
         solved.y,
         solved.solver_dual_bound,
@@ -925,9 +966,9 @@ fn dwell_step(
 
 /// The dwell step's program and how each bin's dwell reads from it.
 struct DwellProgram {
-    lp: LinearProgram,
+    lp: Program,
     /// `τ_i = t_i / unit` as a linear form over the columns.
-    tau: Vec<Vec<(usize, f64)>>,
+    tau: Vec<LinearForm>,
     /// Per bin with set-points, (spin, binary column) per set-point.
     sp_cols: Vec<Vec<(f64, usize)>>,
     /// The hot start, one value per column.
@@ -965,7 +1006,7 @@ fn dwell_program(
         }
     }
     let mut d = DwellProgram {
-        lp: LinearProgram::default(),
+        lp: Program::default(),
         tau: Vec::with_capacity(g.n),
         sp_cols: Vec::new(),
         start: Vec::new(),
@@ -984,7 +1025,7 @@ fn dwell_program(
     // power step's), so the program's objective is the chord model's value
     // of the profile, comparable with `exact_objective`.
     if utility_constant != 0.0 {
-        d.lp.add_col(1.0, 1.0, utility_constant, false);
+        d.lp.column(1.0, 1.0, utility_constant, false);
         d.start.push(1.0);
     }
     frame(&mut d, g.n);
@@ -1019,7 +1060,7 @@ fn dwell_column(
         hi = hi.min(current_s / unit * (1.0 + S.trust)).max(lo);
     }
     let t0 = (current_s / unit).max(lo).min(hi);
-    let ti = d.lp.add_col(lo, hi, 0.0, false);
+    let ti = d.lp.column(lo, hi, 0.0, false);
     d.start.push(t0);
     // Density ratio r = t·2π/(θ·T) = τ · (unit·2π/(θ·T)).
     let k = unit * TAU / (th * period);
@@ -1044,7 +1085,7 @@ fn dwell_column(
     let c = problem.objective.resolution_weight * th * g.weight[i];
     shape.add_to(&mut d.lp, ti, k, r_0, c);
     d.start.extend(shape.fill(r_0, k * t0));
-    d.tau.push(vec![(ti, 1.0)]);
+    d.tau.push(ti.into());
     c * shape.base
 }
 
@@ -1075,26 +1116,33 @@ fn spin_levels(d: &mut DwellProgram, problem: &Problem, g: &Grid, i: usize, allo
     let th = g.theta[i];
     let w_mean = problem.lidar.mean_spin_rad_s();
     let lam = problem.objective.resolution_weight;
-    let ys: Vec<(f64, usize)> = allowed
+    let ys: Vec<(f64, Variable)> = allowed
         .iter()
         .map(|&w| {
             let cost = lam * th * g.weight[i] * (w_mean / w).sqrt();
             d.start.push(0.0);
-            (w, d.lp.add_col(0.0, 1.0, cost, true))
+            (w, d.lp.column(0.0, 1.0, cost, true))
         })
         .collect();
-    let one: Vec<(usize, f64)> = ys.iter().map(|&(_, y)| (y, 1.0)).collect();
-    d.lp.add_row(&one, 1.0, 1.0);
+    d.lp.equal("levels", ys.iter().map(|&(_, y)| y).sum(), 1.0);
     let unit = d.unit;
-    d.tau
-        .push(ys.iter().map(|&(w, y)| (y, th / w / unit)).collect());
-    d.sp_cols.push(ys);
+    let mut tau = Expression::with_capacity(ys.len());
+    for &(w, y) in &ys {
+        tau.add_mul(th / w / unit, y);
+    }
+    d.tau.push(tau);
+    let cols = ys.iter().map(|&(w, y)| (w, d.lp.col(y))).collect();
+    d.sp_cols.push(cols);
 }
 
 /// `frame`: `Σ τ_i = N` (one turn per frame period).
 fn frame(d: &mut DwellProgram, n: usize) {
     let n = n as f64;
-    d.lp.add_row(&d.tau.concat(), n, n);
+    let mut turn = Expression::default();
+    for form in &d.tau {
+        turn.add_mul(1.0, form);
+    }
+    d.lp.equal("frame", turn, n);
 }
 
 /// `budget` under time accounting at the fixed powers `p`:
@@ -1102,22 +1150,19 @@ fn frame(d: &mut DwellProgram, n: usize) {
 /// tight. The power step that ends every joint solve trims the budget
 /// exactly.
 fn dwell_budget(d: &mut DwellProgram, p: &[f64], p_mean: f64, n: usize) {
-    let spend: Vec<(usize, f64)> = d
-        .tau
-        .iter()
-        .zip(p)
-        .flat_map(|(form, &pi)| form.iter().map(move |&(j, a)| (j, a * pi / p_mean)))
-        .collect();
-    d.lp.add_row(&spend, f64::NEG_INFINITY, n as f64);
+    let mut spend = Expression::default();
+    for (form, &pi) in d.tau.iter().zip(p) {
+        for (v, a) in form.linear_coefficients() {
+            spend.add_mul(a * pi / p_mean, v);
+        }
+    }
+    d.lp.at_most("budget", spend, n as f64);
 }
 
 /// `accel`: the change of slowness `s = t/θ` between neighbours,
 /// `|Δs| ≤ accel_share·a·Δθ·(1−trust)³/ω̃³`, linearised at the iterate.
 fn accel(d: &mut DwellProgram, g: &Grid, current: &[f64], a_max: f64) {
     let unit = d.unit;
-    let scaled = |form: &[(usize, f64)], k: f64| -> Vec<(usize, f64)> {
-        form.iter().map(|&(c, a)| (c, a * k)).collect()
-    };
     for i in 0..g.n {
         let j = next_index(i, g.n);
         let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
@@ -1125,8 +1170,10 @@ fn accel(d: &mut DwellProgram, g: &Grid, current: &[f64], a_max: f64) {
         let ds = S.accel_share * a_max * dtheta * (1.0 - S.trust).powi(3) / w_cur.powi(3);
         // s = t/θ = τ·unit/θ.
         let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
-        let diff = [scaled(&d.tau[j], kj), scaled(&d.tau[i], -ki)].concat();
-        d.lp.add_row(&diff, -ds, ds);
+        let mut diff = Expression::default();
+        diff.add_mul(kj, &d.tau[j]);
+        diff.add_mul(-ki, &d.tau[i]);
+        d.lp.between("accel", diff, -ds, ds);
     }
 }
 
@@ -1140,13 +1187,13 @@ fn linearised_eye_cuts(
     current: &[f64],
 ) {
     for c in binding {
-        let mut en: Vec<(usize, f64)> = Vec::new();
+        let mut en = Expression::default();
         for &(b, cnt) in &c.pulses {
             let tau0 = current[b] / d.unit;
             let k = cnt * p[b] / (pulse_rate_hz * c.limit_j) / tau0;
-            en.extend(d.tau[b].iter().map(|&(col, a)| (col, a * k)));
+            en.add_mul(k, &d.tau[b]);
         }
-        d.lp.add_row(&en, f64::NEG_INFINITY, cut_rhs());
+        d.lp.at_most("eye_cuts", en, cut_rhs());
     }
 }
 
@@ -1167,8 +1214,11 @@ fn dwell_answer(problem: &Problem, g: &Grid, d: &DwellProgram, x: &[f64]) -> Vec
             })
             .collect();
     }
-    let eval = |form: &[(usize, f64)]| form.iter().map(|&(j, a)| a * x[j]).sum::<f64>();
-    let mut t: Vec<f64> = d.tau.iter().map(|form| eval(form) * d.unit).collect();
+    let mut t: Vec<f64> = d
+        .tau
+        .iter()
+        .map(|form| d.lp.eval(form, x) * d.unit)
+        .collect();
     // Exact frame period.
     let period = 1.0 / problem.lidar.frame_rate_hz;
     let s: f64 = t.iter().sum();

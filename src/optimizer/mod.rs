@@ -43,12 +43,15 @@
 
 pub mod certificate;
 pub mod config;
+pub mod detection;
 pub mod error;
 mod exact;
 pub mod fast;
 pub mod figures;
 pub mod global;
 mod lp;
+pub mod program;
+mod setpoints;
 pub mod settings;
 mod utility;
 
@@ -61,6 +64,7 @@ use crate::model::lidar::{LidarSpec, PowerAccounting};
 use crate::model::Mode;
 
 pub use config::OptimizerConfig;
+pub use detection::{Detection, ObjectiveKind};
 pub use error::{CertificateError, Infeasible, SpinLimit};
 pub use settings::OptimizerSettings;
 
@@ -93,6 +97,10 @@ pub struct Objective {
     pub floor_weight: f64,
     /// Static priors.
     pub priors: Vec<Prior>,
+    /// The power step's per-bin value: `sqrt` (default) or `detection`.
+    pub kind: ObjectiveKind,
+    /// The detection objective's target and conditions (`kind = "detection"`).
+    pub detection: Detection,
 }
 
 impl Default for Objective {
@@ -103,6 +111,8 @@ impl Default for Objective {
             resolution_weight: 1.0,
             floor_weight: 1e-3,
             priors: Vec::new(),
+            kind: ObjectiveKind::Sqrt,
+            detection: Detection::default(),
         }
     }
 }
@@ -222,6 +232,18 @@ impl Problem {
     }
 }
 
+impl Problem {
+    /// Drops the spin set-points when a finite acceleration limit forbids
+    /// the spin steps between them and the mode moves the spin (the
+    /// optimizer then ramps the spin); returns the set-points dropped.
+    pub fn drop_forbidden_setpoints(&mut self) -> Option<Vec<f64>> {
+        let forbidden = !self.levels.spin_rad_s.is_empty()
+            && self.lidar.limits.spin_accel_rad_s2_max.is_some()
+            && self.objective.mode.controls_resolution();
+        forbidden.then(|| std::mem::take(&mut self.levels.spin_rad_s))
+    }
+}
+
 /// Optimizes for `gaze_deg` and certifies the result; its `optimality`
 /// block states the final power step's exact gap (see [`certificate`]).
 pub fn optimize(problem: &Problem, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
@@ -328,6 +350,13 @@ pub fn exact_objective(
         .enumerate()
         .map(|(i, b)| {
             let (range, res) = utilities(problem, g.theta[i], b);
+            let range = if o.kind == ObjectiveKind::Detection {
+                let dwell = crate::profile::kinematics::BinMotion::dwell_s(b);
+                let x = b.power_w / problem.lidar.average_power_w;
+                detection::exact_range_utility(problem, g.theta[i], dwell, x)
+            } else {
+                range
+            };
             let range = if o.mode.controls_range() {
                 o.range_weight * range
             } else {

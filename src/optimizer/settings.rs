@@ -103,6 +103,13 @@ pub struct OptimizerSettings {
     /// the frame period); without one there either, the step reports that
     /// it found none.
     pub mip_max_nodes_without_incumbent: i32,
+    /// Steps of the search for a choice of spin set-points that meets the
+    /// frame period on equal bins before any solve (default 5·10⁷; one step
+    /// per count of all set-points but the last two: about `C(N+K−2, K−2)`
+    /// for `K` set-points on `N` bins, 2.6·10⁵ at 720 bins and 4
+    /// set-points, 6.3·10⁷ with 5, past the default); past it the dwell
+    /// step decides.
+    pub setpoint_search_steps: u64,
     /// HiGHS's `mip_feasibility_tolerance` for every MILP (default 1e-10,
     /// its minimum): its default, 1e-6, lets a level choice overspend the
     /// budget by far more than the checker's relative 1e-9 (found by
@@ -160,6 +167,7 @@ impl OptimizerSettings {
         repair_tries: 40,
         primal_feasibility_tol: 1e-7,
         dwell_feasibility_tol: 1e-9,
+        setpoint_search_steps: 50_000_000,
         mip_max_nodes: 100,
         mip_max_nodes_without_incumbent: 5000,
         mip_feasibility_tol: 1e-10,

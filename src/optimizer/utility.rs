@@ -17,7 +17,8 @@
 //! pivots; the rows were most of the power and dwell steps' programs).
 //! Every slope is positive (√ grows), which is what makes the fill greedy.
 
-use super::certificate::LinearProgram;
+use super::program::Program;
+use good_lp::{Expression, Variable};
 
 /// `√v` on `[lo, hi]` as segments: the value at `lo` and `(slope, length)`
 /// per segment, slopes decreasing.
@@ -60,21 +61,21 @@ impl SqrtSegments {
     /// returns the columns. The constant `c·√lo` is the caller's.
     pub(super) fn add_to(
         &self,
-        lp: &mut LinearProgram,
-        v: usize,
+        prog: &mut Program,
+        v: Variable,
         k: f64,
         lo: f64,
         c: f64,
-    ) -> Vec<usize> {
-        let deltas: Vec<usize> = self
+    ) -> Vec<Variable> {
+        let deltas: Vec<Variable> = self
             .segments
             .iter()
-            .map(|&(a, len)| lp.add_col(0.0, len, c * a, false))
+            .map(|&(a, len)| prog.column(0.0, len, c * a, false))
             .collect();
         if !deltas.is_empty() {
-            let mut row: Vec<(usize, f64)> = deltas.iter().map(|&d| (d, 1.0)).collect();
-            row.push((v, -k));
-            lp.add_row(&row, f64::NEG_INFINITY, -lo);
+            let mut row: Expression = deltas.iter().copied().sum();
+            row.add_mul(-k, v);
+            prog.at_most("utility", row, -lo);
         }
         deltas
     }

@@ -18,7 +18,9 @@ pub mod gaze_drive;
 #[cfg(feature = "cli")]
 pub mod plots;
 pub mod report;
-pub mod returns;
+/// The return models live in [`crate::model::returns`] (the optimizer's
+/// detection objective calls them too); re-exported here.
+pub use crate::model::returns;
 pub mod scene;
 pub mod stats;
 pub mod sweep;

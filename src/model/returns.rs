@@ -354,6 +354,73 @@ impl ReturnModel {
     }
 }
 
+impl ReturnModel {
+    /// Expected returns per frame from a normal-incidence target `width_m`
+    /// wide at `range_m`, scanned with an angular spacing of `spacing_rad`
+    /// between pulses: `W/(R·Δφ)` pulses meet it (the expectation over the
+    /// scan's phase), each a point with [`Self::detection_probability`].
+    #[must_use]
+    pub fn expected_returns(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        width_m: f64,
+        spacing_rad: f64,
+        range_m: f64,
+    ) -> f64 {
+        let pulses = width_m / (range_m * spacing_rad);
+        pulses * self.detection_probability(power_ratio, reflectivity, 1.0, range_m)
+    }
+
+    /// Detection range: the largest range at which a normal-incidence target
+    /// `width_m` wide of `reflectivity`, scanned at `spacing_rad`, gives at
+    /// least `detect` expected returns per frame ([`Self::expected_returns`]),
+    /// m; 0 when even 1 cm is short. Both factors fall with the range (the
+    /// pulses across the target as `1/R`; `P_D` as the amplitude, or the
+    /// `argus` intensity, falls), so the set of ranges that detect is an
+    /// interval from 0 and bisection finds its end, to a relative 1e-12.
+    /// The bracket is `[0.01, R_max]` m, `R_max` the least of 10⁴ m, the
+    /// range where even `P_D = 1` leaves fewer than `detect` pulses on the
+    /// target (`W/(Δφ·detect)`), and `argus`'s 100 m: beyond each, no range
+    /// detects.
+    #[must_use]
+    pub fn detection_range_m(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        width_m: f64,
+        spacing_rad: f64,
+        detect: f64,
+    ) -> f64 {
+        let ok = |r: f64| {
+            self.expected_returns(power_ratio, reflectivity, width_m, spacing_rad, r) >= detect
+        };
+        let mut hi = (width_m / (spacing_rad * detect)).min(10_000.0);
+        if let Self::Argus { .. } = self {
+            hi = hi.min(ARGUS_RANGE_M);
+        }
+        let mut lo = 0.01;
+        if !(hi > lo && ok(lo)) {
+            return 0.0;
+        }
+        if ok(hi) {
+            return hi;
+        }
+        for _ in 0..100 {
+            if hi - lo <= 1e-12 * hi {
+                break;
+            }
+            let mid = 0.5 * (lo + hi);
+            if ok(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    }
+}
+
 /// Width of the range buckets of [`Saturation`], m (a power of two: the
 /// bucket index `⌊r / w⌋` is exact).
 pub(crate) const RANGE_BUCKET_M: f64 = 0.25;

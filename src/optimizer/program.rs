@@ -1,0 +1,522 @@
+//! The optimizer's programs as good_lp models, solved by HiGHS.
+//!
+//! A [`Program`] holds good_lp variables (boxed, some integral), the
+//! objective (maximised) and named good_lp [`Constraint`]s, each one-sided
+//! or an equality (good_lp's constraints are; a two-sided family such as
+//! `slew` or `accel` is two rows, `≤` then `≥`). HiGHS gets the model
+//! through good_lp's `highs` solver (`HighsProblem::try_into_inner`, so the
+//! options, the hot start, the row duals and the MIP dual bound stay
+//! reachable), one row per constraint in the order they were added.
+//!
+//! The exact certificate never sees anything but these constraints:
+//! [`Program::view`] reads every constraint back through good_lp's
+//! accessors (`Constraint::expression`, `is_equality`) into the
+//! [`LinearProgram`] that [`super::certificate::check`] checks, row for row
+//! the rows HiGHS solved (a `≥` constraint, stored by good_lp as
+//! `lo − a·x ≤ 0`, as `a·x ≥ lo`, the row HiGHS got), so HiGHS's row duals
+//! are the certificate's multipliers as they are.
+
+use std::collections::HashMap;
+
+use good_lp::solvers::highs::highs;
+use good_lp::{
+    variable, Constraint, Expression, IntoAffineExpression, ProblemVariables, SolverModel, Variable,
+};
+
+use super::certificate::{LinearProgram, Row};
+use super::error::Infeasible;
+use super::settings::S;
+use super::OptError;
+
+/// How a constraint was written (good_lp stores every inequality as
+/// `expression ≤ 0`; the row HiGHS gets keeps the written direction).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Sense {
+    AtMost,
+    AtLeast,
+    Equal,
+}
+
+/// One boxed column.
+#[derive(Debug, Clone, Copy)]
+struct Column {
+    lo: f64,
+    hi: f64,
+    cost: f64,
+    integer: bool,
+}
+
+/// A good_lp model: `max cᵀx` subject to named constraints and column boxes.
+#[derive(Clone, Default)]
+pub struct Program {
+    columns: Vec<Column>,
+    /// Where the variables come from (their definitions are `columns`).
+    names: ProblemVariables,
+    vars: Vec<Variable>,
+    index: HashMap<Variable, usize>,
+    constraints: Vec<(Constraint, Sense)>,
+}
+
+impl Program {
+    /// Adds a column `lo ≤ x ≤ hi` of objective coefficient `cost`.
+    pub fn column(&mut self, lo: f64, hi: f64, cost: f64, integer: bool) -> Variable {
+        // Variables are indices: the same definitions in the same order
+        // give the same variables in the `ProblemVariables` HiGHS gets.
+        let v = self.names.add(variable());
+        self.index.insert(v, self.vars.len());
+        self.vars.push(v);
+        self.columns.push(Column {
+            lo,
+            hi,
+            cost,
+            integer,
+        });
+        v
+    }
+
+    /// The column index of `v` (a variable of this program).
+    #[must_use]
+    pub fn col(&self, v: Variable) -> usize {
+        self.index[&v]
+    }
+
+    /// Number of columns.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.columns.len()
+    }
+
+    /// No columns.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.columns.is_empty()
+    }
+
+    /// The box of column `j`.
+    #[must_use]
+    pub fn bounds(&self, j: usize) -> (f64, f64) {
+        (self.columns[j].lo, self.columns[j].hi)
+    }
+
+    /// Number of constraints (rows) so far: the next one's index.
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        self.constraints.len()
+    }
+
+    /// Whether any column is integral.
+    #[must_use]
+    pub fn is_mip(&self) -> bool {
+        self.columns.iter().any(|c| c.integer)
+    }
+
+    fn push(&mut self, name: &str, c: Constraint, sense: Sense) -> usize {
+        self.constraints.push((c.set_name(name.to_owned()), sense));
+        self.constraints.len() - 1
+    }
+
+    /// `e ≤ hi`, named; returns its row.
+    pub fn at_most(&mut self, name: &str, e: Expression, hi: f64) -> usize {
+        self.push(name, nonzero(e).leq(hi), Sense::AtMost)
+    }
+
+    /// `e ≥ lo`, named; returns its row.
+    pub fn at_least(&mut self, name: &str, e: Expression, lo: f64) -> usize {
+        self.push(name, nonzero(e).geq(lo), Sense::AtLeast)
+    }
+
+    /// `e = v`, named; returns its row.
+    pub fn equal(&mut self, name: &str, e: Expression, v: f64) -> usize {
+        self.push(name, nonzero(e).eq(v), Sense::Equal)
+    }
+
+    /// `lo ≤ e ≤ hi` as two rows (`≤` then `≥`); returns both.
+    pub fn between(&mut self, name: &str, e: Expression, lo: f64, hi: f64) -> (usize, usize) {
+        let upper = self.at_most(name, e.clone(), hi);
+        let lower = self.at_least(name, e, lo);
+        (upper, lower)
+    }
+
+    /// The constraints' names, row order.
+    #[must_use]
+    pub fn names(&self) -> Vec<&str> {
+        self.constraints
+            .iter()
+            .map(|(c, _)| c.name().unwrap_or(""))
+            .collect()
+    }
+
+    /// `e` at the point `x` (one value per column), floating point.
+    #[must_use]
+    pub fn eval(&self, e: &Expression, x: &[f64]) -> f64 {
+        let mut terms: Vec<(usize, f64)> = e
+            .linear_coefficients()
+            .map(|(v, a)| (self.col(v), a))
+            .collect();
+        // Column order: the same sum every run.
+        terms.sort_by_key(|t| t.0);
+        terms.iter().map(|&(j, a)| a * x[j]).sum::<f64>() + IntoAffineExpression::constant(e)
+    }
+
+    /// The exact-check view, read back from the good_lp constraints: per
+    /// constraint one row over its coefficients (column order, exact zeros
+    /// dropped), the row HiGHS solved.
+    #[must_use]
+    pub fn view(&self) -> LinearProgram {
+        let rows = self
+            .constraints
+            .iter()
+            .map(|(c, sense)| {
+                let e = c.expression();
+                let mut coefs: Vec<(usize, f64)> = e
+                    .linear_coefficients()
+                    .map(|(v, a)| (self.col(v), a))
+                    .filter(|t| t.1 != 0.0)
+                    .collect();
+                coefs.sort_by_key(|t| t.0);
+                // `e ≤ 0` (or `= 0`) with `e = a·x + k`: `a·x ≤ −k`; a `≥`
+                // row was stored negated: `(−a)·x ≥ k`.
+                let k = IntoAffineExpression::constant(e);
+                let (lo, hi) = match sense {
+                    Sense::AtMost => (f64::NEG_INFINITY, -k),
+                    Sense::Equal => (-k, -k),
+                    Sense::AtLeast => {
+                        for t in &mut coefs {
+                            t.1 = -t.1;
+                        }
+                        (k, f64::INFINITY)
+                    }
+                };
+                Row { coefs, lo, hi }
+            })
+            .collect();
+        LinearProgram {
+            cost: self.columns.iter().map(|c| c.cost).collect(),
+            col_lo: self.columns.iter().map(|c| c.lo).collect(),
+            col_hi: self.columns.iter().map(|c| c.hi).collect(),
+            integer: self.columns.iter().map(|c| c.integer).collect(),
+            rows,
+        }
+    }
+
+    /// The program as a HiGHS model through good_lp (integrality dropped
+    /// when `relax`); HiGHS refusing it (a coefficient or a bound it cannot
+    /// take, e.g. from limits of no physical size) is a solver error, never
+    /// a panic.
+    fn highs_model(
+        &self,
+        relax: bool,
+        nodes: i32,
+        what: &str,
+        opts: &SolveOptions<'_>,
+    ) -> Result<highs::Model, OptError> {
+        let mut vars = ProblemVariables::new();
+        let mut objective = Expression::with_capacity(self.columns.len());
+        for (c, &v) in self.columns.iter().zip(&self.vars) {
+            let def = variable().min(c.lo).max(c.hi);
+            let added = vars.add(if c.integer && !relax {
+                def.integer()
+            } else {
+                def
+            });
+            debug_assert_eq!(added, v);
+            objective.add_mul(c.cost, v);
+        }
+        let mut pb = vars.maximise(objective).using(highs);
+        for (c, _) in &self.constraints {
+            pb.add_constraint(c.clone());
+        }
+        let mut m = pb.try_into_inner().map_err(|e| {
+            OptError::Solver(format!("{what} step: HiGHS refused the program ({e})"))
+        })?;
+        // Pinned for determinism (one thread, fixed seed); MILPs to optimality.
+        m.set_option("threads", 1);
+        m.set_option("random_seed", 0);
+        m.set_option("mip_rel_gap", 0.0);
+        m.set_option("mip_abs_gap", 1e-12);
+        if !relax && self.is_mip() {
+            // A primal heuristic only (the search still closes the gap to
+            // zero): measured, it costs more than it saves on the power
+            // steps' multiple-choice programs.
+            m.set_option("mip_heuristic_run_feasibility_jump", false);
+            // A deterministic work limit (nodes, not seconds): see
+            // `settings::mip_max_nodes`.
+            m.set_option("mip_max_nodes", nodes);
+            m.set_option("mip_detect_symmetry", false);
+            // HiGHS accepts a MILP's rows (and integrality) to this
+            // tolerance, absolute; its default, 1e-6, lets a level choice
+            // overspend the budget by far more than the checker's relative
+            // 1e-9 (found by breaker3). Its minimum.
+            m.set_option("mip_feasibility_tolerance", S.mip_feasibility_tol);
+        }
+        // Measured on the shipped configs' power steps and global bound
+        // (360 bins): HiGHS's presolve costs more than it saves on these
+        // programs (boxed segment columns, few rows): 1.9× (power) to 3×
+        // (global bound) faster without it; and on the power steps' MILPs
+        // (`multi_level`, one-hot levels and eye-safety column bounds)
+        // 1.45× whole process, same answers (the search still closes the
+        // gap to zero).
+        m.set_option("presolve", "off");
+        m.set_option(
+            "primal_feasibility_tolerance",
+            opts.primal_feasibility_tolerance,
+        );
+        if let Some(x0) = opts.initial {
+            // A hot start (HiGHS's `setSolution`): a wrong length is the
+            // caller's bug, refused by HiGHS, and only costs the hot start.
+            let _ = m.try_set_solution(Some(x0), None, None, None);
+        }
+        Ok(m)
+    }
+
+    /// Solves with HiGHS; for a MILP also solves the LP relaxation for the
+    /// row multipliers of the certificate.
+    pub fn solve(&self, what: &str) -> Result<Solved, OptError> {
+        self.solve_with(what, &SolveOptions::default())
+    }
+
+    /// One HiGHS run; `Ok(None)`: the node limit came without an incumbent.
+    fn run(
+        &self,
+        relax: bool,
+        nodes: i32,
+        what: &str,
+        opts: &SolveOptions<'_>,
+    ) -> Result<Option<highs::SolvedModel>, OptError> {
+        let solved = self
+            .highs_model(relax, nodes, what, opts)?
+            .try_solve()
+            .map_err(|e| OptError::Solver(format!("{what} step: {e:?}")))?;
+        match solved.status() {
+            highs::HighsModelStatus::Optimal => Ok(Some(solved)),
+            // The node limit of a MILP's branch and bound, with an
+            // incumbent: a feasible point (checked exactly like any other);
+            // its gap is stated, not assumed zero. Without one, the search
+            // goes on without the limit.
+            highs::HighsModelStatus::ReachedSolutionLimit if !relax && self.is_mip() => Ok((solved
+                .primal_solution_status()
+                == highs::HighsSolutionStatus::Feasible)
+                .then_some(solved)),
+            highs::HighsModelStatus::Infeasible => Err(Infeasible::Step {
+                step: what.to_owned(),
+            }
+            .into()),
+            s => Err(OptError::Solver(format!("{what} step: HiGHS status {s:?}"))),
+        }
+    }
+
+    /// [`Self::run`] under the node limit, then without it when the limit
+    /// came without an incumbent.
+    fn run_limited(
+        &self,
+        relax: bool,
+        what: &str,
+        opts: &SolveOptions<'_>,
+    ) -> Result<highs::SolvedModel, OptError> {
+        match self.run(relax, S.mip_max_nodes, what, opts)? {
+            Some(solved) => Ok(solved),
+            None => self
+                .run(relax, S.mip_max_nodes_without_incumbent, what, opts)?
+                .ok_or_else(|| {
+                    Infeasible::NoIncumbent {
+                        step: what.to_owned(),
+                        nodes: S.mip_max_nodes_without_incumbent,
+                    }
+                    .into()
+                }),
+        }
+    }
+
+    /// [`Self::solve`] with options (a hot start, a feasibility tolerance).
+    pub fn solve_with(&self, what: &str, opts: &SolveOptions<'_>) -> Result<Solved, OptError> {
+        if !self.is_mip() {
+            let main = self.run_limited(false, what, opts)?;
+            let sol = main.get_solution();
+            return Ok(Solved {
+                x: sol.columns().to_vec(),
+                y: sol.dual_rows().to_vec(),
+                solver_objective: main.objective_value(),
+                solver_dual_bound: None,
+            });
+        }
+        // A MILP: its LP relaxation first (its row duals are the
+        // certificate's multipliers anyway). When the relaxation's optimum
+        // is integral (within `relaxation_integrality_tol`), it is the
+        // MILP's optimum (the relaxation bounds the MILP and this point is
+        // a MILP point), so the branch and bound is skipped; the point is
+        // still checked exactly by the certificate. Otherwise HiGHS's MIP
+        // solver runs.
+        let relaxed = self.run_limited(true, what, opts)?;
+        let rsol = relaxed.get_solution();
+        let y = rsol.dual_rows().to_vec();
+        let integral = rsol
+            .columns()
+            .iter()
+            .zip(&self.columns)
+            .all(|(v, c)| !c.integer || (v - v.round()).abs() <= S.relaxation_integrality_tol);
+        let (x, solver_objective, solver_dual_bound) = if integral {
+            let x = rsol
+                .columns()
+                .iter()
+                .zip(&self.columns)
+                .map(|(&v, c)| if c.integer { v.round() } else { v })
+                .collect();
+            let obj = relaxed.objective_value();
+            (x, obj, Some(obj))
+        } else {
+            let main = self.run_limited(false, what, opts)?;
+            (
+                main.get_solution().columns().to_vec(),
+                main.objective_value(),
+                main.double_info_value(c"mip_dual_bound").ok(),
+            )
+        };
+        Ok(Solved {
+            x,
+            y,
+            solver_objective,
+            solver_dual_bound,
+        })
+    }
+}
+
+impl LinearProgram {
+    /// Solves a view built by hand (tests of the checker and of the
+    /// export) through a good_lp [`Program`] of the same columns and rows
+    /// (a ranged row as its two one-sided rows, whose multipliers are summed
+    /// back into the row's: the same bound, row for row).
+    pub fn solve(&self, what: &str) -> Result<Solved, OptError> {
+        let mut prog = Program::default();
+        let vars: Vec<Variable> = (0..self.cost.len())
+            .map(|j| {
+                prog.column(
+                    self.col_lo[j],
+                    self.col_hi[j],
+                    self.cost[j],
+                    self.integer[j],
+                )
+            })
+            .collect();
+        let mut rows_of = Vec::with_capacity(self.rows.len());
+        for r in &self.rows {
+            let mut e = Expression::with_capacity(r.coefs.len());
+            for &(j, a) in &r.coefs {
+                e.add_mul(a, vars[j]);
+            }
+            rows_of.push(match (r.lo.is_finite(), r.hi.is_finite()) {
+                (true, true) if r.lo == r.hi => vec![prog.equal("row", e, r.lo)],
+                (true, true) => {
+                    let (u, l) = prog.between("row", e, r.lo, r.hi);
+                    vec![u, l]
+                }
+                (false, true) => vec![prog.at_most("row", e, r.hi)],
+                (true, false) => vec![prog.at_least("row", e, r.lo)],
+                (false, false) => vec![],
+            });
+        }
+        let mut solved = prog.solve(what)?;
+        solved.y = rows_of
+            .iter()
+            .map(|rows| rows.iter().map(|&k| solved.y[k]).sum())
+            .collect();
+        Ok(solved)
+    }
+}
+
+/// `e` without its exact-zero coefficients (HiGHS gets no zero entries).
+fn nonzero(e: Expression) -> Expression {
+    if (&e).linear_coefficients().all(|(_, a)| a != 0.0) {
+        return e;
+    }
+    let mut out = Expression::with_capacity(0);
+    for (v, a) in (&e).linear_coefficients() {
+        if a != 0.0 {
+            out.add_mul(a, v);
+        }
+    }
+    out + IntoAffineExpression::constant(&e)
+}
+
+/// How HiGHS is run on a program.
+#[derive(Debug, Clone, Copy)]
+pub struct SolveOptions<'a> {
+    /// A starting point (one value per column), passed as a hot start.
+    pub initial: Option<&'a [f64]>,
+    /// HiGHS's `primal_feasibility_tolerance` (its default is 1e-7).
+    pub primal_feasibility_tolerance: f64,
+}
+
+impl Default for SolveOptions<'_> {
+    fn default() -> Self {
+        Self {
+            initial: None,
+            primal_feasibility_tolerance: S.primal_feasibility_tol,
+        }
+    }
+}
+
+/// HiGHS's floating-point answer (untrusted).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solved {
+    /// Primal values, column order.
+    pub x: Vec<f64>,
+    /// Row duals in HiGHS's convention (`c − Aᵀy` are its reduced costs),
+    /// of the LP relaxation for a MILP.
+    pub y: Vec<f64>,
+    /// HiGHS's objective value.
+    pub solver_objective: f64,
+    /// HiGHS's MIP dual bound (a MILP only; a float, not checked): the
+    /// relaxation's optimum when that was integral and no branch and bound
+    /// ran.
+    pub solver_dual_bound: Option<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimizer::certificate::check;
+
+    /// max x + 2y s.t. x + y ≤ 4, x − y ≥ −1, x + 3y = 6 (the names kept),
+    /// 0 ≤ x, y ≤ 10: the view has the rows HiGHS solved (a `≥` row with
+    /// its written coefficients) and HiGHS's duals certify the optimum.
+    #[test]
+    fn the_view_is_the_rows_highs_solved() {
+        let mut p = Program::default();
+        let x = p.column(0.0, 10.0, 1.0, false);
+        let y = p.column(0.0, 10.0, 2.0, false);
+        p.at_most("budget", x + y, 4.0);
+        p.at_least("slew", x - y, -1.0);
+        p.equal("frame", x + 3.0 * y, 6.0);
+        let (hi, lo) = p.between("accel", 2.0 * x - y, -5.0, 5.0);
+        assert_eq!((hi, lo), (3, 4));
+        assert_eq!(p.names(), ["budget", "slew", "frame", "accel", "accel"]);
+        let v = p.view();
+        type Side = (Vec<(usize, f64)>, f64, f64);
+        let rows: Vec<Side> = v
+            .rows
+            .iter()
+            .map(|r| (r.coefs.clone(), r.lo, r.hi))
+            .collect();
+        let inf = f64::INFINITY;
+        assert_eq!(
+            rows,
+            vec![
+                (vec![(0, 1.0), (1, 1.0)], -inf, 4.0),
+                (vec![(0, 1.0), (1, -1.0)], -1.0, inf),
+                (vec![(0, 1.0), (1, 3.0)], 6.0, 6.0),
+                (vec![(0, 2.0), (1, -1.0)], -inf, 5.0),
+                (vec![(0, 2.0), (1, -1.0)], -5.0, inf),
+            ]
+        );
+        let s = p.solve("test").unwrap();
+        // x + 3y = 6 and x + y ≤ 4: x = 3, y = 1 (objective 5).
+        assert_eq!(s.x, vec![3.0, 1.0]);
+        let e = check(&v, &s.x, &s.y);
+        assert!(e.primal_feasible);
+        // HiGHS's duals (½, ½ on `budget` and `frame`) to the last bits.
+        let gap = e.gap().unwrap();
+        let tiny = num_rational::BigRational::new(1.into(), (1_i64 << 50).into());
+        assert!(gap >= num_rational::BigRational::from_integer(0.into()) && gap < tiny);
+        assert_eq!(p.eval(&(x + 3.0 * y), &s.x), 6.0);
+    }
+}
