@@ -531,3 +531,104 @@ pub fn power_scale_to_certify(worst_ratio: f64) -> f64 {
         f64::INFINITY
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eye_safety::head::{Channel, Head};
+
+    fn column(slots: &[f64], offsets_deg: &[f64]) -> Head {
+        Head {
+            cycle_s: 1e-4,
+            origin_radius_mm: 0.0,
+            origin_height_mm: 0.0,
+            exit_diameter_mm: 5.0,
+            divergence_mrad: 0.0,
+            aperture_distance_mm: 100.0,
+            channels: slots
+                .iter()
+                .zip(offsets_deg)
+                .enumerate()
+                .map(|(i, (&slot_s, &az))| Channel {
+                    id: i as u32,
+                    elevation_deg: 0.1 * i as f64,
+                    azimuth_offset_deg: az,
+                    slot_s,
+                    power_scale: 1.0,
+                })
+                .collect(),
+        }
+    }
+
+    /// By hand: from the axis (`r0 = 0`) every ray is radial, `ψ_c = φ_c`;
+    /// a 7 mm aperture and a 5 mm beam give a pass of 12/100 rad = 6.8755°.
+    /// Offsets 0 and 6°: (6 + 6.8755)/6.8755 = 1.87, two passes; offsets
+    /// −10° and 10°: (20 + 6.8755)/6.8755 = 3.91, four; one offset: one.
+    #[test]
+    fn union_passes_by_hand() {
+        let pass = (12.0f64 / 100.0).to_degrees();
+        for (offsets, k) in [
+            (&[0.0, 0.0][..], 1),
+            (&[0.0, 6.0][..], 2),
+            (&[-10.0, 10.0][..], 4),
+        ] {
+            let h = column(&[0.0, 0.0], offsets);
+            let fps = footprints(&h, 7.0);
+            assert_eq!(union_passes(&fps, pass), k, "{offsets:?}");
+        }
+        let h = column(&[0.0], &[30.0]);
+        assert_eq!(union_passes(&footprints(&h, 7.0), pass), 1);
+    }
+
+    fn figures(count_vertical: u32, slots_vertical: u32, union_passes: u32) -> HeadFigures {
+        HeadFigures {
+            channels: count_vertical,
+            channels_at_worst: count_vertical,
+            worst_height_mm: 0.0,
+            worst_azimuth_deg: 0.0,
+            group_height_mm: 0.0,
+            weight_vertical: f64::from(count_vertical),
+            count_vertical,
+            slots_vertical,
+            union_passes,
+            weight_simultaneous: 1.0,
+            count_simultaneous: 1,
+            weight_group: 1.0,
+            count_group: 1,
+            group_spans_time: false,
+            group_window_s: 5e-6,
+            weight_instant: 1.0,
+            weight_stalled: 1.0,
+            count_stalled: 1,
+            weight_stalled_group: 1.0,
+            weight_stalled_simultaneous: 1.0,
+            count_stalled_simultaneous: 1,
+            stalled_group_spans_time: false,
+            footprint_max_mm: 5.0,
+            pass_angle_deg: 6.0,
+            power_scale_max: 1.0,
+            separations: Vec::new(),
+        }
+    }
+
+    /// By hand: a pass of 2.7 ms at 20 kHz holds at most ⌊54⌋ + 1 = 55
+    /// pulses, and a 10 s window meets ⌊(10 + 0.0027)/0.1⌋ + 1 = 101 passes
+    /// of a 10 Hz frame: `N_single` = 5555. 34 channels of one slot whose
+    /// passes lie in two passes' arc (5.4 ms: 109 pulses, 101 passes):
+    /// min(34 · 5555, 1 · 109 · 101) = 11009. Every channel at its own slot
+    /// (`S_v = K_v`): the channels' count, 34 · 5555. The count never drops
+    /// below one channel's.
+    #[test]
+    fn head_pulse_count_by_hand() {
+        let (t2, tau, frame, f_p) = (10.0, 2.7e-3, 0.1, 20_000.0);
+        let n1 = max_pulses_in(tau, f_p) * passes_in_window(t2, tau, frame);
+        assert_eq!(n1, 55.0 * 101.0);
+        let one_slot = head_pulse_count(&figures(34, 1, 2), n1, t2, tau, frame, f_p);
+        assert_eq!(one_slot, 109.0 * 101.0);
+        let own_slots = head_pulse_count(&figures(34, 34, 2), n1, t2, tau, frame, f_p);
+        assert_eq!(own_slots, 34.0 * n1);
+        for k in 1..6 {
+            assert!(head_pulse_count(&figures(34, 1, k), n1, t2, tau, frame, f_p) >= n1);
+        }
+    }
+}
