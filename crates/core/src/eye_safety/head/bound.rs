@@ -348,8 +348,9 @@ pub fn head_figures(
 /// `k` of [`HeadFigures::union_passes`]: channel `c` meets an aperture at
 /// head-frame azimuth `φ` while the head angle is within `φ − ψ_c ±` half
 /// its pass, so every channel's pass lies inside an arc of
-/// `(ψ_max − ψ_min) + pass_max`, at most `k` arcs of `pass_max` (rounded up
-/// by 1e-12 before the ceiling).
+/// `(ψ_max − ψ_min) + pass_max`, at most `k` arcs of `pass_max`
+/// (`k = ⌈1 + spread/pass_max⌉`, the spread's share rounded up by 1e-12
+/// before the ceiling; 1 without spread, at least 2 with any).
 fn union_passes(fps: &[Footprint], pass_max_deg: f64) -> u32 {
     if fps.len() <= 1 || pass_max_deg <= 0.0 {
         return 1;
@@ -359,10 +360,17 @@ fn union_passes(fps: &[Footprint], pass_max_deg: f64) -> u32 {
         .iter()
         .map(|f| f.psi_rad)
         .fold(f64::NEG_INFINITY, f64::max);
-    let x = ((hi - lo).to_degrees() + pass_max_deg) / pass_max_deg * (1.0 + 1e-12);
+    if hi <= lo {
+        // Every hit at one angle: the union is one pass.
+        return 1;
+    }
+    // The spread's share rounded up by 1e-12 (a few ulps of error in the
+    // difference, the conversion and the division), added to one pass;
+    // any spread at all is at least two passes (no spread rounds away).
+    let x = 1.0 + (hi - lo).to_degrees() / pass_max_deg * (1.0 + 1e-12);
     // ψ lies in (−90°, 90°) (offsets and the crossing point inside the
     // aperture's distance): x < 1 + 180/pass, a small count.
-    x.ceil().min(f64::from(u32::MAX)) as u32
+    (x.ceil().min(f64::from(u32::MAX)) as u32).max(2)
 }
 
 /// The most effective pulses (pulses, or pulses of several channels fired at
