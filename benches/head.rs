@@ -1,20 +1,46 @@
-//! The head's bound: `evaluate_segments` on a 360-bin profile with a
-//! 128-channel head (an OS1-128-like column head: every channel fired
-//! together, four azimuth columns; and a VLS-128-like head: sixteen groups
-//! of eight), against the same profile as one channel (today's code path)
-//! in the same run. Prints p50/p99 of plain timed runs and the ratios, then
-//! the criterion figures. Run: `cargo bench --bench head`.
+//! The head's bound: `evaluate_segments` on a 360-bin profile with the
+//! 128-channel heads of the `vls128` and `os1-128` presets (and `vlp16`'s 16
+//! channels), each against the same profile as one channel (the preset's
+//! eye-safety parameters without the head: today's single-channel code path)
+//! in the same run. Prints p50/p99 of plain timed runs ([`SAMPLES`] each) and
+//! the p99 ratios, then the criterion figures. Run: `cargo bench --bench head`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::time::Instant;
 
 use gaze_lidar::eye_safety::bound::Seg;
-use gaze_lidar::eye_safety::head::{power_scale_to_certify, Channel, Head};
+use gaze_lidar::eye_safety::head::power_scale_to_certify;
 use gaze_lidar::eye_safety::{evaluate_segments, EyeSafetyParams};
+use gaze_lidar::model::presets::preset;
 
-const F_P: f64 = 18_761.726_078_799_25; // 1 / 53.3 µs
+/// Timed runs per percentile figure (`GAZE_LIDAR_HEAD_BENCH_SAMPLES`
+/// overrides it and skips the criterion groups: for a profiler's run).
+const SAMPLES: usize = 1000;
 
+fn samples() -> (usize, bool) {
+    match std::env::var("GAZE_LIDAR_HEAD_BENCH_SAMPLES") {
+        Ok(v) => (v.parse().expect("a sample count"), false),
+        Err(_) => (SAMPLES, true),
+    }
+}
+
+/// The calling thread's CPU time, s (`CLOCK_THREAD_CPUTIME_ID`): time the
+/// thread ran, not time it waited for a core on a shared machine.
+fn thread_cpu_s() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a
+    // constant Linux and the BSDs define.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    assert_eq!(rc, 0, "clock_gettime");
+    ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64
+}
+
+/// 360 one-degree bins: power `scale·(1 + 0.5 sin 3x)`, spin 62.8 ± 10 rad/s
+/// (inside every preset's 5–20 Hz limits), accelerating inside the bins.
 fn profile(scale: f64) -> Vec<Seg> {
     (0..360)
         .map(|i| {
@@ -30,92 +56,79 @@ fn profile(scale: f64) -> Vec<Seg> {
         .collect()
 }
 
-fn head(kind: &str) -> Head {
-    let cycle = 1.0 / F_P;
-    let channels = (0..128u32)
-        .map(|i| {
-            let (az, slot) = match kind {
-                "column" => ([-3.0, -1.0, 1.0, 3.0][(i % 4) as usize], 0.0),
-                _ => (
-                    [-4.5, -3.3, -2.0, -0.7, 0.7, 2.0, 3.3, 4.5][(i % 8) as usize] * 0.5,
-                    (i / 8) as f64 * 2.665e-6,
-                ),
-            };
-            Channel {
-                id: i,
-                elevation_deg: -22.5 + 0.35 * f64::from(i),
-                azimuth_offset_deg: az,
-                slot_s: slot,
-                power_scale: 1.0,
-            }
-        })
-        .collect();
-    Head {
-        cycle_s: cycle,
-        origin_radius_mm: if kind == "column" { 15.806 } else { 58.63 },
-        origin_height_mm: 0.0,
-        exit_diameter_mm: if kind == "column" { 10.0 } else { 5.0 },
-        divergence_mrad: 3.0,
-        aperture_distance_mm: 100.0,
-        channels,
+/// p50 and p99 of `n` runs, s: `[cpu p50, cpu p99, wall p50, wall p99]`
+/// (thread CPU time and wall time of each run).
+fn percentiles(n: usize, mut f: impl FnMut()) -> [f64; 4] {
+    for _ in 0..n.min(20) {
+        f();
     }
-}
-
-fn params(head: Option<Head>) -> EyeSafetyParams {
-    EyeSafetyParams {
-        wavelength_nm: 905.0,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm: 5.0,
-        head,
-    }
-}
-
-fn percentiles(mut f: impl FnMut()) -> (f64, f64) {
-    let mut t: Vec<f64> = (0..300)
+    let (mut cpu, mut wall): (Vec<f64>, Vec<f64>) = (0..n)
         .map(|_| {
-            let s = Instant::now();
+            let (s, c) = (Instant::now(), thread_cpu_s());
             f();
-            s.elapsed().as_secs_f64()
+            (thread_cpu_s() - c, s.elapsed().as_secs_f64())
         })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    (t[150], t[296])
+        .unzip();
+    cpu.sort_by(f64::total_cmp);
+    wall.sort_by(f64::total_cmp);
+    let (m, q) = (n / 2, (n * 99 / 100).min(n - 1));
+    [cpu[m], cpu[q], wall[m], wall[q]]
+}
+
+/// The profile scaled to certify under `params` (the largest uniform scale).
+fn certified(params: &EyeSafetyParams, f_p: f64) -> (Vec<Seg>, f64) {
+    let r = evaluate_segments(&profile(1.0), params, f_p).unwrap();
+    let segs = profile(power_scale_to_certify(r.worst_ratio));
+    let cert = evaluate_segments(&segs, params, f_p).unwrap();
+    assert!(cert.worst_ratio <= 1.0, "the profile certifies");
+    (segs, r.worst_ratio)
 }
 
 fn bench(c: &mut Criterion) {
-    let single = params(None);
-    let base = evaluate_segments(&profile(1.0), &single, F_P).unwrap();
-    let segs_single = profile(power_scale_to_certify(base.worst_ratio));
-    let (p50_s, p99_s) = percentiles(|| {
-        black_box(evaluate_segments(black_box(&segs_single), &single, F_P).unwrap());
-    });
-    println!(
-        "single channel: p50 {:.1} µs, p99 {:.1} µs",
-        p50_s * 1e6,
-        p99_s * 1e6
-    );
+    let (n, criterion) = samples();
     let mut g = c.benchmark_group("head");
-    g.bench_function("single_channel_360_bins", |b| {
-        b.iter(|| evaluate_segments(black_box(&segs_single), &single, F_P).unwrap())
-    });
-    for kind in ["column", "groups"] {
-        let hp = params(Some(head(kind)));
-        let r = evaluate_segments(&profile(1.0), &hp, F_P).unwrap();
-        let segs = profile(power_scale_to_certify(r.worst_ratio));
-        let cert = evaluate_segments(&segs, &hp, F_P).unwrap();
-        assert!(cert.worst_ratio <= 1.0, "the {kind} head certifies");
-        let (p50, p99) = percentiles(|| {
-            black_box(evaluate_segments(black_box(&segs), &hp, F_P).unwrap());
+    for name in ["vls128", "os1-128", "vlp16"] {
+        let p = preset(name).unwrap();
+        let f_p = p.lidar.pulse_rate_hz;
+        let hp = p.lidar.limits.eye_safety.clone().unwrap();
+        let single = EyeSafetyParams {
+            head: None,
+            ..hp.clone()
+        };
+        let (segs_single, r_single) = certified(&single, f_p);
+        let (segs, r_head) = certified(&hp, f_p);
+        let one = percentiles(n, || {
+            black_box(evaluate_segments(black_box(&segs_single), &single, f_p).unwrap());
         });
+        let head = percentiles(n, || {
+            black_box(evaluate_segments(black_box(&segs), &hp, f_p).unwrap());
+        });
+        let channels = hp.head.as_ref().unwrap().channels.len();
+        let us = |x: f64| x * 1e6;
         println!(
-            "128-channel {kind} head: p50 {:.1} µs, p99 {:.1} µs ({:.1}× the single channel's p99); head/single ratio {:.2}",
-            p50 * 1e6,
-            p99 * 1e6,
-            p99 / p99_s,
-            r.worst_ratio / base.worst_ratio
+            "{name} ({n} runs each): one channel CPU p50 {:.1} µs p99 {:.1} µs (wall p50 {:.1} p99 {:.1}); \
+             {channels}-channel head CPU p50 {:.1} µs p99 {:.1} µs (wall p50 {:.1} p99 {:.1}); \
+             head/one p99 CPU {:.2}×, wall {:.2}×; head/single eye-safety ratio {:.2}",
+            us(one[0]),
+            us(one[1]),
+            us(one[2]),
+            us(one[3]),
+            us(head[0]),
+            us(head[1]),
+            us(head[2]),
+            us(head[3]),
+            head[1] / one[1],
+            head[3] / one[3],
+            r_head / r_single
         );
-        g.bench_function(format!("head128_{kind}_360_bins"), |b| {
-            b.iter(|| evaluate_segments(black_box(&segs), &hp, F_P).unwrap())
+        if !criterion {
+            continue;
+        }
+        g.bench_function(format!("{name}_single_channel_360_bins"), |b| {
+            b.iter(|| evaluate_segments(black_box(&segs_single), &single, f_p).unwrap())
+        });
+        g.bench_function(format!("{name}_head_360_bins"), |b| {
+            b.iter(|| evaluate_segments(black_box(&segs), &hp, f_p).unwrap())
         });
     }
     g.finish();

@@ -21,9 +21,13 @@
 //!   the AEL at the pulse duration) or within one grouping window (`W_g`,
 //!   compared with the smallest AEL up to the window plus a pulse), each of
 //!   energy at most `s_c·P̂/f_p`, and C5 taken at
-//!   `N_head = K_v × N_single` pulses (the most pulses one channel can put
-//!   into one aperture within `T_max`, times the most channels that can meet
-//!   one height; C5 is nonincreasing in N, so a larger N is conservative).
+//!   `N_head = min(K_v × N_single, S_v × N_union)` effective pulses (the most
+//!   pulses one channel can put into one aperture within `T_max`, times the
+//!   most channels that can meet one height; or the most distinct firing
+//!   slots among those channels times one clock's instants inside the
+//!   channels' union of passes, `k` widest passes long: pulses fired at one
+//!   instant are one effective pulse; C5 is nonincreasing in N, so an upper
+//!   bound of N is conservative).
 //!   When at most one channel can meet any height (`K_v = 1`) and no
 //!   grouping window puts two channels into one position, every effective
 //!   pulse is one channel's: the single-channel Rule 1 figure times the
@@ -63,6 +67,15 @@ pub struct HeadFigures {
     pub weight_vertical: f64,
     /// `K_v`: the most channels that can meet one height.
     pub count_vertical: u32,
+    /// `S_v`: the most distinct firing slots among the channels that can
+    /// meet one height (pulses of one slot reach an aperture at one instant:
+    /// one effective pulse for C5's count).
+    pub slots_vertical: u32,
+    /// `k`: the channels' passes over one aperture position lie inside one
+    /// arc of head turn of at most `k` widest passes (the spread of the
+    /// channels' hit angles plus the widest pass, over the widest pass,
+    /// rounded up).
+    pub union_passes: u32,
     /// `W_sim`: the largest sum of `power_scale` of channels fired together
     /// whose footprints share a point.
     pub weight_simultaneous: f64,
@@ -306,6 +319,8 @@ pub fn head_figures(
         group_height_mm: g.height_mm,
         weight_vertical: v.weight,
         count_vertical: v.count,
+        slots_vertical: overlap::vertical_slots(&fps, &slots),
+        union_passes: union_passes(&fps, fold(|f| f.pass_angle_deg)),
         weight_simultaneous: sim.weight,
         count_simultaneous: sim.count,
         weight_group: g.weight,
@@ -328,6 +343,59 @@ pub fn head_figures(
             Vec::new()
         },
     })
+}
+
+/// `k` of [`HeadFigures::union_passes`]: channel `c` meets an aperture at
+/// head-frame azimuth `φ` while the head angle is within `φ − ψ_c ±` half
+/// its pass, so every channel's pass lies inside an arc of
+/// `(ψ_max − ψ_min) + pass_max`, at most `k` arcs of `pass_max`
+/// (`k = ⌈1 + spread/pass_max⌉`, the spread's share rounded up by 1e-12
+/// before the ceiling; 1 without spread, at least 2 with any).
+fn union_passes(fps: &[Footprint], pass_max_deg: f64) -> u32 {
+    if fps.len() <= 1 || pass_max_deg <= 0.0 {
+        return 1;
+    }
+    let lo = fps.iter().map(|f| f.psi_rad).fold(f64::INFINITY, f64::min);
+    let hi = fps
+        .iter()
+        .map(|f| f.psi_rad)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if hi <= lo {
+        // Every hit at one angle: the union is one pass.
+        return 1;
+    }
+    // The spread's share rounded up by 1e-12 (a few ulps of error in the
+    // difference, the conversion and the division), added to one pass;
+    // any spread at all is at least two passes (no spread rounds away).
+    let x = 1.0 + (hi - lo).to_degrees() / pass_max_deg * (1.0 + 1e-12);
+    // ψ lies in (−90°, 90°) (offsets and the crossing point inside the
+    // aperture's distance): x < 1 + 180/pass, a small count.
+    (x.ceil().min(f64::from(u32::MAX)) as u32).max(2)
+}
+
+/// The most effective pulses (pulses, or pulses of several channels fired at
+/// one instant) the channels meeting one height put into one aperture
+/// within `T_max` (`t2_s`): at most `K_v ×` one channel's (`n1`), and at
+/// most `S_v ×` one clock's instants inside the channels' union of passes:
+/// every pass of that union lasts at most `k·τ` (`k` arcs, each no wider
+/// than the widest pass, each crossed in at most the longest pass `τ`) and
+/// at most `⌊(T + k·τ)/T_f⌋ + 1` of them meet a window of `T`. C5 is
+/// nonincreasing in the count: the smaller upper bound is the tighter
+/// conservative one.
+fn head_pulse_count(
+    h: &HeadFigures,
+    n1: f64,
+    t2_s: f64,
+    pass_s: f64,
+    frame_s: f64,
+    f_p: f64,
+) -> f64 {
+    let by_channels = f64::from(h.count_vertical) * n1;
+    let union_s = f64::from(h.union_passes) * pass_s * (1.0 + 1e-12);
+    let by_slots = f64::from(h.slots_vertical)
+        * max_pulses_in(union_s, f_p)
+        * passes_in_window(t2_s, union_s, frame_s);
+    by_channels.min(by_slots)
 }
 
 /// The window within which pulses are one effective pulse for Rule 1:
@@ -374,7 +442,7 @@ pub fn single_pulse_ratio(h: &HeadFigures, laser: &Laser, s: SingleFigures) -> f
             spans_time: h.group_spans_time,
             window_s: h.group_window_s,
         },
-        f64::from(h.count_vertical) * n1,
+        head_pulse_count(h, n1, t2, s.pass_duration_s, s.frame_s, laser.pulse_rate_hz),
         s.power_max_w / laser.pulse_rate_hz,
         laser,
     )
@@ -433,7 +501,10 @@ pub fn stalled_ratio(h: &HeadFigures, laser: &Laser, power_w: f64) -> f64 {
         return h.weight_stalled * one;
     }
     let t2 = ael::T2_S.min(ael::TIME_BASE_S);
-    let n = f64::from(h.count_stalled) * max_pulses_in(t2, laser.pulse_rate_hz);
+    // The channels sharing one point meet one height: at most `S_v`
+    // distinct instants per cycle.
+    let n =
+        f64::from(h.count_stalled.min(h.slots_vertical)) * max_pulses_in(t2, laser.pulse_rate_hz);
     let r1 = rule1(
         h.count_stalled,
         h.count_stalled,
@@ -466,5 +537,106 @@ pub fn power_scale_to_certify(worst_ratio: f64) -> f64 {
         (1.0 - 1e-9) / worst_ratio
     } else {
         f64::INFINITY
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eye_safety::head::{Channel, Head};
+
+    fn column(slots: &[f64], offsets_deg: &[f64]) -> Head {
+        Head {
+            cycle_s: 1e-4,
+            origin_radius_mm: 0.0,
+            origin_height_mm: 0.0,
+            exit_diameter_mm: 5.0,
+            divergence_mrad: 0.0,
+            aperture_distance_mm: 100.0,
+            channels: slots
+                .iter()
+                .zip(offsets_deg)
+                .enumerate()
+                .map(|(i, (&slot_s, &az))| Channel {
+                    id: i as u32,
+                    elevation_deg: 0.1 * i as f64,
+                    azimuth_offset_deg: az,
+                    slot_s,
+                    power_scale: 1.0,
+                })
+                .collect(),
+        }
+    }
+
+    /// By hand: from the axis (`r0 = 0`) every ray is radial, `ψ_c = φ_c`;
+    /// a 7 mm aperture and a 5 mm beam give a pass of 12/100 rad = 6.8755°.
+    /// Offsets 0 and 6°: (6 + 6.8755)/6.8755 = 1.87, two passes; offsets
+    /// −10° and 10°: (20 + 6.8755)/6.8755 = 3.91, four; one offset: one.
+    #[test]
+    fn union_passes_by_hand() {
+        let pass = (12.0f64 / 100.0).to_degrees();
+        for (offsets, k) in [
+            (&[0.0, 0.0][..], 1),
+            (&[0.0, 6.0][..], 2),
+            (&[-10.0, 10.0][..], 4),
+        ] {
+            let h = column(&[0.0, 0.0], offsets);
+            let fps = footprints(&h, 7.0);
+            assert_eq!(union_passes(&fps, pass), k, "{offsets:?}");
+        }
+        let h = column(&[0.0], &[30.0]);
+        assert_eq!(union_passes(&footprints(&h, 7.0), pass), 1);
+    }
+
+    fn figures(count_vertical: u32, slots_vertical: u32, union_passes: u32) -> HeadFigures {
+        HeadFigures {
+            channels: count_vertical,
+            channels_at_worst: count_vertical,
+            worst_height_mm: 0.0,
+            worst_azimuth_deg: 0.0,
+            group_height_mm: 0.0,
+            weight_vertical: f64::from(count_vertical),
+            count_vertical,
+            slots_vertical,
+            union_passes,
+            weight_simultaneous: 1.0,
+            count_simultaneous: 1,
+            weight_group: 1.0,
+            count_group: 1,
+            group_spans_time: false,
+            group_window_s: 5e-6,
+            weight_instant: 1.0,
+            weight_stalled: 1.0,
+            count_stalled: 1,
+            weight_stalled_group: 1.0,
+            weight_stalled_simultaneous: 1.0,
+            count_stalled_simultaneous: 1,
+            stalled_group_spans_time: false,
+            footprint_max_mm: 5.0,
+            pass_angle_deg: 6.0,
+            power_scale_max: 1.0,
+            separations: Vec::new(),
+        }
+    }
+
+    /// By hand: a pass of 2.7 ms at 20 kHz holds at most ⌊54⌋ + 1 = 55
+    /// pulses, and a 10 s window meets ⌊(10 + 0.0027)/0.1⌋ + 1 = 101 passes
+    /// of a 10 Hz frame: `N_single` = 5555. 34 channels of one slot whose
+    /// passes lie in two passes' arc (5.4 ms: 109 pulses, 101 passes):
+    /// min(34 · 5555, 1 · 109 · 101) = 11009. Every channel at its own slot
+    /// (`S_v = K_v`): the channels' count, 34 · 5555. The count never drops
+    /// below one channel's.
+    #[test]
+    fn head_pulse_count_by_hand() {
+        let (t2, tau, frame, f_p) = (10.0, 2.7e-3, 0.1, 20_000.0);
+        let n1 = max_pulses_in(tau, f_p) * passes_in_window(t2, tau, frame);
+        assert_eq!(n1, 55.0 * 101.0);
+        let one_slot = head_pulse_count(&figures(34, 1, 2), n1, t2, tau, frame, f_p);
+        assert_eq!(one_slot, 109.0 * 101.0);
+        let own_slots = head_pulse_count(&figures(34, 34, 2), n1, t2, tau, frame, f_p);
+        assert_eq!(own_slots, 34.0 * n1);
+        for k in 1..6 {
+            assert!(head_pulse_count(&figures(34, 1, k), n1, t2, tau, frame, f_p) >= n1);
+        }
     }
 }

@@ -94,6 +94,38 @@ pub fn vertical(fps: &[Footprint], weights: &[f64]) -> Meet {
     best
 }
 
+/// The most distinct firing slots (`slots_s`, compared exactly) among the
+/// channels whose height intervals share a point: exact over every height
+/// (the set of channels holding `z` is a subset of the set at the largest
+/// lower end at or below `z`, and a count of distinct slots only grows
+/// with the set, so every lower end is evaluated).
+#[must_use]
+pub fn vertical_slots(fps: &[Footprint], slots_s: &[f64]) -> u32 {
+    let iv: Vec<(f64, f64)> = fps
+        .iter()
+        .map(|f| {
+            (
+                f.z_mm - f.half_height_mm - TOUCH_MM,
+                f.z_mm + f.half_height_mm + TOUCH_MM,
+            )
+        })
+        .collect();
+    let mut best = 0u32;
+    let mut at: Vec<f64> = Vec::with_capacity(iv.len());
+    for &(z, _) in &iv {
+        at.clear();
+        for (i, &(lo, hi)) in iv.iter().enumerate() {
+            if lo <= z && z <= hi {
+                at.push(slots_s[i]);
+            }
+        }
+        at.sort_by(f64::total_cmp);
+        at.dedup();
+        best = best.max(at.len() as u32);
+    }
+    best
+}
+
 /// Pulses of a clock of period `cycle_s` at phase `slot_s` inside the
 /// closed window `[t0_s, t0_s + window_s]` (`0 ≤ t0_s, slot_s < cycle_s`),
 /// rounded up at touching ends.
@@ -133,7 +165,18 @@ fn boxes_max(boxes: &[(f64, f64, f64, f64, f64)]) -> Meet {
     let mut xs: Vec<f64> = boxes.iter().map(|b| b.0).collect();
     xs.sort_by(f64::total_cmp);
     xs.dedup();
-    let mut ends: Vec<(f64, bool, f64)> = Vec::with_capacity(2 * boxes.len());
+    // Every box's height ends, sorted once (stably: pushed in box order,
+    // lower end first): the ends of the boxes active at one left end, in
+    // this order, are exactly the stable sort of those boxes' ends alone,
+    // so the sweep below adds and subtracts in the same order (the same
+    // bits) as sorting each active set on its own.
+    let mut all_ends: Vec<(f64, bool, usize)> = Vec::with_capacity(2 * boxes.len());
+    for (i, b) in boxes.iter().enumerate() {
+        all_ends.push((b.2, false, i));
+        all_ends.push((b.3, true, i));
+    }
+    all_ends.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut is_active = vec![false; boxes.len()];
     let mut err = 0.0f64;
     for (k, &x) in xs.iter().enumerate() {
         // The boxes active here stay active up to the next left end unless
@@ -145,17 +188,21 @@ fn boxes_max(boxes: &[(f64, f64, f64, f64, f64)]) -> Meet {
                 continue;
             }
         }
-        ends.clear();
-        let mut total = 0.0;
-        for b in active() {
-            ends.push((b.2, false, b.4));
-            ends.push((b.3, true, b.4));
-            total += b.4;
+        let (mut total, mut n_ends) = (0.0, 0usize);
+        for (i, b) in boxes.iter().enumerate() {
+            is_active[i] = b.0 <= x && x <= b.1;
+            if is_active[i] {
+                total += b.4;
+                n_ends += 2;
+            }
         }
-        ends.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        err = err.max(2.0 * ends.len() as f64 * f64::EPSILON * total);
+        err = err.max(2.0 * n_ends as f64 * f64::EPSILON * total);
         let (mut w, mut n) = (0.0f64, 0u32);
-        for &(z, close, wi) in &ends {
+        for &(z, close, i) in &all_ends {
+            if !is_active[i] {
+                continue;
+            }
+            let wi = boxes[i].4;
             if close {
                 w -= wi;
                 n -= 1;
@@ -309,6 +356,23 @@ mod tests {
         assert_eq!(vertical(&f, &[1.0, 1.0]).count, 1);
     }
 
+    /// Intervals [−5, 5], [3, 13], [12, 22], [4, 14] with slots 0, 1, 1, 2:
+    /// at z ∈ [4, 5] the first, second and fourth (slots 0, 1, 2: three);
+    /// at [12, 13] the second, third and fourth (slots 1, 1, 2: two).
+    #[test]
+    fn vertical_slots_by_hand() {
+        let f = [
+            fp(0.0, 0.0, 5.0),
+            fp(0.0, 8.0, 5.0),
+            fp(0.0, 17.0, 5.0),
+            fp(0.0, 9.0, 5.0),
+        ];
+        assert_eq!(vertical_slots(&f, &[0.0, 1.0, 1.0, 2.0]), 3);
+        assert_eq!(vertical_slots(&f, &[0.0, 1.0, 1.0, 1.0]), 2);
+        assert_eq!(vertical_slots(&f, &[0.0, 0.0, 0.0, 0.0]), 1);
+        assert_eq!(vertical_slots(&f[..1], &[0.5]), 1);
+    }
+
     /// Pulse counts in closed windows: cycle 10, slot 3, window [0, 5]: one
     /// (t = 3); window [4, 14]: one (13) — touching ends count: [3, 13] two.
     #[test]
@@ -335,6 +399,87 @@ mod tests {
         let (m, multi) = group(&f, &w, &[0.0, 0.0, 1.0], 10.0, 1.0, 40.0, circ);
         assert_eq!(m.count, 3);
         assert!(multi);
+    }
+
+    /// The sweep as it was before the height ends were sorted once (each
+    /// active set's ends sorted on their own), kept to show the change
+    /// keeps every result bit for bit.
+    fn boxes_max_per_set_sort(boxes: &[(f64, f64, f64, f64, f64)]) -> Meet {
+        let mut best = Meet {
+            weight: 0.0,
+            count: 0,
+            count_at_worst: 0,
+            height_mm: 0.0,
+            arc_mm: 0.0,
+        };
+        let mut xs: Vec<f64> = boxes.iter().map(|b| b.0).collect();
+        xs.sort_by(f64::total_cmp);
+        xs.dedup();
+        let mut err = 0.0f64;
+        for (k, &x) in xs.iter().enumerate() {
+            let active = || boxes.iter().filter(|b| b.0 <= x && x <= b.1);
+            if let Some(&next) = xs.get(k + 1) {
+                if active().all(|b| b.1 >= next) {
+                    continue;
+                }
+            }
+            let mut ends: Vec<(f64, bool, f64)> = Vec::new();
+            let mut total = 0.0;
+            for b in active() {
+                ends.push((b.2, false, b.4));
+                ends.push((b.3, true, b.4));
+                total += b.4;
+            }
+            ends.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            err = err.max(2.0 * ends.len() as f64 * f64::EPSILON * total);
+            let (mut w, mut n) = (0.0f64, 0u32);
+            for &(z, close, wi) in &ends {
+                if close {
+                    w -= wi;
+                    n -= 1;
+                    continue;
+                }
+                w += wi;
+                n += 1;
+                best.count = best.count.max(n);
+                if w > best.weight {
+                    best.weight = w;
+                    best.count_at_worst = n;
+                    best.height_mm = z;
+                    best.arc_mm = x;
+                }
+            }
+        }
+        if boxes.len() > 1 {
+            best.weight = best.weight * (1.0 + SUM_MARGIN) + err;
+        }
+        best
+    }
+
+    /// Sorting the height ends once gives the same bits as sorting each
+    /// active set's ends: random boxes with many ties (integer ends) and
+    /// equal weights, where the order of the additions matters.
+    #[test]
+    fn boxes_sweep_sorted_once_is_bit_identical() {
+        use proptest::prelude::*;
+        use proptest::test_runner::{Config, TestRunner};
+        let mut runner = TestRunner::new(Config::with_cases(500));
+        let bx = (0u8..12, 0u8..6, 0u8..12, 0u8..6, 0.1f64..2.0);
+        runner
+            .run(&proptest::collection::vec(bx, 1..40), |v| {
+                let boxes: Vec<_> = v
+                    .iter()
+                    .map(|&(x, wx, z, wz, w)| {
+                        let (x, z) = (f64::from(x), f64::from(z));
+                        (x, x + f64::from(wx), z, z + f64::from(wz), w)
+                    })
+                    .collect();
+                let (a, b) = (boxes_max(&boxes), boxes_max_per_set_sort(&boxes));
+                prop_assert_eq!(a.weight.to_bits(), b.weight.to_bits());
+                prop_assert_eq!(a, b);
+                Ok(())
+            })
+            .unwrap();
     }
 
     /// The sweep (with skipped subsets) against the plain maximum over
