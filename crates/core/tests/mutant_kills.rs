@@ -5,6 +5,7 @@
 
 use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
 use gaze_lidar_core::eye_safety::bound::{Seg, WALK_MAX_PIECES};
+use gaze_lidar_core::eye_safety::head::{Channel, Head};
 use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams, Rule};
 
 fn params(lambda_nm: f64, beam_mm: f64) -> EyeSafetyParams {
@@ -120,4 +121,124 @@ fn pass_count_rule_evaluates_the_first_step_of_a_row() {
         r.worst_ratio
     );
     assert_eq!(r.binding_rule, Rule::T2Train);
+}
+
+fn valid_head(n: u32) -> Head {
+    Head {
+        cycle_s: 1e-3,
+        origin_radius_mm: 40.0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 5.0,
+        divergence_mrad: 1.0,
+        aperture_distance_mm: 100.0,
+        channels: (0..n)
+            .map(|id| Channel {
+                id,
+                elevation_deg: 0.0,
+                azimuth_offset_deg: 0.0,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            })
+            .collect(),
+    }
+}
+
+/// `Err` naming `field`, or `Ok`.
+fn verdict(h: &Head) -> Result<(), String> {
+    h.validate().map_err(|e| e.field)
+}
+
+/// Kills the mutants of `Head::validate` (`head/mod.rs`) that move its one
+/// numeric boundary. Issue 29's head sample drew seven (lines of `b14eeb0`):
+/// 121:60 `>` → `>=` (512 channels refused), 139:13 `||` → `&&` (a crossing
+/// point at or beyond the aperture accepted), 164:83 `<` → `>` (elevation),
+/// 170:64 `delete !` (azimuth offset), 177:55 `delete !` and 177:66 `<` →
+/// `==` (slot), 189:55 `==` → `!=` (duplicate ids). The core's tests built
+/// only valid heads, so no refusal was pinned; an accepting mutant can lower
+/// a figure (a negative `power_scale` subtracts from the overlap weights, a
+/// crossing point at or beyond the aperture gives NaN footprints that meet
+/// no aperture, a slot outside the cycle falls outside every window). Every
+/// limit by hand from the documented boundary: accepted at its edge, refused
+/// just beyond it, naming the field.
+#[test]
+fn head_validation_edges_by_hand() {
+    let ok = |h: &Head| assert_eq!(verdict(h), Ok(()), "{h:?}");
+    let refused = |h: &Head, field: &str| {
+        assert_eq!(verdict(h), Err(field.to_owned()), "{h:?}");
+    };
+    let with = |f: &dyn Fn(&mut Head)| {
+        let mut h = valid_head(2);
+        f(&mut h);
+        h
+    };
+    let ch = |f: &dyn Fn(&mut Channel)| with(&|h: &mut Head| f(&mut h.channels[1]));
+    ok(&valid_head(1));
+    ok(&valid_head(512));
+    refused(&valid_head(0), "channels");
+    refused(&valid_head(513), "channels");
+
+    ok(&with(&|h| h.cycle_s = 1.0));
+    for bad in [1.000_000_1, 0.0, -1e-3, f64::NAN, f64::INFINITY, 1e-310] {
+        refused(&with(&|h| h.cycle_s = bad), "cycle_s");
+    }
+    ok(&with(&|h| h.aperture_distance_mm = 10_000.0));
+    for bad in [10_000.001, 0.0, -100.0, f64::NAN] {
+        refused(
+            &with(&|h| h.aperture_distance_mm = bad),
+            "aperture_distance_mm",
+        );
+    }
+    ok(&with(&|h| h.origin_radius_mm = 0.0));
+    ok(&with(&|h| h.origin_radius_mm = 99.999));
+    for bad in [100.0, 100.001, 1e4, -1e-3, f64::NAN, f64::INFINITY] {
+        refused(&with(&|h| h.origin_radius_mm = bad), "origin_radius_mm");
+    }
+    ok(&with(&|h| h.origin_height_mm = 1e4));
+    ok(&with(&|h| h.origin_height_mm = -1e4));
+    for bad in [10_000.01, -10_000.01, f64::NAN, f64::NEG_INFINITY] {
+        refused(&with(&|h| h.origin_height_mm = bad), "origin_height_mm");
+    }
+    ok(&with(&|h| h.exit_diameter_mm = 999.9));
+    for bad in [1000.0, 0.0, -5.0, f64::NAN] {
+        refused(&with(&|h| h.exit_diameter_mm = bad), "exit_diameter_mm");
+    }
+    ok(&with(&|h| h.divergence_mrad = 0.0));
+    ok(&with(&|h| h.divergence_mrad = 1000.0));
+    for bad in [1000.1, -0.1, f64::NAN] {
+        refused(&with(&|h| h.divergence_mrad = bad), "divergence_mrad");
+    }
+
+    for (edge, bad) in [(89.999, 90.0), (-89.999, -90.0)] {
+        ok(&ch(&|c| c.elevation_deg = edge));
+        refused(&ch(&|c| c.elevation_deg = bad), "channels[1].elevation_deg");
+        ok(&ch(&|c| c.azimuth_offset_deg = edge));
+        refused(
+            &ch(&|c| c.azimuth_offset_deg = bad),
+            "channels[1].azimuth_offset_deg",
+        );
+    }
+    refused(
+        &ch(&|c| c.elevation_deg = f64::NAN),
+        "channels[1].elevation_deg",
+    );
+    refused(
+        &ch(&|c| c.azimuth_offset_deg = f64::NAN),
+        "channels[1].azimuth_offset_deg",
+    );
+    ok(&ch(&|c| c.slot_s = 0.999e-3));
+    for bad in [1e-3, 2e-3, -1e-9, f64::NAN] {
+        refused(&ch(&|c| c.slot_s = bad), "channels[1].slot_s");
+    }
+    ok(&ch(&|c| c.power_scale = 0.0));
+    ok(&ch(&|c| c.power_scale = 1000.0));
+    for bad in [1000.1, -0.1, -1.0, f64::NAN] {
+        refused(&ch(&|c| c.power_scale = bad), "channels[1].power_scale");
+    }
+
+    // Ids: unique in any order; a repeated id is refused naming it.
+    ok(&ch(&|c| c.id = 7));
+    let mut h = valid_head(3);
+    h.channels[0].id = 5;
+    h.channels[2].id = 5;
+    refused(&h, "channels (id 5)");
 }

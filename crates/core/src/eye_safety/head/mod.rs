@@ -33,6 +33,8 @@ pub mod bound;
 pub mod geometry;
 #[cfg(feature = "std")]
 pub mod overlap;
+#[cfg(all(feature = "std", any(kani, test)))]
+mod verification;
 
 #[cfg(feature = "std")]
 pub use bound::{head_figures, power_scale_to_certify, HeadFigures};
