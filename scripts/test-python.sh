@@ -23,8 +23,9 @@ echo "== python: pip install ./python into a fresh venv ($venv)"
 "$PY" -m venv "$venv"
 "$venv/bin/pip" install -q ./python   # exactly what a user runs
 "$venv/bin/python" -m pip install -q pytest hypothesis mypy
-# An independent MCAP writer and reader for the replay test (issue 33).
-"$venv/bin/python" -m pip install -q mcap mcap-ros2-support
+# An independent MCAP writer and reader for the replay test (issue 33), and
+# dask.distributed for examples/python/replay_many.py (pure Python, ~15 s).
+"$venv/bin/python" -m pip install -q mcap mcap-ros2-support "dask[distributed]"
 
 echo "== python: pytest"
 # From outside the source tree, so the installed package is what is tested.

@@ -50,6 +50,7 @@ from ._native import (
     Verdict,
     __version__,
     profile,
+    replay,
 )
 from ._points import as_points, rotate_yaw
 
@@ -245,5 +246,6 @@ __all__ = [
     "check",
     "optimize",
     "profile",
+    "replay",
     "simulate",
 ]
