@@ -94,18 +94,18 @@ def replay_dask(
 ) -> dict[str, dict[str, int]]:
     """dask.distributed: a local cluster of `workers` single-threaded worker
     processes, or the cluster at `scheduler`."""
-    from dask.distributed import (  # type: ignore[import-not-found,import-untyped,unused-ignore]
-        Client,
-        LocalCluster,
-    )
+    import dask.distributed  # type: ignore[import-not-found,import-untyped,unused-ignore]
+
+    # Untyped in places: used through Any.
+    dist: Any = dask.distributed
 
     pairs = _targets(bags, out_dir)
     if scheduler is None:
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+        cluster = dist.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                dashboard_address=None)
-        client = Client(cluster)
+        client = dist.Client(cluster)
     else:
-        cluster, client = None, Client(scheduler)
+        cluster, client = None, dist.Client(scheduler)
     try:
         # pure=False: each call writes a file, never served from a cache.
         futures = [client.submit(replay_one, b, o, options, pure=False) for b, o in pairs]

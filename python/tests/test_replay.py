@@ -248,11 +248,12 @@ def test_the_mounting_yaw_is_read_from_tf_static(tmp_path: pathlib.Path) -> None
 def test_the_binding_writes_what_the_cli_writes(repo: pathlib.Path, tmp_path: pathlib.Path) -> None:
     bag = tmp_path / "drive.mcap"
     write_fixture(bag)
-    for extra_cli, extra_py in [
+    cases: list[tuple[list[str], dict[str, Any]]] = [
         ([], {}),
         (["--compression", "zstd", "--seed", "9", "--mode", "joint", "--sensor-yaw-deg", "30"],
          {"compression": "zstd", "seed": 9, "mode": "joint", "sensor_yaw_deg": 30.0}),
-    ]:
+    ]
+    for extra_cli, extra_py in cases:
         a, b = tmp_path / "cli.mcap", tmp_path / "py.mcap"
         subprocess.run(
             [str(cli(repo)), "replay", str(bag), "--gaze-topic", GAZE, "--cloud-topic", CLOUD,
@@ -263,7 +264,8 @@ def test_the_binding_writes_what_the_cli_writes(repo: pathlib.Path, tmp_path: pa
         assert a.read_bytes() == b.read_bytes()
         assert stats["clouds"] == 30 and stats["messages"] == len(read(bag))
     with pytest.raises(ValueError, match="compression"):
-        gl.replay(bag, tmp_path / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD, compression="gzip")
+        gl.replay(bag, tmp_path / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD,
+                  compression="gzip")  # type: ignore[arg-type]
     (tmp_path / "cut.mcap").write_bytes(bag.read_bytes()[:5000])
     with pytest.raises(ValueError, match="at byte 5000"):
         gl.replay(tmp_path / "cut.mcap", tmp_path / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD)
