@@ -87,11 +87,15 @@ fn bench(c: &mut Criterion) {
     g.bench_function("replay_2s_lz4", |b| {
         b.iter(|| run(&input, Compression::Lz4))
     });
+    g.bench_function("replay_2s_zstd", |b| {
+        b.iter(|| run(&input, Compression::Zstd))
+    });
     g.finish();
     // The real-time factor, best of 5.
     for (name, compression) in [
         ("uncompressed", Compression::None),
         ("lz4", Compression::Lz4),
+        ("zstd", Compression::Zstd),
     ] {
         let mut best = f64::INFINITY;
         let mut best_cpu = f64::INFINITY;

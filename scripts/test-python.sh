@@ -27,8 +27,9 @@ echo "== python: pip install ./python into a fresh venv ($venv)"
 # pandas (optional for users): the to_pandas() tests and push_many's
 # nullable-type cases (pandas "boolean", "Float64") run with it.
 "$venv/bin/python" -m pip install -q pandas
-# An independent MCAP writer and reader for the replay test.
-"$venv/bin/python" -m pip install -q mcap mcap-ros2-support
+# An independent MCAP writer and reader for the replay test, and
+# dask.distributed for examples/python/replay_many.py (pure Python, ~15 s).
+"$venv/bin/python" -m pip install -q mcap mcap-ros2-support "dask[distributed]"
 
 echo "== python: pytest"
 # From outside the source tree, so the installed package is what is tested.

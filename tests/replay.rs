@@ -194,7 +194,11 @@ fn replay_cli(input: &std::path::Path, out: &std::path::Path) -> std::process::O
 #[test]
 fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap() {
     let dir = tempfile::tempdir().unwrap();
-    for (name, compression) in [("plain", None), ("lz4", Some(mcap::Compression::Lz4))] {
+    for (name, compression) in [
+        ("plain", None),
+        ("lz4", Some(mcap::Compression::Lz4)),
+        ("zstd", Some(mcap::Compression::Zstd)),
+    ] {
         let input = dir.path().join(format!("{name}.mcap"));
         let out = dir.path().join(format!("{name}-out.mcap"));
         let bag = bag(compression);
@@ -389,6 +393,288 @@ fn replay_is_deterministic() {
     assert_eq!(replay_cli(&input, &a).status.code(), Some(0));
     assert_eq!(replay_cli(&input, &b).status.code(), Some(0));
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    // Compressed output (zstd, lz4): the same messages, deterministic too.
+    let plain = read_all(&std::fs::read(&a).unwrap());
+    for c in ["zstd", "lz4"] {
+        let runs: Vec<Vec<u8>> = (0..2)
+            .map(|k| {
+                let out = dir.path().join(format!("{c}{k}.mcap"));
+                let o = bin()
+                    .arg("replay")
+                    .arg(&input)
+                    .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD])
+                    .args(["--preset", "paper", "--mode", "range"])
+                    .args(["--compression", c, "--out"])
+                    .arg(&out)
+                    .output()
+                    .unwrap();
+                assert_eq!(
+                    o.status.code(),
+                    Some(0),
+                    "{}",
+                    String::from_utf8_lossy(&o.stderr)
+                );
+                std::fs::read(&out).unwrap()
+            })
+            .collect();
+        assert_eq!(runs[0], runs[1], "{c}");
+        assert_ne!(runs[0], std::fs::read(&a).unwrap(), "{c}: not compressed");
+        let got = read_all(&runs[0]);
+        let key = |m: &Msg| (m.topic.clone(), m.log_time, m.data.clone());
+        assert_eq!(
+            got.iter().map(key).collect::<Vec<_>>(),
+            plain.iter().map(key).collect::<Vec<_>>(),
+            "{c}"
+        );
+    }
+}
+
+/// A bag with `/tf_static` (`base_link` → `roof` → `lidar`, given by
+/// `mounts`: (parent, child, quaternion xyzw)), gaze as Float64 yaw 90° at
+/// 100 Hz and clouds in the `lidar` frame at 10 Hz.
+fn tf_bag(mounts: &[(&str, &str, [f64; 4])]) -> Vec<u8> {
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .compression(None)
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
+        let s = w
+            .add_schema(
+                ty,
+                schemas::ROS2MSG,
+                schemas::ros2msg(ty).unwrap().as_bytes(),
+            )
+            .unwrap();
+        w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
+            .unwrap()
+    };
+    let tf = chan(&mut w, "/tf_static", schemas::TF_MESSAGE);
+    let g = chan(&mut w, "/yaw", schemas::FLOAT64);
+    let c = chan(&mut w, CLOUD, schemas::POINT_CLOUD2);
+    let t0: u64 = 5_000_000_000;
+    let transforms: Vec<cdr::TransformStamped> = mounts
+        .iter()
+        .map(|(parent, child, q)| cdr::TransformStamped {
+            header: Header {
+                sec: 5,
+                nanosec: 0,
+                frame_id: parent,
+            },
+            child_frame_id: child,
+            translation: [1.0, 0.0, 1.8],
+            rotation_xyzw: *q,
+        })
+        .collect();
+    let header = |ch, k: u64, t| MessageHeader {
+        channel_id: ch,
+        sequence: k as u32,
+        log_time: t,
+        publish_time: t,
+    };
+    w.write_to_known_channel(&header(tf, 0, t0), &cdr::encode_tf_message(&transforms))
+        .unwrap();
+    for k in 0..60u64 {
+        let t = t0 + k * 10_000_000;
+        w.write_to_known_channel(&header(g, k, t), &cdr::encode_float64(90.0))
+            .unwrap();
+        if k % 10 == 5 {
+            w.write_to_known_channel(&header(c, k, t), &cloud_msg(5, 0, k, 3000))
+                .unwrap();
+        }
+    }
+    w.finish().unwrap();
+    drop(w);
+    buf
+}
+
+/// A rotation of `deg` about the unit axis `a`, as a quaternion xyzw.
+fn axis_angle(a: [f64; 3], deg: f64) -> [f64; 4] {
+    let h = deg.to_radians() / 2.0;
+    [a[0] * h.sin(), a[1] * h.sin(), a[2] * h.sin(), h.cos()]
+}
+
+/// Replays `bag` (`/yaw` gaze, `extra` options) and checks every adapted
+/// cloud against the rule's mask on the cloud turned by `yaw_deg`.
+fn check_mounting(bag: &[u8], extra: &[&str], yaw_deg: f64) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    std::fs::write(&input, bag).unwrap();
+    let o = bin()
+        .arg("replay")
+        .arg(&input)
+        .args([
+            "--gaze-topic",
+            "/yaw",
+            "--gaze-yaw-deg",
+            "--cloud-topic",
+            CLOUD,
+        ])
+        .args(extra)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let got = read_all(&std::fs::read(&out).unwrap());
+    let profiles: Vec<(u64, gaze_lidar::checker::CertifiedProfile)> = got
+        .iter()
+        .filter(|m| m.topic == "/gaze_lidar/profile")
+        .map(|m| {
+            let p = Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "p").unwrap();
+            (m.log_time, certify(p).unwrap())
+        })
+        .collect();
+    let clouds: Vec<&Msg> = got.iter().filter(|m| m.topic == CLOUD).collect();
+    let adapted: Vec<&Msg> = got
+        .iter()
+        .filter(|m| m.topic == "/lidar/points/adapted")
+        .collect();
+    assert_eq!((clouds.len(), adapted.len()), (6, 6));
+    let (s, c) = yaw_deg.to_radians().sin_cos();
+    let mut adaptive = 0;
+    for (k, (a, cl)) in adapted.iter().zip(&clouds).enumerate() {
+        let src = PointCloud2::decode(&cl.data).unwrap();
+        let sl = src.xyz().unwrap();
+        let dst = PointCloud2::decode(&a.data).unwrap();
+        let dl = dst.xyz().unwrap();
+        let (_, profile) = profiles
+            .iter()
+            .rev()
+            .find(|(t, _)| *t <= a.log_time)
+            .unwrap();
+        adaptive += usize::from(profile.profile().gaze_deg.is_some());
+        let turned: Vec<[f64; 3]> = (0..sl.len())
+            .map(|i| {
+                let [x, y, z] = sl.xyz(sl.point(src.data, i));
+                [c * x - s * y, s * x + c * y, z]
+            })
+            .collect();
+        let mut opts = CloudOptions::new(100.0);
+        opts.frame = CloudFrame::Iso8855;
+        opts.seed = k as u64;
+        let mask = keep_mask(profile, turned.iter().copied(), &opts).unwrap();
+        let want: Vec<&[u8]> = (0..sl.len())
+            .filter(|&i| mask[i])
+            .map(|i| sl.point(src.data, i))
+            .collect();
+        let have: Vec<&[u8]> = (0..dl.len()).map(|i| dl.point(dst.data, i)).collect();
+        assert_eq!(want, have, "cloud {k}, yaw {yaw_deg}");
+    }
+    assert!(adaptive >= 4, "{adaptive} adaptive clouds");
+    err
+}
+
+#[test]
+fn the_mounting_yaw_comes_from_tf_static_unless_given() {
+    let z = [0.0, 0.0, 1.0];
+    // base_link → roof: 60° yaw; roof → lidar: 30° yaw, then a 2° roll
+    // about the lidar's own x axis.
+    let roll = axis_angle([1.0, 0.0, 0.0], 2.0);
+    let lidar = gaze_lidar::replay::tf::mul(axis_angle(z, 30.0), roll);
+    let bag = tf_bag(&[
+        ("base_link", "roof", axis_angle(z, 60.0)),
+        ("roof", "lidar", lidar),
+    ]);
+    // The yaw of the lidar's x axis in base_link: 90° (the roll about it
+    // leaves it where it is).
+    check_mounting(&bag, &[], 90.0);
+    // --sensor-yaw-deg wins over the bag.
+    check_mounting(&bag, &["--sensor-yaw-deg", "0"], 0.0);
+    check_mounting(&bag, &["--sensor-yaw-deg", "-45"], -45.0);
+    // Another vehicle frame: the roof (lidar 30° from it).
+    check_mounting(&bag, &["--vehicle-frame", "roof"], 30.0);
+    // No transform to the vehicle frame: no yaw, and a warning naming it.
+    let err = check_mounting(&bag, &["--vehicle-frame", "map"], 0.0);
+    assert!(
+        err.contains("6 clouds not in the vehicle frame \"map\""),
+        "{err}"
+    );
+    // The transform given with its parent and child the other way round.
+    let inv = axis_angle(z, -90.0);
+    check_mounting(&tf_bag(&[("lidar", "base_link", inv)]), &[], 90.0);
+}
+
+#[test]
+fn a_tilted_static_transform_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    // A 10° pitch under a 30° yaw: beyond the 5° default tolerance.
+    let q = gaze_lidar::replay::tf::mul(
+        axis_angle([0.0, 0.0, 1.0], 30.0),
+        axis_angle([0.0, 1.0, 0.0], 10.0),
+    );
+    std::fs::write(&input, tf_bag(&[("base_link", "lidar", q)])).unwrap();
+    let run = |extra: &[&str]| {
+        bin()
+            .arg("replay")
+            .arg(&input)
+            .args([
+                "--gaze-topic",
+                "/yaw",
+                "--gaze-yaw-deg",
+                "--cloud-topic",
+                CLOUD,
+            ])
+            .args(extra)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[]);
+    common::no_panic(&o, "tilted");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("/tf_static") && err.contains("\"lidar\""),
+        "{err}"
+    );
+    assert!(err.contains("10.000°"), "{err}");
+    assert!(!out.exists());
+    // A wider tolerance, or the yaw given, lets it through.
+    assert_eq!(run(&["--max-mount-tilt-deg", "12"]).status.code(), Some(0));
+    assert_eq!(run(&["--sensor-yaw-deg", "30"]).status.code(), Some(0));
+    // A zero quaternion: exit 2 naming the transform.
+    std::fs::write(&input, tf_bag(&[("base_link", "lidar", [0.0; 4])])).unwrap();
+    let o = run(&[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("transform lidar in base_link"), "{err}");
+}
+
+/// A full disk (here: the file-size limit, `ulimit -f`, with SIGXFSZ
+/// ignored so the write fails with EFBIG) is exit 1 with no output file
+/// and no temporary file left.
+#[test]
+fn a_full_disk_leaves_no_partial_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let out = dir.path().join("out.mcap");
+    let o = Command::new("sh")
+        .arg("-c")
+        // 64 blocks of 512 or 1024 bytes: far less than the output.
+        .arg("trap '' XFSZ; ulimit -f 64 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_gaze-lidar"))
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD, "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    common::no_panic(&o, "full disk");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("output"), "{err}");
+    assert!(!out.exists());
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n != "in.mcap")
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
 }
 
 #[test]

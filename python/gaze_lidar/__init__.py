@@ -88,6 +88,7 @@ from ._native import (
     Verdict,
     __version__,
     profile,
+    replay,
 )
 from ._points import as_points, rotate_yaw
 from ._results import SimulationResult, frames_to_pandas, parse_trials_csv
@@ -319,6 +320,7 @@ __all__ = [
     "optimize",
     "profile",
     "read_gaze",
+    "replay",
     "simulate",
 ]
 

@@ -7,6 +7,7 @@ SI units elsewhere, the unit in each name. Errors: ValueError for bad input
 that cannot be met, Rejected for a profile that fails the checker.
 """
 
+from os import PathLike
 from typing import Any, Literal, Sequence
 
 from typing_extensions import Self, final
@@ -31,6 +32,7 @@ __all__ = [
     "optimize",
     "profile",
     "read_gaze",
+    "replay",
     "simulate",
 ]
 __version__: str
@@ -405,4 +407,51 @@ def simulate(
     "optimized"), fog_pct (list of 0, 25, 50), detect ("k/n"), bins,
     preset, scenario_toml (TOML text), optimizer_toml (TOML text, with the
     "optimized" variant). Releases the GIL while it runs.
+    """
+
+def replay(
+    in_path: str | PathLike[str],
+    out_path: str | PathLike[str],
+    *,
+    gaze_topic: str,
+    cloud_topic: str,
+    preset: str = "paper",
+    mode: Literal["baseline", "range", "resolution", "joint"] = "range",
+    bins: int = 360,
+    config_toml: str | None = None,
+    gaze_yaw_deg: bool = False,
+    sensor_yaw_deg: float | None = None,
+    vehicle_frame: str = "base_link",
+    tf_topic: str = "/tf_static",
+    max_mount_tilt_deg: float = 5.0,
+    rated_range_m: float | None = None,
+    model: Literal["physical", "argus"] = "physical",
+    fog_mor_m: float | None = None,
+    seed: int = 0,
+    cloud_spin_rad_s: float | None = None,
+    timeout_ms: float = 100.0,
+    recover_samples: int = 4,
+    saccade_deg_s: float = 30.0,
+    max_gap_frames: int = 200,
+    reorder_window_ms: float = 200.0,
+    adapted_topic: str | None = None,
+    profile_topic: str = "/gaze_lidar/profile",
+    scene_topic: str = "/gaze_lidar/scene",
+    compression: Literal["none", "lz4", "zstd"] = "none",
+) -> dict[str, int]:
+    """Replays the ROS 2 bag (MCAP) at in_path through the gaze pipeline
+    and writes out_path, as `gaze-lidar replay` does (same Rust code, same
+    options): every input message copied, one adapted cloud per cloud on
+    adapted_topic (default cloud_topic + "/adapted"), one profile@1 document
+    per frame on profile_topic and a foxglove.SceneUpdate per frame on
+    scene_topic. out_path is replaced only when the replay succeeds.
+    Returns the counters (messages, clouds, points_in, points_kept,
+    late_clouds, late_gaze, clouds_without_tf, transforms, samples,
+    invalid, outliers, frames, fail_safe_frames).
+
+    The mounting yaw: sensor_yaw_deg when given, else the bag's static
+    transforms on tf_topic from the cloud's header.frame_id to
+    vehicle_frame. ValueError for a bad option or bag (naming the field or
+    the byte offset), Infeasible for a request the planner cannot meet,
+    OSError when out_path cannot be written. Releases the GIL.
     """

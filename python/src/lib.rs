@@ -7,6 +7,8 @@
 //! `ValueError` for bad input, `Infeasible` for a request that cannot be met,
 //! `Rejected` for a profile that fails the checker.
 
+mod replay;
+
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
@@ -1685,6 +1687,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "GAZE_FORMATS",
         PyList::new(py, gaze_io::FORMATS.iter().map(|(n, _)| *n))?,
     )?;
+    m.add_function(wrap_pyfunction!(replay::replay, m)?)?;
     m.add(
         "PRESETS",
         PyList::new(py, presets::PRESET_NAMES.iter().copied())?,

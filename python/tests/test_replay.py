@@ -60,15 +60,44 @@ def cloud_points(seed: int, n: int) -> np.ndarray[Any, Any]:
     return pts
 
 
-def write_fixture(path: pathlib.Path) -> None:
+TF_MESSAGE = (
+    "geometry_msgs/TransformStamped[] transforms\n"
+    + SEP + "MSG: geometry_msgs/TransformStamped\n"
+    "std_msgs/Header header\nstring child_frame_id\nTransform transform\n"
+    + SEP + "MSG: std_msgs/Header\n" + HEADER
+    + SEP + "MSG: builtin_interfaces/Time\n" + TIME
+    + SEP + "MSG: geometry_msgs/Transform\nVector3 translation\nQuaternion rotation\n"
+    + SEP + "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n"
+    + SEP + "MSG: geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n"
+)
+
+
+def yaw_quaternion(yaw_deg: float, roll_deg: float = 0.0) -> dict[str, float]:
+    """The rotation Rz(yaw)·Rx(roll) as a geometry_msgs/Quaternion."""
+    h, r = np.radians(yaw_deg) / 2, np.radians(roll_deg) / 2
+    # (0, 0, sin h, cos h) ⊗ (sin r, 0, 0, cos r)
+    return {"x": float(np.cos(h) * np.sin(r)), "y": float(np.sin(h) * np.sin(r)),
+            "z": float(np.sin(h) * np.cos(r)), "w": float(np.cos(h) * np.cos(r))}
+
+
+def write_fixture(path: pathlib.Path, compression: str = "LZ4",
+                  mount: dict[str, float] | None = None) -> None:
     """Clouds at 10 Hz and gaze at 100 Hz (looking left) for 3 s, a 0.5 s
-    gap in the gaze from 1.0 s, and an unrelated topic."""
+    gap in the gaze from 1.0 s, and an unrelated topic; with `mount`, a
+    /tf_static message from base_link to the cloud frame "lidar"."""
     with open(path, "wb") as f:
-        w = ros2_writer.Writer(f, compression=mcap_writer.CompressionType.LZ4)
+        w = ros2_writer.Writer(f, compression=getattr(mcap_writer.CompressionType, compression))
         gaze_s = w.register_msgdef("geometry_msgs/msg/Vector3Stamped", VECTOR3_STAMPED)
         cloud_s = w.register_msgdef("sensor_msgs/msg/PointCloud2", POINT_CLOUD2)
         other_s = w.register_msgdef("std_msgs/msg/String", "string data\n")
         msgs: list[tuple[int, str, Any, dict[str, Any]]] = []
+        if mount is not None:
+            tf_s = w.register_msgdef("tf2_msgs/msg/TFMessage", TF_MESSAGE)
+            msgs.append((T0, "/tf_static", tf_s, {"transforms": [{
+                "header": {"stamp": stamp(T0), "frame_id": "base_link"},
+                "child_frame_id": "lidar",
+                "transform": {"translation": {"x": 1.2, "y": 0.0, "z": 1.9}, "rotation": mount},
+            }]}))
         for k in range(300):
             if 100 <= k < 150:
                 continue
@@ -119,9 +148,14 @@ def cli(repo: pathlib.Path) -> pathlib.Path:
     return pathlib.Path(found)
 
 
-def test_replay_of_an_independently_written_bag(repo: pathlib.Path, tmp_path: pathlib.Path) -> None:
+@pytest.mark.parametrize("compression", ["LZ4", "ZSTD", "NONE"])
+def test_replay_of_an_independently_written_bag(
+    repo: pathlib.Path, tmp_path: pathlib.Path, compression: str
+) -> None:
+    if compression == "ZSTD":
+        pytest.importorskip("zstandard")
     bag, out = tmp_path / "drive.mcap", tmp_path / "out.mcap"
-    write_fixture(bag)
+    write_fixture(bag, compression)
     subprocess.run(
         [str(cli(repo)), "replay", str(bag), "--gaze-topic", GAZE, "--cloud-topic", CLOUD,
          "--preset", "paper", "--mode", "range", "--out", str(out)],
@@ -166,3 +200,103 @@ def test_replay_of_an_independently_written_bag(repo: pathlib.Path, tmp_path: pa
         np.testing.assert_array_equal(dst, src[mask])
         thinned += len(src) - len(dst)
     assert thinned > 0
+
+
+def adapted_vs_rule(inp: list[Any], got: list[Any], sensor_yaw_deg: float) -> int:
+    """Checks each adapted cloud against apply_profile on its input cloud
+    (the sensor turned by sensor_yaw_deg); returns the adaptive clouds."""
+    parsed = [(m[2], gl.Profile.from_json(m[3].decode())) for m in got
+              if m[0] == "/gaze_lidar/profile"]
+    clouds = [m for m in inp if m[0] == CLOUD]
+    adapted = [m for m in got if m[0] == CLOUD + "/adapted"]
+    assert len(adapted) == len(clouds) == 30
+    adaptive = 0
+    for k, (c, a) in enumerate(zip(clouds, adapted)):
+        src = np.frombuffer(c[4].data, dtype=POINT)
+        dst = np.frombuffer(a[4].data, dtype=POINT)
+        profile = [p for t, p in parsed if t <= a[2]][-1]
+        adaptive += profile.gaze_deg is not None
+        mask = gl.apply_profile(profile, src[["x", "y", "z"]], rated_range_m=100.0,
+                                frame="iso8855", seed=k, sensor_yaw_deg=sensor_yaw_deg)
+        np.testing.assert_array_equal(dst, src[mask])
+    return adaptive
+
+
+def test_the_mounting_yaw_is_read_from_tf_static(tmp_path: pathlib.Path) -> None:
+    """A /tf_static transform base_link → lidar (a 75° yaw and a 1° roll
+    about the lidar's own x axis) written by mcap-ros2-support: the clouds
+    are turned by 75° before the rule; sensor_yaw_deg overrides it; a 20°
+    roll is refused by name."""
+    bag = tmp_path / "tf.mcap"
+    write_fixture(bag, "NONE", mount=yaw_quaternion(75.0, roll_deg=1.0))
+    out = tmp_path / "out.mcap"
+    stats = gl.replay(bag, out, gaze_topic=GAZE, cloud_topic=CLOUD)
+    assert stats["transforms"] == 1 and stats["clouds_without_tf"] == 0
+    assert adapted_vs_rule(read(bag), read(out), 75.0) >= 10
+    gl.replay(bag, out, gaze_topic=GAZE, cloud_topic=CLOUD, sensor_yaw_deg=-10.0)
+    assert adapted_vs_rule(read(bag), read(out), -10.0) >= 10
+    stats = gl.replay(bag, out, gaze_topic=GAZE, cloud_topic=CLOUD, vehicle_frame="odom")
+    assert stats["clouds_without_tf"] == 30
+    assert adapted_vs_rule(read(bag), read(out), 0.0) >= 10
+    write_fixture(bag, "NONE", mount=yaw_quaternion(75.0, roll_deg=20.0))
+    out.unlink()
+    with pytest.raises(ValueError, match=r"/tf_static: .*\"lidar\".*20\.000°"):
+        gl.replay(bag, out, gaze_topic=GAZE, cloud_topic=CLOUD)
+    assert not out.exists()
+
+
+def test_the_binding_writes_what_the_cli_writes(repo: pathlib.Path, tmp_path: pathlib.Path) -> None:
+    bag = tmp_path / "drive.mcap"
+    write_fixture(bag)
+    cases: list[tuple[list[str], dict[str, Any]]] = [
+        ([], {}),
+        (["--compression", "zstd", "--seed", "9", "--mode", "joint", "--sensor-yaw-deg", "30"],
+         {"compression": "zstd", "seed": 9, "mode": "joint", "sensor_yaw_deg": 30.0}),
+    ]
+    for extra_cli, extra_py in cases:
+        a, b = tmp_path / "cli.mcap", tmp_path / "py.mcap"
+        subprocess.run(
+            [str(cli(repo)), "replay", str(bag), "--gaze-topic", GAZE, "--cloud-topic", CLOUD,
+             "--out", str(a), *extra_cli],
+            check=True, capture_output=True,
+        )
+        stats = gl.replay(str(bag), b, gaze_topic=GAZE, cloud_topic=CLOUD, **extra_py)
+        assert a.read_bytes() == b.read_bytes()
+        assert stats["clouds"] == 30 and stats["messages"] == len(read(bag))
+    with pytest.raises(ValueError, match="compression"):
+        gl.replay(bag, tmp_path / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD,
+                  compression="gzip")  # type: ignore[arg-type]
+    (tmp_path / "cut.mcap").write_bytes(bag.read_bytes()[:5000])
+    with pytest.raises(ValueError, match="at byte 5000"):
+        gl.replay(tmp_path / "cut.mcap", tmp_path / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD)
+    assert not (tmp_path / "x.mcap").exists()
+
+
+def test_many_bags_in_parallel_are_byte_identical_to_one_by_one(
+    repo: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """examples/python/replay_many.py: threads, processes and (when
+    installed) dask.distributed give the files replaying each bag alone
+    gives."""
+    import importlib
+
+    # Importable by name: spawned worker processes import it again.
+    monkeypatch.syspath_prepend(str(repo / "examples/python"))
+    ex = importlib.import_module("replay_many")
+    bags = []
+    for i, c in enumerate(["LZ4", "NONE", "LZ4", "NONE"]):
+        bags.append(tmp_path / f"drive{i}.mcap")
+        write_fixture(bags[-1], c, mount=yaw_quaternion(30.0 * i) if i % 2 else None)
+    options = {"gaze_topic": GAZE, "cloud_topic": CLOUD, "preset": "paper", "mode": "range"}
+    serial = tmp_path / "serial"
+    ex.replay_serial(bags, serial, **options)
+    want = {p.name: p.read_bytes() for p in serial.iterdir()}
+    assert len(want) == len(bags)
+    runs = {"threads": ex.replay_threads, "processes": ex.replay_processes}
+    if ex.dask_available():
+        runs["dask"] = ex.replay_dask
+    for name, run in runs.items():
+        out = tmp_path / name
+        stats = run(bags, out, workers=2, **options)
+        assert sorted(stats) == sorted(str(b) for b in bags)
+        assert {p.name: p.read_bytes() for p in out.iterdir()} == want, name

@@ -6,9 +6,9 @@
 //! over it only when the whole replay succeeded: a failure leaves any old
 //! `--out` as it was and no partial file.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use gaze_lidar::replay::{replay, Compression, GazeKind, ReplayError, ReplayOptions};
+use gaze_lidar::replay::{replay_file, Compression, GazeKind, ReplayError, ReplayOptions};
 use gaze_lidar::sim::returns::ModelKind;
 
 use super::args::finite_between;
@@ -22,11 +22,13 @@ pub enum CompressionArg {
     None,
     /// LZ4 chunks.
     Lz4,
+    /// Zstandard chunks.
+    Zstd,
 }
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The input bag (a rosbag2 MCAP file: uncompressed or LZ4 chunks).
+    /// The input bag (a rosbag2 MCAP file: uncompressed, LZ4 or zstd chunks).
     input: PathBuf,
     /// Gaze topic: geometry_msgs/msg/Vector3Stamped, the gaze direction in
     /// the vehicle frame (ISO 8855: x forward, y left, z up; azimuth
@@ -47,9 +49,22 @@ pub struct Args {
     plan: PlanArgs,
     /// The cloud frame's x axis, degrees counter-clockwise (ISO 8855) from
     /// the vehicle's: a point at azimuth β in the cloud is at β + yaw in the
-    /// vehicle frame of the gaze and the profile.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    sensor_yaw_deg: f64,
+    /// vehicle frame of the gaze and the profile. Given, it wins over the
+    /// bag; else the yaw comes from the static transforms on --tf-topic
+    /// between the cloud's header.frame_id and --vehicle-frame (none when
+    /// the frames are the same or no transform links them).
+    #[arg(long, allow_hyphen_values = true)]
+    sensor_yaw_deg: Option<f64>,
+    /// The vehicle frame (of the gaze and the profile) in the bag's transforms.
+    #[arg(long, default_value = "base_link")]
+    vehicle_frame: String,
+    /// Topic of the static transforms (tf2_msgs/msg/TFMessage).
+    #[arg(long, default_value = "/tf_static")]
+    tf_topic: String,
+    /// Largest roll/pitch tilt of the cloud frame in a transform from the
+    /// bag, degrees (beyond it the replay stops: the mounting is a yaw).
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    max_mount_tilt_deg: f64,
     /// Range of the uniform baseline on the reference target in clear air, m
     /// [default: the preset's rated range].
     #[arg(long, allow_hyphen_values = true)]
@@ -94,15 +109,6 @@ fn replay_error(e: ReplayError) -> CliError {
     }
 }
 
-/// Same file (device and inode) — `--out` must not be the input.
-fn same_file(a: &Path, b: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    match (std::fs::metadata(a), std::fs::metadata(b)) {
-        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
-        _ => false,
-    }
-}
-
 pub fn run(a: &Args) -> Result<u8, CliError> {
     let pipeline = a.filter.settings()?;
     if !(a.reorder_window_ms.is_finite() && (0.0..=60_000.0).contains(&a.reorder_window_ms)) {
@@ -111,12 +117,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             a.reorder_window_ms
         )));
     }
-    if !a.sensor_yaw_deg.is_finite() {
+    if let Some(y) = a.sensor_yaw_deg.filter(|y| !y.is_finite()) {
         return Err(CliError::input(format!(
-            "--sensor-yaw-deg: {} is not a finite angle",
-            a.sensor_yaw_deg
+            "--sensor-yaw-deg: {y} is not a finite angle"
         )));
     }
+    let max_tilt = finite_between("--max-mount-tilt-deg", a.max_mount_tilt_deg, 0.0, 90.0)?;
     let (planner, preset_range_m) = a.plan.planner()?;
     let rated_range_m = match a.rated_range_m {
         Some(r) => finite_between("--rated-range-m", r, 0.0, 1e7)?,
@@ -132,6 +138,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     opts.profile_topic.clone_from(&a.profile_topic);
     opts.scene_topic.clone_from(&a.scene_topic);
     opts.sensor_yaw_deg = a.sensor_yaw_deg;
+    opts.vehicle_frame.clone_from(&a.vehicle_frame);
+    opts.tf_topic.clone_from(&a.tf_topic);
+    opts.max_mount_tilt_deg = max_tilt;
     opts.cloud.model = a.model;
     opts.cloud.fog_mor_m = a.fog_mor_m;
     opts.cloud.seed = a.seed;
@@ -140,54 +149,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     opts.compression = match a.compression {
         CompressionArg::None => Compression::None,
         CompressionArg::Lz4 => Compression::Lz4,
+        CompressionArg::Zstd => Compression::Zstd,
     };
 
-    let input = std::fs::File::open(&a.input)
-        .map_err(|e| CliError::input(format!("{}: {e}", a.input.display())))?;
-    if same_file(&a.input, &a.out) {
-        return Err(CliError::input(format!(
-            "--out {}: is the input file",
-            a.out.display()
-        )));
-    }
-    if a.out.is_dir() {
-        return Err(CliError::input(format!(
-            "--out {}: is a directory",
-            a.out.display()
-        )));
-    }
-    let dir = match a.out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".gaze-lidar-replay.");
-    // An ordinary output file (tempfile's default is 0600); an existing one
-    // keeps its mode.
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::metadata(&a.out)
-            .map(|m| m.permissions().mode() & 0o7777)
-            .unwrap_or(0o644);
-        builder.permissions(std::fs::Permissions::from_mode(mode));
-    }
-    let tmp = builder
-        .tempfile_in(&dir)
-        .map_err(|e| CliError::input(format!("--out {}: {e}", a.out.display())))?;
-    let origin = a.input.display().to_string();
-    let reader = std::io::BufReader::with_capacity(1 << 20, input);
-    let writer = std::io::BufWriter::with_capacity(1 << 20, tmp);
-    let mut writer = writer;
-    let stats =
-        replay(reader, &origin, &mut writer, planner, pipeline, &opts).map_err(replay_error)?;
-    let tmp = writer
-        .into_inner()
-        .map_err(|e| CliError::output(format!("--out {}: {}", a.out.display(), e.error())))?;
-    tmp.as_file()
-        .sync_all()
-        .map_err(|e| CliError::output(format!("--out {}: {e}", a.out.display())))?;
-    tmp.persist(&a.out)
-        .map_err(|e| CliError::output(format!("--out {}: {}", a.out.display(), e.error)))?;
+    let stats = replay_file(&a.input, &a.out, planner, pipeline, &opts).map_err(replay_error)?;
     let s = stats.stream;
     if s.samples == 0 {
         super::io::warn(format!(
@@ -199,6 +164,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         super::io::warn(format!(
             "warning: no message on the cloud topic {}: no adapted cloud written",
             a.cloud_topic
+        ));
+    }
+    if stats.clouds_without_tf > 0 {
+        super::io::warn(format!(
+            "warning: {} clouds not in the vehicle frame {:?} and not linked to it by a transform on {}: no mounting yaw applied (give --sensor-yaw-deg)",
+            stats.clouds_without_tf, a.vehicle_frame, a.tf_topic
         ));
     }
     super::io::warn(format!(

@@ -527,6 +527,61 @@ impl XyzLayout {
     pub fn xyz(&self, p: &[u8]) -> [f64; 3] {
         [self.coord(p, 0), self.coord(p, 1), self.coord(p, 2)]
     }
+
+    /// The bytes of row `r` holding points (`width × step`; the checks of
+    /// [`PointCloud2::xyz`] keep it inside `data`).
+    #[inline]
+    fn row_points<'d>(&self, data: &'d [u8], r: usize) -> &'d [u8] {
+        let at = r * self.row;
+        &data[at..at + self.width * self.step]
+    }
+
+    /// Appends x, y, z of every point (row-major, as [`XyzLayout::point`]
+    /// numbers them) to `out`: [`XyzLayout::xyz`] of each point, with one
+    /// loop for the common layout (little-endian FLOAT32 x, y, z).
+    pub fn decode_all(&self, data: &[u8], out: &mut Vec<[f64; 3]>) {
+        if self.width == 0 {
+            return;
+        }
+        out.reserve(self.len());
+        let f32_le = !self.big && self.offsets.iter().all(|&(_, wide)| !wide);
+        let [ox, oy, oz] = self.offsets.map(|(o, _)| o);
+        let f32_at = |p: &[u8], o: usize| {
+            f64::from(f32::from_le_bytes(p[o..o + 4].try_into().unwrap_or([0; 4])))
+        };
+        for r in 0..self.height {
+            let row = self.row_points(data, r).chunks_exact(self.step);
+            if f32_le {
+                out.extend(row.map(|p| [f32_at(p, ox), f32_at(p, oy), f32_at(p, oz)]));
+            } else {
+                out.extend(row.map(|p| self.xyz(p)));
+            }
+        }
+    }
+
+    /// Byte ranges in `data` of the points `keep` marks, consecutive ones
+    /// in a row merged (so a subset is copied in a few long pieces).
+    #[must_use]
+    pub fn kept_ranges(&self, keep: &[bool]) -> Vec<std::ops::Range<usize>> {
+        let mut out = Vec::new();
+        for r in 0..self.height {
+            let row = &keep[r * self.width..(r + 1) * self.width];
+            let base = r * self.row;
+            let mut c = 0;
+            while c < row.len() {
+                if row[c] {
+                    let start = c;
+                    while c < row.len() && row[c] {
+                        c += 1;
+                    }
+                    out.push(base + start * self.step..base + c * self.step);
+                } else {
+                    c += 1;
+                }
+            }
+        }
+        out
+    }
 }
 
 /// Encodes a `PointCloud2` of `kept` points (one row) taken from `src`'s
@@ -556,11 +611,74 @@ pub fn encode_subset(
     w.u32(u32::try_from(total).unwrap_or(u32::MAX));
     w.bytes_from(
         total,
-        keep.iter()
-            .enumerate()
-            .filter(|(_, &k)| k)
-            .map(|(i, _)| layout.point(src.data, i)),
+        layout.kept_ranges(keep).into_iter().map(|r| &src.data[r]),
     );
     w.u8(u8::from(is_dense));
+    w.finish()
+}
+
+/// `geometry_msgs/msg/TransformStamped`: the pose of `child_frame_id` in
+/// `header.frame_id` (a point in the child frame is `rotation · p +
+/// translation` in the parent frame).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransformStamped<'a> {
+    /// Header (`frame_id`: the parent frame).
+    pub header: Header<'a>,
+    /// The child frame.
+    pub child_frame_id: &'a str,
+    /// Translation, m.
+    pub translation: [f64; 3],
+    /// Rotation as a quaternion `[x, y, z, w]`.
+    pub rotation_xyzw: [f64; 4],
+}
+
+/// Smallest encoding of one `TransformStamped` (empty strings), bytes: a
+/// bound for a corrupt count.
+const TRANSFORM_MIN_BYTES: usize = 4 + 4 + 4 + 4 + 7 * 8;
+
+/// `tf2_msgs/msg/TFMessage`: its transforms.
+pub fn decode_tf_message(buf: &[u8]) -> Result<Vec<TransformStamped<'_>>, ReplayError> {
+    let mut r = Reader::new(buf)?;
+    let n = r.u32("transforms")? as usize;
+    if n > buf.len() / TRANSFORM_MIN_BYTES {
+        return Err(bad(
+            "transforms",
+            format!("{n} transforms in a {}-byte message", buf.len()),
+        ));
+    }
+    let mut out = Vec::with_capacity(n);
+    for _ in 0..n {
+        let header = Header::read(&mut r)?;
+        let child_frame_id = r.string("transforms[].child_frame_id")?;
+        let mut translation = [0.0; 3];
+        for v in &mut translation {
+            *v = r.f64("transforms[].transform.translation")?;
+        }
+        let mut rotation_xyzw = [0.0; 4];
+        for v in &mut rotation_xyzw {
+            *v = r.f64("transforms[].transform.rotation")?;
+        }
+        out.push(TransformStamped {
+            header,
+            child_frame_id,
+            translation,
+            rotation_xyzw,
+        });
+    }
+    Ok(out)
+}
+
+/// `tf2_msgs/msg/TFMessage`, encoded (little-endian).
+#[must_use]
+pub fn encode_tf_message(transforms: &[TransformStamped<'_>]) -> Vec<u8> {
+    let mut w = Writer::new(64 + 128 * transforms.len());
+    w.u32(u32::try_from(transforms.len()).unwrap_or(u32::MAX));
+    for t in transforms {
+        t.header.write(&mut w);
+        w.string(t.child_frame_id);
+        for v in t.translation.iter().chain(&t.rotation_xyzw) {
+            w.f64(*v);
+        }
+    }
     w.finish()
 }

@@ -21,8 +21,9 @@
 //!   `log_time` (fail-safe frames through a gaze gap, as `stream` does);
 //!   the profile of the frame running at that time is applied to the cloud
 //!   by [`crate::pointcloud::keep_mask`] (frame ISO 8855, as ROS's REP 103;
-//!   the cloud turned by [`ReplayOptions::sensor_yaw_deg`] into the vehicle
-//!   frame first). Non-finite points (allowed when `is_dense` is false) are
+//!   the cloud turned by its mounting yaw into the vehicle frame first:
+//!   [`ReplayOptions::sensor_yaw_deg`] when given, else the static
+//!   transforms read so far on `/tf_static` ([`tf`]), else none). Non-finite points (allowed when `is_dense` is false) are
 //!   never returned and are not passed to the rule. The `k`-th cloud (from
 //!   0) is thinned with seed `seed + k` (wrapping).
 //! - every message is copied to the output unchanged, on its own topic.
@@ -39,6 +40,7 @@
 pub mod cdr;
 pub mod scene;
 pub mod schemas;
+pub mod tf;
 
 use std::collections::{BTreeMap, BinaryHeap, HashMap, VecDeque};
 use std::io::{Read, Seek, Write};
@@ -147,6 +149,8 @@ pub enum Compression {
     None,
     /// LZ4.
     Lz4,
+    /// Zstandard.
+    Zstd,
 }
 
 /// What to replay and how.
@@ -166,8 +170,21 @@ pub struct ReplayOptions {
     pub scene_topic: String,
     /// The cloud frame's x axis, degrees counter-clockwise (ISO 8855) from
     /// the vehicle's: a point at azimuth β in the cloud is at β + yaw in
-    /// the vehicle frame the gaze and the profile are in.
-    pub sensor_yaw_deg: f64,
+    /// the vehicle frame the gaze and the profile are in. `None`: read
+    /// from the static transforms on [`ReplayOptions::tf_topic`] between
+    /// the cloud's `header.frame_id` and [`ReplayOptions::vehicle_frame`]
+    /// (no yaw when the two frames are the same, or when no transform
+    /// links them: [`ReplayStats::clouds_without_tf`]). `Some` wins over
+    /// the bag's transforms.
+    pub sensor_yaw_deg: Option<f64>,
+    /// The vehicle frame (the gaze's and the profile's), for the transforms.
+    pub vehicle_frame: String,
+    /// Topic of the static transforms (`tf2_msgs/msg/TFMessage`).
+    pub tf_topic: String,
+    /// Largest tilt of the cloud frame's z axis from the vehicle's (roll
+    /// and pitch together) in a transform from the bag, degrees: beyond it
+    /// the yaw-only mounting model does not hold and the replay stops.
+    pub max_mount_tilt_deg: f64,
     /// How a profile is applied to a cloud (`frame` is ignored: ROS clouds
     /// are ISO 8855, REP 103).
     pub cloud: CloudOptions,
@@ -184,7 +201,8 @@ impl ReplayOptions {
     /// Defaults for the two topics: Vector3Stamped gaze, `<cloud>/adapted`,
     /// `/gaze_lidar/profile`, `/gaze_lidar/scene`, no mounting yaw, the
     /// physical return model at `rated_range_m`, seed 0, a 200 ms reorder
-    /// window, uncompressed chunks.
+    /// window, uncompressed chunks; the mounting yaw from `/tf_static`
+    /// to `base_link`, at most 5° of tilt.
     #[must_use]
     pub fn new(gaze_topic: &str, cloud_topic: &str, rated_range_m: f64) -> Self {
         let mut cloud = CloudOptions::new(rated_range_m);
@@ -196,7 +214,10 @@ impl ReplayOptions {
             adapted_topic: format!("{cloud_topic}/adapted"),
             profile_topic: "/gaze_lidar/profile".to_owned(),
             scene_topic: "/gaze_lidar/scene".to_owned(),
-            sensor_yaw_deg: 0.0,
+            sensor_yaw_deg: None,
+            vehicle_frame: "base_link".to_owned(),
+            tf_topic: "/tf_static".to_owned(),
+            max_mount_tilt_deg: 5.0,
             cloud,
             reorder_window_ns: 200_000_000,
             compression: Compression::None,
@@ -222,6 +243,11 @@ pub struct ReplayStats {
     pub late_clouds: u64,
     /// Gaze samples that arrived after the reorder window (dropped).
     pub late_gaze: u64,
+    /// Clouds in a frame other than the vehicle frame that no static
+    /// transform read so far linked to it (no mounting yaw was applied).
+    pub clouds_without_tf: u64,
+    /// Static transforms read.
+    pub transforms: u64,
     /// The gaze pipeline's counters.
     pub stream: StreamStats,
 }
@@ -352,7 +378,12 @@ struct Replayer<'o, P: FramePlanner, W: Write + Seek> {
     period_ns: u64,
     frame_id: String,
     stats: ReplayStats,
-    yaw: Option<(f64, f64)>,
+    /// Static transforms read so far.
+    tf: tf::TfTree,
+    /// The mounting yaw of the last cloud, degrees (for the picture).
+    yaw_deg: f64,
+    /// The last cloud's points (kept to reuse the allocation).
+    xyz_buf: Vec<[f64; 3]>,
 }
 
 impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
@@ -377,7 +408,7 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
                 f.state,
                 t_ns,
                 &self.frame_id,
-                self.opts.sensor_yaw_deg,
+                self.yaw_deg,
             );
             let scene_ch = self.out.scene;
             self.out.write(scene_ch, t_ns, t_ns, scene.as_bytes())?;
@@ -413,10 +444,65 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
                 self.emit(frames)?;
             }
             self.cloud(&p).map_err(|e| in_message(e, topic, &p))?;
-        } else if !late {
-            self.now_ns = p.log_time;
+        } else {
+            if topic == self.opts.tf_topic && self.opts.sensor_yaw_deg.is_none() {
+                self.transforms(&p).map_err(|e| in_message(e, topic, &p))?;
+            }
+            if !late {
+                self.now_ns = p.log_time;
+            }
         }
         Ok(())
+    }
+
+    fn transforms(&mut self, p: &Pending) -> Result<(), ReplayError> {
+        check_schema(&p.msg.channel, schemas::TF_MESSAGE)?;
+        for t in cdr::decode_tf_message(&p.msg.data)? {
+            self.tf
+                .insert(t.header.frame_id, t.child_frame_id, t.rotation_xyzw)
+                .map_err(|e| ReplayError::Message {
+                    field: format!("transform {} in {}", t.child_frame_id, t.header.frame_id),
+                    reason: e.to_string(),
+                })?;
+            self.stats.transforms += 1;
+        }
+        Ok(())
+    }
+
+    /// The mounting yaw of clouds in `frame`, degrees (see
+    /// [`ReplayOptions::sensor_yaw_deg`]).
+    fn mounting_yaw_deg(&mut self, frame: &str) -> Result<f64, ReplayError> {
+        if let Some(y) = self.opts.sensor_yaw_deg {
+            return Ok(y);
+        }
+        let opts = self.opts;
+        let vehicle = opts.vehicle_frame.as_str();
+        if frame == vehicle {
+            return Ok(0.0);
+        }
+        let topic = || opts.tf_topic.clone();
+        let q = self
+            .tf
+            .rotation(frame, vehicle)
+            .map_err(|e| ReplayError::Topic {
+                topic: topic(),
+                reason: e.to_string(),
+            })?;
+        let Some(q) = q else {
+            self.stats.clouds_without_tf += 1;
+            return Ok(0.0);
+        };
+        let m = tf::mounting(q);
+        if m.tilt_deg > self.opts.max_mount_tilt_deg {
+            return Err(ReplayError::Topic {
+                topic: topic(),
+                reason: format!(
+                    "the transform from the cloud frame {frame:?} to the vehicle frame {vehicle:?} tilts its z axis {:.3}° from the vertical (roll and pitch), beyond the {}° tolerance of the yaw-only mounting (give the yaw with --sensor-yaw-deg to use it anyway)",
+                    m.tilt_deg, opts.max_mount_tilt_deg
+                ),
+            });
+        }
+        Ok(m.yaw_deg)
     }
 
     fn gaze_sample(&self, p: &Pending) -> Result<GazeSample, ReplayError> {
@@ -468,6 +554,12 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         if self.frame_id != cloud.header.frame_id {
             cloud.header.frame_id.clone_into(&mut self.frame_id);
         }
+        let yaw_deg = self.mounting_yaw_deg(cloud.header.frame_id)?;
+        self.yaw_deg = yaw_deg;
+        let yaw = (yaw_deg != 0.0).then(|| {
+            let r = yaw_deg.to_radians();
+            (r.cos(), r.sin())
+        });
         let rel_ns = p.log_time.saturating_sub(self.t0_ns.unwrap_or(p.log_time));
         let profile = match self.profile_at(rel_ns) {
             Some(pr) => pr.clone(),
@@ -477,29 +569,32 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
             }
         };
         let n = layout.len();
-        let mut finite = Vec::with_capacity(n);
-        let mut keep = vec![false; n];
-        let mut index = Vec::with_capacity(n);
-        for i in 0..n {
-            let [x, y, z] = layout.xyz(layout.point(cloud.data, i));
-            if x.is_finite() && y.is_finite() && z.is_finite() {
-                let xyz = match self.yaw {
-                    None => [x, y, z],
-                    Some((c, s)) => [c * x - s * y, s * x + c * y, z],
-                };
-                finite.push(xyz);
-                index.push(i);
-            }
-        }
+        let mut xyz = std::mem::take(&mut self.xyz_buf);
+        xyz.clear();
+        layout.decode_all(cloud.data, &mut xyz);
+        let turn = |[x, y, z]: [f64; 3]| match yaw {
+            None => [x, y, z],
+            Some((c, s)) => [c * x - s * y, s * x + c * y, z],
+        };
+        let finite = |p: &[f64; 3]| p.iter().all(|v| v.is_finite());
         let mut opts = self.opts.cloud.clone();
         opts.frame = CloudFrame::Iso8855;
         opts.seed = opts.seed.wrapping_add(self.stats.clouds);
-        let mask = keep_mask(&profile, finite.iter().copied(), &opts)?;
-        let mut kept = 0u64;
-        for (&i, &k) in index.iter().zip(&mask) {
-            keep[i] = k;
-            kept += u64::from(k);
-        }
+        let keep = if xyz.iter().all(finite) {
+            // Every point (a dense cloud): the mask is the rule's.
+            keep_mask(&profile, xyz.iter().map(|&p| turn(p)), &opts)?
+        } else {
+            // Non-finite points are never returned and not passed to the rule.
+            let index: Vec<usize> = (0..n).filter(|&i| finite(&xyz[i])).collect();
+            let mask = keep_mask(&profile, index.iter().map(|&i| turn(xyz[i])), &opts)?;
+            let mut keep = vec![false; n];
+            for (&i, &k) in index.iter().zip(&mask) {
+                keep[i] = k;
+            }
+            keep
+        };
+        self.xyz_buf = xyz;
+        let kept = keep.iter().filter(|&&k| k).count() as u64;
         let data = cdr::encode_subset(&cloud, &layout, &keep, true);
         let adapted = match self.out.adapted {
             Some(id) => id,
@@ -594,10 +689,22 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     pipeline: PipelineConfig,
     opts: &ReplayOptions,
 ) -> Result<ReplayStats, ReplayError> {
-    if !opts.sensor_yaw_deg.is_finite() {
+    if let Some(y) = opts.sensor_yaw_deg.filter(|y| !y.is_finite()) {
         return Err(ReplayError::Config {
             field: "sensor_yaw_deg",
-            reason: format!("{} is not a finite angle", opts.sensor_yaw_deg),
+            reason: format!("{y} is not a finite angle"),
+        });
+    }
+    if !(opts.max_mount_tilt_deg.is_finite() && (0.0..=90.0).contains(&opts.max_mount_tilt_deg)) {
+        return Err(ReplayError::Config {
+            field: "max_mount_tilt_deg",
+            reason: format!("{} must lie in 0..=90", opts.max_mount_tilt_deg),
+        });
+    }
+    if opts.vehicle_frame.is_empty() {
+        return Err(ReplayError::Config {
+            field: "vehicle_frame",
+            reason: "must not be empty".to_owned(),
         });
     }
     for (field, t) in [
@@ -621,9 +728,12 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     let compression = match opts.compression {
         Compression::None => None,
         Compression::Lz4 => Some(mcap::Compression::Lz4),
+        Compression::Zstd => Some(mcap::Compression::Zstd),
     };
     let mut mcap = mcap::WriteOptions::new()
         .compression(compression)
+        // Single-threaded zstd: the same bytes on every machine.
+        .compression_threads(0)
         .profile("ros2")
         .library(concat!("gaze-lidar ", env!("CARGO_PKG_VERSION")))
         .create(output)
@@ -648,10 +758,6 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     let scene = mcap
         .add_channel(ss, &opts.scene_topic, schemas::JSON, &BTreeMap::new())
         .map_err(write_err)?;
-    let yaw = (opts.sensor_yaw_deg != 0.0).then(|| {
-        let r = opts.sensor_yaw_deg.to_radians();
-        (r.cos(), r.sin())
-    });
     let mut r = Replayer {
         opts,
         stream,
@@ -671,7 +777,9 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
         period_ns,
         frame_id: "base_link".to_owned(),
         stats: ReplayStats::default(),
-        yaw,
+        tf: tf::TfTree::default(),
+        yaw_deg: opts.sensor_yaw_deg.unwrap_or(0.0),
+        xyz_buf: Vec::new(),
     };
     // Every CRC checked (a chunk before any of its messages is used), and
     // no record longer than `MAX_RECORD_BYTES` (a corrupt length must not
@@ -688,8 +796,7 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     let mut held_bytes = 0usize;
     let mut newest = 0u64;
     let mut seq = 0u64;
-    let mcap_err = |offset: u64, e: mcap::McapError| {
-        ReplayError::Mcap {
+    let mcap_err = |offset: u64, e: mcap::McapError| ReplayError::Mcap {
         path: path.to_owned(),
         offset,
         reason: match e {
@@ -697,11 +804,10 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                 "the file ends inside a record (truncated)".to_owned()
             }
             mcap::McapError::UnsupportedCompression(c) => format!(
-                "a chunk is compressed with `{c}`; this build reads uncompressed and lz4 chunks (re-compress the bag, e.g. with the mcap CLI: `mcap compress --compression lz4`)"
+                "a chunk is compressed with `{c}`; replay reads uncompressed, lz4 and zstd chunks"
             ),
             e => e.to_string(),
         },
-    }
     };
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| mcap_err(offset, e))? {
@@ -749,6 +855,70 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     r.out.mcap.finish().map_err(write_err)?;
     let mut stats = r.stats;
     stats.stream = r.stream.stats();
+    Ok(stats)
+}
+
+/// Same file (device and inode).
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+        _ => false,
+    }
+}
+
+/// [`replay`] from the file `input` to the file `output`, as `gaze-lidar
+/// replay` and Python's `gaze_lidar.replay` run it: the output is written
+/// to a temporary file beside `output` and renamed over it only when the
+/// whole replay succeeded (flushed and synced), so a failure (a bad input,
+/// a full disk) leaves any old `output` as it was and no partial file.
+/// A new output file gets mode 0644, an existing one keeps its mode.
+pub fn replay_file<P: FramePlanner>(
+    input: &std::path::Path,
+    output: &std::path::Path,
+    planner: P,
+    pipeline: PipelineConfig,
+    opts: &ReplayOptions,
+) -> Result<ReplayStats, ReplayError> {
+    let origin = input.display().to_string();
+    let out_err =
+        |e: &dyn std::fmt::Display| ReplayError::Write(format!("{}: {e}", output.display()));
+    let file = std::fs::File::open(input).map_err(|source| ReplayError::Read {
+        path: origin.clone(),
+        source,
+    })?;
+    if same_file(input, output) {
+        return Err(ReplayError::Config {
+            field: "out",
+            reason: format!("{} is the input file", output.display()),
+        });
+    }
+    if output.is_dir() {
+        return Err(ReplayError::Config {
+            field: "out",
+            reason: format!("{} is a directory", output.display()),
+        });
+    }
+    let dir = match output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".gaze-lidar-replay.");
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(output)
+            .map(|m| m.permissions().mode() & 0o7777)
+            .unwrap_or(0o644);
+        builder.permissions(std::fs::Permissions::from_mode(mode));
+    }
+    let tmp = builder.tempfile_in(&dir).map_err(|e| out_err(&e))?;
+    let reader = std::io::BufReader::with_capacity(1 << 20, file);
+    let mut writer = std::io::BufWriter::with_capacity(1 << 20, tmp);
+    let stats = replay(reader, &origin, &mut writer, planner, pipeline, opts)?;
+    let tmp = writer.into_inner().map_err(|e| out_err(e.error()))?;
+    tmp.as_file().sync_all().map_err(|e| out_err(&e))?;
+    tmp.persist(output).map_err(|e| out_err(&e.error))?;
     Ok(stats)
 }
 

@@ -36,6 +36,8 @@ pub const VECTOR3_STAMPED: &str = "geometry_msgs/msg/Vector3Stamped";
 pub const FLOAT64: &str = "std_msgs/msg/Float64";
 /// `sensor_msgs/msg/PointCloud2`.
 pub const POINT_CLOUD2: &str = "sensor_msgs/msg/PointCloud2";
+/// `tf2_msgs/msg/TFMessage` (`/tf_static`: the sensor's mounting).
+pub const TF_MESSAGE: &str = "tf2_msgs/msg/TFMessage";
 /// `std_msgs/msg/String` (tests: an unrelated topic).
 pub const STRING: &str = "std_msgs/msg/String";
 /// The profile channel's schema name.
@@ -58,6 +60,26 @@ pub fn ros2msg(name: &str) -> Option<String> {
             ],
         ),
         FLOAT64 => "float64 data\n".to_owned(),
+        TF_MESSAGE => with_deps(
+            "geometry_msgs/TransformStamped[] transforms\n",
+            &[
+                (
+                    "geometry_msgs/TransformStamped",
+                    "std_msgs/Header header\nstring child_frame_id\nTransform transform\n",
+                ),
+                std_header,
+                time,
+                (
+                    "geometry_msgs/Transform",
+                    "Vector3 translation\nQuaternion rotation\n",
+                ),
+                ("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"),
+                (
+                    "geometry_msgs/Quaternion",
+                    "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n",
+                ),
+            ],
+        ),
         STRING => "string data\n".to_owned(),
         POINT_CLOUD2 => with_deps(
             "std_msgs/Header header\nuint32 height\nuint32 width\nPointField[] fields\nbool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n",

@@ -193,3 +193,70 @@ fn vector_azimuth_follows_iso_8855() {
     assert_eq!(vector_azimuth_deg([f64::NAN, 1.0, 0.0]), None);
     assert_eq!(vector_azimuth_deg([1.0, f64::INFINITY, 0.0]), None);
 }
+
+/// The fast paths ([`cdr::XyzLayout::decode_all`], the merged runs of
+/// [`cdr::encode_subset`]) against the plain per-point reads, on clouds of
+/// several rows with padded rows, every coordinate layout and random
+/// subsets.
+#[test]
+fn decode_all_and_kept_ranges_match_the_per_point_reference() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    for case in 0..64 {
+        let (big, wide) = (case % 2 == 1, case % 4 >= 2);
+        let size = if wide { 8 } else { 4 };
+        let step = 3 * size + rng.random_range(0..7usize);
+        let (height, width) = (rng.random_range(1..5usize), rng.random_range(0..40usize));
+        let row = width * step + rng.random_range(0..9usize);
+        let data: Vec<u8> = (0..height * row).map(|_| rng.random()).collect();
+        let t = if wide {
+            datatype::FLOAT64
+        } else {
+            datatype::FLOAT32
+        };
+        // x, y, z in a shuffled order in the point.
+        let perm = [[0, 1, 2], [2, 0, 1], [1, 2, 0]][case % 3];
+        let fields: Vec<PointField> = ["x", "y", "z"]
+            .iter()
+            .zip(perm)
+            .map(|(name, k)| PointField {
+                name,
+                offset: (k * size) as u32,
+                datatype: t,
+                count: 1,
+            })
+            .collect();
+        let c = PointCloud2 {
+            header: Header {
+                sec: 0,
+                nanosec: 0,
+                frame_id: "l",
+            },
+            height: height as u32,
+            width: width as u32,
+            fields,
+            is_bigendian: big,
+            point_step: step as u32,
+            row_step: row as u32,
+            data: &data,
+            is_dense: false,
+        };
+        let l = c.xyz().unwrap();
+        let mut all = Vec::new();
+        l.decode_all(c.data, &mut all);
+        let want: Vec<[f64; 3]> = (0..l.len()).map(|i| l.xyz(l.point(c.data, i))).collect();
+        // Bitwise (NaN payloads included).
+        let bits =
+            |v: &[[f64; 3]]| -> Vec<[u64; 3]> { v.iter().map(|p| p.map(f64::to_bits)).collect() };
+        assert_eq!(bits(&all), bits(&want), "case {case}");
+        let keep: Vec<bool> = (0..l.len()).map(|_| rng.random_bool(0.6)).collect();
+        let sub = cdr::encode_subset(&c, &l, &keep, true);
+        let s = PointCloud2::decode(&sub).unwrap();
+        let naive: Vec<u8> = (0..l.len())
+            .filter(|&i| keep[i])
+            .flat_map(|i| l.point(c.data, i).to_vec())
+            .collect();
+        assert_eq!(s.data, &naive[..], "case {case}");
+        assert_eq!(s.width as usize, keep.iter().filter(|&&k| k).count());
+    }
+}
