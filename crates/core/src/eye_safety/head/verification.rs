@@ -43,7 +43,7 @@ fn meets(v: f64, c: f64, half: f64) -> bool {
     c - half - TOUCH_MM <= v && v <= c + half + TOUCH_MM
 }
 
-/// REQ-HEAD-ENUM-1: `vertical` is the maximum over every height: at any
+/// REQ-OVERLAP-1: `vertical` is the maximum over every height: at any
 /// probe height (a half-millimetre grid, so probes fall on, between and
 /// beyond the interval ends) the channels meeting it weigh at most the
 /// reported weight and number at most the reported count; the reported
@@ -87,7 +87,7 @@ fn vertical_enumeration_is_the_maximum() {
     ]);
 }
 
-/// REQ-HEAD-ENUM-1: `group` with a window of 0 (pulses fired together) is
+/// REQ-OVERLAP-1: `group` with a window of 0 (pulses fired together) is
 /// the maximum over every point and every firing slot: at any probe point
 /// (arc × height, half-millimetre grid) the channels of any one slot whose
 /// boxes hold it weigh at most the reported weight and number at most the
