@@ -31,11 +31,14 @@ def _pandas(what: str) -> Any:
         ) from None
 
 
-def _value(text: str) -> int | float | str | None:
-    """One CSV field: empty → None, an integer, a float (the CLI writes the
-    shortest text that reads back to the same float), else the text."""
+def _value(text: str) -> bool | int | float | str | None:
+    """One CSV field: empty → None, `true`/`false` → a bool, an integer, a
+    float (the CLI writes the shortest text that reads back to the same
+    float), else the text."""
     if text == "":
         return None
+    if text in ("true", "false"):
+        return text == "true"
     try:
         return int(text)
     except ValueError:

@@ -191,7 +191,14 @@ def test_simulate_gives_per_trial_records_and_tables() -> None:
         "roi_pulses",
         "duration_s",
         "density_pts_per_deg_s",
+        "fail_safe_frames",
+        "detected_in_fail_safe",
+        "false_alarms",
+        "early_false_tta_s",
     ]
+    # A constant gaze never runs a fail-safe frame; the default detector has no false alarms.
+    assert all(t["fail_safe_frames"] == 0 and t["false_alarms"] == 0 for t in r.trials)
+    assert all(t["detected_in_fail_safe"] in (False, None) for t in r.trials)
     # Each row's median and count are those of its trials (numpy's median).
     for row in r:
         cell = [t for t in r.trials if (t["model"], t["variant"], t["fog_pct"]) == (row["model"], row["variant"], row["fog_pct"])]
