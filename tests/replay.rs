@@ -794,3 +794,79 @@ fn float64_yaw_gaze_and_a_mounting_yaw() {
         assert_eq!(want, have, "cloud {k}");
     }
 }
+
+#[test]
+fn devices_fifos_and_symlinks_as_out_are_written_through_never_replaced() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let plain = dir.path().join("plain.mcap");
+    let o = replay_cli(&input, &plain);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let expected = std::fs::read(&plain).unwrap();
+
+    // Character devices stay devices (private nodes, made where this user
+    // may: a regression must not replace the system's /dev/null).
+    let node = |name: &str, minor: &str| {
+        let p = dir.path().join(name);
+        let made = Command::new("mknod")
+            .arg(&p)
+            .args(["c", "1", minor])
+            .output();
+        made.is_ok_and(|m| m.status.success()).then_some(p)
+    };
+    if let Some(null) = node("null", "3") {
+        let o = replay_cli(&input, &null);
+        common::no_panic(&o, "null device");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(std::fs::symlink_metadata(&null)
+            .unwrap()
+            .file_type()
+            .is_char_device());
+    }
+    if let Some(full) = node("full", "7") {
+        // A full device is an output error, exit 1.
+        let o = replay_cli(&input, &full);
+        common::no_panic(&o, "full device");
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(std::fs::symlink_metadata(&full)
+            .unwrap()
+            .file_type()
+            .is_char_device());
+    }
+
+    // A FIFO gets the same bytes as a file, and stays a FIFO.
+    let fifo = dir.path().join("fifo");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    let o = replay_cli(&input, &fifo);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(reader.join().unwrap(), expected);
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+
+    // A symbolic link is followed: the link stays, its target is replaced.
+    let target = dir.path().join("target.mcap");
+    std::fs::write(&target, b"old").unwrap();
+    let link = dir.path().join("link.mcap");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let o = replay_cli(&input, &link);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(std::fs::read(&target).unwrap(), expected);
+}

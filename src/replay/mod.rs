@@ -899,6 +899,33 @@ pub fn replay_file<P: FramePlanner>(
             reason: format!("{} is a directory", output.display()),
         });
     }
+    // A device or FIFO is written in place (never replaced by a file); a
+    // symbolic link is followed, so the file it names is the one replaced.
+    let refuse = |what: &str| ReplayError::Config {
+        field: "out",
+        reason: format!("{} is {what}", output.display()),
+    };
+    let resolved;
+    let output = match std::fs::symlink_metadata(output) {
+        Ok(link) if link.file_type().is_symlink() => {
+            resolved =
+                std::fs::canonicalize(output).map_err(|_| refuse("a symbolic link to nothing"))?;
+            resolved.as_path()
+        }
+        _ => output,
+    };
+    if let Ok(meta) = std::fs::metadata(output) {
+        use std::os::unix::fs::FileTypeExt;
+        let ft = meta.file_type();
+        if ft.is_char_device() || ft.is_fifo() {
+            return replay_into_special(file, &origin, output, planner, pipeline, opts);
+        }
+        if ft.is_block_device() || ft.is_socket() {
+            return Err(refuse(
+                "a block device or socket; refusing to write over it",
+            ));
+        }
+    }
     let dir = match output.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => std::path::PathBuf::from("."),
@@ -920,6 +947,36 @@ pub fn replay_file<P: FramePlanner>(
     tmp.as_file().sync_all().map_err(|e| out_err(&e))?;
     tmp.persist(output).map_err(|e| out_err(&e.error))?;
     Ok(stats)
+}
+
+/// [`replay_file`] into a character device or FIFO, written in place (the
+/// node is never replaced by a file): the MCAP writer needs to seek, so the
+/// replay goes to an anonymous temporary file first, then is copied in one
+/// stream; a reader that goes away is not an error, as on stdout.
+fn replay_into_special<P: FramePlanner>(
+    input: std::fs::File,
+    origin: &str,
+    output: &std::path::Path,
+    planner: P,
+    pipeline: PipelineConfig,
+    opts: &ReplayOptions,
+) -> Result<ReplayStats, ReplayError> {
+    use std::io::{Seek as _, SeekFrom};
+    let out_err = |e: std::io::Error| ReplayError::Write(format!("{}: {e}", output.display()));
+    let staged = tempfile::tempfile().map_err(out_err)?;
+    let reader = std::io::BufReader::with_capacity(1 << 20, input);
+    let mut writer = std::io::BufWriter::with_capacity(1 << 20, staged);
+    let stats = replay(reader, origin, &mut writer, planner, pipeline, opts)?;
+    let mut staged = writer.into_inner().map_err(|e| out_err(e.into_error()))?;
+    staged.seek(SeekFrom::Start(0)).map_err(out_err)?;
+    let mut device = std::fs::OpenOptions::new()
+        .write(true)
+        .open(output)
+        .map_err(out_err)?;
+    match std::io::copy(&mut staged, &mut device).and_then(|_| device.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(out_err(e)),
+        _ => Ok(stats),
+    }
 }
 
 #[cfg(test)]
