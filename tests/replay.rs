@@ -870,3 +870,31 @@ fn devices_fifos_and_symlinks_as_out_are_written_through_never_replaced() {
         .is_symlink());
     assert_eq!(std::fs::read(&target).unwrap(), expected);
 }
+
+#[test]
+fn out_equal_to_the_config_file_is_exit_2_and_leaves_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let config = dir.path().join("cfg.toml");
+    let text = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/configs/paper.toml"
+    ))
+    .unwrap();
+    std::fs::write(&config, &text).unwrap();
+    let o = bin()
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD, "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&config)
+        .output()
+        .unwrap();
+    common::no_panic(&o, "out = config");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--config"), "{err}");
+    assert_eq!(std::fs::read(&config).unwrap(), text);
+}

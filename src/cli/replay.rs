@@ -152,6 +152,14 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         CompressionArg::Zstd => Compression::Zstd,
     };
 
+    if let Some(config) = &a.plan.config {
+        if gaze_lidar::replay::same_file(config, &a.out) {
+            return Err(CliError::input(format!(
+                "--out: {} is the --config file",
+                a.out.display()
+            )));
+        }
+    }
     let stats = replay_file(&a.input, &a.out, planner, pipeline, &opts).map_err(replay_error)?;
     let s = stats.stream;
     if s.samples == 0 {

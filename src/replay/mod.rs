@@ -858,8 +858,9 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     Ok(stats)
 }
 
-/// Same file (device and inode).
-fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+/// Whether two paths name one existing file (device and inode; links
+/// followed).
+pub fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
     use std::os::unix::fs::MetadataExt;
     match (std::fs::metadata(a), std::fs::metadata(b)) {
         (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
