@@ -850,7 +850,7 @@ fn check(
                             azimuth_deg,
                             rule,
                             ratio,
-                        } => Some((*ratio, rule.clone(), *azimuth_deg)),
+                        } => Some((*ratio, rule.to_string(), *azimuth_deg)),
                         _ => None,
                     });
                     let report = rej.eye_safety.as_deref();

@@ -1,6 +1,5 @@
 //! `gaze-lidar check`: verify a profile@1 file or a firmware table.
 
-use clap::ValueEnum;
 use std::path::PathBuf;
 
 use gaze_lidar::checker::{certify_with, summarize, CheckOptions, Violation};
@@ -11,16 +10,8 @@ use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::profile::Profile;
 
 use super::io::{read_bytes, warn, Stdout, MAX_PROFILE_BYTES};
+use super::verdict_format::Format;
 use super::CliError;
-
-/// Report format.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Format {
-    /// One line per violation (or a certified summary).
-    Text,
-    /// `{"certified": bool, "violations": [...], "summary": {...}}`.
-    Json,
-}
 
 #[derive(Debug, clap::Args)]
 pub struct Args {

@@ -22,6 +22,7 @@ mod sensor;
 mod simulate;
 mod stream;
 mod table;
+mod verdict_format;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

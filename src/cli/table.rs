@@ -14,7 +14,7 @@ use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::profile::PROFILE_FORMAT;
 
-use super::check::Format;
+use super::verdict_format::Format;
 use super::io::{utf8, warn, Stdout};
 use super::CliError;
 

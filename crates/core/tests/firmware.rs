@@ -8,7 +8,7 @@
 
 mod common;
 
-use gaze_lidar_core::eye_safety::EyeSafetyParams;
+use gaze_lidar_core::eye_safety::{EyeSafetyParams, Rule};
 use gaze_lidar_core::firmware::eye::{
     evaluate, millihz_ceil, pass_timing, DeriveError, IntEyeError, IntEyeLimits, IntRule,
     TrainLimit,
@@ -622,7 +622,7 @@ fn check_table_with_reports_the_integer_verdict() {
         vec![FwViolation::EyeSafety {
             ratio_ppm: 1_250_000,
             azimuth_mdeg: 5_000,
-            rule: "single-pulse energy (C5-corrected)".into(),
+            rule: Rule::SinglePulse,
         }]
     );
     let at = limits(&t, 100_000, 10_000, 5, &[(1, 15)], 15);
@@ -647,7 +647,7 @@ fn check_table_with_reports_the_integer_verdict() {
             FwViolation::EyeSafety {
                 ratio_ppm: 1_250_000,
                 azimuth_mdeg: 5_000,
-                rule: "single-pulse energy (C5-corrected)".into(),
+                rule: Rule::SinglePulse,
             }
         ]
     );
@@ -753,9 +753,9 @@ fn violations_read_as_stated() {
         s(FwViolation::EyeSafety {
             ratio_ppm: 1_250_000,
             azimuth_mdeg: 5_000,
-            rule: "r".into()
+            rule: Rule::TimeBase
         }),
-        "eye_safety: as quantized, at azimuth 5.000° the r is 125.0000 % of the Class 1 limit"
+        "eye_safety: as quantized, at azimuth 5.000° the average power over the 100 s time base is 125.0000 % of the Class 1 limit"
     );
     assert_eq!(
         s(FwViolation::BinCount { count: 0 }),

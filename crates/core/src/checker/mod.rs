@@ -183,7 +183,7 @@ pub enum Violation {
         /// Azimuth of the worst aperture position, degrees.
         azimuth_deg: f64,
         /// Which rule binds.
-        rule: String,
+        rule: crate::eye_safety::Rule,
         /// Exposure / limit (> 1 fails).
         ratio: f64,
     },
@@ -764,7 +764,7 @@ fn check_eye_safety(
 fn eye_safety_violation(r: &ExposureReport) -> Option<Violation> {
     (r.worst_ratio.is_nan() || r.worst_ratio > 1.0).then(|| Violation::EyeSafety {
         azimuth_deg: r.worst_azimuth_deg,
-        rule: r.binding_rule.to_string(),
+        rule: r.binding_rule,
         ratio: r.worst_ratio,
     })
 }

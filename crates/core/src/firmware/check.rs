@@ -66,7 +66,7 @@ pub enum FwViolation {
         /// Aperture azimuth, millidegrees.
         azimuth_mdeg: u32,
         /// Binding rule.
-        rule: String,
+        rule: crate::eye_safety::rule::Rule,
     },
     /// No eye-safety parameters: not Class 1 evidence.
     EyeSafetyMissing,
@@ -264,7 +264,7 @@ fn report_violation(r: &eye::IntEyeReport) -> Option<FwViolation> {
     (!r.class1).then(|| FwViolation::EyeSafety {
         ratio_ppm: r.worst_ratio_ppm,
         azimuth_mdeg: r.azimuth_mdeg,
-        rule: r.rule.to_string(),
+        rule: r.rule,
     })
 }
 
