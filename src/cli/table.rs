@@ -14,8 +14,8 @@ use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::profile::PROFILE_FORMAT;
 
-use super::verdict_format::Format;
 use super::io::{utf8, warn, Stdout};
+use super::verdict_format::Format;
 use super::CliError;
 
 /// What `check` was given.

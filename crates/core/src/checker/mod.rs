@@ -762,7 +762,7 @@ fn check_eye_safety(
 /// an upper bound with its counts rounded towards safety, so the limit is
 /// applied exactly: no tolerance above 1.
 fn eye_safety_violation(r: &ExposureReport) -> Option<Violation> {
-    (r.worst_ratio.is_nan() || r.worst_ratio > 1.0).then(|| Violation::EyeSafety {
+    (r.worst_ratio.is_nan() || r.worst_ratio > 1.0).then_some(Violation::EyeSafety {
         azimuth_deg: r.worst_azimuth_deg,
         rule: r.binding_rule,
         ratio: r.worst_ratio,

@@ -261,7 +261,7 @@ fn eye_violation(table: &FirmwareTable, limits: &IntEyeLimits) -> Option<FwViola
 
 /// The violation an integer eye-safety report implies, if any.
 fn report_violation(r: &eye::IntEyeReport) -> Option<FwViolation> {
-    (!r.class1).then(|| FwViolation::EyeSafety {
+    (!r.class1).then_some(FwViolation::EyeSafety {
         ratio_ppm: r.worst_ratio_ppm,
         azimuth_mdeg: r.azimuth_mdeg,
         rule: r.rule,
