@@ -855,3 +855,60 @@ fn sensor_validation_names_the_key() {
     s.limits.power_slew_w_per_deg_max = None;
     assert_eq!(s.validate(), Ok(()));
 }
+
+/// One comparator for a profile and for its firmware table: a sensor whose
+/// pulse clock, accounting or laser differs is named, field for field, the
+/// same way by both checkers, and so is a declared limit looser than the
+/// sensor's. (The table compared its pulse rate by bit pattern and the
+/// profile by `!=`; both now call `lidar::laser_mismatches`.)
+#[test]
+fn profile_and_its_table_name_the_same_sensor_mismatches() {
+    use gaze_lidar_core::firmware::sensor::against_sensor;
+    use gaze_lidar_core::firmware::{FirmwareConfig, FirmwareTable, FwViolation};
+    let certified = certify(uniform()).expect("uniform certifies");
+    let table = FirmwareTable::from_certified(&certified, &FirmwareConfig::default())
+        .expect("table builds");
+    let fields = |v: Vec<FwViolation>| -> Vec<&'static str> {
+        v.iter()
+            .filter_map(|x| match x {
+                FwViolation::SensorMismatch { field, .. } => Some(*field),
+                _ => None,
+            })
+            .collect()
+    };
+    assert!(fields(against_sensor(&table, &sensor())).is_empty());
+    type Change = Box<dyn Fn(&mut LidarSpec)>;
+    let cases: Vec<(&str, Change)> = vec![
+        (
+            "pulse_rate_hz",
+            Box::new(|s| s.pulse_rate_hz *= 1.0 + 1e-15),
+        ),
+        ("pulse_rate_hz", Box::new(|s| s.pulse_rate_hz = f64::NAN)),
+        (
+            "power_accounting",
+            Box::new(|s| s.power_accounting = PowerAccounting::Time),
+        ),
+        (
+            "eye_safety",
+            Box::new(|s| {
+                if let Some(e) = s.limits.eye_safety.as_mut() {
+                    e.wavelength_nm += 1.0;
+                }
+            }),
+        ),
+    ];
+    for (key, change) in cases {
+        let mut s = sensor();
+        change(&mut s);
+        let profile = check_with(certified.profile(), &CheckOptions::for_sensor(&s));
+        let profile_fields: Vec<&str> = profile
+            .iter()
+            .filter_map(|x| match x {
+                Violation::SensorMismatch { field, .. } => Some(*field),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(profile_fields, vec![key], "profile: {profile:?}");
+        assert_eq!(fields(against_sensor(&table, &s)), vec![key], "table");
+    }
+}

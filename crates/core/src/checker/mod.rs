@@ -19,7 +19,7 @@ use thiserror::Error;
 
 use crate::eye_safety::{self, ExposureReport};
 use crate::model::angle::{next_index, FULL_TURN_DEG};
-use crate::model::lidar::{LidarSpec, PowerAccounting};
+use crate::model::lidar::{laser_mismatches, no_looser, LidarSpec, LimitSide, PowerAccounting};
 use crate::model::valid;
 use crate::profile::{Profile, Region, Summary, PROFILE_FORMAT};
 
@@ -808,16 +808,14 @@ impl<'a> CheckOptions<'a> {
 
 fn check_against_sensor(p: &Profile, sensor: &LidarSpec, v: &mut Vec<Violation>) {
     let (d, s) = (&p.limits, &sensor.limits);
-    // Written so that a NaN on either side is looser (the sensor's limits
-    // are validated where they are read, but this comparison must not rest
-    // on that): "no looser" is `declared <= sensor` for an upper limit,
-    // `declared >= sensor` for a lower one, both false on NaN.
+    // The comparison is `lidar::no_looser`, false on NaN (the sensor's limits
+    // are validated where they are read, but this must not rest on that).
     let mut looser =
-        |field: &'static str, declared: Option<f64>, sensor: Option<f64>, upper: bool| {
+        |field: &'static str, declared: Option<f64>, sensor: Option<f64>, side: LimitSide| {
             let bad = match (declared, sensor) {
                 (_, None) => false,
                 (None, Some(_)) => true,
-                (Some(x), Some(y)) => !(if upper { x <= y } else { x >= y }),
+                (Some(x), Some(y)) => !no_looser(x, y, side),
             };
             if bad {
                 v.push(Violation::LooserThanSensor {
@@ -827,85 +825,69 @@ fn check_against_sensor(p: &Profile, sensor: &LidarSpec, v: &mut Vec<Violation>)
                 });
             }
         };
+    use LimitSide::{Lower, Upper};
     looser(
         "power_w_min",
         Some(d.power_w_min),
         Some(s.power_w_min),
-        false,
+        Lower,
     );
     looser(
         "power_w_max",
         Some(d.power_w_max),
         Some(s.power_w_max),
-        true,
+        Upper,
     );
     looser(
         "spin_rad_s_min",
         Some(d.spin_rad_s_min),
         Some(s.spin_rad_s_min),
-        false,
+        Lower,
     );
     looser(
         "spin_rad_s_max",
         Some(d.spin_rad_s_max),
         Some(s.spin_rad_s_max),
-        true,
+        Upper,
     );
     looser(
         "spin_accel_rad_s2_max",
         d.spin_accel_rad_s2_max,
         s.spin_accel_rad_s2_max,
-        true,
+        Upper,
     );
     looser(
         "power_slew_w_per_deg_max",
         d.power_slew_w_per_deg_max,
         s.power_slew_w_per_deg_max,
-        true,
+        Upper,
     );
     looser(
         "average_power_w",
         Some(p.average_power_w),
         Some(sensor.average_power_w),
-        true,
+        Upper,
     );
-    let mut mismatch = |field: &'static str, detail: String| {
-        v.push(Violation::SensorMismatch { field, detail });
-    };
-    if p.pulse_rate_hz != sensor.pulse_rate_hz {
-        mismatch(
-            "pulse_rate_hz",
-            format!(
-                "{} differs from the sensor's {}",
-                p.pulse_rate_hz, sensor.pulse_rate_hz
-            ),
-        );
-    }
-    if p.frame_rate_hz != sensor.frame_rate_hz {
-        mismatch(
-            "frame_rate_hz",
-            format!(
+    #[allow(clippy::float_cmp)]
+    if !(p.frame_rate_hz == sensor.frame_rate_hz) {
+        v.push(Violation::SensorMismatch {
+            field: "frame_rate_hz",
+            detail: format!(
                 "{} differs from the sensor's {}",
                 p.frame_rate_hz, sensor.frame_rate_hz
             ),
-        );
+        });
     }
-    if p.power_accounting != sensor.power_accounting {
-        mismatch(
-            "power_accounting",
-            format!(
-                "'{}' differs from the sensor's '{}'",
-                p.power_accounting, sensor.power_accounting
-            ),
-        );
+    for (field, detail) in laser_mismatches(
+        p.pulse_rate_hz,
+        p.power_accounting,
+        d.eye_safety.as_ref(),
+        sensor,
+    ) {
+        v.push(Violation::SensorMismatch { field, detail });
     }
-    match (&d.eye_safety, &s.eye_safety) {
-        (Some(x), Some(y)) if x != y => mismatch(
-            "eye_safety",
-            format!("laser parameters {x:?} differ from the sensor's {y:?}"),
-        ),
-        (None, Some(_)) => v.push(Violation::EyeSafetyMissing),
-        _ => {}
+    if d.eye_safety.is_none() && s.eye_safety.is_some() {
+        v.push(Violation::EyeSafetyMissing);
     }
 }
 

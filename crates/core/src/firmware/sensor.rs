@@ -13,7 +13,7 @@ use alloc::vec::Vec;
 use super::build::{budget_weight_total, energy_budget, frame_ticks_for};
 use super::{check_table_evaluated, eye, floor_code, FirmwareTable, FwViolation};
 use crate::checker::REL_TOL;
-use crate::model::lidar::LidarSpec;
+use crate::model::lidar::{laser_mismatches, no_looser, LidarSpec, LimitSide};
 
 /// Every violation of `table` as it will run ([`super::check_table`]) and
 /// against `sensor`, with the integer eye-safety evaluation the verdict
@@ -34,33 +34,16 @@ pub fn check_table_for_sensor(
 pub fn against_sensor(table: &FirmwareTable, sensor: &LidarSpec) -> Vec<FwViolation> {
     let mut v = Vec::new();
     let mismatch = |field, detail| FwViolation::SensorMismatch { field, detail };
-    // Exact, as for a profile: the table runs this laser and pulse clock.
-    if table.pulse_rate_hz.to_bits() != sensor.pulse_rate_hz.to_bits() {
-        v.push(mismatch(
-            "pulse_rate_hz",
-            format!(
-                "{} differs from the sensor's {}",
-                table.pulse_rate_hz, sensor.pulse_rate_hz
-            ),
-        ));
-    }
-    if table.power_accounting != sensor.power_accounting {
-        v.push(mismatch(
-            "power_accounting",
-            format!(
-                "'{}' differs from the sensor's '{}'",
-                table.power_accounting, sensor.power_accounting
-            ),
-        ));
-    }
     let s = &sensor.limits;
-    match (&table.eye_safety, &s.eye_safety) {
-        (Some(x), Some(y)) if x != y => v.push(mismatch(
-            "eye_safety",
-            format!("laser parameters {x:?} differ from the sensor's {y:?}"),
-        )),
-        // A table without parameters is already rejected by check_table.
-        _ => {}
+    // The laser and pulse clock, compared as for a profile (one comparator).
+    // A table without parameters is already rejected by check_table.
+    for (field, detail) in laser_mismatches(
+        table.pulse_rate_hz,
+        table.power_accounting,
+        table.eye_safety.as_ref(),
+        sensor,
+    ) {
+        v.push(mismatch(field, detail));
     }
     // The frame: the tick count the quantizer gives the sensor's frame rate.
     match frame_ticks_for(table.tick_hz, sensor.frame_rate_hz) {
@@ -78,8 +61,8 @@ pub fn against_sensor(table: &FirmwareTable, sensor: &LidarSpec) -> Vec<FwViolat
     let step = table.power_w_per_code;
     let l = &table.limits;
     let mut looser =
-        |field: &'static str, declared: u64, sensor: Option<u64>, upper: bool| match sensor {
-            Some(x) if (upper && declared <= x) || (!upper && declared >= x) => {}
+        |field: &'static str, declared: u64, sensor: Option<u64>, side: LimitSide| match sensor {
+            Some(x) if no_looser(declared, x, side) => {}
             Some(x) => v.push(FwViolation::LooserThanSensor {
                 field,
                 declared,
@@ -94,20 +77,20 @@ pub fn against_sensor(table: &FirmwareTable, sensor: &LidarSpec) -> Vec<FwViolat
         "limits.power_code_max",
         u64::from(l.power_code_max),
         floor_code(s.power_w_max, step).map(u64::from),
-        true,
+        LimitSide::Upper,
     );
     looser(
         "limits.power_code_min",
         u64::from(l.power_code_min),
         floor_code(s.power_w_min, step).map(u64::from),
-        false,
+        LimitSide::Lower,
     );
     let weight = budget_weight_total(table.power_accounting, table.frame_ticks);
     looser(
         "limits.energy_budget",
         l.energy_budget,
         energy_budget(sensor.average_power_w, step, weight).ok(),
-        true,
+        LimitSide::Upper,
     );
     // Spin as the table runs it: bin i sweeps width_mdeg in dwell_ticks.
     // One violation per limit, at the bin furthest past it (with a count).

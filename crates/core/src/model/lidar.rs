@@ -70,6 +70,73 @@ pub struct LidarSpec {
     pub limits: Limits,
 }
 
+/// The side a limit bounds from: an upper limit (`power_w_max`) or a lower
+/// one (`power_w_min`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimitSide {
+    /// The value must not exceed the limit.
+    Upper,
+    /// The value must not fall below the limit.
+    Lower,
+}
+
+/// Whether a declared limit is no looser than the sensor's: `declared <=
+/// sensor` for an upper limit, `>=` for a lower one. Written so that a NaN
+/// on either side is looser. The one comparison the profile checker and the
+/// firmware-table checker both hold declared limits to (`u64` codes and
+/// `f64` watts alike).
+#[must_use]
+pub fn no_looser<T: PartialOrd>(declared: T, sensor: T, side: LimitSide) -> bool {
+    match side {
+        LimitSide::Upper => declared <= sensor,
+        LimitSide::Lower => declared >= sensor,
+    }
+}
+
+/// What must be the same for a file to run on `sensor`, besides its
+/// limits: the pulse clock (exactly: the schedule counts its pulses), the
+/// power accounting and the laser's eye-safety parameters. Each mismatch as
+/// `(field, detail)`; a NaN pulse rate never matches. `eye_safety` absent
+/// is not a mismatch here: each checker names a missing parameter set in
+/// its own way.
+#[must_use]
+pub fn laser_mismatches(
+    pulse_rate_hz: f64,
+    accounting: PowerAccounting,
+    eye_safety: Option<&EyeSafetyParams>,
+    sensor: &LidarSpec,
+) -> Vec<(&'static str, String)> {
+    let mut v = Vec::new();
+    #[allow(clippy::float_cmp)]
+    if !(pulse_rate_hz == sensor.pulse_rate_hz) {
+        v.push((
+            "pulse_rate_hz",
+            format!(
+                "{pulse_rate_hz} differs from the sensor's {}",
+                sensor.pulse_rate_hz
+            ),
+        ));
+    }
+    if accounting != sensor.power_accounting {
+        v.push((
+            "power_accounting",
+            format!(
+                "'{accounting}' differs from the sensor's '{}'",
+                sensor.power_accounting
+            ),
+        ));
+    }
+    if let (Some(x), Some(y)) = (eye_safety, &sensor.limits.eye_safety) {
+        if x != y {
+            v.push((
+                "eye_safety",
+                format!("laser parameters {x:?} differ from the sensor's {y:?}"),
+            ));
+        }
+    }
+    v
+}
+
 impl LidarSpec {
     /// Nominal (mean) spin `ω̄ = 2π · frame_rate_hz`, rad/s.
     #[must_use]
