@@ -18,7 +18,9 @@ use pyo3::exceptions::{PyException, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyDict, PyList};
 
-use gaze_lidar::checker::{certify_with, CertifiedProfile, CheckOptions, Violation};
+use gaze_lidar::checker::{
+    certify_with, CertifiedProfile, CheckOptions, Verdict as CoreVerdict, Violation,
+};
 use gaze_lidar::eye_safety::head::bound::power_scale_to_certify;
 use gaze_lidar::firmware::{FirmwareConfig, FirmwareError, FirmwareTable};
 use gaze_lidar::gaze::{
@@ -700,6 +702,25 @@ type VerdictArgs = (
     Option<f64>,
 );
 
+impl Verdict {
+    /// Python's view of the core's verdict.
+    fn of(v: &CoreVerdict) -> Self {
+        let eye = v.eye_safety.as_ref();
+        Self {
+            certified: v.certified,
+            violations: v.violations.iter().map(|e| e.message.clone()).collect(),
+            limits: v.violations.iter().map(|e| e.limit.to_owned()).collect(),
+            worst_ratio: eye.map(|r| r.worst_ratio),
+            binding_rule: eye.map(|r| r.binding_rule.to_string()),
+            worst_azimuth_deg: eye.map(|r| r.worst_azimuth_deg),
+            head_channels: eye
+                .and_then(|r| r.head.as_ref())
+                .map(|h| h.channels_evaluated),
+            power_scale_to_certify: eye.map(|r| r.power_scale_to_certify),
+        }
+    }
+}
+
 #[pymethods]
 impl Verdict {
     /// A verdict from its fields (what pickle calls; `check` makes them).
@@ -829,48 +850,14 @@ fn check(
                 None => CheckOptions::declared(),
             }
             .allow_missing_eye_safety(no_eye_safety);
-            match certify_with(profile, &opts) {
-                Ok(c) => {
-                    // The evaluation the checker certified with (not a second run).
-                    let eye = c.eye_safety();
-                    Verdict {
-                        head_channels: eye.and_then(|r| r.head.as_ref()).map(|h| h.channels),
-                        power_scale_to_certify: eye.map(|r| power_scale_to_certify(r.worst_ratio)),
-                        certified: true,
-                        violations: Vec::new(),
-                        limits: Vec::new(),
-                        worst_ratio: eye.map(|r| r.worst_ratio),
-                        binding_rule: eye.map(|r| r.binding_rule.to_string()),
-                        worst_azimuth_deg: eye.map(|r| r.worst_azimuth_deg),
-                    }
-                }
-                Err(rej) => {
-                    let eye = rej.violations.iter().find_map(|v| match v {
-                        Violation::EyeSafety {
-                            azimuth_deg,
-                            rule,
-                            ratio,
-                        } => Some((*ratio, rule.to_string(), *azimuth_deg)),
-                        _ => None,
-                    });
-                    let report = rej.eye_safety.as_deref();
-                    Verdict {
-                        head_channels: report.and_then(|r| r.head.as_ref()).map(|h| h.channels),
-                        power_scale_to_certify: report
-                            .map(|r| power_scale_to_certify(r.worst_ratio)),
-                        certified: false,
-                        violations: rej.violations.iter().map(ToString::to_string).collect(),
-                        limits: rej
-                            .violations
-                            .iter()
-                            .map(|v| v.limit_key().to_owned())
-                            .collect(),
-                        worst_ratio: eye.as_ref().map(|e| e.0),
-                        binding_rule: eye.as_ref().map(|e| e.1.clone()),
-                        worst_azimuth_deg: eye.as_ref().map(|e| e.2),
-                    }
-                }
-            }
+            let result = certify_with(profile.clone(), &opts);
+            // The core's one verdict, built from the checker's own
+            // evaluation (what `gaze-lidar check --format json` prints).
+            Verdict::of(&CoreVerdict::of(
+                &result,
+                &profile,
+                sensor.as_ref().map(|s| &s.lidar),
+            ))
         })
     })
 }

@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use gaze_lidar::checker::{certify_with, summarize, CheckOptions, Violation};
-use gaze_lidar::eye_safety::exposure::{ExposureReport, Rule};
+use gaze_lidar::checker::verdict::worst_position;
+use gaze_lidar::checker::{certify_with, CheckOptions, Verdict, Violation};
+use gaze_lidar::eye_safety::exposure::ExposureReport;
 use gaze_lidar::eye_safety::head::bound::power_scale_to_certify;
-use gaze_lidar::eye_safety::head::HeadFigures;
 use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::profile::Profile;
 
@@ -49,37 +49,9 @@ fn sensor_of(a: &Args) -> Result<Option<LidarSpec>, CliError> {
     Ok(None)
 }
 
-/// The eye-safety evaluation as JSON: the figures, the head's (`null`
-/// for one channel), and the largest uniform power scale that certifies.
-fn eye_json(r: &ExposureReport) -> serde_json::Value {
-    serde_json::json!({
-        "worst_azimuth_deg": r.worst_azimuth_deg, "binding_rule": r.binding_rule,
-        "worst_ratio": r.worst_ratio, "margin": r.margin,
-        "stalled_rotor_ratio": r.stalled_rotor_ratio,
-        "evaluated_for": if r.head.is_some() { "head" } else { "one channel" },
-        "head": r.head.as_ref().map(|h| {
-            let (height_mm, beams) = worst_position(r, h);
-            serde_json::json!({
-                "channels_evaluated": h.channels,
-                "worst_azimuth_deg": r.worst_azimuth_deg,
-                "worst_height_mm": height_mm,
-                "beams_meeting_worst": beams,
-                "binding_rule": r.binding_rule,
-                "figures": h,
-            })
-        }),
-        "power_scale_to_certify": power_scale_to_certify(r.worst_ratio),
-    })
-}
-
-/// The worst aperture position's height and the beams meeting it, for the
-/// binding rule: Rule 1's largest group, else the energy rules' height.
-fn worst_position(r: &ExposureReport, h: &HeadFigures) -> (f64, u32) {
-    if r.binding_rule == Rule::SinglePulse {
-        (h.group_height_mm, h.count_group)
-    } else {
-        (h.worst_height_mm, h.channels_at_worst)
-    }
+/// The verdict as one line of JSON.
+fn verdict_json(v: &Verdict) -> Result<serde_json::Value, CliError> {
+    serde_json::to_value(v).map_err(|e| CliError::output(format!("verdict as JSON: {e}")))
 }
 
 /// One line naming what was evaluated: the head (channels, the worst
@@ -88,7 +60,7 @@ fn worst_position(r: &ExposureReport, h: &HeadFigures) -> (f64, u32) {
 fn head_line(r: &ExposureReport) -> String {
     match &r.head {
         Some(h) => {
-            let (height_mm, beams) = worst_position(r, h);
+            let (height_mm, beams) = worst_position(r.binding_rule, h);
             format!(
                 "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height; {} beam(s) meet it; binding rule: {}",
                 h.channels, r.worst_azimuth_deg, height_mm, beams, r.binding_rule
@@ -136,20 +108,16 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         opts = CheckOptions::for_sensor(s).allow_missing_eye_safety(a.no_eye_safety);
     }
     let mut out = Stdout::new();
-    match certify_with(profile.clone(), &opts) {
+    let result = certify_with(profile.clone(), &opts);
+    // One verdict, built from the checker's own evaluation (what Python's
+    // `Verdict` holds too).
+    let verdict = Verdict::of(&result, &profile, sensor.as_ref());
+    match result {
         Ok(c) => {
             // The evaluation the checker certified with (not a second run).
             let eye = c.eye_safety();
             match a.format {
-                Format::Json => {
-                    let v = serde_json::json!({
-                        "certified": true, "violations": [], "summary": c.summary(),
-                        "eye_safety_evaluated": eye.is_some(),
-                        "sensor": sensor.as_ref().map(|s| s.name.clone()),
-                        "eye_safety": eye.map(eye_json),
-                    });
-                    out.line(v)?;
-                }
+                Format::Json => out.line(verdict_json(&verdict)?)?,
                 Format::Text => {
                     let s = c.summary();
                     out.line(format_args!(
@@ -182,22 +150,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         }
         Err(rej) => {
             match a.format {
-                Format::Json => {
-                    let summary = rej
-                        .violations
-                        .iter()
-                        .all(|v| !matches!(v, gaze_lidar::checker::Violation::BinCount { .. }))
-                        .then(|| summarize(&profile));
-                    let v = serde_json::json!({
-                        "certified": false,
-                        "violations": rej.violations.iter().map(|v| serde_json::json!({
-                            "limit": v.limit_key(), "message": v.to_string(), "detail": v,
-                        })).collect::<Vec<_>>(),
-                        "summary": summary,
-                        "eye_safety": rej.eye_safety.as_deref().map(eye_json),
-                    });
-                    out.line(v)?;
-                }
+                Format::Json => out.line(verdict_json(&verdict)?)?,
                 Format::Text => {
                     // One line per violation; the eye-safety one also names
                     // what was evaluated and the power scale that certifies.

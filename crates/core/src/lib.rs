@@ -54,7 +54,8 @@ pub mod verification;
 
 #[cfg(feature = "std")]
 pub use checker::{
-    certify, certify_for_sensor, certify_with, CertifiedProfile, CheckOptions, Rejected, Violation,
+    certify, certify_for_sensor, certify_with, CertifiedProfile, CheckOptions, Rejected, Verdict,
+    Violation,
 };
 pub use eye_safety::rule::Rule;
 #[cfg(feature = "std")]

@@ -912,3 +912,47 @@ fn profile_and_its_table_name_the_same_sensor_mismatches() {
         assert_eq!(fields(against_sensor(&table, &s)), vec![key], "table");
     }
 }
+
+/// The one serialisable verdict: certified and rejected alike, built from
+/// the checker's own evaluation. A profile rejected for a non-eye-safety
+/// limit still carries the eye-safety figures the checker computed, and
+/// the JSON names every violation's key with its message and typed detail.
+#[test]
+fn verdict_is_the_checkers_own_result_as_data() {
+    use gaze_lidar_core::checker::Verdict;
+    let p = uniform();
+    let ok = certify_with(p.clone(), &CheckOptions::declared());
+    let v = Verdict::of(&ok, &p, None);
+    let c = ok.as_ref().expect("uniform certifies");
+    assert!(v.certified && v.violations.is_empty() && v.eye_safety_evaluated);
+    assert_eq!(v.summary.as_ref(), Some(c.summary()));
+    let eye = v.eye_safety.as_ref().expect("evaluated");
+    let report = c.eye_safety().expect("evaluated");
+    assert_eq!(eye.worst_ratio.to_bits(), report.worst_ratio.to_bits());
+    assert_eq!(eye.binding_rule, report.binding_rule);
+    assert_eq!(eye.evaluated_for, "one channel");
+    assert!(eye.head.is_none());
+
+    // Over the power limit but eye-safe: rejected, eye figures kept.
+    let mut q = uniform();
+    q.limits.power_w_max = 0.5 * q.bins[0].power_w;
+    let rej = certify_with(q.clone(), &CheckOptions::for_sensor(&sensor()));
+    let v = Verdict::of(&rej, &q, Some(&sensor()));
+    let err = rej.as_ref().unwrap_err();
+    assert!(!v.certified);
+    assert_eq!(v.violations.len(), err.violations.len());
+    assert!(v.violations.iter().any(|e| e.limit == "power_w_max"));
+    assert_eq!(v.sensor.as_deref(), Some("test"));
+    let eye = v
+        .eye_safety
+        .as_ref()
+        .expect("the checker evaluated eye safety");
+    assert!(eye.worst_ratio < 1.0, "{}", eye.worst_ratio);
+    let json = serde_json::to_value(&v).unwrap();
+    assert_eq!(json["certified"], false);
+    let first = &json["violations"][0];
+    assert_eq!(first["limit"], v.violations[0].limit);
+    assert_eq!(first["message"], v.violations[0].message);
+    assert!(first["detail"]["kind"].is_string());
+    assert_eq!(json["eye_safety"]["evaluated_for"], "one channel");
+}

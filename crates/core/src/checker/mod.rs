@@ -13,6 +13,9 @@
 // must fail every check, which `x > limit` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod verdict;
+pub use verdict::Verdict;
+
 use serde::Serialize;
 use std::fmt;
 use thiserror::Error;
