@@ -16,6 +16,7 @@
 //! wall time are printed; the test asserts a generous wall bound
 //! (`GAZE_LIDAR_FAMILY_MAX_WALL_S`, default 20 s: the machine is shared),
 //! the 2 s target is read from the printed CPU times.
+//! `GAZE_LIDAR_FAMILY_ONLY=K` runs member `K` alone and prints its file.
 //! `GAZE_LIDAR_FAMILY_BIN=PATH` runs another build of the binary instead
 //! (a baseline in the same run).
 #![cfg(feature = "solver")]
@@ -381,7 +382,16 @@ fn the_random_family_is_answered_certified_and_fast() {
     let mut failures = Vec::new();
     let mut cpus = Vec::new();
     let every = std::env::var("GAZE_LIDAR_FAMILY").is_ok_and(|v| v == "all");
-    for m in selected(&all, every) {
+    let only: Option<usize> = std::env::var("GAZE_LIDAR_FAMILY_ONLY")
+        .ok()
+        .map(|s| s.parse().expect("GAZE_LIDAR_FAMILY_ONLY"));
+    for m in selected(&all, every || only.is_some()) {
+        if only.is_some_and(|k| k != m.index) {
+            continue;
+        }
+        if only.is_some() {
+            eprintln!("{}", m.toml);
+        }
         let (outcome, cpu, wall) = match run_member(m) {
             Ok(r) => r,
             Err(e) => {

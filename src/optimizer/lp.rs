@@ -351,7 +351,6 @@ fn power_step(
                         lp: program.lp.view(),
                         bins: program.bins,
                         one: program.one,
-                        transitions: program.transitions,
                         tightening: (top > 1.0).then_some(top),
                         p_mean: problem.lidar.average_power_w,
                         floor_w: problem.lidar.limits.power_w_min,
@@ -481,9 +480,6 @@ struct PowerProgram {
     bins: Vec<PowerBin>,
     /// The column fixed at 1 that carries the utilities' constants.
     one: Option<usize>,
-    /// `slew_levels`' transition columns: (level binary of a bin, level
-    /// binary of its next bin, the transition's column).
-    transitions: Vec<(usize, usize, usize)>,
 }
 
 /// Builds the power step's program: per bin its columns and utility (and
@@ -515,23 +511,13 @@ fn power_program(
         lp.col(v)
     });
     budget(&mut lp, problem, g, t, &x);
-    let mut transitions = Vec::new();
     if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
         slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
-        if !problem.levels.power_w.is_empty() {
-            transitions = slew_levels(&mut lp, g, &x, s, problem.lidar.average_power_w);
-        }
     }
     if let Some(e) = eye {
         eye_cuts(&mut lp, problem, e, pool, factor, &x)?;
     }
-    Ok(PowerProgram {
-        lp,
-        x,
-        bins,
-        one,
-        transitions,
-    })
+    Ok(PowerProgram { lp, x, bins, one })
 }
 
 /// Per bin, the eye-safety caps of the single-bin cuts in `pool` as column
@@ -697,74 +683,6 @@ fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
     }
 }
 
-/// `slew_levels` (hardware levels under a slew limit): the level choices
-/// of neighbours `i`, `j` linked by transition columns `y_kl ∈ [0, 1]`, one
-/// per pair of levels within the slew row's limit of each other (compared
-/// with a relative 10⁻⁹ of head-room, so a pair the `slew` row accepts is
-/// never left out), with `Σ_l y_kl = z_ik` and `Σ_k y_kl = z_jl` (edges on
-/// which every pair is within reach are left out). An integral level choice
-/// meets these rows exactly when it meets the `slew` rows (its transitions
-/// are its consecutive pairs), so the MILP's points are unchanged; its LP
-/// relaxation is the flow on the ring of level layers, which cannot mix
-/// far-apart levels into a ramp no level choice can follow (the aggregate
-/// `slew` rows can), so the relaxation, and the certificate's bound from
-/// its duals, is far tighter. Returns the transitions (binary of `i`,
-/// binary of `j`, transition column).
-fn slew_levels(
-    lp: &mut Program,
-    g: &Grid,
-    x: &[LinearForm],
-    s: f64,
-    p_mean: f64,
-) -> Vec<(usize, usize, usize)> {
-    // Per bin its (x level, binary), ordered by level then column.
-    let levels: Vec<Vec<(f64, Variable)>> = x
-        .iter()
-        .map(|form| {
-            let mut v: Vec<(f64, usize, Variable)> = form
-                .linear_coefficients()
-                .map(|(z, a)| (a, lp.col(z), z))
-                .collect();
-            v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            v.into_iter().map(|(a, _, z)| (a, z)).collect()
-        })
-        .collect();
-    let mut transitions = Vec::new();
-    for i in 0..g.n {
-        let j = next_index(i, g.n);
-        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
-        let reach = lim * (1.0 + 1e-9);
-        let (li, lj) = (&levels[i], &levels[j]);
-        if li
-            .iter()
-            .all(|a| lj.iter().all(|b| (a.0 - b.0).abs() <= reach))
-        {
-            continue;
-        }
-        let minus = |&(_, z): &(f64, Variable)| {
-            let mut e = Expression::default();
-            e.add_mul(-1.0, z);
-            e
-        };
-        let mut out: Vec<Expression> = li.iter().map(minus).collect();
-        let mut inn: Vec<Expression> = lj.iter().map(minus).collect();
-        for (ka, &(xa, za)) in li.iter().enumerate() {
-            for (lb, &(xb, zb)) in lj.iter().enumerate() {
-                if (xa - xb).abs() <= reach {
-                    let y = lp.column(0.0, 1.0, 0.0, false);
-                    out[ka].add_mul(1.0, y);
-                    inn[lb].add_mul(1.0, y);
-                    transitions.push((lp.col(za), lp.col(zb), lp.col(y)));
-                }
-            }
-        }
-        for e in out.into_iter().chain(inn) {
-            lp.equal("slew_levels", e, 0.0);
-        }
-    }
-    transitions
-}
-
 /// `eye_cuts`: every cut of the pool on more than one bin as a row
 /// `Σ n_b·x_b·P̄ / (f_p·limit) ≤ cut_rhs` (single-bin cuts are column
 /// bounds, see [`eye_caps`]).
@@ -917,8 +835,6 @@ pub(super) struct PowerLp {
     pub(super) tightening: Option<f64>,
     /// The column fixed at 1 that carries the utilities' constants.
     one: Option<usize>,
-    /// See [`PowerProgram::transitions`].
-    transitions: Vec<(usize, usize, usize)>,
     p_mean: f64,
     floor_w: f64,
     y: Vec<f64>,
@@ -952,12 +868,6 @@ impl PowerLp {
                     let k = zs.iter().position(|&(lv, _)| lv == pi)?;
                     v[zs[k].1] = 1.0;
                 }
-            }
-        }
-        // A transition is taken where both its levels are chosen.
-        for &(zi, zj, y) in &self.transitions {
-            if v[zi] == 1.0 && v[zj] == 1.0 {
-                v[y] = 1.0;
             }
         }
         Some(v)
