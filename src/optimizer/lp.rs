@@ -513,6 +513,9 @@ fn power_program(
     budget(&mut lp, problem, g, t, &x);
     if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
         slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
+        if !problem.levels.power_w.is_empty() {
+            slew_levels(&mut lp, g, &x, s, problem.lidar.average_power_w);
+        }
     }
     if let Some(e) = eye {
         eye_cuts(&mut lp, problem, e, pool, factor, &x)?;
@@ -680,6 +683,53 @@ fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
         let mut d = x[j].clone();
         d.add_mul(-1.0, &x[i]);
         lp.between("slew", d, -lim, lim);
+    }
+}
+
+/// `slew_levels` (hardware levels under a slew limit): for each pair of
+/// neighbours and each level `k` of one, `z_k ≤ Σ z_l` over the other's
+/// levels `l` within the slew row's limit of `k` (a row only where some
+/// level is out of reach). Every level choice that meets the `slew` rows
+/// meets these (a level within the limit, compared with a relative 10⁻⁹ of
+/// head-room, is always counted), so the MILP's points are unchanged; its
+/// LP relaxation, which the aggregate `slew` rows let mix far-apart levels
+/// into a ramp no level choice can follow, is tighter, and so is the
+/// certificate's bound (the relaxation's duals).
+fn slew_levels(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
+    // Per bin its (x level, binary), ordered by level then column.
+    let levels: Vec<Vec<(f64, Variable)>> = x
+        .iter()
+        .map(|form| {
+            let mut v: Vec<(f64, usize, Variable)> = form
+                .linear_coefficients()
+                .map(|(z, a)| (a, lp.col(z), z))
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            v.into_iter().map(|(a, _, z)| (a, z)).collect()
+        })
+        .collect();
+    for i in 0..g.n {
+        let j = next_index(i, g.n);
+        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
+        let reach = lim * (1.0 + 1e-9);
+        for (a, b) in [(i, j), (j, i)] {
+            for &(xa, za) in &levels[a] {
+                let near: Vec<Variable> = levels[b]
+                    .iter()
+                    .filter(|(xb, _)| (xb - xa).abs() <= reach)
+                    .map(|&(_, z)| z)
+                    .collect();
+                if near.len() == levels[b].len() {
+                    continue;
+                }
+                let mut e = Expression::default();
+                e.add_mul(1.0, za);
+                for z in near {
+                    e.add_mul(-1.0, z);
+                }
+                lp.at_most("slew_levels", e, 0.0);
+            }
+        }
     }
 }
 
