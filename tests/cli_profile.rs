@@ -329,9 +329,7 @@ fn every_preset_and_mode_optimizes_from_the_command_line() {
             let err = common::stderr(&o);
             assert!(o.status.success(), "{preset} {mode}: {err}");
             let text = stdout(&o);
-            // Every gap labelled; an optimality block wherever a program's
-            // answer is the profile (not yet: resolution mode under an
-            // acceleration limit, whose smoothed spin is no program's answer).
+            // Every gap labelled; an optimality block in every mode.
             for l in text.lines() {
                 assert_eq!(
                     l.matches(", gap ").count(),
@@ -339,12 +337,10 @@ fn every_preset_and_mode_optimizes_from_the_command_line() {
                     "{preset} {mode}: {l}"
                 );
             }
-            if !(accel && mode == "resolution") {
-                assert!(
-                    text.contains(" relative to the bound)"),
-                    "{preset} {mode}: {text}"
-                );
-            }
+            assert!(
+                text.contains(" relative to the bound)"),
+                "{preset} {mode}: {text}"
+            );
             let note = err.lines().filter(|l| l.contains("ramps the spin")).count();
             let dropped = accel && mode != "range";
             assert_eq!(note, usize::from(dropped), "{preset} {mode}: {err}");

@@ -40,18 +40,15 @@ proptest! {
         };
         let profile = c.profile();
         let opt = profile.optimality.as_ref();
-        if resolution && smooth {
-            // No power step, and the smoothed spin is not the program's
-            // point: no figures are claimed for the answer.
-            prop_assert!(opt.is_none() && cert.is_err());
-            return Ok(());
-        }
         let opt = opt.expect("an optimality block");
         let d = opt.dwell_step.as_ref().expect("every dwell program certified");
         prop_assert!(d.programs >= 1);
         prop_assert!(d.gap >= 0.0 && d.upper_bound >= d.objective);
         // The widening's price: HiGHS at 1e-9, rows widened by 2e-9·(1 + Σ|a|).
-        prop_assert!(d.gap <= 1e-5 * d.objective.abs().max(1.0), "gap {}", d.gap);
+        // A smoothed spin in `resolution` mode is certified on the program
+        // linearised at it, whose optimum it is not: its gap is larger.
+        let tol = if resolution && smooth { 1e-3 } else { 1e-5 };
+        prop_assert!(d.gap <= tol * d.objective.abs().max(1.0), "gap {}", d.gap);
         let cert = cert.expect("a certificate");
         if resolution {
             prop_assert_eq!(cert.step, Step::Dwell);

@@ -33,6 +33,7 @@ use num_rational::BigRational;
 use num_traits::{Signed, Zero};
 
 use serde::Serialize;
+use std::fmt::Write as _;
 
 use super::error::CertificateError;
 pub use super::program::{Program, SolveOptions, Solved};
@@ -148,11 +149,7 @@ impl LinearProgram {
     /// [`Self::to_mps`] under the MPS `NAME` given.
     #[must_use]
     pub fn to_mps_named(&self, name: &str) -> String {
-        use std::fmt::Write as _;
-        let mut s = String::new();
-        let _ = writeln!(s, "NAME {name}");
-        let _ = writeln!(s, "OBJSENSE\n    MAX");
-        let _ = writeln!(s, "ROWS\n N obj");
+        let mut s = format!("NAME {name}\nOBJSENSE\n    MAX\nROWS\n N obj\n");
         for (i, r) in self.rows.iter().enumerate() {
             let kind = match (r.lo.is_finite(), r.hi.is_finite()) {
                 (true, true) if r.lo == r.hi => 'E',
@@ -162,14 +159,23 @@ impl LinearProgram {
             };
             let _ = writeln!(s, " {kind} r{i}");
         }
-        // Column-wise entries.
+        self.mps_columns(&mut s);
+        self.mps_rhs_and_ranges(&mut s);
+        self.mps_bounds(&mut s);
+        s.push_str("ENDATA\n");
+        s
+    }
+
+    /// The MPS `COLUMNS` section: column-wise entries, integral columns
+    /// between `INTORG`/`INTEND` markers.
+    fn mps_columns(&self, s: &mut String) {
         let mut by_col: Vec<Vec<(usize, f64)>> = vec![Vec::new(); self.cost.len()];
         for (i, r) in self.rows.iter().enumerate() {
             for &(j, a) in &r.coefs {
                 by_col[j].push((i, a));
             }
         }
-        let _ = writeln!(s, "COLUMNS");
+        s.push_str("COLUMNS\n");
         let mut in_int = false;
         for (j, entries) in by_col.iter().enumerate() {
             if self.integer[j] != in_int {
@@ -184,9 +190,13 @@ impl LinearProgram {
             }
         }
         if in_int {
-            let _ = writeln!(s, " MARKER 'MARKER' 'INTEND'");
+            s.push_str(" MARKER 'MARKER' 'INTEND'\n");
         }
-        let _ = writeln!(s, "RHS");
+    }
+
+    /// The MPS `RHS` section and, for two-sided rows, `RANGES`.
+    fn mps_rhs_and_ranges(&self, s: &mut String) {
+        s.push_str("RHS\n");
         for (i, r) in self.rows.iter().enumerate() {
             let rhs = if r.hi.is_finite() { r.hi } else { r.lo };
             if rhs.is_finite() && rhs != 0.0 {
@@ -201,12 +211,16 @@ impl LinearProgram {
             .map(|(i, r)| (i, r.hi - r.lo))
             .collect();
         if !ranged.is_empty() {
-            let _ = writeln!(s, "RANGES");
+            s.push_str("RANGES\n");
             for (i, w) in ranged {
                 let _ = writeln!(s, " rng r{i} {w:?}");
             }
         }
-        let _ = writeln!(s, "BOUNDS");
+    }
+
+    /// The MPS `BOUNDS` section.
+    fn mps_bounds(&self, s: &mut String) {
+        s.push_str("BOUNDS\n");
         for j in 0..self.cost.len() {
             let (lo, hi) = (self.col_lo[j], self.col_hi[j]);
             if lo == hi {
@@ -224,8 +238,6 @@ impl LinearProgram {
                 let _ = writeln!(s, " PL bnd x{j}");
             }
         }
-        let _ = writeln!(s, "ENDATA");
-        s
     }
 }
 

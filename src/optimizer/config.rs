@@ -205,7 +205,27 @@ impl OptimizerConfig {
     /// Builds and validates the problem.
     pub fn problem(&self) -> Result<Problem, OptError> {
         let mut preset = self.preset()?;
-        let lid = &mut preset.lidar;
+        self.apply_lidar(&mut preset.lidar)?;
+        self.apply_limits(&mut preset.lidar.limits)?;
+        let focus = self.focus.clone().unwrap_or(preset.focus);
+        focus.validate().map_err(|e| OptError::Invalid {
+            field: "focus".into(),
+            reason: e.to_string(),
+        })?;
+        self.validate_objective()?;
+        let bins = self.bins.unwrap_or(360);
+        super::validate_bins(bins, "bins")?;
+        Ok(Problem {
+            lidar: preset.lidar,
+            focus,
+            levels: self.levels.clone(),
+            objective: self.objective.clone(),
+            bins,
+        })
+    }
+
+    /// `[lidar]`'s overrides onto the preset's sensor.
+    fn apply_lidar(&self, lid: &mut crate::model::lidar::LidarSpec) -> Result<(), OptError> {
         if let Some(v) = self.lidar.frame_rate_hz {
             lid.frame_rate_hz = positive("lidar.frame_rate_hz", v)?;
         }
@@ -218,8 +238,13 @@ impl OptimizerConfig {
         if let Some(v) = self.lidar.power_accounting {
             lid.power_accounting = v;
         }
+        Ok(())
+    }
+
+    /// `[limits]`'s overrides onto the preset's limits, then the ranges
+    /// checked.
+    fn apply_limits(&self, lim: &mut crate::model::lidar::Limits) -> Result<(), OptError> {
         let l = &self.limits;
-        let lim = &mut lid.limits;
         if let Some(v) = l.power_w_min {
             lim.power_w_min = nonneg("limits.power_w_min", v)?;
         }
@@ -267,11 +292,11 @@ impl OptimizerConfig {
             })?;
             lim.eye_safety = Some(v.clone());
         }
-        let focus = self.focus.clone().unwrap_or(preset.focus);
-        focus.validate().map_err(|e| OptError::Invalid {
-            field: "focus".into(),
-            reason: e.to_string(),
-        })?;
+        Ok(())
+    }
+
+    /// `[objective]`: weights, priors, the detection target, the mode.
+    fn validate_objective(&self) -> Result<(), OptError> {
         let o = &self.objective;
         weight("objective.range_weight", o.range_weight)?;
         weight("objective.resolution_weight", o.resolution_weight)?;
@@ -289,21 +314,13 @@ impl OptimizerConfig {
             }
         }
         o.detection.validate()?;
-        let bins = self.bins.unwrap_or(360);
-        super::validate_bins(bins, "bins")?;
         if o.mode == crate::model::Mode::Baseline {
             return Err(OptError::Invalid {
                 field: "objective.mode".into(),
                 reason: "baseline has nothing to optimize; use range, resolution or joint".into(),
             });
         }
-        Ok(Problem {
-            lidar: preset.lidar,
-            focus,
-            levels: self.levels.clone(),
-            objective: self.objective.clone(),
-            bins,
-        })
+        Ok(())
     }
 }
 

@@ -188,6 +188,9 @@ pub enum CertificateError {
     /// The dwell step's point failed the exact check.
     #[error("the dwell step's answer could not be certified exactly: {0}")]
     DwellStep(Box<CertificateError>),
+    /// HiGHS failed on the program linearised at a `resolution`-mode answer.
+    #[error("the dwell program at the answer could not be solved: {0}")]
+    AnswerProgram(String),
     /// Resolution mode whose profile is not a program's answer.
     #[error("this mode has no power step, and the profile's dwell is not the dwell step's answer (smoothed spin, or the move shortened for eye safety)")]
     NoProgram,

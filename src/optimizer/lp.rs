@@ -513,6 +513,9 @@ fn power_program(
     budget(&mut lp, problem, g, t, &x);
     if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
         slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
+        if !problem.levels.power_w.is_empty() {
+            slew_levels(&mut lp, g, &x, s, problem.lidar.average_power_w);
+        }
     }
     if let Some(e) = eye {
         eye_cuts(&mut lp, problem, e, pool, factor, &x)?;
@@ -680,6 +683,53 @@ fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
         let mut d = x[j].clone();
         d.add_mul(-1.0, &x[i]);
         lp.between("slew", d, -lim, lim);
+    }
+}
+
+/// `slew_levels` (hardware levels under a slew limit): for each pair of
+/// neighbours and each level `k` of one, `z_k ≤ Σ z_l` over the other's
+/// levels `l` within the slew row's limit of `k` (a row only where some
+/// level is out of reach). Every level choice that meets the `slew` rows
+/// meets these (a level within the limit, compared with a relative 10⁻⁹ of
+/// head-room, is always counted), so the MILP's points are unchanged; its
+/// LP relaxation, which the aggregate `slew` rows let mix far-apart levels
+/// into a ramp no level choice can follow, is tighter, and so is the
+/// certificate's bound (the relaxation's duals).
+fn slew_levels(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
+    // Per bin its (x level, binary), ordered by level then column.
+    let levels: Vec<Vec<(f64, Variable)>> = x
+        .iter()
+        .map(|form| {
+            let mut v: Vec<(f64, usize, Variable)> = form
+                .linear_coefficients()
+                .map(|(z, a)| (a, lp.col(z), z))
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            v.into_iter().map(|(a, _, z)| (a, z)).collect()
+        })
+        .collect();
+    for i in 0..g.n {
+        let j = next_index(i, g.n);
+        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
+        let reach = lim * (1.0 + 1e-9);
+        for (a, b) in [(i, j), (j, i)] {
+            for &(xa, za) in &levels[a] {
+                let near: Vec<Variable> = levels[b]
+                    .iter()
+                    .filter(|(xb, _)| (xb - xa).abs() <= reach)
+                    .map(|&(_, z)| z)
+                    .collect();
+                if near.len() == levels[b].len() {
+                    continue;
+                }
+                let mut e = Expression::default();
+                e.add_mul(1.0, za);
+                for z in near {
+                    e.add_mul(-1.0, z);
+                }
+                lp.at_most("slew_levels", e, 0.0);
+            }
+        }
     }
 }
 
@@ -942,7 +992,7 @@ fn dwell_step(
     p: &[f64],
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
-    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current)?;
+    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, false)?;
     let solved = d.lp.solve_with(
         "dwell",
         &SolveOptions {
@@ -964,6 +1014,44 @@ fn dwell_step(
     Ok(DwellStep { t, cert })
 }
 
+/// The certificate of a `resolution`-mode answer whose dwell `answer` (s,
+/// per bin) is no program's point: the spin rebuilt continuous under an
+/// acceleration limit, or the move shortened for eye safety. Its program is
+/// the dwell step's linearised at the answer (no eye-safety cuts, the
+/// trust region around the answer, the acceleration rows at least the
+/// answer's own slowness steps, every box widened to hold the answer), so
+/// the answer, filled into the utility's segments, is a point of it; the
+/// multipliers are HiGHS's row duals of that program, and the point and
+/// bound are checked exactly on its rows widened by twice the dwell
+/// step's tolerance, as every dwell step's.
+fn answer_dwell_certificate(
+    problem: &Problem,
+    g: &Grid,
+    p: &[f64],
+    answer: &[f64],
+) -> Result<Certified, CertificateError> {
+    let f_p = problem.lidar.pulse_rate_hz;
+    let solver = |e: OptError| CertificateError::AnswerProgram(e.to_string());
+    let d = dwell_program(problem, g, &[], f_p, p, answer, true).map_err(solver)?;
+    let solved =
+        d.lp.solve_with(
+            "dwell",
+            &SolveOptions {
+                initial: Some(&d.start),
+                primal_feasibility_tolerance: S.dwell_feasibility_tol,
+            },
+        )
+        .map_err(solver)?;
+    Certified::new(
+        Step::Dwell,
+        d.lp.view().widened(2.0 * S.dwell_feasibility_tol),
+        d.start,
+        solved.y,
+        solved.solver_dual_bound,
+    )
+    .map_err(|e| CertificateError::DwellStep(Box::new(e)))
+}
+
 /// The dwell step's program and how each bin's dwell reads from it.
 struct DwellProgram {
     lp: Program,
@@ -981,6 +1069,9 @@ struct DwellProgram {
 /// set-points: the `levels` family, one binary per set-point and a one-hot
 /// row), then the constraint families in a fixed order — `frame`,
 /// `budget` (time accounting), `accel`, `eye_cuts` (linearised).
+/// `contain`: the program is linearised at an answer `current` and must
+/// contain it (see [`answer_dwell_certificate`]): its boxes and
+/// acceleration rows are widened to the answer where it lies outside them.
 fn dwell_program(
     problem: &Problem,
     g: &Grid,
@@ -988,6 +1079,7 @@ fn dwell_program(
     pulse_rate_hz: f64,
     p: &[f64],
     current: &[f64],
+    contain: bool,
 ) -> Result<DwellProgram, OptError> {
     let l = &problem.lidar.limits;
     let setpoints = &problem.levels.spin_rad_s;
@@ -1016,7 +1108,7 @@ fn dwell_program(
     for i in 0..g.n {
         if setpoints.is_empty() {
             let trust = l.spin_accel_rad_s2_max.is_some() || touched[i];
-            utility_constant += dwell_column(&mut d, problem, g, i, current[i], trust);
+            utility_constant += dwell_column(&mut d, problem, g, i, current[i], (trust, contain));
         } else {
             spin_levels(&mut d, problem, g, i, &allowed);
         }
@@ -1033,22 +1125,23 @@ fn dwell_program(
         dwell_budget(&mut d, p, problem.lidar.average_power_w, g.n);
     }
     if let Some(a_max) = l.spin_accel_rad_s2_max {
-        accel(&mut d, g, current, a_max);
+        accel(&mut d, g, current, a_max, contain);
     }
     linearised_eye_cuts(&mut d, binding, pulse_rate_hz, p, current);
     Ok(d)
 }
 
 /// Bin `i`'s continuous dwell column `τ_i` (boxed by the spin limits and,
-/// where `trust`, the trust region around the iterate `current_s`) and its
-/// density utility's segments; returns the utility's constant.
+/// where `trust`, the trust region around the iterate `current_s`; where
+/// `contain`, widened to hold `current_s`) and its density utility's
+/// segments; returns the utility's constant.
 fn dwell_column(
     d: &mut DwellProgram,
     problem: &Problem,
     g: &Grid,
     i: usize,
     current_s: f64,
-    trust: bool,
+    (trust, contain): (bool, bool),
 ) -> f64 {
     let l = &problem.lidar.limits;
     let period = 1.0 / problem.lidar.frame_rate_hz;
@@ -1058,6 +1151,10 @@ fn dwell_column(
     if trust {
         lo = lo.max(current_s / unit * (1.0 - S.trust));
         hi = hi.min(current_s / unit * (1.0 + S.trust)).max(lo);
+    }
+    if contain {
+        lo = lo.min(current_s / unit);
+        hi = hi.max(current_s / unit);
     }
     let t0 = (current_s / unit).max(lo).min(hi);
     let ti = d.lp.column(lo, hi, 0.0, false);
@@ -1160,16 +1257,21 @@ fn dwell_budget(d: &mut DwellProgram, p: &[f64], p_mean: f64, n: usize) {
 }
 
 /// `accel`: the change of slowness `s = t/θ` between neighbours,
-/// `|Δs| ≤ accel_share·a·Δθ·(1−trust)³/ω̃³`, linearised at the iterate.
-fn accel(d: &mut DwellProgram, g: &Grid, current: &[f64], a_max: f64) {
+/// `|Δs| ≤ accel_share·a·Δθ·(1−trust)³/ω̃³`, linearised at the iterate;
+/// where `contain`, at least the iterate's own `|Δs|`.
+fn accel(d: &mut DwellProgram, g: &Grid, current: &[f64], a_max: f64, contain: bool) {
     let unit = d.unit;
     for i in 0..g.n {
         let j = next_index(i, g.n);
         let w_cur = (g.theta[i] / current[i]).max(g.theta[j] / current[j]);
         let dtheta = 0.5 * (g.theta[i] + g.theta[j]);
-        let ds = S.accel_share * a_max * dtheta * (1.0 - S.trust).powi(3) / w_cur.powi(3);
+        let mut ds = S.accel_share * a_max * dtheta * (1.0 - S.trust).powi(3) / w_cur.powi(3);
         // s = t/θ = τ·unit/θ.
         let (ki, kj) = (unit / g.theta[i], unit / g.theta[j]);
+        if contain {
+            let own = (kj * (current[j] / unit) - ki * (current[i] / unit)).abs();
+            ds = ds.max(own * (1.0 + 1e-9));
+        }
         let mut diff = Expression::default();
         diff.add_mul(kj, &d.tau[j]);
         diff.add_mul(-ki, &d.tau[i]);
@@ -1337,6 +1439,13 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
     let profile = build_profile(problem, &g, gaze_deg, &it.p, &spins);
     if let Some(d) = it.dwell.as_mut() {
         d.is_answer = mode == Mode::Resolution && !smooth && !shortened;
+        if mode == Mode::Resolution && (smooth || shortened) && problem.levels.spin_rad_s.is_empty()
+        {
+            // The answer's dwell is no program's point: its own program.
+            d.last = answer_dwell_certificate(problem, &g, &it.p, &dwell_of(&g, &spins));
+            d.programs += 1;
+            d.is_answer = true;
+        }
     }
     Ok(Solution {
         profile,
