@@ -184,6 +184,46 @@ fn point_cloud2_layout_errors_name_the_field() {
 }
 
 #[test]
+fn ambiguous_point_layouts_are_refused_by_name() {
+    let b = cloud_bytes(false, false, 16, &[[1.0, 2.0, 3.0]]);
+    let c = PointCloud2::decode(&b).unwrap();
+    assert!(c.xyz().is_ok());
+    // A second x.
+    let mut d = c.clone();
+    let mut x2 = d.fields[0].clone();
+    x2.offset = 12;
+    d.fields.push(x2);
+    let e = d.xyz().unwrap_err().to_string();
+    assert!(
+        e.starts_with("fields") && e.contains("x is given more than once"),
+        "{e}"
+    );
+    // x, y and z at one offset (a 4-byte point).
+    let mut d = c.clone();
+    for f in &mut d.fields {
+        f.offset = 0;
+    }
+    let e = d.xyz().unwrap_err().to_string();
+    assert!(e.starts_with("fields") && e.contains("overlaps"), "{e}");
+    // y straddling x's last bytes.
+    let mut d = c.clone();
+    d.fields[1].offset = 2;
+    assert!(d.xyz().unwrap_err().to_string().contains("overlaps field"));
+    // Another field inside z.
+    let mut d = c.clone();
+    d.fields[3].offset = 9;
+    let e = d.xyz().unwrap_err().to_string();
+    assert!(
+        e.contains("z (bytes 8..12) overlaps field intensity"),
+        "{e}"
+    );
+    // Adjacent is fine.
+    let mut d = c;
+    d.fields[3].offset = 12;
+    assert!(d.xyz().is_ok());
+}
+
+#[test]
 fn vector_azimuth_follows_iso_8855() {
     assert_eq!(vector_azimuth_deg([1.0, 0.0, 0.0]), Some(0.0));
     assert_eq!(vector_azimuth_deg([0.0, 1.0, 0.0]), Some(90.0));
@@ -249,6 +289,9 @@ fn decode_all_and_kept_ranges_match_the_per_point_reference() {
         let bits =
             |v: &[[f64; 3]]| -> Vec<[u64; 3]> { v.iter().map(|p| p.map(f64::to_bits)).collect() };
         assert_eq!(bits(&all), bits(&want), "case {case}");
+        let streamed: Vec<[f64; 3]> = l.points(c.data).collect();
+        assert_eq!(l.points(c.data).len(), l.len());
+        assert_eq!(bits(&streamed), bits(&want), "case {case}");
         let keep: Vec<bool> = (0..l.len()).map(|_| rng.random_bool(0.6)).collect();
         let sub = cdr::encode_subset(&c, &l, &keep, true);
         let s = PointCloud2::decode(&sub).unwrap();
