@@ -303,3 +303,68 @@ fn decode_all_and_kept_ranges_match_the_per_point_reference() {
         assert_eq!(s.width as usize, keep.iter().filter(|&&k| k).count());
     }
 }
+
+fn empty_message(
+    channel: &std::sync::Arc<mcap::Channel<'static>>,
+    t: u64,
+) -> mcap::Message<'static> {
+    mcap::Message {
+        channel: channel.clone(),
+        sequence: 0,
+        log_time: t,
+        publish_time: t,
+        data: std::borrow::Cow::Owned(Vec::new()),
+    }
+}
+
+fn channel(id: u16, topic: &str) -> std::sync::Arc<mcap::Channel<'static>> {
+    std::sync::Arc::new(mcap::Channel {
+        id,
+        topic: topic.to_owned(),
+        schema: None,
+        message_encoding: "cdr".to_owned(),
+        metadata: std::collections::BTreeMap::new(),
+    })
+}
+
+#[test]
+fn the_window_bounds_many_empty_messages_by_their_bookkeeping() {
+    // Two million empty messages at one time: none is old, so only the
+    // byte bound releases them, and it must count them although their
+    // data is empty.
+    let ch = channel(1, "/empty");
+    let mut w = super::Window::new(200_000_000);
+    let mut released = 0u64;
+    for _ in 0..2_000_000u64 {
+        w.push(empty_message(&ch, 5));
+        while w.pop_due().is_some() {
+            released += 1;
+        }
+        assert!(w.held_bytes <= super::MAX_WINDOW_BYTES + super::HELD_OVERHEAD_BYTES);
+    }
+    let cap = super::MAX_WINDOW_BYTES / super::HELD_OVERHEAD_BYTES + 1;
+    assert!(w.heap.len() <= cap, "{} held", w.heap.len());
+    assert!(released >= 2_000_000 - cap as u64);
+}
+
+#[test]
+fn one_far_future_stamp_does_not_move_the_windows_clock() {
+    let (a, b, c) = (channel(1, "/a"), channel(2, "/b"), channel(3, "/c"));
+    let mut w = super::Window::new(200_000_000);
+    w.push(empty_message(&a, 1_000_000_000));
+    assert_eq!(w.clock(), 1_000_000_000);
+    w.push(empty_message(&c, u64::MAX / 2));
+    w.push(empty_message(&b, 1_100_000_000));
+    assert_eq!(w.clock(), 1_100_000_000);
+    // Nothing is 200 ms older than the clock yet: nothing is due.
+    assert!(w.pop_due().is_none());
+    w.push(empty_message(&a, 1_350_000_000));
+    assert_eq!(w.clock(), 1_350_000_000);
+    // The clock is 1.35 s: the messages at 1.0 and 1.1 s are more than
+    // 200 ms older, due; the far one is released only at the end.
+    assert_eq!(w.pop_due().map(|p| p.log_time), Some(1_000_000_000));
+    assert_eq!(w.pop_due().map(|p| p.log_time), Some(1_100_000_000));
+    assert!(w.pop_due().is_none());
+    assert_eq!(w.pop().map(|p| p.log_time), Some(1_350_000_000));
+    assert_eq!(w.pop().map(|p| p.log_time), Some(u64::MAX / 2));
+}
