@@ -307,11 +307,13 @@ def test_the_binding_checks_options_by_keyword_before_reading(tmp_path: pathlib.
     write_fixture(cut)
     cut.write_bytes(cut.read_bytes()[:5000])
     out = tmp_path / "x.mcap"
-    for key, value in [("fog_mor_m", 5e-324), ("cloud_spin_rad_s", 5e-324),
-                       ("sensor_yaw_deg", 5e-324), ("rated_range_m", 5e-324),
-                       ("max_mount_tilt_deg", 5e-324), ("reorder_window_ms", 5e-324),
-                       ("cloud_spin_rad_s", 0.0), ("fog_mor_m", -1.0), ("bins", 36000),
-                       ("scene_topic", "/gaze_lidar/profile"), ("adapted_topic", GAZE)]:
+    cases: list[tuple[str, Any]] = [
+        ("fog_mor_m", 5e-324), ("cloud_spin_rad_s", 5e-324), ("sensor_yaw_deg", 5e-324),
+        ("rated_range_m", 5e-324), ("max_mount_tilt_deg", 5e-324),
+        ("reorder_window_ms", 5e-324), ("cloud_spin_rad_s", 0.0), ("fog_mor_m", -1.0),
+        ("bins", 36000), ("scene_topic", "/gaze_lidar/profile"), ("adapted_topic", GAZE),
+    ]
+    for key, value in cases:
         with pytest.raises(ValueError, match=rf"^{key}: "):
             gl.replay(cut, out, gaze_topic=GAZE, cloud_topic=CLOUD, **{key: value})
     with pytest.raises(ValueError, match=r"^out_path: "):
@@ -335,7 +337,7 @@ def test_attachments_metadata_and_sequences_of_an_independent_bag_are_copied(
         w.add_metadata(name="rosbag2", data={"vehicle": "car 7"})
         schemas: dict[int, int] = {}
         channels: dict[int, int] = {}
-        sequences = []
+        sequences: list[tuple[str, int, int]] = []
         for schema, channel, message in reader.iter_messages():
             if schema is not None and schema.id not in schemas:
                 schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
