@@ -49,8 +49,10 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64) -> PyResult<f64> {
 /// cloud on adapted_topic (default cloud_topic + "/adapted"), one
 /// profile@1 document per frame on profile_topic and a foxglove.SceneUpdate
 /// per frame on scene_topic (the options and rules of `gaze-lidar replay`;
-/// out_path is replaced only when the replay succeeds). Returns the
-/// counters (messages, clouds, points_in, points_kept, frames, …).
+/// out_path is replaced only when the replay succeeds; input messages keep
+/// their sequence numbers, attachments and metadata are copied). Returns
+/// the counters (messages, clouds, points_in, points_kept, attachments,
+/// metadata, frames, …).
 ///
 /// Raises ValueError for a bad option or a bad bag (truncated, corrupt,
 /// wrong topic type: the message names the byte offset or the field),
