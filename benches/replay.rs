@@ -5,7 +5,9 @@
 //! the real-time factor (seconds of drive per second of replay) on the
 //! wall clock and on the process's CPU time (user + system, from
 //! `/proc/self/stat`: the one-core figure, meaningful on a loaded machine;
-//! the replay is single-threaded).
+//! the replay is single-threaded), and the output's size; then the size
+//! of the uncompressed output rewritten with zstd at its default level
+//! (3) against the level replay writes ([`ZSTD_LEVEL`]).
 //! Run: `cargo bench --bench replay`.
 
 #[path = "common/bag.rs"]
@@ -18,7 +20,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use gaze_lidar::gaze::ClosedFormPlanner;
 use gaze_lidar::model::presets;
 use gaze_lidar::planner::Mode;
-use gaze_lidar::replay::{replay, Compression, PipelineConfig, ReplayOptions};
+use gaze_lidar::replay::{replay, Compression, PipelineConfig, ReplayOptions, ZSTD_LEVEL};
 
 const SECONDS: u64 = 2;
 
@@ -46,9 +48,16 @@ fn run(input: &[u8], compression: Compression) -> Vec<u8> {
 
 /// Baseline: every message read and written back, nothing else.
 fn copy(input: &[u8]) -> Vec<u8> {
+    copy_as(input, None, 0)
+}
+
+/// Every message read and written back with this compression and level.
+fn copy_as(input: &[u8], compression: Option<mcap::Compression>, level: u32) -> Vec<u8> {
     let mut out = Cursor::new(Vec::with_capacity(input.len()));
     let mut w = mcap::WriteOptions::new()
-        .compression(None)
+        .compression(compression)
+        .compression_level(level)
+        .compression_threads(0)
         .create(&mut out)
         .unwrap();
     for m in mcap::MessageStream::new(input).unwrap() {
@@ -99,9 +108,10 @@ fn bench(c: &mut Criterion) {
     ] {
         let mut best = f64::INFINITY;
         let mut best_cpu = f64::INFINITY;
+        let mut size = 0;
         for _ in 0..5 {
             let (t, c) = (Instant::now(), cpu_s());
-            std::hint::black_box(run(&input, compression));
+            size = std::hint::black_box(run(&input, compression)).len();
             best = best.min(t.elapsed().as_secs_f64());
             best_cpu = best_cpu.min(cpu_s() - c);
         }
@@ -113,13 +123,27 @@ fn bench(c: &mut Criterion) {
             })
             .fold(f64::INFINITY, f64::min);
         println!(
-            "replay ({name} output): {SECONDS} s of drive ({} points) in {best:.3} s wall = {:.1}× real time, {best_cpu:.3} s CPU = {:.1}× real time on one core; copy alone {copy_s:.3} s wall (replay/copy = {:.2})",
+            "replay ({name} output): {SECONDS} s of drive ({} points) in {best:.3} s wall = {:.1}× real time, {best_cpu:.3} s CPU = {:.1}× real time on one core; copy alone {copy_s:.3} s wall (replay/copy = {:.2}); output {size} bytes",
             SECONDS * 10 * bag::POINTS as u64,
             SECONDS as f64 / best,
             SECONDS as f64 / best_cpu,
             best / copy_s
         );
     }
+    // The size cost of the fast zstd level: the uncompressed output
+    // rewritten at zstd's default level and at replay's.
+    let plain = run(&input, Compression::None);
+    let zstd = Some(mcap::Compression::Zstd);
+    let (t3, d3) = (Instant::now(), copy_as(&plain, zstd, 3).len());
+    let t3 = t3.elapsed().as_secs_f64();
+    let (t1, d1) = (Instant::now(), copy_as(&plain, zstd, ZSTD_LEVEL).len());
+    let t1 = t1.elapsed().as_secs_f64();
+    println!(
+        "zstd on the {} -byte output: level 3 {d3} bytes in {t3:.3} s, level {ZSTD_LEVEL} {d1} bytes in {t1:.3} s (size ×{:.3}, time ×{:.2})",
+        plain.len(),
+        d1 as f64 / d3 as f64,
+        t1 / t3
+    );
 }
 
 criterion_group!(benches, bench);

@@ -331,8 +331,11 @@ fn a_truncated_or_corrupt_bag_is_exit_2_naming_the_offset_and_leaves_no_output()
     common::no_panic(&o, "truncated");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains(&format!("at byte {}", bag.len() / 2)), "{err}");
-    assert!(err.contains("truncated"), "{err}");
+    assert!(err.contains("at byte "), "{err}");
+    assert!(
+        err.contains(&format!("truncated after {} bytes", bag.len() / 2)),
+        "{err}"
+    );
     assert_eq!(std::fs::read(&out).unwrap(), b"old");
     // A flipped byte inside the data: a CRC or parse error, exit 2.
     let mut bad = bag.clone();
@@ -897,4 +900,545 @@ fn out_equal_to_the_config_file_is_exit_2_and_leaves_it() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--config"), "{err}");
     assert_eq!(std::fs::read(&config).unwrap(), text);
+}
+
+/// `bag` read back and written again after `edit` changed its messages
+/// (topic, schema name, log_time, data, sequence), with the attachments
+/// and metadata records `extra` adds.
+fn rewrite(
+    bag: &[u8],
+    edit: impl FnOnce(&mut Vec<mcap::Message<'static>>),
+    extra: impl FnOnce(&mut mcap::Writer<Cursor<&mut Vec<u8>>>),
+) -> Vec<u8> {
+    let mut msgs: Vec<mcap::Message<'static>> = mcap::MessageStream::new(bag)
+        .unwrap()
+        .map(|m| {
+            let m = m.unwrap();
+            mcap::Message {
+                channel: std::sync::Arc::new(mcap::Channel {
+                    id: m.channel.id,
+                    topic: m.channel.topic.clone(),
+                    schema: m.channel.schema.as_ref().map(|s| {
+                        std::sync::Arc::new(mcap::Schema {
+                            id: s.id,
+                            name: s.name.clone(),
+                            encoding: s.encoding.clone(),
+                            data: std::borrow::Cow::Owned(s.data.to_vec()),
+                        })
+                    }),
+                    message_encoding: m.channel.message_encoding.clone(),
+                    metadata: m.channel.metadata.clone(),
+                }),
+                sequence: m.sequence,
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+                data: std::borrow::Cow::Owned(m.data.into_owned()),
+            }
+        })
+        .collect();
+    edit(&mut msgs);
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .compression(None)
+        .chunk_size(Some(64 * 1024))
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    extra(&mut w);
+    for m in &msgs {
+        w.write(m).unwrap();
+    }
+    w.finish().unwrap();
+    drop(w);
+    buf
+}
+
+fn run_replay(
+    input: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> std::process::Output {
+    let o = bin()
+        .arg("replay")
+        .arg(input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD])
+        .args(["--preset", "paper", "--mode", "range"])
+        .args(extra)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    common::no_panic(&o, "replay");
+    o
+}
+
+/// The messages a replay adds (adapted clouds, profiles, scenes): (topic,
+/// log_time, data), in the order written.
+fn added(out: &[u8]) -> Vec<(String, u64, Vec<u8>)> {
+    read_all(out)
+        .into_iter()
+        .filter(|m| ![GAZE, CLOUD, OTHER].contains(&m.topic.as_str()))
+        .map(|m| (m.topic, m.log_time, m.data))
+        .collect()
+}
+
+/// stderr without the program's `gaze-lidar: error: ` prefix.
+fn message(o: &std::process::Output) -> String {
+    let e = String::from_utf8_lossy(&o.stderr);
+    e.strip_prefix("gaze-lidar: error: ")
+        .unwrap_or(&e)
+        .to_owned()
+}
+
+#[test]
+fn output_topics_that_collide_with_inputs_or_each_other_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let (once, twice) = (dir.path().join("once.mcap"), dir.path().join("twice.mcap"));
+    assert_eq!(run_replay(&input, &once, &[]).status.code(), Some(0));
+    // Replaying the output again: its adapted, profile and scene topics are
+    // input topics now; refused (exit 2) naming the option.
+    let o = run_replay(&once, &twice, &[]);
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.starts_with(
+            "--profile-topic: \"/gaze_lidar/profile\" is also a topic of the input bag"
+        ) || err.starts_with("--adapted-topic: \"/lidar/points/adapted\" is also a topic")
+            || err.starts_with("--scene-topic: \"/gaze_lidar/scene\" is also a topic"),
+        "{err}"
+    );
+    assert!(!twice.exists());
+    // With new output topics it runs, and no topic has two channels.
+    let new_topics = [
+        "--adapted-topic",
+        "/a2",
+        "--profile-topic",
+        "/p2",
+        "--scene-topic",
+        "/s2",
+    ];
+    let o = run_replay(&once, &twice, &new_topics);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let bytes = std::fs::read(&twice).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let mut topics: Vec<&str> = summary
+        .channels
+        .values()
+        .map(|c| c.topic.as_str())
+        .collect();
+    let n = topics.len();
+    topics.sort_unstable();
+    topics.dedup();
+    assert_eq!(topics.len(), n, "{topics:?}");
+    // Output topics equal to each other or to an input topic.
+    for (args, flag) in [
+        (
+            &["--profile-topic", "/gaze_lidar/scene"][..],
+            "--scene-topic",
+        ),
+        (
+            &["--adapted-topic", "/x", "--scene-topic", "/x"][..],
+            "--scene-topic",
+        ),
+        (&["--adapted-topic", GAZE][..], "--adapted-topic"),
+        (&["--profile-topic", "/tf_static"][..], "--profile-topic"),
+    ] {
+        let o = run_replay(&input, &twice, args);
+        let err = message(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.starts_with(flag), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn out_dash_is_stdout_and_a_missing_folder_is_exit_2_naming_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let file = dir.path().join("file.mcap");
+    assert_eq!(run_replay(&input, &file, &[]).status.code(), Some(0));
+    let o = bin()
+        .current_dir(dir.path())
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD])
+        .args(["--preset", "paper", "--mode", "range", "--out", "-"])
+        .output()
+        .unwrap();
+    common::no_panic(&o, "stdout");
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(o.stdout, std::fs::read(&file).unwrap());
+    assert!(!dir.path().join("-").exists());
+    // A bad input writes nothing to stdout.
+    std::fs::write(&input, b"not an mcap").unwrap();
+    let o = bin()
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD, "--out", "-"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+    // A missing output folder: bad input, named.
+    std::fs::write(&input, bag(None)).unwrap();
+    let o = run_replay(&input, &dir.path().join("no/such/dir/out.mcap"), &[]);
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.starts_with("--out: "), "{err}");
+    assert!(err.contains("no/such/dir"), "{err}");
+}
+
+#[test]
+fn a_far_future_stamp_or_reordered_clouds_do_not_change_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = bag(None);
+    let t0 = read_all(&plain).iter().map(|m| m.log_time).min().unwrap();
+    let clouds = |msgs: &[mcap::Message<'static>]| -> Vec<usize> {
+        (0..msgs.len())
+            .filter(|&i| msgs[i].channel.topic == CLOUD)
+            .collect()
+    };
+    // Two clouds 100 ms apart written in the other order (inside the
+    // 200 ms window), and one message on an unrelated topic stamped a
+    // thousand seconds ahead, early in the file.
+    let shuffled = rewrite(
+        &plain,
+        |m| {
+            let c = clouds(m);
+            m.swap(c[3], c[4]);
+            m.swap(c[10], c[11]);
+            let mut far = m.iter().find(|x| x.channel.topic == OTHER).unwrap().clone();
+            far.log_time = t0 + 1_000_000_000_000;
+            m.insert(5, far);
+        },
+        |_| {},
+    );
+    let reference = rewrite(
+        &plain,
+        |m| {
+            let mut far = m.iter().find(|x| x.channel.topic == OTHER).unwrap().clone();
+            far.log_time = t0 + 1_000_000_000_000;
+            m.push(far);
+        },
+        |_| {},
+    );
+    let run = |name: &str, bytes: &[u8]| {
+        let (i, o) = (
+            dir.path().join(format!("{name}.mcap")),
+            dir.path().join(format!("{name}-out.mcap")),
+        );
+        std::fs::write(&i, bytes).unwrap();
+        let r = run_replay(&i, &o, &[]);
+        assert_eq!(
+            r.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        added(&std::fs::read(&o).unwrap())
+    };
+    let want = run("reference", &reference);
+    let have = run("shuffled", &shuffled);
+    assert!(
+        want.iter()
+            .filter(|m| m.0 == "/lidar/points/adapted")
+            .count()
+            == 30
+    );
+    assert_eq!(want.len(), have.len());
+    for (k, (w, h)) in want.iter().zip(&have).enumerate() {
+        assert_eq!((&w.0, w.1), (&h.0, h.1), "message {k}");
+        assert!(w.2 == h.2, "message {k} on {} differs", w.0);
+    }
+}
+
+/// Start offsets of the top-level records of an MCAP file.
+fn record_starts(b: &[u8]) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut at = 8;
+    while at + 9 <= b.len() {
+        out.push(at);
+        let len = u64::from_le_bytes(b[at + 1..at + 9].try_into().unwrap()) as usize;
+        let footer = b[at] == 0x02;
+        at += 9 + len;
+        if footer {
+            break;
+        }
+    }
+    out
+}
+
+#[test]
+fn corruption_is_reported_at_the_bad_records_start_and_data_after_the_footer_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // Larger than one 1 MiB read, so how far the reader got is not the
+    // record's start.
+    let bag = rewrite(
+        &bag(None),
+        |m| {
+            let more: Vec<_> = m.clone();
+            for (k, mut x) in more.into_iter().enumerate() {
+                x.log_time += 4_000_000_000;
+                x.sequence = k as u32;
+                m.push(x);
+            }
+        },
+        |_| {},
+    );
+    assert!(bag.len() > 2 << 20, "{}", bag.len());
+    let starts = record_starts(&bag);
+    let containing = |at: usize| *starts.iter().rev().find(|&&s| s <= at).unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    for frac in [0.2, 0.45, 0.7] {
+        let at = (bag.len() as f64 * frac) as usize;
+        let mut bad = bag.clone();
+        bad[at] ^= 0x5A;
+        std::fs::write(&input, &bad).unwrap();
+        let o = run_replay(&input, &out, &[]);
+        let err = message(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!("at byte {}:", containing(at))),
+            "flipped byte {at}, record at {}: {err}",
+            containing(at)
+        );
+        // Truncated there.
+        std::fs::write(&input, &bag[..at]).unwrap();
+        let o = run_replay(&input, &out, &[]);
+        let err = message(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!("at byte {}:", containing(at))),
+            "{err}"
+        );
+        assert!(
+            err.contains(&format!("truncated after {at} bytes")),
+            "{err}"
+        );
+    }
+    // Bytes after the end magic.
+    let mut long = bag.clone();
+    long.extend_from_slice(b"trailing");
+    std::fs::write(&input, &long).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("at byte {}:", bag.len())), "{err}");
+    assert!(err.contains("after the end magic"), "{err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn float_flags_are_range_checked_by_name_before_the_bag_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("cut.mcap");
+    // A truncated bag: an option error must come first.
+    let b = bag(None);
+    std::fs::write(&input, &b[..b.len() / 2]).unwrap();
+    let out = dir.path().join("out.mcap");
+    for (flag, values) in [
+        ("--fog-mor-m", &["5e-324", "0", "-1", "1e300", "inf"][..]),
+        ("--cloud-spin-rad-s", &["5e-324", "0", "-3", "1e9"][..]),
+        ("--sensor-yaw-deg", &["5e-324", "1e9", "nan"][..]),
+        ("--rated-range-m", &["5e-324", "0"][..]),
+        ("--max-mount-tilt-deg", &["5e-324", "91"][..]),
+        ("--reorder-window-ms", &["5e-324", "-1", "1e9"][..]),
+        ("--timeout-ms", &["5e-324"][..]),
+        ("--saccade-deg-s", &["5e-324"][..]),
+        ("--bins", &["36000", "1441"][..]),
+    ] {
+        for v in values {
+            let o = run_replay(&input, &out, &[flag, v]);
+            let err = message(&o);
+            assert_eq!(o.status.code(), Some(2), "{flag} {v}: {err}");
+            assert!(err.starts_with(&format!("{flag}: ")), "{flag} {v}: {err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+        }
+    }
+    // The argus model's fog levels: named by the flag too.
+    let o = run_replay(&input, &out, &["--model", "argus", "--fog-mor-m", "150"]);
+    let err = message(&o);
+    assert!(err.starts_with("--fog-mor-m: "), "{err}");
+    // 1440 bins are fine.
+    std::fs::write(&input, &b).unwrap();
+    let o = run_replay(&input, &out, &["--bins", "1440"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+#[test]
+fn sequences_attachments_and_metadata_are_copied_and_stamps_are_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = bag(None);
+    let t0 = read_all(&plain).iter().map(|m| m.log_time).min().unwrap();
+    // Sequence numbers of its own, an attachment, a metadata record, and
+    // one message on an unrelated topic at log_time 0.
+    let rich = rewrite(
+        &plain,
+        |m| {
+            for (k, x) in m.iter_mut().enumerate() {
+                x.sequence = 1000 + 7 * k as u32;
+            }
+            let mut zero = m.iter().find(|x| x.channel.topic == OTHER).unwrap().clone();
+            zero.log_time = 0;
+            zero.publish_time = 0;
+            zero.sequence = 5;
+            m.insert(0, zero);
+        },
+        |w| {
+            w.attach(&mcap::Attachment {
+                log_time: t0,
+                create_time: t0 + 1,
+                name: "calibration.yaml".into(),
+                media_type: "application/yaml".into(),
+                data: std::borrow::Cow::Borrowed(b"lidar: {yaw: 0}\n"),
+            })
+            .unwrap();
+            w.write_metadata(&mcap::records::Metadata {
+                name: "rosbag2".into(),
+                metadata: BTreeMap::from([("vehicle".to_owned(), "car 7".to_owned())]),
+            })
+            .unwrap();
+        },
+    );
+    let (i, o) = (
+        dir.path().join("rich.mcap"),
+        dir.path().join("rich-out.mcap"),
+    );
+    std::fs::write(&i, &rich).unwrap();
+    let r = run_replay(&i, &o, &[]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let got = std::fs::read(&o).unwrap();
+    // Sequences kept.
+    let seq = |b: &[u8]| -> Vec<(String, u64, u32)> {
+        let mut v: Vec<_> = mcap::MessageStream::new(b)
+            .unwrap()
+            .map(|m| m.unwrap())
+            .filter(|m| [GAZE, CLOUD, OTHER].contains(&m.channel.topic.as_str()))
+            .map(|m| (m.channel.topic.clone(), m.log_time, m.sequence))
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(seq(&got), seq(&rich));
+    // Attachment and metadata copied.
+    let summary = mcap::Summary::read(&got).unwrap().unwrap();
+    assert_eq!(summary.attachment_indexes.len(), 1);
+    let a = mcap::read::attachment(&got, &summary.attachment_indexes[0]).unwrap();
+    assert_eq!(
+        (
+            a.name.as_str(),
+            a.media_type.as_str(),
+            &a.data[..],
+            a.log_time
+        ),
+        (
+            "calibration.yaml",
+            "application/yaml",
+            &b"lidar: {yaw: 0}\n"[..],
+            t0
+        )
+    );
+    assert_eq!(summary.metadata_indexes.len(), 1);
+    let m = mcap::read::metadata(&got, &summary.metadata_indexes[0]).unwrap();
+    assert_eq!(m.name, "rosbag2");
+    assert_eq!(m.metadata.get("vehicle").map(String::as_str), Some("car 7"));
+    // The profile stamps are those of the bag without the message at 0,
+    // to the nanosecond.
+    let (pi, po) = (
+        dir.path().join("plain.mcap"),
+        dir.path().join("plain-out.mcap"),
+    );
+    std::fs::write(&pi, &plain).unwrap();
+    assert_eq!(run_replay(&pi, &po, &[]).status.code(), Some(0));
+    let stamps = |b: &[u8]| -> Vec<u64> {
+        read_all(b)
+            .iter()
+            .filter(|m| m.topic == "/gaze_lidar/profile")
+            .map(|m| m.log_time)
+            .collect()
+    };
+    let want = stamps(&std::fs::read(&po).unwrap());
+    assert_eq!(stamps(&got), want);
+    // On the frame grid: whole microseconds from the first.
+    assert!(want.iter().all(|t| (t - want[0]) % 1000 == 0), "{want:?}");
+}
+
+#[path = "../benches/common/bag.rs"]
+#[allow(dead_code)]
+mod drive;
+
+/// SIGINT and SIGTERM during a replay: the temporary output is removed and
+/// the exit status is 128 + the signal; an old output stays as it was.
+#[test]
+fn a_signal_removes_the_temporary_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("drive.mcap");
+    drive::write_bag(std::fs::File::create(&input).unwrap(), 3).unwrap();
+    let out = dir.path().join("out.mcap");
+    std::fs::write(&out, b"old").unwrap();
+    let temps = || -> Vec<String> {
+        std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n.starts_with(".gaze-lidar-replay"))
+            .collect()
+    };
+    for (sig, code) in [("INT", 130), ("TERM", 143)] {
+        let mut child = bin()
+            .arg("replay")
+            .arg(&input)
+            .args([
+                "--gaze-topic",
+                "/dms/gaze",
+                "--cloud-topic",
+                "/lidar/points",
+            ])
+            .args(["--preset", "vls128", "--out"])
+            .arg(&out)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Wait for the temporary file, then for some output in it.
+        let start = std::time::Instant::now();
+        while temps().is_empty() {
+            assert!(start.elapsed().as_secs() < 60, "no temporary file");
+            assert!(child.try_wait().unwrap().is_none(), "finished too early");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(150));
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "finished before the signal"
+        );
+        let k = Command::new("kill")
+            .args([format!("-{sig}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(k.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "SIG{sig}: {status:?}");
+        assert!(temps().is_empty(), "SIG{sig}: {:?}", temps());
+        assert_eq!(std::fs::read(&out).unwrap(), b"old");
+    }
 }

@@ -446,8 +446,10 @@ def replay(
     per frame on profile_topic and a foxglove.SceneUpdate per frame on
     scene_topic. out_path is replaced only when the replay succeeds.
     Returns the counters (messages, clouds, points_in, points_kept,
-    late_clouds, late_gaze, clouds_without_tf, transforms, samples,
-    invalid, outliers, frames, fail_safe_frames).
+    late_clouds, late_gaze, clouds_without_tf, transforms, attachments,
+    metadata, samples, invalid, outliers, frames, fail_safe_frames). Input
+    messages keep their sequence numbers; attachments and metadata records
+    are copied. bins: 4..=1440 (each frame's profile is written out).
 
     The mounting yaw: sensor_yaw_deg when given, else the bag's static
     transforms on tf_topic from the cloud's header.frame_id to

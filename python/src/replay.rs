@@ -18,18 +18,28 @@ use super::{
 
 fn replay_error(py: Python<'_>, e: ReplayError) -> PyErr {
     match e {
+        // Options are named by their keyword.
+        ReplayError::Config {
+            field: "out",
+            reason,
+        } => value_error(format!("out_path: {reason}")),
         ReplayError::Gaze(g) => gaze_error(py, g),
         ReplayError::Write(_) => PyOSError::new_err(e.to_string()),
         e => value_error(e.to_string()),
     }
 }
 
+/// Most bins of a replayed profile (the CLI's limit: each frame's profile
+/// is written to the output).
+const MAX_REPLAY_BINS: usize = 1440;
+
+/// `lo < v < hi`, `v` finite and not subnormal (the one numeric boundary).
 fn in_range(field: &str, v: f64, lo: f64, hi: f64) -> PyResult<f64> {
-    if v.is_finite() && v > lo && v < hi {
+    if gaze_lidar::model::valid::finite(v).is_ok() && v > lo && v < hi {
         Ok(v)
     } else {
         Err(value_error(format!(
-            "{field}: {v} must be finite, > {lo} and < {hi}"
+            "{field}: {v} must be finite (not subnormal), > {lo} and < {hi}"
         )))
     }
 }
@@ -39,8 +49,10 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64) -> PyResult<f64> {
 /// cloud on adapted_topic (default cloud_topic + "/adapted"), one
 /// profile@1 document per frame on profile_topic and a foxglove.SceneUpdate
 /// per frame on scene_topic (the options and rules of `gaze-lidar replay`;
-/// out_path is replaced only when the replay succeeds). Returns the
-/// counters (messages, clouds, points_in, points_kept, frames, …).
+/// out_path is replaced only when the replay succeeds; input messages keep
+/// their sequence numbers, attachments and metadata are copied). Returns
+/// the counters (messages, clouds, points_in, points_kept, attachments,
+/// metadata, frames, …).
 ///
 /// Raises ValueError for a bad option or a bad bag (truncated, corrupt,
 /// wrong topic type: the message names the byte offset or the field),
@@ -105,10 +117,13 @@ pub fn replay<'py>(
                 let bins = usize::try_from(bins)
                     .ok()
                     .filter(|b| {
-                        (gaze_lidar::model::angle::MIN_BINS..=gaze_lidar::model::angle::MAX_BINS)
-                            .contains(b)
+                        (gaze_lidar::model::angle::MIN_BINS..=MAX_REPLAY_BINS).contains(b)
                     })
-                    .ok_or_else(|| value_error(format!("bins: {bins} must lie in [4, 36000]")))?;
+                    .ok_or_else(|| {
+                        value_error(format!(
+                            "bins: {bins} must lie in [4, {MAX_REPLAY_BINS}] for replay (each frame's profile is written to the output, ~240 bytes per bin)"
+                        ))
+                    })?;
                 let preset = preset_of(preset)?;
                 closed_form(&preset, mode, Some(0.0), bins).map_err(|e| plan_error(py, e))?;
                 let rated = preset.lidar.rated_range_m;
@@ -143,7 +158,9 @@ pub fn replay<'py>(
             },
             stream: StreamConfig { max_gap_frames },
         };
-        if !(reorder_window_ms.is_finite() && (0.0..=60_000.0).contains(&reorder_window_ms)) {
+        if !(gaze_lidar::model::valid::finite(reorder_window_ms).is_ok()
+            && (0.0..=60_000.0).contains(&reorder_window_ms))
+        {
             return Err(value_error(format!(
                 "reorder_window_ms: {reorder_window_ms} must lie in 0..=60000"
             )));
@@ -180,6 +197,7 @@ pub fn replay<'py>(
                 )))
             }
         };
+        opts.validate().map_err(|e| replay_error(py, e))?;
         let stats = detached(py, || {
             replay_file(&in_path, &out_path, planner, pipeline, &opts)
         })?
@@ -193,6 +211,8 @@ pub fn replay<'py>(
         d.set_item("late_gaze", stats.late_gaze)?;
         d.set_item("clouds_without_tf", stats.clouds_without_tf)?;
         d.set_item("transforms", stats.transforms)?;
+        d.set_item("attachments", stats.attachments)?;
+        d.set_item("metadata", stats.metadata)?;
         let s = stats.stream;
         d.set_item("samples", s.samples)?;
         d.set_item("invalid", s.invalid)?;

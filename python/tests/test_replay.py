@@ -267,7 +267,7 @@ def test_the_binding_writes_what_the_cli_writes(repo: pathlib.Path, tmp_path: pa
         gl.replay(bag, tmp_path / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD,
                   compression="gzip")  # type: ignore[arg-type]
     (tmp_path / "cut.mcap").write_bytes(bag.read_bytes()[:5000])
-    with pytest.raises(ValueError, match="at byte 5000"):
+    with pytest.raises(ValueError, match=r"at byte \d+: .*truncated after 5000 bytes"):
         gl.replay(tmp_path / "cut.mcap", tmp_path / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD)
     assert not (tmp_path / "x.mcap").exists()
 
@@ -300,3 +300,65 @@ def test_many_bags_in_parallel_are_byte_identical_to_one_by_one(
         stats = run(bags, out, workers=2, **options)
         assert sorted(stats) == sorted(str(b) for b in bags)
         assert {p.name: p.read_bytes() for p in out.iterdir()} == want, name
+
+
+def test_the_binding_checks_options_by_keyword_before_reading(tmp_path: pathlib.Path) -> None:
+    cut = tmp_path / "cut.mcap"
+    write_fixture(cut)
+    cut.write_bytes(cut.read_bytes()[:5000])
+    out = tmp_path / "x.mcap"
+    cases: list[tuple[str, Any]] = [
+        ("fog_mor_m", 5e-324), ("cloud_spin_rad_s", 5e-324), ("sensor_yaw_deg", 5e-324),
+        ("rated_range_m", 5e-324), ("max_mount_tilt_deg", 5e-324),
+        ("reorder_window_ms", 5e-324), ("cloud_spin_rad_s", 0.0), ("fog_mor_m", -1.0),
+        ("bins", 36000), ("scene_topic", "/gaze_lidar/profile"), ("adapted_topic", GAZE),
+    ]
+    for key, value in cases:
+        with pytest.raises(ValueError, match=rf"^{key}: "):
+            gl.replay(cut, out, gaze_topic=GAZE, cloud_topic=CLOUD, **{key: value})
+    with pytest.raises(ValueError, match=r"^out_path: "):
+        gl.replay(cut, tmp_path / "no" / "such" / "x.mcap", gaze_topic=GAZE, cloud_topic=CLOUD)
+    assert not out.exists()
+
+
+def test_attachments_metadata_and_sequences_of_an_independent_bag_are_copied(
+        tmp_path: pathlib.Path) -> None:
+    bag, out = tmp_path / "drive.mcap", tmp_path / "out.mcap"
+    write_fixture(bag)
+    # The same messages rewritten with an attachment and a metadata record,
+    # by the independent writer.
+    rich = tmp_path / "rich.mcap"
+    with open(bag, "rb") as f, open(rich, "wb") as g:
+        reader = mcap_reader.make_reader(f)
+        w = mcap_writer.Writer(g)
+        w.start(profile="ros2", library="test")
+        w.add_attachment(create_time=T0, log_time=T0, name="calibration.yaml",
+                         media_type="application/yaml", data=b"lidar: {yaw: 0}\n")
+        w.add_metadata(name="rosbag2", data={"vehicle": "car 7"})
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        sequences: list[tuple[str, int, int]] = []
+        for schema, channel, message in reader.iter_messages():
+            if schema is not None and schema.id not in schemas:
+                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
+            if channel.id not in channels:
+                channels[channel.id] = w.register_channel(
+                    channel.topic, channel.message_encoding,
+                    schemas.get(channel.schema_id, 0), channel.metadata)
+            seq = 1000 + 3 * len(sequences)
+            sequences.append((channel.topic, message.log_time, seq))
+            w.add_message(channels[channel.id], message.log_time, message.data,
+                          message.publish_time, seq)
+        w.finish()
+    stats = gl.replay(rich, out, gaze_topic=GAZE, cloud_topic=CLOUD)
+    assert stats["attachments"] == 1 and stats["metadata"] == 1
+    with open(out, "rb") as f:
+        reader = mcap_reader.make_reader(f)
+        attachments = list(reader.iter_attachments())
+        metadata = list(reader.iter_metadata())
+        got = sorted((c.topic, m.log_time, m.sequence) for _, c, m in reader.iter_messages()
+                     if c.topic in (GAZE, CLOUD, OTHER))
+    assert [(a.name, a.media_type, a.data) for a in attachments] == [
+        ("calibration.yaml", "application/yaml", b"lidar: {yaw: 0}\n")]
+    assert [(m.name, m.metadata) for m in metadata] == [("rosbag2", {"vehicle": "car 7"})]
+    assert got == sorted(sequences)

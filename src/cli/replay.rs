@@ -8,10 +8,12 @@
 
 use std::path::PathBuf;
 
-use gaze_lidar::replay::{replay_file, Compression, GazeKind, ReplayError, ReplayOptions};
+use gaze_lidar::replay::{
+    replay_file_staged, replay_file_to, Compression, GazeKind, ReplayError, ReplayOptions, Staging,
+};
 use gaze_lidar::sim::returns::ModelKind;
 
-use super::args::finite_between;
+use super::args::{finite, finite_between};
 use super::gaze_args::{FilterArgs, PlanArgs};
 use super::CliError;
 
@@ -42,7 +44,8 @@ pub struct Args {
     /// Cloud topic: sensor_msgs/msg/PointCloud2 (x, y, z FLOAT32 or FLOAT64).
     #[arg(long)]
     cloud_topic: String,
-    /// Output MCAP (replaced only when the replay succeeds).
+    /// Output MCAP (replaced only when the replay succeeds); `-`: stdout
+    /// (the whole file, written once the replay succeeded).
     #[arg(long)]
     out: PathBuf,
     #[command(flatten)]
@@ -101,7 +104,17 @@ pub struct Args {
     compression: CompressionArg,
 }
 
+/// Most bins of a replayed profile: each frame's profile@1 document is
+/// written to the output (about 240 bytes of JSON per bin: 1440 bins are
+/// some 340 KB per frame, 3.4 MB/s at 10 Hz, already more than the
+/// adapted clouds of a 32-channel sensor); the optimizer's limit too.
+pub const MAX_REPLAY_BINS: i64 = 1440;
+
 fn replay_error(e: ReplayError) -> CliError {
+    // An option is named by its flag.
+    if let ReplayError::Config { field, reason } = &e {
+        return CliError::input(format!("--{}: {reason}", field.replace('_', "-")));
+    }
     if e.is_input_error() {
         CliError::input(e.to_string())
     } else {
@@ -109,20 +122,43 @@ fn replay_error(e: ReplayError) -> CliError {
     }
 }
 
+/// On SIGINT or SIGTERM, a thread removes the temporary output file named
+/// in the returned [`Staging`] (if any) and exits 128 + the signal (130,
+/// 143), as a shell reports a process the signal ended. (Devices, FIFOs and
+/// stdout are staged in an anonymous temporary file, which the system
+/// removes with the process.)
+fn remove_on_signal() -> Result<&'static Staging, CliError> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    static STAGING: Staging = std::sync::Mutex::new(None);
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
+        .map_err(|e| CliError::output(format!("installing the signal handler: {e}")))?;
+    std::thread::spawn(move || {
+        if let Some(sig) = signals.forever().next() {
+            let staged = STAGING
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            if let Some(path) = staged.as_ref() {
+                let _ = std::fs::remove_file(path);
+            }
+            std::process::exit(128 + sig);
+        }
+    });
+    Ok(&STAGING)
+}
+
 pub fn run(a: &Args) -> Result<u8, CliError> {
     let pipeline = a.filter.settings()?;
-    if !(a.reorder_window_ms.is_finite() && (0.0..=60_000.0).contains(&a.reorder_window_ms)) {
+    let window_ms = finite("--reorder-window-ms", a.reorder_window_ms)?;
+    if !(0.0..=60_000.0).contains(&window_ms) {
         return Err(CliError::input(format!(
-            "--reorder-window-ms: {} must lie in 0..=60000",
-            a.reorder_window_ms
+            "--reorder-window-ms: {window_ms} must lie in 0..=60000"
         )));
     }
-    if let Some(y) = a.sensor_yaw_deg.filter(|y| !y.is_finite()) {
+    if let Some(b) = a.plan.bins.filter(|&b| b > MAX_REPLAY_BINS) {
         return Err(CliError::input(format!(
-            "--sensor-yaw-deg: {y} is not a finite angle"
+            "--bins: {b} is more than replay's {MAX_REPLAY_BINS} (each frame's profile is written to the output, ~240 bytes per bin)"
         )));
     }
-    let max_tilt = finite_between("--max-mount-tilt-deg", a.max_mount_tilt_deg, 0.0, 90.0)?;
     let (planner, preset_range_m) = a.plan.planner()?;
     let rated_range_m = match a.rated_range_m {
         Some(r) => finite_between("--rated-range-m", r, 0.0, 1e7)?,
@@ -140,12 +176,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     opts.sensor_yaw_deg = a.sensor_yaw_deg;
     opts.vehicle_frame.clone_from(&a.vehicle_frame);
     opts.tf_topic.clone_from(&a.tf_topic);
-    opts.max_mount_tilt_deg = max_tilt;
+    opts.max_mount_tilt_deg = a.max_mount_tilt_deg;
     opts.cloud.model = a.model;
     opts.cloud.fog_mor_m = a.fog_mor_m;
     opts.cloud.seed = a.seed;
     opts.cloud.cloud_spin_rad_s = a.cloud_spin_rad_s;
-    opts.reorder_window_ns = (a.reorder_window_ms * 1e6).round() as u64;
+    opts.reorder_window_ns = (window_ms * 1e6).round() as u64;
     opts.compression = match a.compression {
         CompressionArg::None => Compression::None,
         CompressionArg::Lz4 => Compression::Lz4,
@@ -160,7 +196,15 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             )));
         }
     }
-    let stats = replay_file(&a.input, &a.out, planner, pipeline, &opts).map_err(replay_error)?;
+    // Every option checked before anything is read.
+    opts.validate().map_err(replay_error)?;
+    let stats = if a.out.as_os_str() == "-" {
+        replay_file_to(&a.input, std::io::stdout().lock(), planner, pipeline, &opts)
+    } else {
+        let staging = remove_on_signal()?;
+        replay_file_staged(&a.input, &a.out, planner, pipeline, &opts, staging)
+    }
+    .map_err(replay_error)?;
     let s = stats.stream;
     if s.samples == 0 {
         super::io::warn(format!(

@@ -425,6 +425,36 @@ impl<'a> PointCloud2<'a> {
             }
             offsets[k] = (f.offset as usize, wide);
         }
+        // An ambiguous layout is refused: a name given twice, or x, y, z
+        // sharing bytes with each other or with another field.
+        for axis in ["x", "y", "z"] {
+            if self.fields.iter().filter(|f| f.name == axis).count() > 1 {
+                return Err(bad(
+                    "fields",
+                    format!("field {axis} is given more than once (ambiguous layout)"),
+                ));
+            }
+        }
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let (o, wide) = offsets[k];
+            let end = o + if wide { 8 } else { 4 };
+            for f in &self.fields {
+                if f.name == *axis {
+                    continue;
+                }
+                let size = datatype::size(f.datatype).unwrap_or(1) as u64;
+                let f_end = u64::from(f.offset) + size * u64::from(f.count.max(1));
+                if u64::from(f.offset) < end as u64 && (o as u64) < f_end {
+                    return Err(bad(
+                        "fields",
+                        format!(
+                            "field {axis} (bytes {o}..{end}) overlaps field {} (bytes {}..{f_end}) (ambiguous layout)",
+                            f.name, f.offset
+                        ),
+                    ));
+                }
+            }
+        }
         let step = self.point_step as usize;
         let row = self.row_step as usize;
         let width = self.width as usize;
@@ -559,6 +589,20 @@ impl XyzLayout {
         }
     }
 
+    /// x, y, z of every point, row-major (as [`XyzLayout::point`] numbers
+    /// them), decoded as they are read: nothing is allocated.
+    #[must_use]
+    pub fn points<'d>(&'d self, data: &'d [u8]) -> Points<'d> {
+        Points {
+            layout: self,
+            data,
+            f32_le: !self.big && self.offsets.iter().all(|&(_, wide)| !wide),
+            at: 0,
+            col: 0,
+            left: self.len(),
+        }
+    }
+
     /// Byte ranges in `data` of the points `keep` marks, consecutive ones
     /// in a row merged (so a subset is copied in a few long pieces).
     #[must_use]
@@ -583,6 +627,55 @@ impl XyzLayout {
         out
     }
 }
+
+/// The points of a cloud, decoded one by one ([`XyzLayout::points`]).
+#[derive(Debug, Clone)]
+pub struct Points<'d> {
+    layout: &'d XyzLayout,
+    data: &'d [u8],
+    f32_le: bool,
+    /// Byte offset of the next point.
+    at: usize,
+    /// Its column.
+    col: usize,
+    /// Points not yet returned.
+    left: usize,
+}
+
+impl Iterator for Points<'_> {
+    type Item = [f64; 3];
+
+    #[inline]
+    fn next(&mut self) -> Option<[f64; 3]> {
+        let l = self.layout;
+        if self.left == 0 {
+            return None;
+        }
+        self.left -= 1;
+        let p = &self.data[self.at..self.at + l.step];
+        self.col += 1;
+        if self.col == l.width {
+            // The next row starts `row` bytes after this row's start.
+            self.at += l.step + l.row - l.width * l.step;
+            self.col = 0;
+        } else {
+            self.at += l.step;
+        }
+        Some(if self.f32_le {
+            let f =
+                |o: usize| f64::from(f32::from_le_bytes(p[o..o + 4].try_into().unwrap_or([0; 4])));
+            [f(l.offsets[0].0), f(l.offsets[1].0), f(l.offsets[2].0)]
+        } else {
+            l.xyz(p)
+        })
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.left, Some(self.left))
+    }
+}
+
+impl ExactSizeIterator for Points<'_> {}
 
 /// Encodes a `PointCloud2` of `kept` points (one row) taken from `src`'s
 /// data in order: same header, fields, byte order and point step.

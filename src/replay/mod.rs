@@ -25,8 +25,10 @@
 //!   [`ReplayOptions::sensor_yaw_deg`] when given, else the static
 //!   transforms read so far on `/tf_static` ([`tf`]), else none). Non-finite points (allowed when `is_dense` is false) are
 //!   never returned and are not passed to the rule. The `k`-th cloud (from
-//!   0) is thinned with seed `seed + k` (wrapping).
-//! - every message is copied to the output unchanged, on its own topic.
+//!   0, in the order written: `log_time`) is thinned with seed `seed + k`
+//!   (wrapping).
+//! - every message is copied to the output unchanged, on its own topic,
+//!   with its sequence number; attachments and metadata records too.
 //!
 //! The output adds, with their schemas embedded: the adapted cloud (the kept
 //! points' bytes, same header, fields and point step, one row) on
@@ -46,7 +48,7 @@ use std::collections::{BTreeMap, BinaryHeap, HashMap, VecDeque};
 use std::io::{Read, Seek, Write};
 
 use mcap::records::MessageHeader;
-use mcap::sans_io::{LinearReaderOptions, MessageReadEvent, MessageReader};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
@@ -142,6 +144,9 @@ pub enum GazeKind {
     YawDeg,
 }
 
+/// The zstd level of [`Compression::Zstd`] output.
+pub const ZSTD_LEVEL: u32 = 1;
+
 /// Output compression of the MCAP chunks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Compression {
@@ -149,7 +154,7 @@ pub enum Compression {
     None,
     /// LZ4.
     Lz4,
-    /// Zstandard.
+    /// Zstandard, level [`ZSTD_LEVEL`].
     Zstd,
 }
 
@@ -189,9 +194,12 @@ pub struct ReplayOptions {
     /// are ISO 8855, REP 103).
     pub cloud: CloudOptions,
     /// Messages are processed in `log_time` order once they are this much
-    /// older than the newest message read, ns; a message later than that is
-    /// processed late (a late gaze sample is dropped, a late cloud gets the
-    /// profile of the frame it fell in, or the baseline).
+    /// older than the window's clock, ns: the second-newest of the topics'
+    /// newest `log_time`s, so one far-future stamp does not move it (and
+    /// at most 96 MiB are held, each message counted with its
+    /// bookkeeping). A message later than that is processed late (a late
+    /// gaze sample is dropped, a late cloud gets the profile of the frame
+    /// it fell in, or the baseline).
     pub reorder_window_ns: u64,
     /// Output compression.
     pub compression: Compression,
@@ -248,6 +256,10 @@ pub struct ReplayStats {
     pub clouds_without_tf: u64,
     /// Static transforms read.
     pub transforms: u64,
+    /// Attachments copied.
+    pub attachments: u64,
+    /// Metadata records copied.
+    pub metadata: u64,
     /// The gaze pipeline's counters.
     pub stream: StreamStats,
 }
@@ -278,9 +290,111 @@ impl Ord for Pending {
     }
 }
 
-/// Most bytes of message data held in the reorder window; past this the
-/// oldest message is processed whatever its age (memory stays bounded).
+/// Most bytes held in the reorder window, each message counted as its
+/// data plus [`HELD_OVERHEAD_BYTES`]; past this the oldest message is
+/// processed whatever its age (memory stays bounded, however small the
+/// messages).
 const MAX_WINDOW_BYTES: usize = 96 << 20;
+
+/// What one held message costs besides its data, bytes: its entry in the
+/// heap (twice over: the heap's vector grows by doubling) and the data's
+/// allocation header, rounded up.
+const HELD_OVERHEAD_BYTES: usize = 2 * std::mem::size_of::<Pending>() + 32;
+
+/// The file's magic, bytes.
+const MAGIC_BYTES: u64 = 8;
+
+/// A record's opcode and length, bytes.
+const RECORD_HEAD_BYTES: u64 = 9;
+
+/// The reorder window: messages wait in a heap ordered by (`log_time`,
+/// order read) and leave it, oldest first, once they are more than the
+/// window older than the release clock, or when the held bytes pass
+/// [`MAX_WINDOW_BYTES`].
+///
+/// The release clock is the second-newest of the topics' newest
+/// `log_time`s (the newest when a single topic has been read): a topic
+/// whose clock runs ahead, or one far-future stamp on any topic, does not
+/// move it, so it cannot turn the window off for the others.
+struct Window {
+    heap: BinaryHeap<Pending>,
+    window_ns: u64,
+    held_bytes: usize,
+    seq: u64,
+    /// Newest `log_time` per channel.
+    newest: HashMap<u16, u64>,
+    /// The newest of those and its channel; the newest of the others.
+    first: Option<(u64, u16)>,
+    second: u64,
+}
+
+impl Window {
+    fn new(window_ns: u64) -> Self {
+        Self {
+            heap: BinaryHeap::new(),
+            window_ns,
+            held_bytes: 0,
+            seq: 0,
+            newest: HashMap::new(),
+            first: None,
+            second: 0,
+        }
+    }
+
+    fn cost(msg: &mcap::Message<'_>) -> usize {
+        msg.data.len() + HELD_OVERHEAD_BYTES
+    }
+
+    fn push(&mut self, msg: mcap::Message<'static>) {
+        let (ch, t) = (msg.channel.id, msg.log_time);
+        let slot = self.newest.entry(ch).or_insert(t);
+        *slot = (*slot).max(t);
+        let t_ch = *slot;
+        match self.first {
+            None => self.first = Some((t_ch, ch)),
+            Some((_, c)) if c == ch => self.first = Some((t_ch, ch)),
+            Some((f, _)) if t_ch > f => {
+                self.second = f;
+                self.first = Some((t_ch, ch));
+            }
+            Some(_) => self.second = self.second.max(t_ch),
+        }
+        self.held_bytes += Self::cost(&msg);
+        self.heap.push(Pending {
+            log_time: t,
+            seq: self.seq,
+            msg,
+        });
+        self.seq += 1;
+    }
+
+    /// The release clock (see the type's documentation).
+    fn clock(&self) -> u64 {
+        if self.newest.len() < 2 {
+            self.first.map_or(0, |f| f.0)
+        } else {
+            self.second
+        }
+    }
+
+    /// The oldest message, if it is due.
+    fn pop_due(&mut self) -> Option<Pending> {
+        let top = self.heap.peek()?;
+        let old = self.clock().saturating_sub(top.log_time) > self.window_ns;
+        if old || self.held_bytes > MAX_WINDOW_BYTES {
+            self.pop()
+        } else {
+            None
+        }
+    }
+
+    /// The oldest message.
+    fn pop(&mut self) -> Option<Pending> {
+        let p = self.heap.pop()?;
+        self.held_bytes -= Self::cost(&p.msg);
+        Some(p)
+    }
+}
 
 /// Frames remembered for clouds that arrive late.
 const FRAME_HISTORY: usize = 64;
@@ -291,6 +405,28 @@ const MAX_RECORD_BYTES: usize = 256 << 20;
 
 /// Input bytes read per call.
 const READ_BYTES: usize = 1 << 20;
+
+/// An iterator of a known length (the finite points of a cloud).
+struct Counted<I> {
+    inner: I,
+    left: usize,
+}
+
+impl<I: Iterator> Iterator for Counted<I> {
+    type Item = I::Item;
+
+    fn next(&mut self) -> Option<I::Item> {
+        let v = self.inner.next()?;
+        self.left = self.left.saturating_sub(1);
+        Some(v)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.left, Some(self.left))
+    }
+}
+
+impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
 /// Gaze azimuth (degrees, `[0, 360)`) of a direction vector in the vehicle
 /// frame; `None` when its horizontal part is zero or not finite.
@@ -314,9 +450,22 @@ struct Out<W: Write + Seek> {
 }
 
 impl<W: Write + Seek> Out<W> {
-    fn channel_for(&mut self, ch: &mcap::Channel<'_>) -> Result<u16, ReplayError> {
+    fn channel_for(
+        &mut self,
+        ch: &mcap::Channel<'_>,
+        opts: &ReplayOptions,
+    ) -> Result<u16, ReplayError> {
         if let Some(&id) = self.channels.get(&ch.id) {
             return Ok(id);
+        }
+        if let Some(field) = opts.output_field(&ch.topic) {
+            return Err(config(
+                field,
+                format!(
+                    "{:?} is also a topic of the input bag: the output would hold two channels of it (replaying a replay's output needs new output topics)",
+                    ch.topic
+                ),
+            ));
         }
         let schema_id = match &ch.schema {
             None => 0,
@@ -340,6 +489,7 @@ impl<W: Write + Seek> Out<W> {
         Ok(id)
     }
 
+    /// A message on a channel this replay adds, numbered 1, 2, … per channel.
     fn write(
         &mut self,
         channel_id: u16,
@@ -349,11 +499,25 @@ impl<W: Write + Seek> Out<W> {
     ) -> Result<(), ReplayError> {
         let seq = self.sequences.entry(channel_id).or_insert(0);
         *seq = seq.wrapping_add(1);
+        let sequence = *seq;
+        self.write_as(channel_id, sequence, log_time, publish_time, data)
+    }
+
+    /// A message with its own sequence number (a copied one keeps the
+    /// input's).
+    fn write_as(
+        &mut self,
+        channel_id: u16,
+        sequence: u32,
+        log_time: u64,
+        publish_time: u64,
+        data: &[u8],
+    ) -> Result<(), ReplayError> {
         self.mcap
             .write_to_known_channel(
                 &MessageHeader {
                     channel_id,
-                    sequence: *seq,
+                    sequence,
                     log_time,
                     publish_time,
                 },
@@ -369,7 +533,10 @@ struct Replayer<'o, P: FramePlanner, W: Write + Seek> {
     stream: GazeStream<P>,
     baseline: CertifiedProfile,
     out: Out<W>,
-    /// `log_time` of the first message processed: the gaze clock's zero.
+    /// `log_time` of the first gaze or cloud message processed: the gaze
+    /// clock's zero (the frame times, seconds since it, stay small, so the
+    /// stamps written back are exact to the nanosecond even when another
+    /// topic starts at `log_time` 0).
     t0_ns: Option<u64>,
     /// Newest `log_time` processed (the frame clock is never run backwards).
     now_ns: u64,
@@ -382,8 +549,6 @@ struct Replayer<'o, P: FramePlanner, W: Write + Seek> {
     tf: tf::TfTree,
     /// The mounting yaw of the last cloud, degrees (for the picture).
     yaw_deg: f64,
-    /// The last cloud's points (kept to reuse the allocation).
-    xyz_buf: Vec<[f64; 3]>,
 }
 
 impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
@@ -422,11 +587,18 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
 
     fn process(&mut self, p: Pending) -> Result<(), ReplayError> {
         self.stats.messages += 1;
-        self.t0_ns.get_or_insert(p.log_time);
-        let ch_id = self.out.channel_for(&p.msg.channel)?;
-        self.out
-            .write(ch_id, p.msg.log_time, p.msg.publish_time, &p.msg.data)?;
         let topic = p.msg.channel.topic.as_str();
+        if topic == self.opts.gaze_topic || topic == self.opts.cloud_topic {
+            self.t0_ns.get_or_insert(p.log_time);
+        }
+        let ch_id = self.out.channel_for(&p.msg.channel, self.opts)?;
+        self.out.write_as(
+            ch_id,
+            p.msg.sequence,
+            p.msg.log_time,
+            p.msg.publish_time,
+            &p.msg.data,
+        )?;
         let late = p.log_time < self.now_ns;
         if topic == self.opts.gaze_topic {
             let sample = self.gaze_sample(&p).map_err(|e| in_message(e, topic, &p))?;
@@ -569,9 +741,6 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
             }
         };
         let n = layout.len();
-        let mut xyz = std::mem::take(&mut self.xyz_buf);
-        xyz.clear();
-        layout.decode_all(cloud.data, &mut xyz);
         let turn = |[x, y, z]: [f64; 3]| match yaw {
             None => [x, y, z],
             Some((c, s)) => [c * x - s * y, s * x + c * y, z],
@@ -580,20 +749,28 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         let mut opts = self.opts.cloud.clone();
         opts.frame = CloudFrame::Iso8855;
         opts.seed = opts.seed.wrapping_add(self.stats.clouds);
-        let keep = if xyz.iter().all(finite) {
+        // The points are decoded as the rule reads them (no copy of the
+        // cloud: memory is the message, one byte per point and the output).
+        let points = || layout.points(cloud.data);
+        let finite_n = points().filter(finite).count();
+        let keep = if finite_n == n {
             // Every point (a dense cloud): the mask is the rule's.
-            keep_mask(&profile, xyz.iter().map(|&p| turn(p)), &opts)?
+            keep_mask(&profile, points().map(turn), &opts)?
         } else {
             // Non-finite points are never returned and not passed to the rule.
-            let index: Vec<usize> = (0..n).filter(|&i| finite(&xyz[i])).collect();
-            let mask = keep_mask(&profile, index.iter().map(|&i| turn(xyz[i])), &opts)?;
-            let mut keep = vec![false; n];
-            for (&i, &k) in index.iter().zip(&mask) {
-                keep[i] = k;
-            }
-            keep
+            let mask = keep_mask(
+                &profile,
+                Counted {
+                    inner: points().filter(finite).map(turn),
+                    left: finite_n,
+                },
+                &opts,
+            )?;
+            let mut rule = mask.into_iter();
+            points()
+                .map(|p| finite(&p) && rule.next().unwrap_or(false))
+                .collect()
         };
-        self.xyz_buf = xyz;
         let kept = keep.iter().filter(|&&k| k).count() as u64;
         let data = cdr::encode_subset(&cloud, &layout, &keep, true);
         let adapted = match self.out.adapted {
@@ -630,7 +807,142 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
     }
 }
 
+/// Largest `--reorder-window-ms`, ns.
+pub const MAX_REORDER_WINDOW_NS: u64 = 60_000_000_000;
+
+fn config(field: &'static str, reason: impl Into<String>) -> ReplayError {
+    ReplayError::Config {
+        field,
+        reason: reason.into(),
+    }
+}
+
+/// `v` passes the one numeric boundary ([`crate::model::valid::finite`]:
+/// finite, zero or normal) and lies in `lo..=hi`.
+fn in_range(field: &'static str, v: f64, lo: f64, hi: f64) -> Result<f64, ReplayError> {
+    if crate::model::valid::finite(v).is_ok() && (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(config(
+            field,
+            format!(
+                "{} must be finite (not subnormal) and lie in {}..={}",
+                crate::text::Num(v),
+                crate::text::Num(lo),
+                crate::text::Num(hi)
+            ),
+        ))
+    }
+}
+
+/// `v` is normal (finite, not subnormal), `> 0` and `<= hi`.
+fn positive_to(field: &'static str, v: f64, hi: f64) -> Result<f64, ReplayError> {
+    if crate::model::valid::positive(v).is_ok() && v <= hi {
+        Ok(v)
+    } else {
+        Err(config(
+            field,
+            format!(
+                "{} must be finite (not subnormal), > 0 and <= {}",
+                crate::text::Num(v),
+                crate::text::Num(hi)
+            ),
+        ))
+    }
+}
+
 impl ReplayOptions {
+    /// Checks every option before anything is read, naming it by its
+    /// field (the Python keyword; the CLI's flag is `--` and the field with
+    /// `-` for `_`): angles finite and not subnormal (the mounting yaw
+    /// within ±360°, the tilt tolerance 0..=90°), the rated range, fog MOR
+    /// (m, `<= 1e7`) and the cloud spin (rad/s, `<= 1e4`) normal and
+    /// positive, the reorder window at most 60 s, the topics non-empty and
+    /// the three output topics distinct from each other and from the gaze,
+    /// cloud and transform topics. An input channel on an output topic is
+    /// refused when it is met ([`replay`]).
+    pub fn validate(&self) -> Result<(), ReplayError> {
+        if let Some(y) = self.sensor_yaw_deg {
+            in_range("sensor_yaw_deg", y, -360.0, 360.0)?;
+        }
+        in_range("max_mount_tilt_deg", self.max_mount_tilt_deg, 0.0, 90.0)?;
+        if self.vehicle_frame.is_empty() {
+            return Err(config("vehicle_frame", "must not be empty"));
+        }
+        positive_to("rated_range_m", self.cloud.rated_range_m, 1e7)?;
+        if let Some(m) = self.cloud.fog_mor_m {
+            positive_to("fog_mor_m", m, 1e7)?;
+        }
+        if let Some(w) = self.cloud.cloud_spin_rad_s {
+            positive_to("cloud_spin_rad_s", w, 1e4)?;
+        }
+        if self.reorder_window_ns > MAX_REORDER_WINDOW_NS {
+            return Err(config(
+                "reorder_window_ms",
+                format!("{} ns is longer than 60 s", self.reorder_window_ns),
+            ));
+        }
+        for (field, t) in [
+            ("gaze_topic", &self.gaze_topic),
+            ("cloud_topic", &self.cloud_topic),
+            ("tf_topic", &self.tf_topic),
+        ] {
+            if t.is_empty() {
+                return Err(config(field, "must not be empty"));
+            }
+        }
+        if self.gaze_topic == self.cloud_topic {
+            return Err(config(
+                "cloud_topic",
+                format!("{:?} is also the gaze topic", self.cloud_topic),
+            ));
+        }
+        let outputs = [
+            ("adapted_topic", &self.adapted_topic),
+            ("profile_topic", &self.profile_topic),
+            ("scene_topic", &self.scene_topic),
+        ];
+        for (k, (field, t)) in outputs.iter().enumerate() {
+            if t.is_empty() {
+                return Err(config(field, "must not be empty"));
+            }
+            for (name, input) in [
+                ("gaze topic", &self.gaze_topic),
+                ("cloud topic", &self.cloud_topic),
+                ("transform topic", &self.tf_topic),
+            ] {
+                if *t == input {
+                    return Err(config(
+                        field,
+                        format!("{t:?} is the {name}: an output topic must be new"),
+                    ));
+                }
+            }
+            if let Some((other, _)) = outputs[..k].iter().find(|(_, o)| o == t) {
+                return Err(config(
+                    field,
+                    format!(
+                        "{t:?} is also the {}: each output needs its own topic",
+                        other.replace('_', " ")
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The output option naming `topic`, if any.
+    fn output_field(&self, topic: &str) -> Option<&'static str> {
+        [
+            ("adapted_topic", &self.adapted_topic),
+            ("profile_topic", &self.profile_topic),
+            ("scene_topic", &self.scene_topic),
+        ]
+        .into_iter()
+        .find(|(_, t)| *t == topic)
+        .map(|(f, _)| f)
+    }
+
     fn gaze_kind_schema(&self) -> &'static str {
         match self.gaze_kind {
             GazeKind::Vector3 => schemas::VECTOR3_STAMPED,
@@ -689,38 +1001,18 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     pipeline: PipelineConfig,
     opts: &ReplayOptions,
 ) -> Result<ReplayStats, ReplayError> {
-    if let Some(y) = opts.sensor_yaw_deg.filter(|y| !y.is_finite()) {
-        return Err(ReplayError::Config {
-            field: "sensor_yaw_deg",
-            reason: format!("{y} is not a finite angle"),
-        });
-    }
-    if !(opts.max_mount_tilt_deg.is_finite() && (0.0..=90.0).contains(&opts.max_mount_tilt_deg)) {
-        return Err(ReplayError::Config {
-            field: "max_mount_tilt_deg",
-            reason: format!("{} must lie in 0..=90", opts.max_mount_tilt_deg),
-        });
-    }
-    if opts.vehicle_frame.is_empty() {
-        return Err(ReplayError::Config {
-            field: "vehicle_frame",
-            reason: "must not be empty".to_owned(),
-        });
-    }
-    for (field, t) in [
-        ("adapted_topic", &opts.adapted_topic),
-        ("profile_topic", &opts.profile_topic),
-        ("scene_topic", &opts.scene_topic),
-    ] {
-        if t == &opts.gaze_topic || t == &opts.cloud_topic || t.is_empty() {
-            return Err(ReplayError::Config {
-                field,
-                reason: format!("{t:?} must be a new, non-empty topic"),
-            });
-        }
-    }
+    opts.validate()?;
     // Fail early on bad cloud options (rated range, fog, model).
-    crate::pointcloud::return_model(&opts.cloud)?;
+    crate::pointcloud::return_model(&opts.cloud).map_err(|c| {
+        config(
+            match c.field.as_str() {
+                "rated_range_m" => "rated_range_m",
+                "fog_mor_m" => "fog_mor_m",
+                _ => "model",
+            },
+            c.reason,
+        )
+    })?;
     let baseline = planner.plan(None)?;
     let stream =
         GazeStream::with_config(planner, pipeline.filter, pipeline.failsafe, pipeline.stream);
@@ -732,6 +1024,14 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     };
     let mut mcap = mcap::WriteOptions::new()
         .compression(compression)
+        // zstd at level 1, its fastest positive level (the default, 3, is
+        // about half as fast on point clouds; see the README for the size
+        // cost); LZ4 at its default.
+        .compression_level(if opts.compression == Compression::Zstd {
+            ZSTD_LEVEL
+        } else {
+            0
+        })
         // Single-threaded zstd: the same bytes on every machine.
         .compression_threads(0)
         .profile("ros2")
@@ -779,40 +1079,62 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
         stats: ReplayStats::default(),
         tf: tf::TfTree::default(),
         yaw_deg: opts.sensor_yaw_deg.unwrap_or(0.0),
-        xyz_buf: Vec::new(),
     };
-    // Every CRC checked (a chunk before any of its messages is used), and
-    // no record longer than `MAX_RECORD_BYTES` (a corrupt length must not
-    // allocate without bound).
-    let mut reader = MessageReader::new_with_options(
+    // Every CRC checked (a chunk's before any of its messages is used), no
+    // byte after the end magic, and no record longer than
+    // `MAX_RECORD_BYTES` (a corrupt length must not allocate without
+    // bound). Chunks are read whole and unpacked here, so every error is
+    // reported at the start of the top-level record it is in.
+    let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
-            .with_prevalidate_chunk_crcs(true)
+            .with_emit_chunks(true)
             .with_validate_data_section_crc(true)
             .with_validate_summary_section_crc(true)
+            .with_check_finishes_after_end_magic(true)
             .with_record_length_limit(MAX_RECORD_BYTES),
     );
-    let mut offset: u64 = 0;
-    let mut heap: BinaryHeap<Pending> = BinaryHeap::new();
-    let mut held_bytes = 0usize;
-    let mut newest = 0u64;
-    let mut seq = 0u64;
-    let mcap_err = |offset: u64, e: mcap::McapError| ReplayError::Mcap {
+    // Start of the next top-level record (after the 8-byte magic).
+    let mut next_record: u64 = MAGIC_BYTES;
+    let mut footer_end: Option<u64> = None;
+    let mut past_data_end = false;
+    let mut links = mcap::read::ChannelAccumulator::<'static>::default();
+    let mut window = Window::new(opts.reorder_window_ns);
+    let input_bytes = std::cell::Cell::new(0u64);
+    let mcap_err = |offset: u64, what: &str, e: mcap::McapError| {
+        ReplayError::Mcap {
         path: path.to_owned(),
         offset,
-        reason: match e {
-            mcap::McapError::UnexpectedEof => {
-                "the file ends inside a record (truncated)".to_owned()
+        reason: format!(
+            "{what}{}",
+            match e {
+                mcap::McapError::UnexpectedEof => format!(
+                    "the file ends inside this record (truncated after {} bytes)",
+                    input_bytes.get()
+                ),
+                mcap::McapError::UnsupportedCompression(c) => format!(
+                    "a chunk is compressed with `{c}`; replay reads uncompressed, lz4 and zstd chunks"
+                ),
+                mcap::McapError::BytesAfterEndMagic => {
+                    "data after the end magic (an MCAP file ends with its footer and the magic)"
+                        .to_owned()
+                }
+                e => e.to_string(),
             }
-            mcap::McapError::UnsupportedCompression(c) => format!(
-                "a chunk is compressed with `{c}`; replay reads uncompressed, lz4 and zstd chunks"
-            ),
-            e => e.to_string(),
-        },
+        ),
+    }
     };
     while let Some(event) = reader.next_event() {
-        match event.map_err(|e| mcap_err(offset, e))? {
-            MessageReadEvent::ReadRequest(_) => {
-                let buf = reader.insert(READ_BYTES);
+        let event = event.map_err(|e| {
+            let at = match (&e, footer_end) {
+                (mcap::McapError::BadMagic, _) if next_record == MAGIC_BYTES => 0,
+                (_, Some(end)) => end,
+                _ => next_record,
+            };
+            mcap_err(at, "", e)
+        })?;
+        match event {
+            LinearReadEvent::ReadRequest(want) => {
+                let buf = reader.insert(want.clamp(1, READ_BYTES));
                 let n = loop {
                     match input.read(buf) {
                         Ok(n) => break n,
@@ -825,31 +1147,98 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                         }
                     }
                 };
-                offset += n as u64;
+                input_bytes.set(input_bytes.get() + n as u64);
                 reader.notify_read(n);
             }
-            MessageReadEvent::Message(msg) => {
-                newest = newest.max(msg.log_time);
-                held_bytes += msg.data.len();
-                heap.push(Pending {
-                    log_time: msg.log_time,
-                    seq,
-                    msg,
-                });
-                seq += 1;
-                while let Some(top) = heap.peek() {
-                    let old = newest.saturating_sub(top.log_time) > opts.reorder_window_ns;
-                    if !(old || held_bytes > MAX_WINDOW_BYTES) {
-                        break;
+            LinearReadEvent::Record { opcode, data } => {
+                let at = next_record;
+                next_record += RECORD_HEAD_BYTES + data.len() as u64;
+                if opcode == mcap::records::op::FOOTER {
+                    // The end magic follows; anything after it is an error.
+                    footer_end = Some(next_record + MAGIC_BYTES);
+                }
+                let record = mcap::parse_record(opcode, data).map_err(|e| mcap_err(at, "", e))?;
+                if past_data_end {
+                    // The summary repeats schemas, channels and indexes.
+                    continue;
+                }
+                let records = match record {
+                    mcap::records::Record::DataEnd(_) => {
+                        past_data_end = true;
+                        continue;
                     }
-                    let p = heap.pop().expect("peeked");
-                    held_bytes -= p.msg.data.len();
-                    r.process(p)?;
+                    mcap::records::Record::Chunk { header, data } => {
+                        if header.uncompressed_size > MAX_RECORD_BYTES as u64 {
+                            return Err(mcap_err(
+                                at,
+                                "",
+                                mcap::McapError::ChunkTooLarge(header.uncompressed_size),
+                            ));
+                        }
+                        // Unpacked and its CRC checked before any of its
+                        // messages is used.
+                        mcap::read::ChunkReader::new(header, &data)
+                            .and_then(|c| {
+                                c.map(|r| r.map(mcap::records::Record::into_owned))
+                                    .collect::<Result<Vec<_>, _>>()
+                            })
+                            .map_err(|e| mcap_err(at, "in this chunk: ", e))?
+                    }
+                    other => vec![other.into_owned()],
+                };
+                for (k, record) in records.into_iter().enumerate() {
+                    let inside = |e| mcap_err(at, &format!("record {k} of this chunk: "), e);
+                    match record {
+                        mcap::records::Record::Schema { header, data } => {
+                            links
+                                .add_schema(header, std::borrow::Cow::Owned(data.into_owned()))
+                                .map_err(inside)?;
+                        }
+                        mcap::records::Record::Channel(c) => {
+                            links.add_channel(c).map_err(inside)?;
+                        }
+                        mcap::records::Record::Message { header, data } => {
+                            let Some(channel) = links.get(header.channel_id) else {
+                                return Err(inside(mcap::McapError::UnknownChannel(
+                                    header.sequence,
+                                    header.channel_id,
+                                )));
+                            };
+                            window.push(mcap::Message {
+                                channel,
+                                sequence: header.sequence,
+                                log_time: header.log_time,
+                                publish_time: header.publish_time,
+                                data: std::borrow::Cow::Owned(data.into_owned()),
+                            });
+                            while let Some(p) = window.pop_due() {
+                                r.process(p)?;
+                            }
+                        }
+                        mcap::records::Record::Attachment { header, data, .. } => {
+                            r.out
+                                .mcap
+                                .attach(&mcap::Attachment {
+                                    log_time: header.log_time,
+                                    create_time: header.create_time,
+                                    name: header.name,
+                                    media_type: header.media_type,
+                                    data,
+                                })
+                                .map_err(write_err)?;
+                            r.stats.attachments += 1;
+                        }
+                        mcap::records::Record::Metadata(m) => {
+                            r.out.mcap.write_metadata(&m).map_err(write_err)?;
+                            r.stats.metadata += 1;
+                        }
+                        _ => {}
+                    }
                 }
             }
         }
     }
-    while let Some(p) = heap.pop() {
+    while let Some(p) = window.pop() {
         r.process(p)?;
     }
     r.out.mcap.finish().map_err(write_err)?;
@@ -880,6 +1269,25 @@ pub fn replay_file<P: FramePlanner>(
     planner: P,
     pipeline: PipelineConfig,
     opts: &ReplayOptions,
+) -> Result<ReplayStats, ReplayError> {
+    replay_file_staged(input, output, planner, pipeline, opts, &Staging::default())
+}
+
+/// The path of the temporary file a [`replay_file_staged`] is writing, for
+/// a signal handler to remove: set while it exists, `None` otherwise; held
+/// locked while the file is renamed into place (a handler that takes the
+/// lock then finds `None` and must remove nothing).
+pub type Staging = std::sync::Mutex<Option<std::path::PathBuf>>;
+
+/// [`replay_file`], publishing its temporary file in `staging` (see
+/// [`Staging`]; `gaze-lidar replay` removes it on SIGINT and SIGTERM).
+pub fn replay_file_staged<P: FramePlanner>(
+    input: &std::path::Path,
+    output: &std::path::Path,
+    planner: P,
+    pipeline: PipelineConfig,
+    opts: &ReplayOptions,
+    staging: &Staging,
 ) -> Result<ReplayStats, ReplayError> {
     let origin = input.display().to_string();
     let out_err =
@@ -931,6 +1339,23 @@ pub fn replay_file<P: FramePlanner>(
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => std::path::PathBuf::from("."),
     };
+    // A folder that is missing or takes no new file is a bad --out (exit
+    // 2), found before the input is read.
+    match std::fs::metadata(&dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => {
+            return Err(refuse(&format!(
+                "in {}, which is not a folder",
+                dir.display()
+            )))
+        }
+        Err(e) => {
+            return Err(refuse(&format!(
+                "in the folder {}, which cannot be used: {e}",
+                dir.display()
+            )))
+        }
+    }
     let mut builder = tempfile::Builder::new();
     builder.prefix(".gaze-lidar-replay.");
     {
@@ -940,20 +1365,40 @@ pub fn replay_file<P: FramePlanner>(
             .unwrap_or(0o644);
         builder.permissions(std::fs::Permissions::from_mode(mode));
     }
-    let tmp = builder.tempfile_in(&dir).map_err(|e| out_err(&e))?;
-    let reader = std::io::BufReader::with_capacity(1 << 20, file);
-    let mut writer = std::io::BufWriter::with_capacity(1 << 20, tmp);
-    let stats = replay(reader, &origin, &mut writer, planner, pipeline, opts)?;
-    let tmp = writer.into_inner().map_err(|e| out_err(e.error()))?;
-    tmp.as_file().sync_all().map_err(|e| out_err(&e))?;
-    tmp.persist(output).map_err(|e| out_err(&e.error))?;
-    Ok(stats)
+    let tmp = builder.tempfile_in(&dir).map_err(|e| {
+        refuse(&format!(
+            "in the folder {}, which takes no new file: {e}",
+            dir.display()
+        ))
+    })?;
+    let set = |p: Option<std::path::PathBuf>| {
+        *staging
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) = p;
+    };
+    set(Some(tmp.path().to_path_buf()));
+    let written = (|| {
+        let reader = std::io::BufReader::with_capacity(1 << 20, file);
+        let mut writer = std::io::BufWriter::with_capacity(1 << 20, tmp);
+        let stats = replay(reader, &origin, &mut writer, planner, pipeline, opts)?;
+        let tmp = writer.into_inner().map_err(|e| out_err(e.error()))?;
+        tmp.as_file().sync_all().map_err(|e| out_err(&e))?;
+        Ok((stats, tmp))
+    })();
+    let mut staged = staging
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    // Renamed (or removed, on an error) with the lock held.
+    let result = written.and_then(|(stats, tmp)| {
+        tmp.persist(output).map_err(|e| out_err(&e.error))?;
+        Ok(stats)
+    });
+    *staged = None;
+    result
 }
 
 /// [`replay_file`] into a character device or FIFO, written in place (the
-/// node is never replaced by a file): the MCAP writer needs to seek, so the
-/// replay goes to an anonymous temporary file first, then is copied in one
-/// stream; a reader that goes away is not an error, as on stdout.
+/// node is never replaced by a file), through [`replay_file_to`].
 fn replay_into_special<P: FramePlanner>(
     input: std::fs::File,
     origin: &str,
@@ -962,22 +1407,71 @@ fn replay_into_special<P: FramePlanner>(
     pipeline: PipelineConfig,
     opts: &ReplayOptions,
 ) -> Result<ReplayStats, ReplayError> {
-    use std::io::{Seek as _, SeekFrom};
     let out_err = |e: std::io::Error| ReplayError::Write(format!("{}: {e}", output.display()));
+    let stats = stage(input, origin, planner, pipeline, opts)?;
+    let device = std::fs::OpenOptions::new()
+        .write(true)
+        .open(output)
+        .map_err(out_err)?;
+    stats.send(device).map_err(out_err)
+}
+
+/// A finished replay in an anonymous temporary file.
+struct Staged {
+    file: std::fs::File,
+    stats: ReplayStats,
+}
+
+impl Staged {
+    /// Copies the file to `out` in one stream; a reader that goes away
+    /// (a closed pipe) is not an error.
+    fn send(mut self, mut out: impl Write) -> Result<ReplayStats, std::io::Error> {
+        use std::io::{Seek as _, SeekFrom};
+        self.file.seek(SeekFrom::Start(0))?;
+        match std::io::copy(&mut self.file, &mut out).and_then(|_| out.flush()) {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e),
+            _ => Ok(self.stats),
+        }
+    }
+}
+
+/// The replay staged whole in an anonymous temporary file (the MCAP
+/// writer seeks).
+fn stage<P: FramePlanner>(
+    input: std::fs::File,
+    origin: &str,
+    planner: P,
+    pipeline: PipelineConfig,
+    opts: &ReplayOptions,
+) -> Result<Staged, ReplayError> {
+    let out_err = |e: std::io::Error| ReplayError::Write(format!("temporary file: {e}"));
     let staged = tempfile::tempfile().map_err(out_err)?;
     let reader = std::io::BufReader::with_capacity(1 << 20, input);
     let mut writer = std::io::BufWriter::with_capacity(1 << 20, staged);
     let stats = replay(reader, origin, &mut writer, planner, pipeline, opts)?;
-    let mut staged = writer.into_inner().map_err(|e| out_err(e.into_error()))?;
-    staged.seek(SeekFrom::Start(0)).map_err(out_err)?;
-    let mut device = std::fs::OpenOptions::new()
-        .write(true)
-        .open(output)
-        .map_err(out_err)?;
-    match std::io::copy(&mut staged, &mut device).and_then(|_| device.flush()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(out_err(e)),
-        _ => Ok(stats),
-    }
+    let file = writer.into_inner().map_err(|e| out_err(e.into_error()))?;
+    Ok(Staged { file, stats })
+}
+
+/// [`replay`] from the file `input` to a stream (`gaze-lidar replay --out
+/// -`: stdout): the replay is staged whole in an anonymous temporary file
+/// and written out only when it succeeded, so a failure writes nothing; a
+/// reader that goes away is not an error.
+pub fn replay_file_to<P: FramePlanner>(
+    input: &std::path::Path,
+    out: impl Write,
+    planner: P,
+    pipeline: PipelineConfig,
+    opts: &ReplayOptions,
+) -> Result<ReplayStats, ReplayError> {
+    let origin = input.display().to_string();
+    let file = std::fs::File::open(input).map_err(|source| ReplayError::Read {
+        path: origin.clone(),
+        source,
+    })?;
+    stage(file, &origin, planner, pipeline, opts)?
+        .send(out)
+        .map_err(|e| ReplayError::Write(format!("stdout: {e}")))
 }
 
 #[cfg(test)]

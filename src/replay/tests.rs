@@ -184,6 +184,46 @@ fn point_cloud2_layout_errors_name_the_field() {
 }
 
 #[test]
+fn ambiguous_point_layouts_are_refused_by_name() {
+    let b = cloud_bytes(false, false, 16, &[[1.0, 2.0, 3.0]]);
+    let c = PointCloud2::decode(&b).unwrap();
+    assert!(c.xyz().is_ok());
+    // A second x.
+    let mut d = c.clone();
+    let mut x2 = d.fields[0].clone();
+    x2.offset = 12;
+    d.fields.push(x2);
+    let e = d.xyz().unwrap_err().to_string();
+    assert!(
+        e.starts_with("fields") && e.contains("x is given more than once"),
+        "{e}"
+    );
+    // x, y and z at one offset (a 4-byte point).
+    let mut d = c.clone();
+    for f in &mut d.fields {
+        f.offset = 0;
+    }
+    let e = d.xyz().unwrap_err().to_string();
+    assert!(e.starts_with("fields") && e.contains("overlaps"), "{e}");
+    // y straddling x's last bytes.
+    let mut d = c.clone();
+    d.fields[1].offset = 2;
+    assert!(d.xyz().unwrap_err().to_string().contains("overlaps field"));
+    // Another field inside z.
+    let mut d = c.clone();
+    d.fields[3].offset = 9;
+    let e = d.xyz().unwrap_err().to_string();
+    assert!(
+        e.contains("z (bytes 8..12) overlaps field intensity"),
+        "{e}"
+    );
+    // Adjacent is fine.
+    let mut d = c;
+    d.fields[3].offset = 12;
+    assert!(d.xyz().is_ok());
+}
+
+#[test]
 fn vector_azimuth_follows_iso_8855() {
     assert_eq!(vector_azimuth_deg([1.0, 0.0, 0.0]), Some(0.0));
     assert_eq!(vector_azimuth_deg([0.0, 1.0, 0.0]), Some(90.0));
@@ -249,6 +289,9 @@ fn decode_all_and_kept_ranges_match_the_per_point_reference() {
         let bits =
             |v: &[[f64; 3]]| -> Vec<[u64; 3]> { v.iter().map(|p| p.map(f64::to_bits)).collect() };
         assert_eq!(bits(&all), bits(&want), "case {case}");
+        let streamed: Vec<[f64; 3]> = l.points(c.data).collect();
+        assert_eq!(l.points(c.data).len(), l.len());
+        assert_eq!(bits(&streamed), bits(&want), "case {case}");
         let keep: Vec<bool> = (0..l.len()).map(|_| rng.random_bool(0.6)).collect();
         let sub = cdr::encode_subset(&c, &l, &keep, true);
         let s = PointCloud2::decode(&sub).unwrap();
@@ -259,4 +302,69 @@ fn decode_all_and_kept_ranges_match_the_per_point_reference() {
         assert_eq!(s.data, &naive[..], "case {case}");
         assert_eq!(s.width as usize, keep.iter().filter(|&&k| k).count());
     }
+}
+
+fn empty_message(
+    channel: &std::sync::Arc<mcap::Channel<'static>>,
+    t: u64,
+) -> mcap::Message<'static> {
+    mcap::Message {
+        channel: channel.clone(),
+        sequence: 0,
+        log_time: t,
+        publish_time: t,
+        data: std::borrow::Cow::Owned(Vec::new()),
+    }
+}
+
+fn channel(id: u16, topic: &str) -> std::sync::Arc<mcap::Channel<'static>> {
+    std::sync::Arc::new(mcap::Channel {
+        id,
+        topic: topic.to_owned(),
+        schema: None,
+        message_encoding: "cdr".to_owned(),
+        metadata: std::collections::BTreeMap::new(),
+    })
+}
+
+#[test]
+fn the_window_bounds_many_empty_messages_by_their_bookkeeping() {
+    // Two million empty messages at one time: none is old, so only the
+    // byte bound releases them, and it must count them although their
+    // data is empty.
+    let ch = channel(1, "/empty");
+    let mut w = super::Window::new(200_000_000);
+    let mut released = 0u64;
+    for _ in 0..2_000_000u64 {
+        w.push(empty_message(&ch, 5));
+        while w.pop_due().is_some() {
+            released += 1;
+        }
+        assert!(w.held_bytes <= super::MAX_WINDOW_BYTES + super::HELD_OVERHEAD_BYTES);
+    }
+    let cap = super::MAX_WINDOW_BYTES / super::HELD_OVERHEAD_BYTES + 1;
+    assert!(w.heap.len() <= cap, "{} held", w.heap.len());
+    assert!(released >= 2_000_000 - cap as u64);
+}
+
+#[test]
+fn one_far_future_stamp_does_not_move_the_windows_clock() {
+    let (a, b, c) = (channel(1, "/a"), channel(2, "/b"), channel(3, "/c"));
+    let mut w = super::Window::new(200_000_000);
+    w.push(empty_message(&a, 1_000_000_000));
+    assert_eq!(w.clock(), 1_000_000_000);
+    w.push(empty_message(&c, u64::MAX / 2));
+    w.push(empty_message(&b, 1_100_000_000));
+    assert_eq!(w.clock(), 1_100_000_000);
+    // Nothing is 200 ms older than the clock yet: nothing is due.
+    assert!(w.pop_due().is_none());
+    w.push(empty_message(&a, 1_350_000_000));
+    assert_eq!(w.clock(), 1_350_000_000);
+    // The clock is 1.35 s: the messages at 1.0 and 1.1 s are more than
+    // 200 ms older, due; the far one is released only at the end.
+    assert_eq!(w.pop_due().map(|p| p.log_time), Some(1_000_000_000));
+    assert_eq!(w.pop_due().map(|p| p.log_time), Some(1_100_000_000));
+    assert!(w.pop_due().is_none());
+    assert_eq!(w.pop().map(|p| p.log_time), Some(1_350_000_000));
+    assert_eq!(w.pop().map(|p| p.log_time), Some(u64::MAX / 2));
 }

@@ -35,6 +35,23 @@ fn conj([x, y, z, w]: Quat) -> Quat {
     [-x, -y, -z, w]
 }
 
+/// `q / |q|`, computed as `(q / m) / |q / m|` with `m` the largest
+/// component's magnitude (so `|q / m|` lies in `[1, 2]`: no overflow or
+/// underflow whatever the scale); `None` when `q` is zero or not finite.
+#[must_use]
+pub fn normalized(q: Quat) -> Option<Quat> {
+    if !q.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let m = q.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    if m == 0.0 {
+        return None;
+    }
+    let s = q.map(|v| v / m);
+    let norm = s.iter().map(|v| v * v).sum::<f64>().sqrt();
+    Some(s.map(|v| v / norm))
+}
+
 /// Why a transform cannot be used.
 #[derive(Debug, Clone, PartialEq)]
 pub enum TfError {
@@ -61,13 +78,11 @@ pub struct TfTree {
 
 impl TfTree {
     /// Adds (or replaces) the transform of `child` in `parent`; the
-    /// quaternion is normalised (a norm off 1 by rounding is common).
+    /// quaternion is normalised (a norm off 1 by rounding is common), any
+    /// finite non-zero one: scaled by its largest component first, so
+    /// neither squaring overflows nor underflows ([`normalized`]).
     pub fn insert(&mut self, parent: &str, child: &str, q: Quat) -> Result<(), TfError> {
-        let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if !(norm.is_finite() && norm > 1e-6 && norm < 1e6) {
-            return Err(TfError::BadQuaternion(q));
-        }
-        let q = q.map(|v| v / norm);
+        let q = normalized(q).ok_or(TfError::BadQuaternion(q))?;
         self.parents
             .insert(child.to_owned(), (parent.to_owned(), q));
         Ok(())
@@ -222,5 +237,28 @@ mod tests {
             Err(TfError::BadQuaternion(_))
         ));
         assert!(t.insert("a", "b", [f64::NAN, 0.0, 0.0, 1.0]).is_err());
+    }
+
+    #[test]
+    fn quaternions_of_any_finite_scale_normalise_to_the_same_rotation() {
+        let q = axis_angle([0.0, 0.0, 1.0], 37.0);
+        for scale in [1e-200, 1e-300, 1e-310, 1e200, 1e300, 1.7e308] {
+            let s = q.map(|v| v * scale);
+            if s.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            let mut t = TfTree::default();
+            t.insert("base_link", "lidar", s).unwrap();
+            let m = mounting(t.rotation("lidar", "base_link").unwrap().unwrap());
+            // Subnormal scales lose digits of the components themselves.
+            let tol = if scale < 1e-300 { 1e-3 } else { 1e-9 };
+            assert!((m.yaw_deg - 37.0).abs() < tol, "{scale}: {m:?}");
+        }
+        assert_eq!(normalized([0.0; 4]), None);
+        assert_eq!(normalized([f64::INFINITY, 0.0, 0.0, 0.0]), None);
+        assert_eq!(
+            normalized([0.0, 0.0, 0.0, -1e300]),
+            Some([0.0, 0.0, 0.0, -1.0])
+        );
     }
 }
