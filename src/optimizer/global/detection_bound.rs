@@ -56,6 +56,9 @@ pub(super) const DWELL_CELLS: usize = 32;
 /// refinement starts) takes every `COARSE.0`-th power node and every
 /// `COARSE.1`-th dwell node.
 const COARSE: (usize, usize) = (16, 4);
+/// The multiplier search's grid (every `.0`-th power node, every `.1`-th
+/// dwell node).
+const SEARCH_STRIDE: (usize, usize) = (64, 8);
 /// A bin's refinement stops when its best cell's bound is within this
 /// share of the bin's weight of the best value found, or after
 /// [`MAX_SPLITS`] splits (either way the bound stays valid).
@@ -264,12 +267,63 @@ impl Lagrangian<'_, '_> {
         (leaves[i].0, leaves[i].1)
     }
 
+    /// The search grid's cells of one bin's table (every
+    /// [`SEARCH_STRIDE`]`.0`-th power node, every `.1`-th dwell node) as
+    /// `(g, a·x₀, τ₀)`: the cell's bound at `(μ, ν)` is
+    /// `c·g − μ·a·x₀ − ν·τ₀` with `g = λ_R u(x₁, τ₁) + λ_ρ √(k τ₁)`.
+    fn search_cells(&self, b: &Bin, stride: (usize, usize)) -> Vec<(f64, f64, f64)> {
+        let t = b.table;
+        let xs = if t.discrete {
+            (0..t.x.len()).map(|k| (k, k)).collect()
+        } else {
+            cells(t.x.len(), stride.0)
+        };
+        let mut out = Vec::new();
+        for &(l0, l1) in &cells(t.tau.len(), stride.1) {
+            let res = self.resolution_weight * (b.k * t.tau[l1]).max(0.0).sqrt();
+            let a = if self.time { t.tau[l0] } else { b.theta };
+            for &(k0, k1) in &xs {
+                out.push((
+                    self.range_weight * t.u(k1, l1) + res,
+                    a * t.x[k0],
+                    t.tau[l0],
+                ));
+            }
+        }
+        out
+    }
+
+    /// The bound at `(mu, nu)` on the search grid (`cells` per bin from
+    /// [`Self::search_cells`]).
+    fn at_search(&self, cells: &[Vec<(f64, f64, f64)>], mu: f64, nu: f64) -> f64 {
+        let mut total = mu * self.budget + nu * self.frame;
+        let mut magnitude = total.abs();
+        for (b, cs) in self.bins.iter().zip(cells) {
+            let (mut best, mut mag) = (f64::NEG_INFINITY, 0.0);
+            for &(g, ax, tau) in cs {
+                let v = b.c * g - mu * ax - nu * tau;
+                if v > best {
+                    best = v;
+                    mag = b.c * g.abs() + mu * ax + nu * tau;
+                }
+            }
+            total += best;
+            magnitude += mag;
+        }
+        let terms = (self.bins.len() + 2) as f64;
+        total + (1e-12 + 2.0 * terms * f64::EPSILON) * magnitude
+    }
+
     /// The bound at `(mu, nu)`: on the coarse cells, or refined.
     fn at(&self, mu: f64, nu: f64, refine: bool) -> f64 {
         let mut total = mu * self.budget + nu * self.frame;
         let mut magnitude = total.abs();
+        // Bins of equal weight and width have equal maxima.
+        let mut seen: HashMap<(u64, u64), (f64, f64)> = HashMap::new();
         for b in &self.bins {
-            let (v, m) = self.bin_bound(b, mu, nu, refine);
+            let (v, m) = *seen
+                .entry((b.c.to_bits(), b.theta.to_bits()))
+                .or_insert_with(|| self.bin_bound(b, mu, nu, refine));
             total += v;
             magnitude += m;
         }
@@ -300,12 +354,22 @@ fn minimise(f: impl Fn(f64) -> f64, start: f64) -> f64 {
             k += 1;
         }
     }
+    let m = golden(&f, lo, hi, 40);
+    if f(m) <= f0 {
+        m
+    } else {
+        0.0
+    }
+}
+
+/// Golden-section minimum of a convex `f` on `[lo, hi]`, `steps` steps.
+fn golden(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize) -> f64 {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut a, mut b) = (lo, hi);
     let mut c = b - g * (b - a);
     let mut d = a + g * (b - a);
     let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..40 {
+    for _ in 0..steps {
         if fc <= fd {
             b = d;
             d = c;
@@ -320,11 +384,15 @@ fn minimise(f: impl Fn(f64) -> f64, start: f64) -> f64 {
             fd = f(d);
         }
     }
-    let m = 0.5 * (a + b);
-    if f(m) <= f0 {
-        m
+    0.5 * (a + b)
+}
+
+/// `b` if `f(b) <= f(a)`, else `a`.
+fn keep_better(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    if f(b) <= f(a) {
+        b
     } else {
-        0.0
+        a
     }
 }
 
@@ -358,13 +426,37 @@ pub(super) fn bound(problem: &Problem, g: &Grid, b: &Boxes) -> Option<f64> {
     let dwell_moves = b.w_lo < b.w_hi;
     // Scales: a unit of budget or frame is worth about the objective per
     // unit of it.
-    let scale = (lag.at(0.0, 0.0, false) / b.n).max(1e-12);
+    let search: Vec<_> = lag
+        .bins
+        .iter()
+        .map(|b| lag.search_cells(b, SEARCH_STRIDE))
+        .collect();
+    let scale = (lag.at_search(&search, 0.0, 0.0) / b.n).max(1e-12);
     let (mut mu, mut nu) = (0.0, 0.0);
-    for _ in 0..if dwell_moves { 3 } else { 1 } {
-        mu = minimise(|m| lag.at(m, nu, false), scale);
+    for _ in 0..if dwell_moves { 2 } else { 1 } {
+        mu = minimise(|m| lag.at_search(&search, m, nu), scale);
         if dwell_moves {
-            nu = minimise(|v| lag.at(mu, v, false), scale);
+            nu = minimise(|v| lag.at_search(&search, mu, v), scale);
         }
+    }
+    // Then once on the refinement's starting grid, near the coarse optimum.
+    let search: Vec<_> = lag
+        .bins
+        .iter()
+        .map(|b| lag.search_cells(b, COARSE))
+        .collect();
+    let at = |m: f64, v: f64| lag.at_search(&search, m, v);
+    mu = keep_better(
+        |m| at(m, nu),
+        mu,
+        golden(|m| at(m, nu), 0.7 * mu, 1.4 * mu, 20),
+    );
+    if dwell_moves {
+        nu = keep_better(
+            |v| at(mu, v),
+            nu,
+            golden(|v| at(mu, v), 0.7 * nu, 1.4 * nu, 20),
+        );
     }
     let v = lag.at(mu, nu, true);
     (v.is_finite()).then_some(v * (1.0 + S.objective_margin))
