@@ -34,8 +34,8 @@
 //!
 //! The dwell step keeps the `√r` resolution utility (`λ_ρ`); `u`'s
 //! dependence on the density enters through the power step at the current
-//! dwell. The global bound (`optimality.global`) is derived for the `√`
-//! utilities only and is not given under `kind = "detection"`.
+//! dwell. The global bound (`optimality.global`) under detection is a
+//! Lagrangian on a grid of cells (`global::detection_bound`).
 
 use std::cell::RefCell;
 use std::collections::HashMap;

@@ -92,6 +92,8 @@
 
 use std::f64::consts::TAU;
 
+mod detection_bound;
+
 use super::certificate::{check, next_down, to_f64_up};
 use super::lp::{grid, Grid};
 use super::program::Program;
@@ -354,6 +356,13 @@ fn objective_of(problem: &Problem, g: &Grid, profile: &Profile) -> f64 {
         .enumerate()
         .map(|(i, b)| {
             let (range, res) = super::utilities(problem, g.theta[i], b);
+            let range = if o.kind == super::ObjectiveKind::Detection {
+                let dwell = crate::profile::kinematics::BinMotion::dwell_s(b);
+                let x = b.power_w / problem.lidar.average_power_w;
+                super::detection::exact_range_utility(problem, g.theta[i], dwell, x)
+            } else {
+                range
+            };
             g.theta[i] * g.weight[i] * (o.range_weight * range + o.resolution_weight * res)
         })
         .sum()
@@ -365,12 +374,6 @@ pub(super) fn bound(
     gaze_deg: f64,
     profile: &Profile,
 ) -> Result<GlobalOptimality, OptError> {
-    if problem.objective.kind != super::ObjectiveKind::Sqrt {
-        return Err(OptError::Invalid {
-            field: "objective.kind".into(),
-            reason: "the global bound is derived for the √ utilities only".into(),
-        });
-    }
     let upper_bound = upper_bound(problem, gaze_deg)?;
     let j = model_objective(problem, gaze_deg, profile)?;
     let objective = j - S.objective_margin * j.abs();
@@ -423,6 +426,11 @@ pub fn model_objective(
 pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     let g = grid(problem, gaze_deg)?;
     let b = boxes(problem, &g)?;
+    if problem.objective.kind == super::ObjectiveKind::Detection {
+        return detection_bound::bound(problem, &g, &b).ok_or_else(|| {
+            OptError::Solver("global bound: the detection Lagrangian has no finite value".into())
+        });
+    }
     let mode = problem.objective.mode;
     let slew_moves =
         mode.controls_range() && problem.lidar.limits.power_slew_w_per_deg_max.is_some();
