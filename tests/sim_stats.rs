@@ -288,13 +288,22 @@ mod grid {
         for i in 1..3 {
             assert_eq!(tta(i, ModelKind::Argus, 0), tta(0, ModelKind::Argus, 0));
             for fog in [0, 25, 50] {
-                assert_eq!(tta(i, ModelKind::Physical, fog), tta(0, ModelKind::Physical, fog));
+                assert_eq!(
+                    tta(i, ModelKind::Physical, fog),
+                    tta(0, ModelKind::Physical, fog)
+                );
             }
         }
         // A lower threshold sees farther: detection earlier (larger TTA).
         for fog in [25, 50] {
-            assert!(tta(0, ModelKind::Argus, fog) > tta(1, ModelKind::Argus, fog), "{fog}");
-            assert!(tta(1, ModelKind::Argus, fog) > tta(2, ModelKind::Argus, fog), "{fog}");
+            assert!(
+                tta(0, ModelKind::Argus, fog) > tta(1, ModelKind::Argus, fog),
+                "{fog}"
+            );
+            assert!(
+                tta(1, ModelKind::Argus, fog) > tta(2, ModelKind::Argus, fog),
+                "{fog}"
+            );
         }
     }
 }
