@@ -6,7 +6,11 @@
 #     (4 variants × 3 fog levels × 100 trials each), prints the table,
 #     writes CSV, JSON, the plots and the reproduction report, which adds the
 #     paper's pipeline (carla geometry, ARGUS detector and arrival, argus model;
-#     PIPELINE_TRIALS per cell, default 100).
+#     PIPELINE_TRIALS per cell, default 100) and its sensitivity section: the
+#     pipeline swept over mount height, grid phase, tick, spawn distance and
+#     fog threshold, five values each (SWEEP_TRIALS per cell, default 30: fewer
+#     than the main run, to keep the script's run time to a few minutes), with
+#     one figure per key in $OUT/plots/.
 # Outputs go to $OUT (default: out/); the report to docs/reproduction.md.
 # CHECK=1: fail unless the regenerated report equals the committed one byte
 # for byte (git diff --exit-code).
@@ -14,7 +18,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cargo build --release --quiet
-B=target/release/gaze-lidar
+B=${CARGO_TARGET_DIR:-target}/release/gaze-lidar
 OUT=${OUT:-out}
 TRIALS=${TRIALS:-100}
 mkdir -p "$OUT/profiles"
@@ -25,7 +29,13 @@ for mode in baseline range resolution joint; do
 done
 echo "== the intersection experiment: ${TRIALS} trials per cell" >&2
 $B simulate --trials "$TRIALS" --seed 1 --plots "$OUT/plots" --trials-csv "$OUT/trials.csv" \
-  --report docs/reproduction.md --paper-pipeline-trials "${PIPELINE_TRIALS:-100}" --export-json "$OUT/results.json" --export-csv "$OUT/results.csv"
+  --report docs/reproduction.md --paper-pipeline-trials "${PIPELINE_TRIALS:-100}" --export-json "$OUT/results.json" --export-csv "$OUT/results.csv" \
+  --sweep-trials "${SWEEP_TRIALS:-30}" \
+  --sweep mount_height=2.9,2.95,3,3.05,3.1 \
+  --sweep grid_phase=0,0.2,0.4,0.6,0.8 \
+  --sweep tick=0.025,0.04,0.05,0.075,0.1 \
+  --sweep spawn_distance=100,105,110,115,120 \
+  --sweep fog_threshold=0.5,0.75,1,1.5,2
 echo "results: $OUT/results.json, $OUT/results.csv, $OUT/trials.csv; plots: $OUT/plots/; report: docs/reproduction.md" >&2
 if [ "${CHECK:-0}" = 1 ]; then
   git diff --exit-code -- docs/reproduction.md

@@ -219,4 +219,91 @@ mod grid {
         assert!(t.starts_with("sweep of speed_kmh"));
         assert_eq!(t.lines().count(), 2 + 2);
     }
+
+    /// The configurations of a sweep over `spec` from `base`.
+    fn swept(spec: &str, base: &SimConfig) -> Vec<SimConfig> {
+        let sw = sim::sweep::parse(spec).expect("sweep");
+        sw.values
+            .iter()
+            .map(|&v| SimConfig {
+                scenario: sim::sweep::apply(&base.scenario, &sw.key, v).expect("apply"),
+                ..base.clone()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_sweep_run_together_equals_each_value_run_alone() {
+        // Planar: the values share the trial's pulses; the results must be
+        // those of separate runs, bit for bit (rows and every trial).
+        let base = SimConfig {
+            trials: 6,
+            ..SimConfig::default()
+        };
+        for spec in ["fog_threshold=0.5,1,2", "speed_kmh=40,50", "gaze_deg=80,90"] {
+            let configs = swept(spec, &base);
+            let together = sim::run_many(&configs, &|| {}).expect("run_many");
+            for (c, r) in configs.iter().zip(&together) {
+                let alone = sim::run(c, &|| {}).expect("run");
+                assert_eq!(&alone, r, "{spec}");
+                assert_eq!(
+                    sim::table::render_json(&alone).expect("json"),
+                    sim::table::render_json(r).expect("json"),
+                    "{spec}"
+                );
+            }
+        }
+        // Carla: the values share CARLA's drop-off draws.
+        let carla = SimConfig {
+            models: vec![ModelKind::Argus],
+            variants: vec![Variant::Baseline, Variant::Resolution],
+            fog_pcts: vec![0],
+            trials: 2,
+            geometry: sim::Geometry::Carla,
+            detector: sim::Detector::Argus,
+            arrival: sim::Arrival::ArgusCentre,
+            ..SimConfig::default()
+        };
+        let configs = swept("grid_phase=0,0.5", &carla);
+        let together = sim::run_many(&configs, &|| {}).expect("run_many");
+        for (c, r) in configs.iter().zip(&together) {
+            assert_eq!(&sim::run(c, &|| {}).expect("run"), r);
+        }
+    }
+
+    #[test]
+    fn the_fog_threshold_scales_the_argus_thresholds_only_in_fog() {
+        let base = SimConfig {
+            variants: vec![Variant::Baseline],
+            trials: 4,
+            ..SimConfig::default()
+        };
+        let r = sim::run_many(&swept("fog_threshold=0.25,1,4", &base), &|| {}).expect("run");
+        let tta = |i: usize, m: ModelKind, fog: u32| {
+            r[i].row(m, "baseline", fog)
+                .and_then(|x| x.tta_median_s)
+                .unwrap_or(0.0)
+        };
+        // Clear air has no threshold; the physical model none at all.
+        for i in 1..3 {
+            assert_eq!(tta(i, ModelKind::Argus, 0), tta(0, ModelKind::Argus, 0));
+            for fog in [0, 25, 50] {
+                assert_eq!(
+                    tta(i, ModelKind::Physical, fog),
+                    tta(0, ModelKind::Physical, fog)
+                );
+            }
+        }
+        // A lower threshold sees farther: detection earlier (larger TTA).
+        for fog in [25, 50] {
+            assert!(
+                tta(0, ModelKind::Argus, fog) > tta(1, ModelKind::Argus, fog),
+                "{fog}"
+            );
+            assert!(
+                tta(1, ModelKind::Argus, fog) > tta(2, ModelKind::Argus, fog),
+                "{fog}"
+            );
+        }
+    }
 }

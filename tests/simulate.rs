@@ -149,6 +149,64 @@ fn plots_are_written() {
 }
 
 #[test]
+fn sweeps_plot_one_figure_per_key_and_bad_sweeps_name_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(
+        &[
+            "simulate",
+            "--trials",
+            "2",
+            "--model",
+            "argus",
+            "--variant",
+            "baseline",
+            "--sweep",
+            "fog_threshold=0.5,1",
+            "--sweep",
+            "grid_phase=0,0.5",
+            "--plots",
+            dir.path().to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
+    assert!(stdout(&o).contains("sweep of argus_fog_threshold_scale"));
+    for f in [
+        "sweep_fog_threshold.svg",
+        "sweep_fog_threshold.png",
+        "sweep_grid_phase.svg",
+        "sweep_grid_phase.png",
+    ] {
+        let meta = std::fs::metadata(dir.path().join(f)).unwrap();
+        assert!(meta.len() > 1000, "{f}");
+    }
+    let svg = std::fs::read_to_string(dir.path().join("sweep_fog_threshold.svg")).unwrap();
+    assert!(svg.contains("fog_threshold") && svg.contains("fog 50 %"));
+    for (sweep, names) in [
+        ("grid_phase=1", "carla.grid_phase_steps"),
+        ("fog_threshold=0.5,-1", "argus_fog_threshold_scale"),
+        ("nope=1", "nope"),
+    ] {
+        assert_bad_input(&run(&["simulate", "--sweep", sweep], None), names);
+    }
+    let report = dir.path().join("r.md");
+    assert_bad_input(
+        &run(
+            &[
+                "simulate",
+                "--report",
+                report.to_str().unwrap(),
+                "--sweep",
+                "tick=0.05",
+            ],
+            None,
+        ),
+        "--paper-pipeline-trials",
+    );
+    assert!(!report.exists());
+}
+
+#[test]
 fn bad_simulate_input() {
     assert_bad_input(&run(&["simulate", "--trials", "0"], None), "trials");
     assert_bad_input(&run(&["simulate", "--trials", "-5"], None), "trials");

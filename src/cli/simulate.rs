@@ -97,11 +97,20 @@ pub struct Args {
     export_csv: Option<PathBuf>,
     /// Sensitivity sweep `KEY=V1,V2,…` (repeatable, one table per key): any
     /// numeric scenario key (`speed_kmh`, `carla.mount_height_m`, …) or the
-    /// aliases `mount_height`, `tick` (`carla.tick_s`), `spawn_distance`;
-    /// the whole grid is run once per value and printed as tables (`--format
+    /// aliases `mount_height`, `tick` (`carla.tick_s`), `spawn_distance`,
+    /// `grid_phase` (`carla.grid_phase_steps`, the scan grid's azimuth phase
+    /// in steps) and `fog_threshold` (`argus_fog_threshold_scale`); the
+    /// whole grid is run once per value and printed as tables (`--format
     /// json`: `{"sweeps": [...]}`).
+    /// With `--plots DIR`: one figure per key (`sweep_KEY.svg`/`.png`).
+    /// With `--report`: the sweeps run the paper's pipeline (needs
+    /// `--paper-pipeline-trials`) and make the report's sensitivity section.
     #[arg(long)]
     sweep: Vec<String>,
+    /// With `--report` and `--sweep`: trials per cell of each swept value
+    /// (default: `--paper-pipeline-trials`).
+    #[arg(long, allow_hyphen_values = true)]
+    sweep_trials: Option<i64>,
     /// Disable ray culling (reference path; results are identical).
     #[arg(long, hide = true)]
     brute_force: bool,
@@ -201,6 +210,11 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         return Err(super::config::no_solver("--optimizer-config"));
     }
     let gaze = gaze_drive(a, &scenario)?;
+    if gaze.is_some() && !a.sweep.is_empty() {
+        return Err(CliError::input(
+            "--sweep runs the paper's grid: --gaze/--gaze-behaviour are not available with it",
+        ));
+    }
     let config = SimConfig {
         models: if a.model.is_empty() {
             if gaze.is_some() {
@@ -230,8 +244,23 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         optimizer,
         ..SimConfig::default()
     };
-    if !a.sweep.is_empty() {
+    if !a.sweep.is_empty() && a.report.is_none() {
         return run_sweeps(a, &config);
+    }
+    // With --report, the sweeps make the sensitivity section (on the
+    // paper's pipeline): parsed and validated before anything runs.
+    let sweeps = parse_sweeps(&a.sweep)?;
+    let sweep_trials: usize = match a.sweep_trials {
+        Some(n) => int_in("--sweep-trials", n, 1, 100_000)?,
+        None => paper_pipeline_trials,
+    };
+    if !sweeps.is_empty() && paper_pipeline_trials == 0 {
+        return Err(CliError::input(
+            "--sweep with --report: the sensitivity section sweeps the paper's pipeline: add --paper-pipeline-trials N",
+        ));
+    }
+    if a.sweep_trials.is_some() && sweeps.is_empty() {
+        return Err(CliError::input("--sweep-trials needs --sweep"));
     }
     // Every output path is checked before the run — against the others
     // (the plots' file names included) and against the inputs: a bad one
@@ -242,7 +271,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         .file_opt("--export-csv", a.export_csv.as_deref())
         .file_opt("--trials-csv", a.trials_csv.as_deref())
         .file_opt("--report", a.report.as_deref());
-    let plot_names = sim::plots::file_names(&config);
+    let mut plot_names = sim::plots::file_names(&config);
+    for sw in &sweeps {
+        plot_names.extend(sim::plots::sweep_file_names(sw));
+    }
     if let Some(dir) = &a.plots {
         outputs.folder("--plots", dir, &plot_names);
     }
@@ -333,16 +365,44 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             c.vehicle_ground_clearance_m =
                 (c.mount_height_m + c.argus_road_z_m + 0.05).clamp(0.0, 0.49 * c.vehicle_height_m);
             extras.push(lifted);
+            // The sensitivity section: every swept value of the pipeline.
+            let mut swept = Vec::new();
+            for sw in &sweeps {
+                let configs = sweep_configs(
+                    sw,
+                    &SimConfig {
+                        trials: sweep_trials,
+                        ..pc.clone()
+                    },
+                )?;
+                let results = sim::run_many(&configs, &|| {}).map_err(sim_error)?;
+                swept.push((sw.clone(), results, configs.into_iter().next()));
+            }
             let runs = extras
                 .into_iter()
                 .map(|c| sim::run(&c, &|| {}).map(|r| (r, c)))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| CliError::input(e.to_string()))?;
-            Some(((r, pc), runs))
+            Some(((r, pc), runs, swept))
         } else {
             None
         };
-        let runs: &[(sim::GridResult, SimConfig)] = pipeline.as_ref().map_or(&[], |(_, r)| r);
+        let runs: &[(sim::GridResult, SimConfig)] = pipeline.as_ref().map_or(&[], |(_, r, _)| r);
+        let sensitivity: Vec<sim::report::SweepRun<'_>> = pipeline
+            .as_ref()
+            .map(|(_, _, swept)| {
+                swept
+                    .iter()
+                    .filter_map(|(sw, results, config)| {
+                        Some(sim::report::SweepRun {
+                            sweep: sw,
+                            results,
+                            config: config.as_ref()?,
+                        })
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
         let others: Vec<(&sim::GridResult, &SimConfig)> = runs
             .iter()
             .filter(|(_, c)| c.fog_pcts == [0])
@@ -355,16 +415,26 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         let md = sim::report::render_with_pipelines(
             &result,
             &config,
-            pipeline.as_ref().map(|((r, c), _)| (r, c)),
+            pipeline.as_ref().map(|((r, c), _, _)| (r, c)),
             &sim::report::PipelineExtras {
                 other_samplings: &others,
                 lifted,
+                sensitivity: &sensitivity,
             },
         );
         outputs.set(path, md);
+        if let (Some(dir), Some((_, _, swept))) = (&a.plots, &pipeline) {
+            for (sw, results, config) in swept {
+                if let Some(config) = config {
+                    for (name, bytes) in render_sweep_plot(sw, results, config)? {
+                        outputs.set(&dir.join(name), bytes);
+                    }
+                }
+            }
+        }
     }
     if let Some(dir) = &a.plots {
-        for (name, bytes) in render_plots(&result, &config, &plot_names)? {
+        for (name, bytes) in render_plots(&result, &config, &sim::plots::file_names(&config))? {
             outputs.set(&dir.join(name), bytes);
         }
     }
@@ -436,52 +506,106 @@ fn render_plots(
         .collect()
 }
 
-/// `--sweep`: the grid once per value of each key; tables (or JSON) on stdout.
-fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
-    if a.report.is_some()
-        || a.plots.is_some()
-        || a.trials_csv.is_some()
-        || a.export_json.is_some()
-        || a.export_csv.is_some()
-    {
-        return Err(CliError::input(
-            "--sweep prints its tables on stdout: --report, --plots, --trials-csv, --export-json and --export-csv are not available with it",
-        ));
+/// A simulation error as the CLI reports it (input: exit 2; else exit 1).
+fn sim_error(e: sim::SimError) -> CliError {
+    if e.is_input_error() {
+        CliError::input(e.to_string())
+    } else {
+        CliError::infeasible(e.to_string())
     }
-    let sweeps = a
-        .sweep
+}
+
+/// Parses every `--sweep` (a bad one: exit 2 naming it).
+fn parse_sweeps(specs: &[String]) -> Result<Vec<sim::sweep::Sweep>, CliError> {
+    specs
         .iter()
         .map(|s| sim::sweep::parse(s))
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| CliError::input(e.to_string()))?;
-    // Every value is validated before anything runs.
-    let mut configs = Vec::new();
-    for sw in &sweeps {
-        let mut per_value = Vec::new();
-        for &v in &sw.values {
-            let scenario = sim::sweep::apply(&config.scenario, &sw.key, v)
+        .map_err(|e| CliError::input(e.to_string()))
+}
+
+/// One configuration per value of `sweep` (every value validated).
+fn sweep_configs(
+    sweep: &sim::sweep::Sweep,
+    config: &SimConfig,
+) -> Result<Vec<SimConfig>, CliError> {
+    sweep
+        .values
+        .iter()
+        .map(|&v| {
+            let scenario = sim::sweep::apply(&config.scenario, &sweep.key, v)
                 .map_err(|e| CliError::input(e.to_string()))?;
-            per_value.push(SimConfig {
+            Ok(SimConfig {
                 scenario,
                 ..config.clone()
-            });
-        }
-        configs.push(per_value);
+            })
+        })
+        .collect()
+}
+
+/// Renders a sweep's figure (in a private temporary folder) and returns
+/// its files' bytes by name.
+fn render_sweep_plot(
+    sweep: &sim::sweep::Sweep,
+    results: &[sim::GridResult],
+    config: &SimConfig,
+) -> Result<Vec<(String, Vec<u8>)>, CliError> {
+    let staging = tempfile::Builder::new()
+        .prefix("gaze-lidar-plots")
+        .tempdir()
+        .map_err(|e| CliError::output(format!("--plots: temporary folder: {e}")))?;
+    sim::plots::write_sweep(sweep, results, config, staging.path())
+        .map_err(|e| CliError::output(e.to_string()))?;
+    sim::plots::sweep_file_names(sweep)
+        .into_iter()
+        .map(|name| {
+            let path = staging.path().join(&name);
+            std::fs::read(&path)
+                .map(|b| (name, b))
+                .map_err(|e| CliError::output(format!("--plots: {}: {e}", path.display())))
+        })
+        .collect()
+}
+
+/// `--sweep` without `--report`: the grid once per value of each key
+/// (the values of a key run together, [`sim::run_many`]); tables (or JSON)
+/// on stdout, with `--plots DIR` one figure per key.
+fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
+    if a.trials_csv.is_some() || a.export_json.is_some() || a.export_csv.is_some() {
+        return Err(CliError::input(
+            "--sweep prints its tables on stdout: --trials-csv, --export-json and --export-csv are not available with it",
+        ));
     }
+    if a.sweep_trials.is_some() {
+        return Err(CliError::input(
+            "--sweep-trials sets the trials of the report's sweeps: use --trials without --report",
+        ));
+    }
+    let sweeps = parse_sweeps(&a.sweep)?;
+    // Every value is validated before anything runs.
+    let configs = sweeps
+        .iter()
+        .map(|sw| sweep_configs(sw, config))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut outputs = Outputs::default();
+    outputs.claim_stdout("the sweep tables");
+    if let Some(dir) = &a.plots {
+        let names: Vec<String> = sweeps
+            .iter()
+            .flat_map(sim::plots::sweep_file_names)
+            .collect();
+        outputs.folder("--plots", dir, &names);
+    }
+    outputs.check()?;
     let mut text = String::new();
     let mut json = Vec::new();
     for (sw, per_value) in sweeps.iter().zip(&configs) {
-        let results = per_value
-            .iter()
-            .map(|c| sim::run(c, &|| {}))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| {
-                if e.is_input_error() {
-                    CliError::input(e.to_string())
-                } else {
-                    CliError::infeasible(e.to_string())
-                }
-            })?;
+        let results = sim::run_many(per_value, &|| {}).map_err(sim_error)?;
+        if let Some(dir) = &a.plots {
+            for (name, bytes) in render_sweep_plot(sw, &results, config)? {
+                outputs.set(&dir.join(name), bytes);
+            }
+        }
         match a.format {
             Format::Json => {
                 let values = sw
@@ -508,10 +632,14 @@ fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
             .map_err(|e| CliError::input(e.to_string()))?;
         text.push('\n');
     }
-    let mut outputs = Outputs::default();
-    outputs.claim_stdout("the sweep tables");
-    outputs.check()?;
     outputs.stdout(text);
     outputs.commit()?;
+    if let Some(dir) = &a.plots {
+        for sw in &sweeps {
+            for name in sim::plots::sweep_file_names(sw) {
+                warn(format_args!("wrote {}", dir.join(name).display()));
+            }
+        }
+    }
     Ok(0)
 }

@@ -516,14 +516,7 @@ pub fn run(
     let statics = config.scenario.static_boxes();
     let models: Vec<ReturnModel> = fogs
         .iter()
-        .map(|&fog| {
-            ReturnModel::new(
-                ModelKind::Physical,
-                fog,
-                sensor.lidar.rated_range_m,
-                sensor.lidar.reference_reflectivity,
-            )
-        })
+        .map(|&fog| super::return_model(&config.scenario, ModelKind::Physical, fog, sensor))
         .collect();
     let nominal = sensor.focus.regions(config.scenario.gaze_deg);
     let per_trial: Result<Vec<Vec<TrialRecord>>, SimError> = (0..config.trials)

@@ -656,164 +656,286 @@ struct Job {
 
 /// Runs the grid; `tick` is called once per finished trial (progress bars).
 pub fn run(config: &SimConfig, tick: &(dyn Fn() + Sync)) -> Result<GridResult, SimError> {
-    config.scenario.validate()?;
-    if config.trials == 0 || config.trials > 100_000 {
-        return Err(SimError::Argument(format!(
-            "trials: {} must lie in 1..=100000",
-            config.trials
-        )));
+    if config.per_cell && config.geometry == Geometry::Planar {
+        let prep = Prepared::new(config)?;
+        let sensor_of = |v: Variant| prep.sensor_of(v);
+        let records =
+            run_planar_per_cell(config, &prep.fogs, prep.table.as_ref(), &sensor_of, tick)?;
+        let rows = rows_of(config, &records, &sensor_of);
+        return Ok(GridResult {
+            rows,
+            trials: records,
+        });
     }
-    if config.detector == Detector::Argus && config.geometry != Geometry::Carla {
-        return Err(SimError::Argument(
-            "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)"
-                .into(),
-        ));
-    }
-    if config.geometry == Geometry::Carla && config.scenario.false_alarms_per_frame > 0.0 {
-        return Err(SimError::Argument(
-            "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)"
-                .into(),
-        ));
-    }
-    if config.geometry == Geometry::Carla {
-        config.scenario.validate_carla()?;
-    } else if config.sampling() != Sampling::Drift {
-        return Err(SimError::Argument(format!(
-            "--sampling {} needs --geometry carla (the planar geometry has only the drift pulse clock)",
-            config.sampling().name()
-        )));
-    }
-    let fogs: Vec<FogLevel> = config
-        .fog_pcts
+    let mut results = run_many(std::slice::from_ref(config), tick)?;
+    Ok(results.remove(0))
+}
+
+/// Runs several grids (a sweep's values) at once, each result identical to
+/// [`run`]'s: trial by trial, every configuration in turn, so the work that
+/// does not depend on the swept value is shared — the pulses' azimuths and
+/// ray directions (planar, [`trial::PulseCache`]) and CARLA's drop-off
+/// draws ([`carla::TrialRays`]). `tick` is called once per finished trial
+/// and cell of any configuration.
+pub fn run_many(
+    configs: &[SimConfig],
+    tick: &(dyn Fn() + Sync),
+) -> Result<Vec<GridResult>, SimError> {
+    let preps = configs
         .iter()
-        .map(|&f| FogLevel::of(f))
-        .collect::<Result<_, _>>()?;
-    // Plan every variant once up front so a bad one fails before any work.
-    for &m in &config.models {
-        for v in config.variants.iter().filter_map(|v| v.mode()) {
-            variant_profile_for(&config.sensor, m, v, config.scenario.gaze_deg, config.bins)
-                .map_err(|source| SimError::Plan {
-                    variant: v.name(),
-                    source,
-                })?;
+        .map(Prepared::new)
+        .collect::<Result<Vec<_>, _>>()?;
+    let most = configs.iter().map(|c| c.trials).max().unwrap_or(0);
+    let per_trial: Vec<Result<Vec<Vec<TrialRecord>>, SimError>> = (0..most)
+        .into_par_iter()
+        .map_init(trial::PulseCache::default, |pulses, trial| {
+            // The pulses' allocations are reused from trial to trial.
+            pulses.clear();
+            let mut rays = carla::TrialRays::default();
+            preps
+                .iter()
+                .map(|prep| {
+                    if trial >= prep.config.trials {
+                        return Ok(Vec::new());
+                    }
+                    match prep.config.geometry {
+                        Geometry::Planar => planar_trial(prep, trial, pulses, tick),
+                        Geometry::Carla => carla_trial(prep, trial, &mut rays, tick),
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let per_trial = per_trial.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let mut by_config: Vec<Vec<Vec<TrialRecord>>> = vec![Vec::new(); preps.len()];
+    for trial in per_trial {
+        for (i, records) in trial.into_iter().enumerate() {
+            by_config[i].push(records);
         }
     }
-    let table = OptTable::build(config)?;
-    let opt_sensor = table.as_ref().map(|t| t.sensor(&config.sensor));
-    let sensor_of = |v: Variant| sensor_for(v, opt_sensor.as_ref(), &config.sensor);
-    let records = match config.geometry {
-        Geometry::Planar => run_planar(config, &fogs, table.as_ref(), &sensor_of, tick)?,
-        Geometry::Carla => run_carla(config, &fogs, table.as_ref(), &sensor_of, tick)?,
-    };
-    let rows = rows_of(config, &records, &sensor_of);
-    Ok(GridResult {
-        rows,
-        trials: records,
-    })
+    preps
+        .iter()
+        .zip(by_config)
+        .map(|(prep, per_trial)| {
+            let records = in_planar_order(prep.config, Ok(per_trial))?;
+            let sensor_of = |v: Variant| prep.sensor_of(v);
+            let rows = rows_of(prep.config, &records, &sensor_of);
+            Ok(GridResult {
+                rows,
+                trials: records,
+            })
+        })
+        .collect()
+}
+
+/// The return model of `kind` at `fog` for `sensor` in `scenario`: the
+/// scenario's `argus_fog_threshold_scale` multiplies the `argus` model's
+/// intensity threshold (the physical model has no fog threshold).
+#[must_use]
+pub fn return_model(
+    scenario: &Scenario,
+    kind: ModelKind,
+    fog: FogLevel,
+    sensor: &Preset,
+) -> ReturnModel {
+    let mut m = ReturnModel::new(
+        kind,
+        fog,
+        sensor.lidar.rated_range_m,
+        sensor.lidar.reference_reflectivity,
+    );
+    if let ReturnModel::Argus { threshold, .. } = &mut m {
+        if scenario.argus_fog_threshold_scale != 1.0 {
+            *threshold *= scenario.argus_fog_threshold_scale;
+        }
+    }
+    m
+}
+
+/// A configuration checked and set up for its trials.
+struct Prepared<'c> {
+    config: &'c SimConfig,
+    fogs: Vec<FogLevel>,
+    table: Option<OptTable>,
+    opt_sensor: Option<Preset>,
+    /// Planar geometry: the static boxes.
+    statics: Vec<scene::Aabb>,
+    /// Carla geometry: the static boxes.
+    carla_statics: Vec<carla::geometry::StaticBox>,
+    /// Planar geometry: the physical model's saturation bounds, once per
+    /// distinct model (building and vehicle hits, to the farthest a planar
+    /// ray can reach).
+    saturations: Vec<(ReturnModel, Option<returns::Saturation>)>,
+}
+
+impl<'c> Prepared<'c> {
+    fn new(config: &'c SimConfig) -> Result<Self, SimError> {
+        config.scenario.validate()?;
+        if config.trials == 0 || config.trials > 100_000 {
+            return Err(SimError::Argument(format!(
+                "trials: {} must lie in 1..=100000",
+                config.trials
+            )));
+        }
+        if config.detector == Detector::Argus && config.geometry != Geometry::Carla {
+            return Err(SimError::Argument(
+                "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)"
+                    .into(),
+            ));
+        }
+        if config.geometry == Geometry::Carla && config.scenario.false_alarms_per_frame > 0.0 {
+            return Err(SimError::Argument(
+                "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)"
+                    .into(),
+            ));
+        }
+        if config.geometry == Geometry::Carla {
+            config.scenario.validate_carla()?;
+        } else if config.sampling() != Sampling::Drift {
+            return Err(SimError::Argument(format!(
+                "--sampling {} needs --geometry carla (the planar geometry has only the drift pulse clock)",
+                config.sampling().name()
+            )));
+        }
+        let fogs: Vec<FogLevel> = config
+            .fog_pcts
+            .iter()
+            .map(|&f| FogLevel::of(f))
+            .collect::<Result<_, _>>()?;
+        // Plan every variant once up front so a bad one fails before any work.
+        for &m in &config.models {
+            for v in config.variants.iter().filter_map(|v| v.mode()) {
+                variant_profile_for(&config.sensor, m, v, config.scenario.gaze_deg, config.bins)
+                    .map_err(|source| SimError::Plan {
+                        variant: v.name(),
+                        source,
+                    })?;
+            }
+        }
+        let table = OptTable::build(config)?;
+        let opt_sensor = table.as_ref().map(|t| t.sensor(&config.sensor));
+        let mut prep = Self {
+            config,
+            fogs,
+            table,
+            opt_sensor,
+            statics: Vec::new(),
+            carla_statics: Vec::new(),
+            saturations: Vec::new(),
+        };
+        match config.geometry {
+            Geometry::Planar => {
+                prep.statics = config.scenario.static_boxes();
+                let reflectivity = [
+                    config.scenario.building_reflectivity,
+                    config.scenario.vehicle_reflectivity,
+                ];
+                let mut saturations: Vec<(ReturnModel, Option<returns::Saturation>)> = Vec::new();
+                for &model in &config.models {
+                    for &variant in &config.variants {
+                        let sensor = prep.sensor_of(variant);
+                        for &fog in &prep.fogs {
+                            let m = return_model(&config.scenario, model, fog, sensor);
+                            if !saturations.iter().any(|(x, _)| *x == m) {
+                                let sat = returns::Saturation::new(
+                                    &m,
+                                    reflectivity,
+                                    PLANAR_SATURATION_RANGE_M,
+                                );
+                                saturations.push((m, sat));
+                            }
+                        }
+                    }
+                }
+                prep.saturations = saturations;
+            }
+            Geometry::Carla => prep.carla_statics = config.scenario.carla_static_boxes(),
+        }
+        Ok(prep)
+    }
+
+    /// The sensor and driver model a variant runs with.
+    fn sensor_of(&self, variant: Variant) -> &Preset {
+        sensor_for(variant, self.opt_sensor.as_ref(), &self.config.sensor)
+    }
+
+    fn saturation_of(&self, m: &ReturnModel) -> Option<&returns::Saturation> {
+        self.saturations
+            .iter()
+            .find(|(x, _)| x == m)
+            .and_then(|(_, s)| s.as_ref())
+    }
 }
 
 /// Range of the planar saturation tables, m (hits beyond take the model).
 const PLANAR_SATURATION_RANGE_M: f64 = 400.0;
 
-/// The planar geometry: per trial, every cell planned, cells sharing a
+/// One trial of the planar geometry: every cell planned, cells sharing a
 /// timeline and the driver's regions cast together ([`trial::run_group`]);
-/// records in the order of [`run_planar_per_cell`], bit-identical to it.
-fn run_planar<'s>(
-    config: &SimConfig,
-    fogs: &[FogLevel],
-    table: Option<&OptTable>,
-    sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
+/// the records bit-identical to [`run_planar_per_cell`]'s.
+fn planar_trial(
+    prep: &Prepared<'_>,
+    trial: usize,
+    pulses: &mut trial::PulseCache,
     tick: &(dyn Fn() + Sync),
 ) -> Result<Vec<TrialRecord>, SimError> {
-    if config.per_cell {
-        return run_planar_per_cell(config, fogs, table, sensor_of, tick);
-    }
-    let statics = config.scenario.static_boxes();
-    // The physical model's saturation bounds, once per distinct model
-    // (building and vehicle hits, to the farthest a planar ray can reach).
-    let reflectivity = [
-        config.scenario.building_reflectivity,
-        config.scenario.vehicle_reflectivity,
-    ];
-    let mut saturations: Vec<(ReturnModel, Option<returns::Saturation>)> = Vec::new();
-    for &model in &config.models {
-        for &variant in &config.variants {
-            let sensor = sensor_of(variant);
-            for &fog in fogs {
-                let m = ReturnModel::new(
+    let config = prep.config;
+    let d = draw(config.seed, trial, &config.scenario);
+    let sensor_of = |v: Variant| prep.sensor_of(v);
+    let plans = plan_trial(
+        config,
+        &prep.fogs,
+        prep.table.as_ref(),
+        &sensor_of,
+        d.gaze_deg,
+    )?;
+    // Group the plans by timeline and regions (first-seen order).
+    let groups = group_plans(&plans, |a, b| a.regions == b.regions);
+    let mut out = Vec::new();
+    for g in &groups {
+        let mut cells = Vec::new();
+        let mut keys = Vec::new();
+        for &i in g {
+            let plan = &plans[i];
+            for (fog, model) in &plan.models {
+                cells.push(trial::GroupCell {
+                    profile: plan.profile.profile(),
+                    rof_keep: plan.rof_keep,
                     model,
-                    fog,
-                    sensor.lidar.rated_range_m,
-                    sensor.lidar.reference_reflectivity,
-                );
-                if !saturations.iter().any(|(x, _)| *x == m) {
-                    let sat = returns::Saturation::new(&m, reflectivity, PLANAR_SATURATION_RANGE_M);
-                    saturations.push((m, sat));
-                }
+                    driver_range_m: fog.mor_m,
+                    saturation: prep.saturation_of(model),
+                });
+                keys.push((plan.model, plan.variant, fog.fog_pct));
             }
         }
+        let first = &plans[g[0]];
+        let setup = trial::TrialSetup {
+            scenario: &config.scenario,
+            statics: &prep.statics,
+            profile: first.profile.profile(),
+            rof_keep: first.rof_keep,
+            regions: &first.regions,
+            model: cells[0].model,
+            driver_range_m: cells[0].driver_range_m,
+            detection: config.detection,
+            brute_force: config.brute_force,
+            arrival: config.arrival,
+            ego_yaw_deg: config.scenario.carla.ego_yaw_deg,
+            gaze_deg: d.gaze_deg,
+        };
+        let outcomes = trial::run_group_with(&setup, &cells, &d, pulses);
+        for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
+            tick();
+            out.push(TrialRecord {
+                model,
+                variant: variant.name(),
+                fog_pct,
+                trial,
+                outcome,
+            });
+        }
     }
-    let saturation_of = |m: &ReturnModel| {
-        saturations
-            .iter()
-            .find(|(x, _)| x == m)
-            .and_then(|(_, s)| s.as_ref())
-    };
-    let per_trial: Result<Vec<Vec<TrialRecord>>, SimError> = (0..config.trials)
-        .into_par_iter()
-        .map(|trial| {
-            let d = draw(config.seed, trial, &config.scenario);
-            let plans = plan_trial(config, fogs, table, sensor_of, d.gaze_deg)?;
-            // Group the plans by timeline and regions (first-seen order).
-            let groups = group_plans(&plans, |a, b| a.regions == b.regions);
-            let mut out = Vec::new();
-            for g in &groups {
-                let mut cells = Vec::new();
-                let mut keys = Vec::new();
-                for &i in g {
-                    let plan = &plans[i];
-                    for (fog, model) in &plan.models {
-                        cells.push(trial::GroupCell {
-                            profile: plan.profile.profile(),
-                            rof_keep: plan.rof_keep,
-                            model,
-                            driver_range_m: fog.mor_m,
-                            saturation: saturation_of(model),
-                        });
-                        keys.push((plan.model, plan.variant, fog.fog_pct));
-                    }
-                }
-                let first = &plans[g[0]];
-                let setup = trial::TrialSetup {
-                    scenario: &config.scenario,
-                    statics: &statics,
-                    profile: first.profile.profile(),
-                    rof_keep: first.rof_keep,
-                    regions: &first.regions,
-                    model: cells[0].model,
-                    driver_range_m: cells[0].driver_range_m,
-                    detection: config.detection,
-                    brute_force: config.brute_force,
-                    arrival: config.arrival,
-                    ego_yaw_deg: config.scenario.carla.ego_yaw_deg,
-                    gaze_deg: d.gaze_deg,
-                };
-                let outcomes = trial::run_group(&setup, &cells, &d);
-                for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
-                    tick();
-                    out.push(TrialRecord {
-                        model,
-                        variant: variant.name(),
-                        fog_pct,
-                        trial,
-                        outcome,
-                    });
-                }
-            }
-            Ok(out)
-        })
-        .collect();
-    in_planar_order(config, per_trial)
+    Ok(out)
 }
 
 /// The planar geometry one job per (model, variant, fog, trial), each cast
@@ -854,12 +976,7 @@ fn run_planar_per_cell<'s>(
                 table,
             )?;
             let regions = sensor.focus.regions(d.gaze_deg);
-            let model = ReturnModel::new(
-                job.model,
-                job.fog,
-                sensor.lidar.rated_range_m,
-                sensor.lidar.reference_reflectivity,
-            );
+            let model = return_model(&config.scenario, job.model, job.fog, sensor);
             let setup = trial::TrialSetup {
                 scenario: &config.scenario,
                 statics: &statics,
@@ -915,17 +1032,7 @@ fn plan_trial<'s>(
                 plan_variant(&config.sensor, model, variant, gaze_deg, config.bins, table)?;
             let models = fogs
                 .iter()
-                .map(|&fog| {
-                    (
-                        fog,
-                        ReturnModel::new(
-                            model,
-                            fog,
-                            sensor.lidar.rated_range_m,
-                            sensor.lidar.reference_reflectivity,
-                        ),
-                    )
-                })
+                .map(|&fog| (fog, return_model(&config.scenario, model, fog, sensor)))
                 .collect();
             plans.push(Plan {
                 model,
@@ -958,68 +1065,67 @@ fn group_plans(plans: &[Plan], also: impl Fn(&Plan, &Plan) -> bool) -> Vec<Vec<u
     groups
 }
 
-/// The `carla` geometry: per trial, every cell planned, cells sharing a
-/// timeline cast together ([`carla::run_group`]); records in the planar order.
-fn run_carla<'s>(
-    config: &SimConfig,
-    fogs: &[FogLevel],
-    table: Option<&OptTable>,
-    sensor_of: &(dyn Fn(Variant) -> &'s Preset + Sync),
+/// One trial of the `carla` geometry: every cell planned, cells sharing a
+/// timeline cast together ([`carla::run_group`]).
+fn carla_trial(
+    prep: &Prepared<'_>,
+    trial: usize,
+    rays: &mut carla::TrialRays,
     tick: &(dyn Fn() + Sync),
 ) -> Result<Vec<TrialRecord>, SimError> {
-    let statics = config.scenario.carla_static_boxes();
-    let per_trial: Result<Vec<Vec<TrialRecord>>, SimError> = (0..config.trials)
-        .into_par_iter()
-        .map(|trial| {
-            let d = draw(config.seed, trial, &config.scenario);
-            let plans = plan_trial(config, fogs, table, sensor_of, d.gaze_deg)?;
-            // Group the plans by timeline (first-seen order).
-            let groups = group_plans(&plans, |_, _| true);
-            let mut out = Vec::new();
-            let mut rays = carla::TrialRays::default();
-            for g in &groups {
-                let mut specs = Vec::new();
-                let mut keys = Vec::new();
-                for &i in g {
-                    let plan = &plans[i];
-                    for (fog, model) in &plan.models {
-                        specs.push(carla::CellSpec {
-                            profile: plan.profile.profile(),
-                            rof_keep: plan.rof_keep,
-                            regions: &plan.regions,
-                            model,
-                            driver_range_m: fog.mor_m,
-                        });
-                        keys.push((plan.model, plan.variant, fog.fog_pct));
-                    }
-                }
-                let setup = carla::GroupSetup {
-                    scenario: &config.scenario,
-                    statics: &statics,
-                    cells: &specs,
-                    detector: config.detector,
-                    arrival: config.arrival,
-                    detection: config.detection,
-                    brute_force: config.brute_force,
-                    gaze_deg: d.gaze_deg,
-                    sampling: config.sampling(),
-                };
-                let outcomes = carla::run_group_with(&setup, &d, &mut rays);
-                for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
-                    tick();
-                    out.push(TrialRecord {
-                        model,
-                        variant: variant.name(),
-                        fog_pct,
-                        trial,
-                        outcome,
-                    });
-                }
+    let config = prep.config;
+    let d = draw(config.seed, trial, &config.scenario);
+    let sensor_of = |v: Variant| prep.sensor_of(v);
+    let plans = plan_trial(
+        config,
+        &prep.fogs,
+        prep.table.as_ref(),
+        &sensor_of,
+        d.gaze_deg,
+    )?;
+    // Group the plans by timeline (first-seen order).
+    let groups = group_plans(&plans, |_, _| true);
+    let mut out = Vec::new();
+    for g in &groups {
+        let mut specs = Vec::new();
+        let mut keys = Vec::new();
+        for &i in g {
+            let plan = &plans[i];
+            for (fog, model) in &plan.models {
+                specs.push(carla::CellSpec {
+                    profile: plan.profile.profile(),
+                    rof_keep: plan.rof_keep,
+                    regions: &plan.regions,
+                    model,
+                    driver_range_m: fog.mor_m,
+                });
+                keys.push((plan.model, plan.variant, fog.fog_pct));
             }
-            Ok(out)
-        })
-        .collect();
-    in_planar_order(config, per_trial)
+        }
+        let setup = carla::GroupSetup {
+            scenario: &config.scenario,
+            statics: &prep.carla_statics,
+            cells: &specs,
+            detector: config.detector,
+            arrival: config.arrival,
+            detection: config.detection,
+            brute_force: config.brute_force,
+            gaze_deg: d.gaze_deg,
+            sampling: config.sampling(),
+        };
+        let outcomes = carla::run_group_with(&setup, &d, rays);
+        for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
+            tick();
+            out.push(TrialRecord {
+                model,
+                variant: variant.name(),
+                fog_pct,
+                trial,
+                outcome,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// The records of every trial in the planar order: model, variant, fog, trial.

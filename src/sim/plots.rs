@@ -8,6 +8,7 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
+use super::sweep::{figure_stem, short_name, Sweep};
 use super::{GridResult, ModelKind, SimConfig};
 use crate::model::presets;
 use crate::planner::{closed_form, Mode};
@@ -329,5 +330,150 @@ pub fn write_all(
             .collect::<Vec<_>>(),
         file_names(config)
     );
+    Ok(written)
+}
+
+/// The file names [`write_sweep`] writes (an SVG and a PNG).
+#[must_use]
+pub fn sweep_file_names(sweep: &Sweep) -> Vec<String> {
+    let stem = figure_stem(sweep);
+    vec![format!("{stem}.svg"), format!("{stem}.png")]
+}
+
+/// One sweep's figure: a panel per (model, fog level), the median TTA of
+/// the car from the right per variant against the key's values, each with
+/// its bootstrap 95 % interval as an error bar (variants drawn slightly
+/// apart along x so the bars stay visible).
+fn draw_sweep<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    sweep: &Sweep,
+    results: &[GridResult],
+    config: &SimConfig,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let title = format!(
+        "Sensitivity to {} — median TTA at detection, car from the right (95 % interval)",
+        short_name(&sweep.key)
+    );
+    let root = root.titled(&title, ("sans-serif", 20))?;
+    let panels = root.split_evenly((config.models.len(), config.fog_pcts.len()));
+    let xs: Vec<f64> = sweep.values.clone();
+    let (x_lo, x_hi) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    let span = if x_hi > x_lo { x_hi - x_lo } else { 1.0 };
+    let x_range = (x_lo - 0.08 * span)..(x_hi + 0.08 * span);
+    let dx = 0.012 * span;
+    for (m, &model) in config.models.iter().enumerate() {
+        // One y range per model so its panels compare.
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for r in results {
+            for row in r.rows.iter().filter(|x| x.model == model) {
+                for y in [
+                    row.stats.tta_ci_lo_s,
+                    row.tta_median_s,
+                    row.stats.tta_ci_hi_s,
+                ]
+                .into_iter()
+                .flatten()
+                {
+                    lo = lo.min(y);
+                    hi = hi.max(y);
+                }
+            }
+        }
+        let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) };
+        let pad = ((hi - lo) * 0.08).max(0.05);
+        let y_range = (lo - pad).max(0.0)..(hi + pad);
+        for (f, &fog) in config.fog_pcts.iter().enumerate() {
+            let panel = &panels[m * config.fog_pcts.len() + f];
+            let mut chart = ChartBuilder::on(panel)
+                .caption(
+                    format!("{} model, fog {fog} %", model.name()),
+                    ("sans-serif", 16),
+                )
+                .margin(8)
+                .x_label_area_size(36)
+                .y_label_area_size(56)
+                .build_cartesian_2d(x_range.clone(), y_range.clone())?;
+            chart
+                .configure_mesh()
+                .x_desc(short_name(&sweep.key))
+                .y_desc("median TTA [s]")
+                .label_style(("sans-serif", 12))
+                .draw()?;
+            let nv = config.variants.len() as f64;
+            for (i, v) in config.variants.iter().enumerate() {
+                let color = COLORS[i % COLORS.len()];
+                let off = (i as f64 - 0.5 * (nv - 1.0)) * dx;
+                let points: Vec<(f64, &super::Row)> = xs
+                    .iter()
+                    .zip(results)
+                    .filter_map(|(&x, r)| Some((x + off, r.row(model, v.name(), fog)?)))
+                    .collect();
+                let line: Vec<(f64, f64)> = points
+                    .iter()
+                    .filter_map(|(x, row)| Some((*x, row.tta_median_s?)))
+                    .collect();
+                let series =
+                    chart.draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))?;
+                if m == 0 && f == 0 {
+                    series.label(v.name()).legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(3))
+                    });
+                }
+                chart.draw_series(line.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+                for (x, row) in &points {
+                    if let (Some(a), Some(b)) = (row.stats.tta_ci_lo_s, row.stats.tta_ci_hi_s) {
+                        let style = color.stroke_width(1);
+                        let w = 0.4 * dx;
+                        chart.draw_series([
+                            PathElement::new(vec![(*x, a), (*x, b)], style),
+                            PathElement::new(vec![(x - w, a), (x + w, a)], style),
+                            PathElement::new(vec![(x - w, b), (x + w, b)], style),
+                        ])?;
+                    }
+                }
+            }
+            if m == 0 && f == 0 {
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::LowerLeft)
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK)
+                    .label_font(("sans-serif", 12))
+                    .draw()?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes a sweep's figure into `dir` (created if missing); returns the
+/// files (those of [`sweep_file_names`]). `results` holds one grid per
+/// value of `sweep`, each run with `config` (but for the swept key).
+pub fn write_sweep(
+    sweep: &Sweep,
+    results: &[GridResult],
+    config: &SimConfig,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, PlotError> {
+    register_font();
+    std::fs::create_dir_all(dir).map_err(|e| PlotError {
+        path: dir.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let mut written = Vec::new();
+    let stem = figure_stem(sweep);
+    let height = 60 + 300 * config.models.len() as u32;
+    svg_and_png!(dir, stem, (1200, height), written, |root| {
+        draw_sweep(root, sweep, results, config)
+    });
     Ok(written)
 }

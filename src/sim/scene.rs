@@ -88,6 +88,11 @@ pub struct Scenario {
     /// The detector's false detections per frame: in each frame, one with
     /// this probability (`[0, 1]`; planar geometry only; default 0).
     pub false_alarms_per_frame: f64,
+    /// The fog threshold: a factor on the `argus` return model's intensity
+    /// thresholds in fog (the ARGUS code's 0.055 at code fog 50 and 0.0041
+    /// at code fog 100; 1 = the code's values, 0 = no threshold). The
+    /// physical model has no fog threshold and ignores it.
+    pub argus_fog_threshold_scale: f64,
     /// The `carla` geometry's parameters (table `[carla]`; ignored by `planar`).
     pub carla: CarlaParams,
 }
@@ -111,6 +116,7 @@ impl Default for Scenario {
             vehicle_reflectivity: 0.1,
             building_reflectivity: 0.3,
             false_alarms_per_frame: 0.0,
+            argus_fog_threshold_scale: 1.0,
             carla: CarlaParams::default(),
         }
     }
@@ -245,6 +251,13 @@ impl Scenario {
                 "false_alarms_per_frame",
                 self.false_alarms_per_frame,
                 "must be a probability per frame in [0, 1]",
+            );
+        }
+        if !(0.0..=100.0).contains(&self.argus_fog_threshold_scale) {
+            return bad(
+                "argus_fog_threshold_scale",
+                self.argus_fog_threshold_scale,
+                "must lie in [0, 100] (1: the ARGUS code's thresholds)",
             );
         }
         if self.vehicle_width_m >= self.lane_width_m {

@@ -1,13 +1,16 @@
 //! Sensitivity sweeps: the same run repeated over values of one scenario
-//! key (`simulate --sweep KEY=V1,V2,…`), one table per key.
+//! key (`simulate --sweep KEY=V1,V2,…`), one table and one figure per key.
 //!
 //! A key is any numeric key of the scenario TOML, dotted for the `[carla]`
 //! table (`speed_kmh`, `carla.mount_height_m`, `carla.tick_s`,
 //! `carla.spawn_distance_m`, …), or an alias: `mount_height` =
 //! `carla.mount_height_m`, `tick` = `carla.tick_s`, `spawn_distance` =
-//! `carla.spawn_distance_m`. Each value goes through the scenario's own
-//! validation. The grid phase and the fog threshold are not scenario keys
-//! and cannot be swept yet.
+//! `carla.spawn_distance_m`, `grid_phase` = `carla.grid_phase_steps` (the
+//! azimuth phase of CARLA's scan grid in fractions of a step; `carla`
+//! geometry), `fog_threshold` = `argus_fog_threshold_scale` (a factor on
+//! the `argus` return model's intensity thresholds in fog). Each value goes
+//! through the scenario's own validation; the values of a sweep run
+//! together ([`super::run_many`]), sharing what does not depend on them.
 
 use std::fmt::Write;
 
@@ -15,11 +18,29 @@ use super::scene::{Scenario, ScenarioError};
 use super::GridResult;
 
 /// Aliases of the sweep keys.
-pub const ALIASES: [(&str, &str); 3] = [
+pub const ALIASES: [(&str, &str); 5] = [
     ("mount_height", "carla.mount_height_m"),
     ("tick", "carla.tick_s"),
     ("spawn_distance", "carla.spawn_distance_m"),
+    ("grid_phase", "carla.grid_phase_steps"),
+    ("fog_threshold", "argus_fog_threshold_scale"),
 ];
+
+/// The alias of a scenario key, or the key itself.
+#[must_use]
+pub fn short_name(key: &str) -> &str {
+    ALIASES
+        .iter()
+        .find(|(_, k)| *k == key)
+        .map_or(key, |(a, _)| *a)
+}
+
+/// The stem of a sweep's figure (`--plots`): `sweep_` and the key's short
+/// name (its alias, or the key with `.` as `_`).
+#[must_use]
+pub fn figure_stem(sweep: &Sweep) -> String {
+    format!("sweep_{}", short_name(&sweep.key).replace('.', "_"))
+}
 
 /// Most values in one sweep.
 pub const MAX_VALUES: usize = 50;
@@ -40,7 +61,7 @@ pub enum SweepError {
     #[error("--sweep: '{0}' is not KEY=V1,V2,… (at least one number, at most 50)")]
     Syntax(String),
     /// The key is not a numeric scenario key.
-    #[error("--sweep: '{0}' is not a numeric scenario key (e.g. speed_kmh, carla.mount_height_m, tick, mount_height, spawn_distance)")]
+    #[error("--sweep: '{0}' is not a numeric scenario key (e.g. speed_kmh, carla.mount_height_m, mount_height, tick, spawn_distance, grid_phase, fog_threshold)")]
     Key(String),
     /// A value is rejected by the scenario.
     #[error("--sweep {key}={value}: {reason}")]
@@ -190,6 +211,21 @@ mod tests {
         assert_eq!(s.key, "carla.tick_s");
         assert_eq!(s.values, vec![0.05, 0.1]);
         assert_eq!(parse("speed_kmh=30").unwrap().key, "speed_kmh");
+        assert_eq!(
+            parse("grid_phase=0,0.5").unwrap().key,
+            "carla.grid_phase_steps"
+        );
+        assert_eq!(
+            parse("fog_threshold=0.5,2").unwrap().key,
+            "argus_fog_threshold_scale"
+        );
+        assert_eq!(short_name("carla.grid_phase_steps"), "grid_phase");
+        assert_eq!(short_name("speed_kmh"), "speed_kmh");
+        // A grid phase is a fraction of one step; a threshold factor >= 0.
+        let e = parse("grid_phase=1").unwrap_err().to_string();
+        assert!(e.contains("carla.grid_phase_steps"), "{e}");
+        let e = parse("fog_threshold=-1").unwrap_err().to_string();
+        assert!(e.contains("argus_fog_threshold_scale"), "{e}");
         assert!(matches!(parse("speed_kmh"), Err(SweepError::Syntax(_))));
         assert!(matches!(parse("speed_kmh=a"), Err(SweepError::Syntax(_))));
         assert!(matches!(parse("nope=1"), Err(SweepError::Key(_))));

@@ -621,6 +621,111 @@ pub fn run_group(
     cells: &[GroupCell<'_>],
     draw: &TrialDraw,
 ) -> Vec<TrialOutcome> {
+    run_group_with(setup, cells, draw, &mut PulseCache::default())
+}
+
+/// One pulse of a trial: its frame, azimuth, bin and (once a ray was cast
+/// along it) the ray's direction `(sin, cos)`.
+#[derive(Debug, Clone, Copy)]
+struct Pulse {
+    frame: u64,
+    az_deg: f64,
+    bin: usize,
+    dir: Option<(f64, f64)>,
+}
+
+/// The pulses of a trial, shared by every [`run_group_with`] call over the
+/// same timeline and phase (the values of a sweep): where the head points
+/// at each pulse does not depend on the scene, so it is computed once.
+/// The key holds every bit the pulses depend on (pulse and frame rate, the
+/// bins' extents and spins, the trial's phase), so a cached pulse equals
+/// the one computed afresh, bit for bit.
+#[derive(Debug, Default)]
+pub struct PulseCache {
+    /// Key, pulses; entries from `live` on are spare (allocations kept).
+    memo: Vec<(Vec<u64>, Vec<Pulse>)>,
+    live: usize,
+}
+
+impl PulseCache {
+    /// Forgets every entry but keeps the allocations (for the next trial).
+    pub fn clear(&mut self) {
+        self.live = 0;
+    }
+
+    /// The first `n` pulses of `profile`'s timeline starting `phase_s`
+    /// into its turn.
+    fn pulses(
+        &mut self,
+        profile: &Profile,
+        tl: &Timeline<'_>,
+        phase_s: f64,
+        n: u64,
+    ) -> &mut Vec<Pulse> {
+        let mut key = Vec::with_capacity(3 + 4 * profile.bins.len());
+        key.extend([
+            profile.pulse_rate_hz.to_bits(),
+            profile.frame_rate_hz.to_bits(),
+            phase_s.to_bits(),
+        ]);
+        for b in &profile.bins {
+            key.extend([
+                b.start_deg.to_bits(),
+                b.width_deg.to_bits(),
+                b.spin_start_rad_s.to_bits(),
+                b.spin_end_rad_s.to_bits(),
+            ]);
+        }
+        let i = match self.memo[..self.live].iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                if self.live == self.memo.len() {
+                    self.memo.push((Vec::new(), Vec::new()));
+                }
+                let slot = &mut self.memo[self.live];
+                slot.0 = key;
+                slot.1.clear();
+                self.live += 1;
+                self.live - 1
+            }
+        };
+        let pulses = &mut self.memo[i].1;
+        let period = tl.period_s();
+        let pulse_rate = profile.pulse_rate_hz;
+        let mut k = pulses.len() as u64;
+        let (mut current_frame, mut bin_hint) =
+            pulses.last().map_or((u64::MAX, 0), |p| (p.frame, p.bin));
+        while k < n {
+            let t = k as f64 / pulse_rate;
+            let tau_total = t + phase_s;
+            let frame = (tau_total / period).floor() as u64;
+            let tau = (tau_total - frame as f64 * period).clamp(0.0, period);
+            if frame != current_frame {
+                current_frame = frame;
+                bin_hint = 0;
+            }
+            let (az_deg, bin) = tl.azimuth_at_from(tau, bin_hint);
+            bin_hint = bin;
+            pulses.push(Pulse {
+                frame,
+                az_deg,
+                bin,
+                dir: None,
+            });
+            k += 1;
+        }
+        pulses
+    }
+}
+
+/// [`run_group`] with the trial's pulses shared through `cache`.
+#[must_use]
+pub fn run_group_with(
+    setup: &TrialSetup<'_>,
+    cells: &[GroupCell<'_>],
+    draw: &TrialDraw,
+    cache: &mut PulseCache,
+) -> Vec<TrialOutcome> {
     let sc = setup.scenario;
     let tl = Timeline::new(setup.profile);
     let period = tl.period_s();
@@ -695,7 +800,7 @@ pub fn run_group(
     let mut car_arcs = [static_arcs[0]; 2];
     let n_pulses = (t_end * pulse_rate).floor() as u64;
     let mut frames = 0u64;
-    let mut bin_hint = 0usize;
+    let pulses = cache.pulses(setup.profile, &tl, phase, n_pulses);
 
     let cast = |c: f64,
                 s: f64,
@@ -754,13 +859,11 @@ pub fn run_group(
 
     for k in 0..n_pulses {
         let t = k as f64 / pulse_rate;
-        let tau_total = t + phase;
-        let frame = (tau_total / period).floor() as u64;
-        let tau = (tau_total - frame as f64 * period).clamp(0.0, period);
+        let pulse = &mut pulses[k as usize];
+        let frame = pulse.frame;
         if frame != current_frame {
             current_frame = frame;
             frames += 1;
-            bin_hint = 0;
             let t0 = (frame as f64 * period - phase).max(0.0);
             let t1 = (frame + 1) as f64 * period - phase;
             for (j, arc) in car_arcs.iter_mut().enumerate() {
@@ -792,8 +895,7 @@ pub fn run_group(
                 }
             }
         }
-        let (az, bin) = tl.azimuth_at_from(tau, bin_hint);
-        bin_hint = bin;
+        let (az, bin) = (pulse.az_deg, pulse.bin);
         let fact = facts[bin];
         let in_roi = fact.roi.unwrap_or_else(|| setup.regions.roi.contains(az));
         roi_pulses += u64::from(in_roi);
@@ -810,8 +912,7 @@ pub fn run_group(
         if mask == 0 {
             continue;
         }
-        let rad = az.to_radians();
-        let (s, c) = rad.sin_cos();
+        let (s, c) = *pulse.dir.get_or_insert_with(|| az.to_radians().sin_cos());
         let Some((range, cos_i, refl, car)) = cast_masked(c, s, t, mask) else {
             continue;
         };

@@ -794,6 +794,7 @@ fn run<const W: usize>(
         jitter_frac: p.async_tick_jitter_frac,
         phase_frac: draw.phase_frac,
         seed: mix64(draw.noise_seed ^ 0x6361_726c_6174_6963),
+        grid_phase_steps: p.grid_phase_steps,
         t_end_s: t_end,
     });
     let n_pulses = schedule.len() as u64;

@@ -57,6 +57,13 @@ pub struct CarlaParams {
     /// length is drawn uniformly from `tick_s · [1 − j, 1 + j]`. Assumed
     /// 0.2: the spread of the server's frame times is not known.
     pub async_tick_jitter_frac: f64,
+    /// The azimuth phase of CARLA's scan grid at the trial's first tick, in
+    /// steps of the grid (`[0, 1)`; one step = 360°·f·dt / points per laser
+    /// per tick): added to the start angle CARLA's rule gives (`--sampling
+    /// carla` and `carla-async`; `drift` draws its phase per trial). Assumed
+    /// 0: CARLA's angle is 0 at spawn, but how the sensor's first tick lines
+    /// up with the scene is not in ARGUS's code.
+    pub grid_phase_steps: f64,
     /// Building height, m.
     pub building_height_m: f64,
     /// Reflectivity of the road (physical model).
@@ -103,6 +110,7 @@ impl Default for CarlaParams {
             vehicle_height_m: 1.55,
             vehicle_ground_clearance_m: 0.15,
             async_tick_jitter_frac: 0.2,
+            grid_phase_steps: 0.0,
             building_height_m: 10.0,
             ground_reflectivity: 0.15,
             spawn_distance_m: 100.0,
@@ -131,7 +139,7 @@ impl CarlaParams {
                 "must lie in 1..=256",
             ));
         }
-        let finite: [(&'static str, f64, f64, f64); 22] = [
+        let finite: [(&'static str, f64, f64, f64); 23] = [
             ("carla.upper_fov_deg", self.upper_fov_deg, -89.0, 89.0),
             ("carla.lower_fov_deg", self.lower_fov_deg, -89.0, 89.0),
             ("carla.range_m", self.range_m, 1.0, 1000.0),
@@ -174,6 +182,7 @@ impl CarlaParams {
                 0.0,
                 0.9,
             ),
+            ("carla.grid_phase_steps", self.grid_phase_steps, 0.0, 1.0),
             (
                 "carla.building_height_m",
                 self.building_height_m,
@@ -209,6 +218,13 @@ impl CarlaParams {
             if !(v.is_finite() && lo <= v && v <= hi) {
                 return Err((field, v, "out of range (see the [carla] table's docs)"));
             }
+        }
+        if self.grid_phase_steps >= 1.0 {
+            return Err((
+                "carla.grid_phase_steps",
+                self.grid_phase_steps,
+                "must lie in [0, 1) (a fraction of one azimuth step)",
+            ));
         }
         if self.vehicle_ground_clearance_m >= 0.5 * self.vehicle_height_m {
             return Err((

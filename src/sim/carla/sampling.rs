@@ -50,7 +50,10 @@
 //! spawn is 0, and a whole number `m` of ticks has passed since then (ARGUS
 //! spawns the sensor before the run; how many ticks before is not in the
 //! code): `frac(m · f · dt)` turns, `m` drawn per trial. At 20 Hz and
-//! 0.05 s every `m` gives 0: all trials see the same azimuths.
+//! 0.05 s every `m` gives 0: all trials see the same azimuths. The
+//! scenario's `carla.grid_phase_steps` (assumed 0) shifts that start by a
+//! fraction of one azimuth step of the nominal tick's grid, the sensitivity
+//! sweep's "grid phase".
 //!
 //! **Asynchronous CARLA** (ARGUS never sets `synchronous_mode` or
 //! `fixed_delta_seconds`): the same rules with each tick's `DeltaTime`
@@ -143,6 +146,9 @@ pub struct ScheduleSpec {
     pub phase_frac: f64,
     /// Seed of the asynchronous tick lengths.
     pub seed: u64,
+    /// CARLA sampling: the scan grid's phase at the first tick, in steps
+    /// of the nominal tick's grid (`[0, 1)`; `drift` ignores it).
+    pub grid_phase_steps: f64,
     /// Simulate while the pulse time (drift) or tick start (carla) is below this, s.
     pub t_end_s: f64,
 }
@@ -205,6 +211,12 @@ fn carla(spec: &ScheduleSpec) -> (Vec<Scheduled>, f64) {
     let adv0 = spec.frame_rate_hz * spec.tick_s;
     let m = ticks_since_spawn(spec.phase_frac);
     let mut u = (m as f64 * adv0).fract();
+    if spec.grid_phase_steps != 0.0 {
+        let points0 = points_per_laser(pps, spec.tick_s, spec.channels);
+        if points0 > 0 {
+            u = (u + spec.grid_phase_steps * adv0 / f64::from(points0)).fract();
+        }
+    }
     let mut frame = 0u64;
     let mut t = 0.0;
     let mut out = Vec::new();
@@ -258,8 +270,38 @@ mod tests {
             jitter_frac: 0.2,
             phase_frac: 0.3,
             seed: 7,
+            grid_phase_steps: 0.0,
             t_end_s: 1.0,
         }
+    }
+
+    #[test]
+    fn grid_phase_shifts_every_carla_azimuth_by_its_fraction_of_a_step() {
+        let base = schedule(&paper(Sampling::Carla)).0;
+        for g in [0.25, 0.5, 0.999] {
+            let shifted = schedule(&ScheduleSpec {
+                grid_phase_steps: g,
+                ..paper(Sampling::Carla)
+            })
+            .0;
+            assert_eq!(shifted.len(), base.len());
+            for (a, b) in base.iter().zip(&shifted) {
+                // In degrees: b = a + g · 360/391 (mod 360).
+                let d = (b.tau_s - a.tau_s) / 0.05 * 360.0;
+                let d = d.rem_euclid(360.0);
+                assert!((d - g * 360.0 / 391.0).abs() < 1e-9, "{g}: {d}");
+                assert_eq!(a.tick, b.tick);
+            }
+        }
+        // The drift clock has its own per-trial phase and ignores it.
+        let drift = paper(Sampling::Drift);
+        assert_eq!(
+            schedule(&drift),
+            schedule(&ScheduleSpec {
+                grid_phase_steps: 0.5,
+                ..drift
+            })
+        );
     }
 
     #[test]
