@@ -1,7 +1,8 @@
-//! Tests that pin two parts of the bound no other core test reached
+//! Tests that pin parts of the bound and the head no other core test reached
 //! (`specs/mutants.md`): a window walk over more than `WALK_MAX_PIECES`
-//! envelope pieces inside one pass, and the multi-pass pass-count rule on a
-//! pass longer than half a frame. Each names the mutant it kills.
+//! envelope pieces inside one pass, a walk's reach over the whole pass arc,
+//! the multi-pass pass-count rule on a pass longer than half a frame, and
+//! the head description's validation edges. Each names the mutant it kills.
 
 use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
 use gaze_lidar_core::eye_safety::bound::{Seg, WALK_MAX_PIECES};
