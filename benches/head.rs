@@ -4,15 +4,30 @@
 //! eye-safety parameters without the head: today's single-channel code path)
 //! in the same run. Prints p50/p99 of plain timed runs ([`SAMPLES`] each) and
 //! the p99 ratios, then the criterion figures. Run: `cargo bench --bench head`.
+//!
+//! The same run also times the single-channel paths the head must not slow
+//! down, in thread CPU time: gaze sample → certified profile through the
+//! stream (closed form on the `paper` preset, 360 bins; the optimizer's fast
+//! path, cache warm) and the checker (`check`, library: structure, limits,
+//! the eye-safety bound; no file parsing) on the 10⁶-bin rough profile of
+//! `benches/check.rs`. To compare two versions of the code, build this
+//! bench at each and run the two binaries in turn on the same machine (see
+//! `specs/eye_safety.md`, "Performance").
+
+#[path = "common/big_profile.rs"]
+mod big_profile;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::time::Instant;
 
+use gaze_lidar::checker::check;
 use gaze_lidar::eye_safety::bound::Seg;
 use gaze_lidar::eye_safety::head::power_scale_to_certify;
 use gaze_lidar::eye_safety::{evaluate_segments, EyeSafetyParams};
-use gaze_lidar::model::presets::preset;
+use gaze_lidar::gaze::{ClosedFormPlanner, FailSafeConfig, FilterConfig, GazeSample, GazeStream};
+use gaze_lidar::model::presets::{self, preset};
+use gaze_lidar::planner::Mode;
 
 /// Timed runs per percentile figure (`GAZE_LIDAR_HEAD_BENCH_SAMPLES`
 /// overrides it and skips the criterion groups: for a profiler's run).
@@ -84,8 +99,114 @@ fn certified(params: &EyeSafetyParams, f_p: f64) -> (Vec<Seg>, f64) {
     (segs, r.worst_ratio)
 }
 
+/// Gaze samples at 200 Hz: fixations of 0.4 s at three directions, small
+/// jitter (the trace of `benches/gaze.rs`), `n` of them.
+fn gaze_trace(n: usize) -> Vec<GazeSample> {
+    (0..n)
+        .map(|k| {
+            let g = 90.0 + 40.0 * ((k / 80) % 3) as f64 + 0.02 * (k % 5) as f64;
+            GazeSample {
+                t_s: k as f64 / 200.0,
+                gaze_deg: g,
+                valid: true,
+            }
+        })
+        .collect()
+}
+
+/// Thread CPU time of every `push` that produced a frame (one sample in
+/// ten plans and certifies a profile), over `n` samples: `[p50, p99]`, s.
+fn frame_cpu<P: gaze_lidar::gaze::FramePlanner>(planner: P, n: usize) -> [f64; 2] {
+    let mut s = GazeStream::new(planner, FilterConfig::default(), FailSafeConfig::default());
+    let mut cpu = Vec::new();
+    for x in gaze_trace(n) {
+        let c = thread_cpu_s();
+        let frames = s.push(&x).unwrap();
+        let dt = thread_cpu_s() - c;
+        if !frames.is_empty() {
+            cpu.push(dt);
+        }
+        black_box(frames);
+    }
+    cpu.sort_by(f64::total_cmp);
+    let q = (cpu.len() * 99 / 100).min(cpu.len() - 1);
+    [cpu[cpu.len() / 2], cpu[q]]
+}
+
+/// The single-channel targets (see the module doc). `GAZE_LIDAR_HEAD_BENCH_BIG`
+/// sets the runs of the 10⁶-bin check (default 3 under `cargo bench`, 0 as
+/// the smoke test of `cargo test --all-targets`).
+fn single_channel_targets(n: usize) {
+    let us = |x: f64| x * 1e6;
+    let cf = ClosedFormPlanner {
+        preset: presets::paper(),
+        mode: Mode::Joint,
+        bins: 360,
+    };
+    let samples = 10 * n.max(400);
+    let [p50, p99] = frame_cpu(cf, samples);
+    println!(
+        "single channel: gaze -> certified, closed form (paper, joint, 360 bins; {} frames): \
+         CPU p50 {:.1} µs p99 {:.1} µs",
+        samples / 10,
+        us(p50),
+        us(p99)
+    );
+    #[cfg(feature = "solver")]
+    {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/examples/configs/multi_level.toml"
+        );
+        let problem = gaze_lidar::optimizer::OptimizerConfig::read(std::path::Path::new(path))
+            .unwrap()
+            .problem()
+            .unwrap();
+        let mut planner = gaze_lidar::gaze::OptimizerPlanner::new(problem).unwrap();
+        for x in gaze_trace(samples).iter().step_by(10) {
+            use gaze_lidar::gaze::FramePlanner;
+            planner.plan(Some(x.gaze_deg)).unwrap();
+        }
+        let [p50, p99] = frame_cpu(planner, samples);
+        println!(
+            "single channel: gaze -> certified, optimizer fast path (multi_level, cache warm): \
+             CPU p50 {:.1} µs p99 {:.1} µs",
+            us(p50),
+            us(p99)
+        );
+    }
+    let runs: usize = std::env::var("GAZE_LIDAR_HEAD_BENCH_BIG")
+        .map(|v| v.parse().expect("a run count"))
+        .unwrap_or(if std::env::args().any(|a| a == "--bench") {
+            3
+        } else {
+            0
+        });
+    if runs > 0 {
+        let p = big_profile::big_profile(1_000_000, big_profile::Roughness::Rough);
+        let mut cpu: Vec<f64> = (0..runs)
+            .map(|_| {
+                let c = thread_cpu_s();
+                assert!(
+                    check(black_box(&p)).is_empty(),
+                    "the 10^6-bin profile certifies"
+                );
+                thread_cpu_s() - c
+            })
+            .collect();
+        cpu.sort_by(f64::total_cmp);
+        println!(
+            "single channel: check (library) of the 10^6-bin rough profile ({runs} runs): \
+             CPU min {:.3} s median {:.3} s",
+            cpu[0],
+            cpu[runs / 2]
+        );
+    }
+}
+
 fn bench(c: &mut Criterion) {
     let (n, criterion) = samples();
+    single_channel_targets(n);
     let mut g = c.benchmark_group("head");
     for name in ["vls128", "os1-128", "vlp16"] {
         let p = preset(name).unwrap();

@@ -21,6 +21,31 @@ pub struct Laser {
     pub pulse_rate_hz: f64,
 }
 
+/// The AEL infima ([`Laser::ael_inf_j`]) at both ends of the last segment
+/// [`Laser::linear_capped_max_memo`] evaluated, for one `one_pass_s`: the
+/// consecutive pieces of a window walk share an end, and the pruning bounds
+/// of the walks share both, so these are looked up, not computed again
+/// (the same values).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct AelEnds {
+    one_pass_bits: u64,
+    ends: [Option<(u64, f64)>; 2],
+}
+
+impl AelEnds {
+    /// `laser.ael_inf_j(t_s, one_pass_s)`, looked up if kept.
+    fn get(&self, laser: &Laser, t_s: f64, one_pass_s: f64) -> f64 {
+        if self.one_pass_bits == one_pass_s.to_bits() {
+            for (t_bits, ael_j) in self.ends.into_iter().flatten() {
+                if t_bits == t_s.to_bits() {
+                    return ael_j;
+                }
+            }
+        }
+        laser.ael_inf_j(t_s, one_pass_s)
+    }
+}
+
 impl Laser {
     /// AEL for an exposure of `t_s` (clamped to the pulse duration below and
     /// the table's end above), restrictive at row edges.
@@ -172,19 +197,50 @@ impl Laser {
         cap_j: f64,
         one_pass_s: f64,
     ) -> (f64, f64) {
+        self.linear_capped_max_memo(
+            t0,
+            t1,
+            e0_j,
+            slope_w,
+            cap_j,
+            one_pass_s,
+            &mut AelEnds::default(),
+        )
+    }
+
+    /// [`Self::linear_capped_max`], the AEL infima at `t0` and `t1` looked
+    /// up in `ends` when an earlier call computed them (and left there).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn linear_capped_max_memo(
+        &self,
+        t0: f64,
+        t1: f64,
+        e0_j: f64,
+        slope_w: f64,
+        cap_j: f64,
+        one_pass_s: f64,
+        ends: &mut AelEnds,
+    ) -> (f64, f64) {
         if t1.is_nan() || t0.is_nan() || t1 < t0 {
             return (0.0, t0);
         }
         let energy = |t: f64| (e0_j + slope_w * (t - t0)).min(cap_j);
         let mut best = (0.0, t0);
-        let mut consider = |t: f64| {
-            let r = energy(t) / self.ael_inf_j(t, one_pass_s);
+        let mut consider_with = |t: f64, ael_j: f64| {
+            let r = energy(t) / ael_j;
             if r > best.0 {
                 best = (r, t);
             }
         };
-        consider(t0);
-        consider(t1);
+        let ael_t0 = ends.get(self, t0, one_pass_s);
+        let ael_t1 = ends.get(self, t1, one_pass_s);
+        *ends = AelEnds {
+            one_pass_bits: one_pass_s.to_bits(),
+            ends: [Some((t0.to_bits(), ael_t0)), Some((t1.to_bits(), ael_t1))],
+        };
+        consider_with(t0, ael_t0);
+        consider_with(t1, ael_t1);
+        let mut consider = |t: f64| consider_with(t, self.ael_inf_j(t, one_pass_s));
         if slope_w > 0.0 && e0_j < cap_j {
             let t_cap = t0 + (cap_j - e0_j) / slope_w;
             if t_cap > t0 && t_cap < t1 {
@@ -475,6 +531,42 @@ impl PerJouleCache {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The kept AEL ends change nothing: a chain of segments sharing ends
+    /// (as a walk's pieces), the same segment again (as the pruning bounds)
+    /// and a change of `one_pass_s`, every band and row edge crossed, give
+    /// the bits of the plain evaluation.
+    #[test]
+    fn kept_ael_ends_are_the_plain_evaluation() {
+        for (band, c4) in [
+            (Band::RetinalNir, 2.5),
+            (Band::Ir1400, 1.0),
+            (Band::Ir1500, 1.0),
+        ] {
+            let laser = Laser {
+                band,
+                c4,
+                pulse_duration_s: 5e-9,
+                pulse_rate_hz: 1e5,
+            };
+            let mut ends = AelEnds::default();
+            let mut t = 1e-7;
+            for k in 0..400 {
+                let one_pass_s = if k % 50 < 25 { 0.2 } else { 40.0 };
+                let t1 = t * (1.0 + 0.05 * (k % 7) as f64) + 1e-7;
+                let (e0, slope, cap) = (1e-6 * (k % 5) as f64, 1e-3 * (k % 3) as f64, 2e-5);
+                let plain = laser.linear_capped_max(t, t1, e0, slope, cap, one_pass_s);
+                let kept =
+                    laser.linear_capped_max_memo(t, t1, e0, slope, cap, one_pass_s, &mut ends);
+                assert_eq!(plain.0.to_bits(), kept.0.to_bits(), "{band:?} {k}");
+                assert_eq!(plain.1.to_bits(), kept.1.to_bits(), "{band:?} {k}");
+                let again =
+                    laser.linear_capped_max_memo(t, t1, e0, slope, cap, one_pass_s, &mut ends);
+                assert_eq!(plain.0.to_bits(), again.0.to_bits());
+                t = if t1 > 50.0 { 1e-7 } else { t1 };
+            }
+        }
+    }
 
     /// Mutant 475:32 of the old `bound.rs` (11a69c7): `pass_count_max`'s
     /// candidates `k·T_f − τ` (where a window first meets `k + 1` passes)

@@ -4,7 +4,7 @@
 
 use super::count::{time_rounding_s, PRUNE_SLACK, REACH_SLACK};
 use super::envelope::Envelope;
-use super::laser::Laser;
+use super::laser::{AelEnds, Laser};
 use super::search::Best;
 use super::seg::Seg;
 use super::sliding::SlidingMax;
@@ -84,16 +84,18 @@ impl Walks<'_> {
                     walks[b].p_span.total_cmp(&walks[a].p_span).then(a.cmp(&b))
                 });
                 let mut g = (f64::NAN, 0.0);
+                let mut ends = AelEnds::default();
                 for k in order {
                     let w = walks[k];
                     if g.0 != w.p_span {
-                        let (r, _) = laser.linear_capped_max(
+                        let (r, _) = laser.linear_capped_max_memo(
                             -pad,
                             t_walk - pad,
                             w.p_span * delta,
                             w.p_span,
                             self.e_pass,
                             self.one_pass_s,
+                            &mut ends,
                         );
                         g = (w.p_span, r * (1.0 + PRUNE_SLACK));
                     }
@@ -188,6 +190,8 @@ impl Walks<'_> {
         let pad = time_rounding_s(env.frame_s);
         let b0 = env.bp(w.start);
         let (mut e, mut l, mut idx) = (0.0f64, 0.0f64, w.start);
+        // Consecutive pieces share a window length: its AEL is kept.
+        let mut ends = AelEnds::default();
         for _ in 0..WALK_MAX_PIECES {
             let (next_idx, piece_p) = if w.dir > 0 {
                 (idx + 1, env.p_of(idx))
@@ -198,13 +202,14 @@ impl Walks<'_> {
             if seg_end > delta {
                 let l0 = l.max(delta);
                 let e0 = e + piece_p * (l0 - l);
-                best.take(laser.linear_capped_max(
+                best.take(laser.linear_capped_max_memo(
                     l0 - delta - pad,
                     seg_end - delta - pad,
                     e0,
                     piece_p,
                     e_pass,
                     self.one_pass_s,
+                    &mut ends,
                 ));
             }
             e += piece_p * (seg_end - l);
@@ -217,13 +222,14 @@ impl Walks<'_> {
                 } else {
                     (l - delta).max(0.0)
                 };
-                best.take(laser.linear_capped_max(
+                best.take(laser.linear_capped_max_memo(
                     t_c - pad,
                     t_reach.max(t_c) - pad,
                     e_pass,
                     0.0,
                     e_pass,
                     self.one_pass_s,
+                    &mut ends,
                 ));
                 return;
             }
@@ -235,13 +241,14 @@ impl Walks<'_> {
         // Truncated: longer windows gain at most `p_span` per second.
         let l0 = l.max(delta);
         let e0 = e + w.p_span * (l0 - l);
-        best.take(laser.linear_capped_max(
+        best.take(laser.linear_capped_max_memo(
             l0 - delta - pad,
             t_reach - pad,
             e0,
             w.p_span,
             e_pass,
             self.one_pass_s,
+            &mut ends,
         ));
     }
 }

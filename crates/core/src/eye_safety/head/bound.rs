@@ -36,6 +36,8 @@
 //! A 1-channel head is the single-channel bound times 1.0: the same bits.
 
 use serde::Serialize;
+use std::cell::RefCell;
+use std::rc::Rc;
 
 use super::geometry::{footprints, Footprint};
 use super::overlap;
@@ -269,6 +271,12 @@ pub fn energy_ratios(
 
 /// The head's overlap figures for `params` (band from `laser`) at spins up
 /// to `spin_max_rad_s`.
+///
+/// Everything but the two enumerations whose boxes widen with the fastest
+/// spin (`W_g` and `W_inst`) depends on the head, the band's aperture and
+/// the grouping window alone: it is computed once per head
+/// ([`HeadOverlaps`], kept per thread for the last [`MEMO_HEADS`] heads)
+/// and the same for every profile.
 pub fn head_figures(
     head: &Head,
     params: &EyeSafetyParams,
@@ -286,31 +294,24 @@ pub fn head_figures(
             reason: "must be 1 / head.cycle_s: every channel of the head fires once per cycle",
         });
     }
-    let a = laser.band.aperture_mm();
-    let fps = footprints(head, a);
-    let scales: Vec<f64> = head.channels.iter().map(|c| c.power_scale).collect();
-    let slots: Vec<f64> = head.channels.iter().map(|c| c.slot_s).collect();
-    let zeros = vec![0.0; slots.len()];
+    let t_g = group_window_s(laser);
+    let o = head_overlaps(head, laser.band.aperture_mm(), t_g);
     let r = head.aperture_distance_mm;
     let circ = core::f64::consts::TAU * r;
-    let t_g = group_window_s(laser);
     let smear = r * spin_max_rad_s * t_g * (1.0 + overlap::SUM_MARGIN);
-    let v = overlap::vertical(&fps, &scales);
-    let (sim, _) = overlap::group(&fps, &scales, &slots, head.cycle_s, 0.0, 0.0, circ);
-    let (g, spans) = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, smear, circ);
-    let (disc, _) = overlap::group(&fps, &scales, &zeros, head.cycle_s, 0.0, 0.0, circ);
+    let (g, spans) = overlap::group(&o.fps, &o.scales, &o.slots, head.cycle_s, t_g, smear, circ);
     let turn_per_pulse = r * spin_max_rad_s * head.cycle_s * (1.0 + overlap::SUM_MARGIN);
     let (inst, _) = overlap::group(
-        &fps,
-        &scales,
-        &zeros,
+        &o.fps,
+        &o.scales,
+        &o.zeros,
         head.cycle_s,
         0.0,
         turn_per_pulse,
         circ,
     );
-    let (g0, spans0) = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, 0.0, circ);
-    let fold = |f: fn(&Footprint) -> f64| fps.iter().map(f).fold(0.0, f64::max);
+    let (v, sim, disc) = (o.vertical, o.simultaneous, o.stalled);
+    let (g0, spans0) = o.stalled_group;
     Ok(HeadFigures {
         channels: head.channels.len() as u32,
         channels_at_worst: v.count_at_worst,
@@ -319,8 +320,8 @@ pub fn head_figures(
         group_height_mm: g.height_mm,
         weight_vertical: v.weight,
         count_vertical: v.count,
-        slots_vertical: overlap::vertical_slots(&fps, &slots),
-        union_passes: union_passes(&fps, fold(|f| f.pass_angle_deg)),
+        slots_vertical: o.slots_vertical,
+        union_passes: o.union_passes,
         weight_simultaneous: sim.weight,
         count_simultaneous: sim.count,
         weight_group: g.weight,
@@ -334,14 +335,141 @@ pub fn head_figures(
         weight_stalled_simultaneous: sim.weight,
         count_stalled_simultaneous: sim.count,
         stalled_group_spans_time: spans0,
-        footprint_max_mm: fold(|f| f.width_mm),
-        pass_angle_deg: fold(|f| f.pass_angle_deg),
-        power_scale_max: scales.iter().copied().fold(0.0, f64::max),
-        separations: if v.count > 1 {
-            separations(&fps, &scales, r, head.cycle_s)
-        } else {
-            Vec::new()
-        },
+        footprint_max_mm: o.footprint_max_mm,
+        pass_angle_deg: o.pass_angle_deg,
+        power_scale_max: o.power_scale_max,
+        separations: o.separations.clone(),
+    })
+}
+
+/// What [`head_figures`] takes from the head alone (with the band's
+/// aperture and the grouping window): the footprints and every overlap
+/// enumeration that does not depend on the spin.
+#[derive(Debug)]
+pub struct HeadOverlaps {
+    fps: Vec<Footprint>,
+    scales: Vec<f64>,
+    slots: Vec<f64>,
+    /// One slot for every channel (pulses of any time at one instant).
+    zeros: Vec<f64>,
+    /// `W_v`, `K_v` and the worst height.
+    vertical: overlap::Meet,
+    slots_vertical: u32,
+    union_passes: u32,
+    /// `W_sim` (the channels fired together sharing a point; the same with
+    /// the head stopped).
+    simultaneous: overlap::Meet,
+    /// `W_disc`: every channel sharing a point, the head stopped.
+    stalled: overlap::Meet,
+    /// `W_g` with the head stopped, and whether it spans two times.
+    stalled_group: (overlap::Meet, bool),
+    separations: Vec<Separation>,
+    footprint_max_mm: f64,
+    pass_angle_deg: f64,
+    power_scale_max: f64,
+}
+
+impl HeadOverlaps {
+    /// The profile-independent figures of `head` for an aperture of
+    /// `aperture_mm` and the grouping window `group_window_s`.
+    #[must_use]
+    pub fn new(head: &Head, aperture_mm: f64, group_window_s: f64) -> Self {
+        let fps = footprints(head, aperture_mm);
+        let scales: Vec<f64> = head.channels.iter().map(|c| c.power_scale).collect();
+        let slots: Vec<f64> = head.channels.iter().map(|c| c.slot_s).collect();
+        let zeros = vec![0.0; slots.len()];
+        let r = head.aperture_distance_mm;
+        let circ = core::f64::consts::TAU * r;
+        let t_g = group_window_s;
+        let vertical = overlap::vertical(&fps, &scales);
+        let (simultaneous, _) = overlap::group(&fps, &scales, &slots, head.cycle_s, 0.0, 0.0, circ);
+        let (stalled, _) = overlap::group(&fps, &scales, &zeros, head.cycle_s, 0.0, 0.0, circ);
+        let stalled_group = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, 0.0, circ);
+        let fold = |f: fn(&Footprint) -> f64| fps.iter().map(f).fold(0.0, f64::max);
+        let pass_angle_deg = fold(|f| f.pass_angle_deg);
+        Self {
+            slots_vertical: overlap::vertical_slots(&fps, &slots),
+            union_passes: union_passes(&fps, pass_angle_deg),
+            separations: if vertical.count > 1 {
+                separations(&fps, &scales, r, head.cycle_s)
+            } else {
+                Vec::new()
+            },
+            footprint_max_mm: fold(|f| f.width_mm),
+            pass_angle_deg,
+            power_scale_max: scales.iter().copied().fold(0.0, f64::max),
+            fps,
+            scales,
+            slots,
+            zeros,
+            vertical,
+            simultaneous,
+            stalled,
+            stalled_group,
+        }
+    }
+}
+
+/// Heads whose [`HeadOverlaps`] each thread keeps (the most recently
+/// computed ones).
+pub const MEMO_HEADS: usize = 4;
+
+/// A kept head: its inputs, compared bit for bit, and its figures.
+struct Memo {
+    head: Head,
+    aperture_bits: u64,
+    group_window_bits: u64,
+    overlaps: Rc<HeadOverlaps>,
+}
+
+std::thread_local! {
+    static MEMO: RefCell<Vec<Memo>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Whether two heads are the same bits (`==` would take `-0.0` for `0.0`).
+fn same_bits(a: &Head, b: &Head) -> bool {
+    let f = |x: f64, y: f64| x.to_bits() == y.to_bits();
+    f(a.cycle_s, b.cycle_s)
+        && f(a.origin_radius_mm, b.origin_radius_mm)
+        && f(a.origin_height_mm, b.origin_height_mm)
+        && f(a.exit_diameter_mm, b.exit_diameter_mm)
+        && f(a.divergence_mrad, b.divergence_mrad)
+        && f(a.aperture_distance_mm, b.aperture_distance_mm)
+        && a.channels.len() == b.channels.len()
+        && a.channels.iter().zip(&b.channels).all(|(c, d)| {
+            c.id == d.id
+                && f(c.elevation_deg, d.elevation_deg)
+                && f(c.azimuth_offset_deg, d.azimuth_offset_deg)
+                && f(c.slot_s, d.slot_s)
+                && f(c.power_scale, d.power_scale)
+        })
+}
+
+/// [`HeadOverlaps::new`], kept per thread: a head evaluated again (every
+/// frame of a stream, every profile of an optimizer run) reuses its figures,
+/// the same values as computing them again.
+fn head_overlaps(head: &Head, aperture_mm: f64, group_window_s: f64) -> Rc<HeadOverlaps> {
+    let (aperture_bits, group_window_bits) = (aperture_mm.to_bits(), group_window_s.to_bits());
+    MEMO.with(|memo| {
+        let mut memo = memo.borrow_mut();
+        if let Some(m) = memo.iter().find(|m| {
+            m.aperture_bits == aperture_bits
+                && m.group_window_bits == group_window_bits
+                && same_bits(&m.head, head)
+        }) {
+            return Rc::clone(&m.overlaps);
+        }
+        let overlaps = Rc::new(HeadOverlaps::new(head, aperture_mm, group_window_s));
+        if memo.len() >= MEMO_HEADS {
+            memo.remove(0);
+        }
+        memo.push(Memo {
+            head: head.clone(),
+            aperture_bits,
+            group_window_bits,
+            overlaps: Rc::clone(&overlaps),
+        });
+        overlaps
     })
 }
 
@@ -586,6 +714,55 @@ mod tests {
         }
         let h = column(&[0.0], &[30.0]);
         assert_eq!(union_passes(&footprints(&h, 7.0), pass), 1);
+    }
+
+    /// The kept figures are the computed ones: more heads than are kept,
+    /// each evaluated again after the others pushed it out and again while
+    /// kept, give the same bits as the first evaluation; a head that
+    /// differs in one bit (`-0.0` for `0.0`, one `power_scale`) is not
+    /// taken for a kept one.
+    #[test]
+    fn kept_head_figures_are_the_computed_ones() {
+        let params = EyeSafetyParams {
+            wavelength_nm: 905.0,
+            pulse_duration_s: 5e-9,
+            beam_diameter_mm: 5.0,
+            head: None,
+        };
+        let laser = crate::eye_safety::exposure::laser(&params, 1e4).unwrap();
+        let heads: Vec<Head> = (0..MEMO_HEADS + 2)
+            .map(|k| {
+                let n = 2 + k;
+                let slots: Vec<f64> = (0..n).map(|i| 1e-5 * (i % 3) as f64).collect();
+                let offsets: Vec<f64> = (0..n).map(|i| 0.7 * (i + k) as f64).collect();
+                column(&slots, &offsets)
+            })
+            .collect();
+        let bits =
+            |h: &Head, spin: f64| format!("{:?}", head_figures(h, &params, &laser, spin).unwrap());
+        let first: Vec<String> = heads.iter().map(|h| bits(h, 300.0)).collect();
+        for round in 0..2 {
+            for (h, want) in heads.iter().zip(&first).rev() {
+                assert_eq!(&bits(h, 300.0), want, "round {round}");
+                assert_eq!(bits(h, 300.0), *want, "kept");
+            }
+        }
+        // The spin-dependent figures follow the spin of each call.
+        // (Two beams 10° apart, 5.5 mm between their boxes: a head turn of
+        // 10 mm per pulse spacing puts both in one instant's box.)
+        let apart = column(&[0.0, 0.0], &[0.0, 10.0]);
+        let (slow, fast) = (bits(&apart, 30.0), bits(&apart, 1000.0));
+        assert_ne!(slow, fast);
+        assert_eq!(bits(&apart, 30.0), slow);
+        let mut scaled = heads[0].clone();
+        scaled.channels[1].power_scale = 0.5;
+        assert!(!same_bits(&scaled, &heads[0]));
+        assert_ne!(bits(&scaled, 300.0), first[0]);
+        let mut signed = heads[0].clone();
+        signed.origin_height_mm = -0.0;
+        assert_eq!(signed, heads[0]);
+        assert!(!same_bits(&signed, &heads[0]));
+        assert!(same_bits(&heads[0].clone(), &heads[0]));
     }
 
     fn figures(count_vertical: u32, slots_vertical: u32, union_passes: u32) -> HeadFigures {
