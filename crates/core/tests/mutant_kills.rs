@@ -1,8 +1,7 @@
-//! Tests that pin parts of the bound and the head no other core test reached
+//! Tests that pin two parts of the bound no other core test reached
 //! (`specs/mutants.md`): a window walk over more than `WALK_MAX_PIECES`
-//! envelope pieces inside one pass, a walk's reach over the whole pass arc,
-//! the multi-pass pass-count rule on a pass longer than half a frame, and
-//! the head description's validation edges. Each names the mutant it kills.
+//! envelope pieces inside one pass, and the multi-pass pass-count rule on a
+//! pass longer than half a frame. Each names the mutant it kills.
 
 use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
 use gaze_lidar_core::eye_safety::bound::{Seg, WALK_MAX_PIECES};
@@ -288,4 +287,25 @@ fn walk_spans_the_whole_pass_arc() {
         r.rule_ratios
     );
     assert!(r.worst_ratio > 1.0);
+}
+
+/// Kills `head/mod.rs` `one` → `0.0` / `-1.0` (a channel's `power_scale`
+/// read as 0 or −1 when the file omits it: every such head would certify
+/// with no energy) and `aperture_distance_default` → `0.0` / `1.0` / `-1.0`
+/// (the aperture at the axis instead of 100 mm): the defaults a head file
+/// gets for the fields it may omit, by the description (`power_scale` 1,
+/// `origin_height_mm` 0, `aperture_distance_mm` 100).
+#[test]
+fn head_file_defaults_are_the_description_s() {
+    let h: Head = serde_json::from_str(
+        r#"{"cycle_s": 1e-3, "origin_radius_mm": 40.0, "exit_diameter_mm": 5.0,
+            "divergence_mrad": 1.0,
+            "channels": [{"id": 7, "elevation_deg": 0.0, "azimuth_offset_deg": 0.0,
+                          "slot_s": 0.0}]}"#,
+    )
+    .unwrap();
+    assert_eq!(h.channels[0].power_scale, 1.0);
+    assert_eq!(h.origin_height_mm, 0.0);
+    assert_eq!(h.aperture_distance_mm, 100.0);
+    h.validate().unwrap();
 }
