@@ -1,6 +1,8 @@
 //! The head oracle (`tests/head_oracle_defs/`): a brute-force reference for
 //! the eye safety of a whole multi-beam head, and its self-tests (each able
-//! to fail). `HEAD_ORACLE_CASES` scales the random runs.
+//! to fail). `HEAD_ORACLE_CASES` scales the random runs; `HEAD_ORACLE_SHAPES`
+//! caps the fixed-shape runs (real heads, separated pairs) for quick nets
+//! such as the mutant runs of `specs/mutants.md` (default: all of them).
 
 mod head_oracle_defs;
 mod reference_defs;
@@ -501,6 +503,15 @@ fn cases(d: usize) -> usize {
         .unwrap_or(d)
 }
 
+/// How many of a fixed-shape test's cases run (env `HEAD_ORACLE_SHAPES`,
+/// default all): the first `n` in the test's order, at least one.
+fn shapes_max() -> usize {
+    std::env::var("HEAD_ORACLE_SHAPES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(usize::MAX, |n: usize| n.max(1))
+}
+
 /// `HEAD_ORACLE_LONG=1`: full effort (more phases, starts and positions).
 fn long_run() -> bool {
     std::env::var_os("HEAD_ORACLE_LONG").is_some()
@@ -837,7 +848,8 @@ fn head_bound_is_never_below_the_oracle_on_random_heads() {
 
 /// The same on the real-head shapes, on the 4-bin scan: VLP-16 and
 /// OS1-128 at 905/865 nm by default; with `HEAD_ORACLE_LONG=1` also
-/// VLS-128 and every shape at 1550 nm.
+/// VLS-128 and every shape at 1550 nm; `HEAD_ORACLE_SHAPES=n` only the
+/// first `n` of them.
 #[test]
 fn head_bound_is_never_below_the_oracle_on_real_heads() {
     let effort = head_oracle_defs::Effort {
@@ -859,6 +871,7 @@ fn head_bound_is_never_below_the_oracle_on_real_heads() {
             ("vls128-like", vls128_like(), 1550.0),
         ]);
     }
+    shapes.truncate(shapes_max());
     for (name, h, lambda) in shapes {
         let p = if lambda > 1000.0 { 2e-3 } else { 0.05e-3 };
         let s = OScan {
@@ -1002,7 +1015,8 @@ fn head_bound_is_never_below_the_oracle_on_wild_heads() {
 /// 0.35 s has one AEL (8 mJ), so such a window holds twice one pass; at
 /// 905 nm the windows of a few ms. Scans with a fast or slow sector between
 /// the two passes, turning at 5 Hz or at 0.05 Hz (a turn longer than T2, so
-/// the short windows, not the 10 s ones, bind).
+/// the short windows, not the 10 s ones, bind). `HEAD_ORACLE_SHAPES=n`:
+/// only the first `n` pairs (in loop order).
 #[test]
 fn head_bound_is_never_below_the_oracle_on_separated_pairs() {
     let effort = head_oracle_defs::Effort {
@@ -1021,9 +1035,14 @@ fn head_bound_is_never_below_the_oracle_on_separated_pairs() {
     } else {
         (&[6.0], &[(0.2, 5.0), (0.5, 0.05)])
     };
+    let mut left = shapes_max();
     for &lambda in &[1550.0, 905.0] {
         for &delta in deltas {
             for &(between, frame_hz) in motions {
+                if left == 0 {
+                    continue;
+                }
+                left -= 1;
                 let w = std::f64::consts::TAU * frame_hz;
                 let p = if lambda > 1000.0 { 20e-3 } else { 0.5e-3 };
                 // The aperture at φ ≈ 100°: channel 0 (offset +Δ/2) passes

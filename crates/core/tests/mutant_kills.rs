@@ -242,3 +242,70 @@ fn head_validation_edges_by_hand() {
     h.channels[2].id = 5;
     refused(&h, "channels (id 5)");
 }
+
+/// Kills `bound/mod.rs` `evaluate_with`: `two_h_deg: 2.0 * half_deg` →
+/// `2.0 + half_deg` (the window walks reach `2° + h` instead of the pass arc
+/// `2h`: for `h > 2°` a window inside one pass that is longer than `2° + h`
+/// is never walked).
+///
+/// 1450 nm, beam 10 mm: `2h = (3.5571 + 10)/100` rad = 7.7676°, `h` =
+/// 3.8838°; the mutant reaches 5.8838°. A hot sector of 7.5° at 1 rad/s
+/// (`t_hot` = 0.1309 s, 100 kHz, power `p`), flanked by 1° dark sectors at
+/// 2.336e-3 rad/s (the 0.27° a pass holds beyond the hot sector take 2 s, so
+/// every whole pass that holds the sector lasts over 2 s and its figure is
+/// about 8× lower); the rest of the turn dark at 1 rad/s. An aperture at the
+/// sector's middle sees all of it (3.75° < `h`). By hand: any clock phase
+/// puts at least `⌊t_hot · f⌋` = 13089 pulses of `p/f` within a window no
+/// longer than `t_hot`, whose AEL is at most `4.4e-3 · t_hot^0.25` =
+/// 2.64659e-3 J: at `p` = 0.020624 W the true ratio is at least 1.0200. The
+/// mutant's longest walk holds at most 5.8838/7.5 of the sector, a figure
+/// about `(5.8838/7.5)^0.75` = 0.83 of that (it certified).
+#[test]
+fn walk_spans_the_whole_pass_arc() {
+    let two_h_deg = ((APERTURE_IR_MM + 10.0) / 100.0f64).to_degrees();
+    assert!(two_h_deg > 4.0 + 1.5, "{two_h_deg}");
+    let (f_p, p) = (1e5, 0.020624);
+    let hot_deg = 7.5;
+    let slow = (two_h_deg - hot_deg).to_radians() / 2.0;
+    let segs = vec![
+        seg(0.0, 100.0, 0.0, 1.0),
+        seg(100.0, 1.0, 0.0, slow),
+        seg(101.0, hot_deg, p, 1.0),
+        seg(101.0 + hot_deg, 1.0, 0.0, slow),
+        seg(102.0 + hot_deg, 258.0 - hot_deg, 0.0, 1.0),
+    ];
+    let t_hot = hot_deg.to_radians();
+    let pulses = (t_hot * f_p).floor();
+    assert_eq!(pulses, 13089.0);
+    let truth_lb = pulses * p / f_p / (4.4e-3 * t_hot.powf(0.25));
+    assert!((truth_lb - 1.0200).abs() < 1e-3, "{truth_lb}");
+    let r = evaluate_segments(&segs, &params(1450.0, 10.0), f_p).unwrap();
+    assert!(
+        r.rule_ratios[1] >= truth_lb,
+        "pass train {} below {truth_lb} ({:?})",
+        r.rule_ratios[1],
+        r.rule_ratios
+    );
+    assert!(r.worst_ratio > 1.0);
+}
+
+/// Kills `head/mod.rs` `one` → `0.0` / `-1.0` (a channel's `power_scale`
+/// read as 0 or −1 when the file omits it: every such head would certify
+/// with no energy) and `aperture_distance_default` → `0.0` / `1.0` / `-1.0`
+/// (the aperture at the axis instead of 100 mm): the defaults a head file
+/// gets for the fields it may omit, by the description (`power_scale` 1,
+/// `origin_height_mm` 0, `aperture_distance_mm` 100).
+#[test]
+fn head_file_defaults_are_the_description_s() {
+    let h: Head = serde_json::from_str(
+        r#"{"cycle_s": 1e-3, "origin_radius_mm": 40.0, "exit_diameter_mm": 5.0,
+            "divergence_mrad": 1.0,
+            "channels": [{"id": 7, "elevation_deg": 0.0, "azimuth_offset_deg": 0.0,
+                          "slot_s": 0.0}]}"#,
+    )
+    .unwrap();
+    assert_eq!(h.channels[0].power_scale, 1.0);
+    assert_eq!(h.origin_height_mm, 0.0);
+    assert_eq!(h.aperture_distance_mm, 100.0);
+    h.validate().unwrap();
+}
