@@ -28,7 +28,9 @@
 //! limits, [`certify_with`] with [`CheckOptions`]. Success is a
 //! [`CertifiedProfile`] (only the checker can build one); failure is
 //! [`Rejected`], listing every [`Violation`] and, for eye safety, the
-//! binding [`Rule`] and the [`ExposureReport`] it rests on.
+//! binding [`Rule`] and the [`ExposureReport`] it rests on. [`Verdict`]
+//! is either outcome as serialisable data (what `gaze-lidar check --format
+//! json` prints and Python's `Verdict` holds), built with `Verdict::of`.
 //!
 //! Proofs: Kani harnesses live beside the code they verify (`mod
 //! verification` in each module); every harness body also runs as a test.
