@@ -21,7 +21,6 @@ use pyo3::types::{IntoPyDict, PyDict, PyList};
 use gaze_lidar::checker::{
     certify_with, CertifiedProfile, CheckOptions, Verdict as CoreVerdict, Violation,
 };
-use gaze_lidar::eye_safety::head::bound::power_scale_to_certify;
 use gaze_lidar::firmware::{FirmwareConfig, FirmwareError, FirmwareTable};
 use gaze_lidar::gaze::{
     ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeError, GazeSample, Notice,
