@@ -1251,7 +1251,7 @@ fn float_flags_are_range_checked_by_name_before_the_bag_is_read() {
         ("--fog-mor-m", &["5e-324", "0", "-1", "1e300", "inf"][..]),
         ("--cloud-spin-rad-s", &["5e-324", "0", "-3", "1e9"][..]),
         ("--sensor-yaw-deg", &["5e-324", "1e9", "nan"][..]),
-        ("--rated-range-m", &["5e-324", "0"][..]),
+        ("--rated-range-m", &["5e-324", "0", "1.0000001e7"][..]),
         ("--max-mount-tilt-deg", &["5e-324", "91"][..]),
         ("--reorder-window-ms", &["5e-324", "-1", "1e9"][..]),
         ("--timeout-ms", &["5e-324"][..]),
@@ -1270,15 +1270,18 @@ fn float_flags_are_range_checked_by_name_before_the_bag_is_read() {
     let o = run_replay(&input, &out, &["--model", "argus", "--fog-mor-m", "150"]);
     let err = message(&o);
     assert!(err.starts_with("--fog-mor-m: "), "{err}");
-    // 1440 bins are fine.
+    // 1440 bins and a rated range of exactly 10⁷ m (the README's upper
+    // end, inclusive) are fine.
     std::fs::write(&input, &b).unwrap();
-    let o = run_replay(&input, &out, &["--bins", "1440"]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    for args in [&["--bins", "1440"][..], &["--rated-range-m", "1e7"][..]] {
+        let o = run_replay(&input, &out, args);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
 }
 
 #[test]

@@ -161,6 +161,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     }
     let (planner, preset_range_m) = a.plan.planner()?;
     let rated_range_m = match a.rated_range_m {
+        // (0, 10⁷] as the library and the README have it: 10⁷ itself is fine.
+        Some(r) if r == 1e7 => r,
         Some(r) => finite_between("--rated-range-m", r, 0.0, 1e7)?,
         None => preset_range_m,
     };
