@@ -1048,6 +1048,9 @@ fn output_topics_that_collide_with_inputs_or_each_other_are_refused_by_name() {
         ),
         (&["--adapted-topic", GAZE][..], "--adapted-topic"),
         (&["--profile-topic", "/tf_static"][..], "--profile-topic"),
+        // The transform topic may not be an input topic either.
+        (&["--tf-topic", CLOUD][..], "--tf-topic"),
+        (&["--tf-topic", GAZE][..], "--tf-topic"),
     ] {
         let o = run_replay(&input, &twice, args);
         let err = message(&o);
@@ -1391,8 +1394,9 @@ fn sequences_attachments_and_metadata_are_copied_and_stamps_are_exact() {
 #[allow(dead_code)]
 mod drive;
 
-/// SIGINT and SIGTERM during a replay: the temporary output is removed and
-/// the exit status is 128 + the signal; an old output stays as it was.
+/// SIGINT, SIGTERM and SIGHUP during a replay: the temporary output is
+/// removed and the exit status is 128 + the signal; an old output stays as
+/// it was.
 #[test]
 fn a_signal_removes_the_temporary_output() {
     let dir = tempfile::tempdir().unwrap();
@@ -1407,7 +1411,7 @@ fn a_signal_removes_the_temporary_output() {
             .filter(|n| n.starts_with(".gaze-lidar-replay"))
             .collect()
     };
-    for (sig, code) in [("INT", 130), ("TERM", 143)] {
+    for (sig, code) in [("INT", 130), ("TERM", 143), ("HUP", 129)] {
         let mut child = bin()
             .arg("replay")
             .arg(&input)
@@ -1444,4 +1448,79 @@ fn a_signal_removes_the_temporary_output() {
         assert!(temps().is_empty(), "SIG{sig}: {:?}", temps());
         assert_eq!(std::fs::read(&out).unwrap(), b"old");
     }
+}
+
+/// One corrupted opcode byte turns a chunk (or a message) into an
+/// "unknown" record, which MCAP readers skip: the replay must not drop its
+/// messages and succeed. The summary's statistics count them, so the bag
+/// is refused (exit 2) at the statistics record, with no output. The data
+/// section's CRC is zeroed ("not computed", as some writers leave it), so
+/// only the count can tell.
+#[test]
+fn a_record_lost_to_a_corrupted_opcode_is_exit_2_not_a_silent_drop() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = bag(None);
+    // Top-level records after the 8-byte magic: opcode, u64 length, data.
+    let (mut at, mut chunks, mut corrupted) = (8usize, 0, false);
+    while at + 9 <= b.len() {
+        let op = b[at];
+        let len = u64::from_le_bytes(b[at + 1..at + 9].try_into().unwrap()) as usize;
+        match op {
+            // The second chunk (or the second top-level message).
+            0x06 | 0x05 if !corrupted => {
+                chunks += 1;
+                if chunks == 2 {
+                    b[at] = 0xEE;
+                    corrupted = true;
+                }
+            }
+            // Data End: its CRC of the data section, zeroed.
+            0x0F => b[at + 9..at + 13].fill(0),
+            0x02 => break, // the footer
+            _ => {}
+        }
+        at += 9 + len;
+    }
+    assert!(corrupted, "the fixture has at least two chunks");
+    let input = dir.path().join("opcode.mcap");
+    std::fs::write(&input, &b).unwrap();
+    let out = dir.path().join("out.mcap");
+    let o = run_replay(&input, &out, &[]);
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("statistics record counts"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!out.exists());
+}
+
+/// Frames whose adaptive profile cannot be certified run the baseline:
+/// `stream` warns per frame, and `replay` says how many in one line (it
+/// said nothing, and every frame was fail-safe). The vls128 preset's
+/// resolution closed form steps its spin, which the sensor's acceleration
+/// limit forbids, so no frame's adaptive profile certifies.
+#[test]
+fn frames_that_fall_back_to_the_baseline_are_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let out = dir.path().join("out.mcap");
+    let o = bin()
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD])
+        .args(["--preset", "vls128", "--mode", "resolution", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    common::no_panic(&o, "replay");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("had no certified adaptive profile for their gaze and ran the baseline"),
+        "{err}"
+    );
+    // The paper preset plans every gaze: no such line.
+    let o = run_replay(&input, &out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("ran the baseline instead"), "{err}");
 }

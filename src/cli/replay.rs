@@ -122,15 +122,16 @@ fn replay_error(e: ReplayError) -> CliError {
     }
 }
 
-/// On SIGINT or SIGTERM, a thread removes the temporary output file named
-/// in the returned [`Staging`] (if any) and exits 128 + the signal (130,
-/// 143), as a shell reports a process the signal ended. (Devices, FIFOs and
+/// On SIGINT, SIGTERM or SIGHUP (a closed terminal), a thread removes the
+/// temporary output file named in the returned [`Staging`] (if any) and
+/// exits 128 + the signal (130, 143, 129), as a shell reports a process the
+/// signal ended. (Devices, FIFOs and
 /// stdout are staged in an anonymous temporary file, which the system
 /// removes with the process.)
 fn remove_on_signal() -> Result<&'static Staging, CliError> {
-    use signal_hook::consts::{SIGINT, SIGTERM};
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     static STAGING: Staging = std::sync::Mutex::new(None);
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
         .map_err(|e| CliError::output(format!("installing the signal handler: {e}")))?;
     std::thread::spawn(move || {
         if let Some(sig) = signals.forever().next() {
@@ -224,6 +225,18 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         super::io::warn(format!(
             "warning: {} clouds not in the vehicle frame {:?} and not linked to it by a transform on {}: no mounting yaw applied (give --sensor-yaw-deg)",
             stats.clouds_without_tf, a.vehicle_frame, a.tf_topic
+        ));
+    }
+    if stats.plan_fallbacks > 0 {
+        super::io::warn(format!(
+            "warning: {} frame(s) had no certified adaptive profile for their gaze and ran the baseline instead (fail-safe; `stream` names each)",
+            stats.plan_fallbacks
+        ));
+    }
+    if stats.resyncs > 0 {
+        super::io::warn(format!(
+            "warning: the gaze clock jumped or ran backwards {} time(s): one fail-safe frame each, frame clock restarted, gaze history discarded",
+            stats.resyncs
         ));
     }
     super::io::warn(format!(

@@ -52,7 +52,9 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
-use crate::gaze::{Frame, FramePlanner, GazeError, GazeSample, GazeStream, State, StreamStats};
+use crate::gaze::{
+    Frame, FramePlanner, GazeError, GazeSample, GazeStream, Notice, State, StreamStats,
+};
 use crate::pointcloud::{keep_mask, CloudError, CloudFrame, CloudOptions};
 
 /// Why a replay stopped.
@@ -260,6 +262,12 @@ pub struct ReplayStats {
     pub attachments: u64,
     /// Metadata records copied.
     pub metadata: u64,
+    /// Frames whose adaptive profile could not be certified (or planned):
+    /// they ran the baseline, as `stream` warns.
+    pub plan_fallbacks: u64,
+    /// Gaze clock jumps (or steps back): one fail-safe frame each, the
+    /// frame clock restarted, the gaze history discarded.
+    pub resyncs: u64,
     /// The gaze pipeline's counters.
     pub stream: StreamStats,
 }
@@ -557,6 +565,14 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
     }
 
     fn emit(&mut self, frames: Vec<Frame>) -> Result<(), ReplayError> {
+        // What `stream` tells the user, counted for the summary.
+        for n in self.stream.take_notices() {
+            match n {
+                Notice::PlanFallback { .. } => self.stats.plan_fallbacks += 1,
+                Notice::Resync { .. } => self.stats.resyncs += 1,
+                Notice::Late { .. } => {}
+            }
+        }
         let t0 = self.t0_ns.unwrap_or(0);
         for f in frames {
             let start_ns = (f.t_s.max(0.0) * 1e9).round() as u64;
@@ -897,6 +913,16 @@ impl ReplayOptions {
                 format!("{:?} is also the gaze topic", self.cloud_topic),
             ));
         }
+        // The transform topic carries tf2 messages: it cannot be the gaze
+        // or the cloud topic (their messages would be read as transforms).
+        for (name, t) in [
+            ("gaze topic", &self.gaze_topic),
+            ("cloud topic", &self.cloud_topic),
+        ] {
+            if self.tf_topic == *t {
+                return Err(config("tf_topic", format!("{t:?} is also the {name}")));
+            }
+        }
         let outputs = [
             ("adapted_topic", &self.adapted_topic),
             ("profile_topic", &self.profile_topic),
@@ -1097,6 +1123,7 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     let mut next_record: u64 = MAGIC_BYTES;
     let mut footer_end: Option<u64> = None;
     let mut past_data_end = false;
+    let mut messages_read: u64 = 0;
     let mut links = mcap::read::ChannelAccumulator::<'static>::default();
     let mut window = Window::new(opts.reorder_window_ns);
     let input_bytes = std::cell::Cell::new(0u64);
@@ -1159,7 +1186,13 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                 }
                 let record = mcap::parse_record(opcode, data).map_err(|e| mcap_err(at, "", e))?;
                 if past_data_end {
-                    // The summary repeats schemas, channels and indexes.
+                    // The summary repeats schemas, channels and indexes;
+                    // its statistics must agree with what was read (a
+                    // record whose opcode was corrupted is skipped as
+                    // unknown, so only the count can tell).
+                    if let mcap::records::Record::Statistics(s) = &record {
+                        check_message_count(path, at, s.message_count, messages_read)?;
+                    }
                     continue;
                 }
                 let records = match record {
@@ -1198,6 +1231,7 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                             links.add_channel(c).map_err(inside)?;
                         }
                         mcap::records::Record::Message { header, data } => {
+                            messages_read += 1;
                             let Some(channel) = links.get(header.channel_id) else {
                                 return Err(inside(mcap::McapError::UnknownChannel(
                                     header.sequence,
@@ -1245,6 +1279,29 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     let mut stats = r.stats;
     stats.stream = r.stream.stats();
     Ok(stats)
+}
+
+/// The summary's message count against the messages the data section
+/// held: a mismatch means records were lost (a corrupted opcode reads as an
+/// unknown record, which MCAP readers skip) or the summary lies; either
+/// way the bag is not what it says, and replaying the rest would silently
+/// drop messages.
+fn check_message_count(
+    path: &str,
+    offset: u64,
+    declared: u64,
+    read: u64,
+) -> Result<(), ReplayError> {
+    if declared == read {
+        return Ok(());
+    }
+    Err(ReplayError::Mcap {
+        path: path.to_owned(),
+        offset,
+        reason: format!(
+            "the statistics record counts {declared} messages, the data section holds {read} (a record is corrupt or missing)"
+        ),
+    })
 }
 
 /// Whether two paths name one existing file (device and inode; links
