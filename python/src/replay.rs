@@ -213,6 +213,8 @@ pub fn replay<'py>(
         d.set_item("transforms", stats.transforms)?;
         d.set_item("attachments", stats.attachments)?;
         d.set_item("metadata", stats.metadata)?;
+        d.set_item("plan_fallbacks", stats.plan_fallbacks)?;
+        d.set_item("resyncs", stats.resyncs)?;
         let s = stats.stream;
         d.set_item("samples", s.samples)?;
         d.set_item("invalid", s.invalid)?;
