@@ -450,7 +450,8 @@ def replay(
     metadata, plan_fallbacks (frames that ran the baseline because no
     adaptive profile certified), resyncs (gaze clock jumps), samples,
     invalid, outliers, frames, fail_safe_frames). Input messages keep
-    their sequence numbers; attachments and metadata records are copied. bins: 4..=1440 (each frame's profile is written out).
+    their sequence numbers; attachments and metadata records are copied.
+    bins: 4..=1440 (each frame's profile is written out).
 
     The mounting yaw: sensor_yaw_deg when given, else the bag's static
     transforms on tf_topic from the cloud's header.frame_id to
