@@ -228,16 +228,15 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
         for m in &got {
             match m.topic.as_str() {
                 "/gaze_lidar/profile" => {
-                    assert_eq!(m.schema, "jsonschema gaze_lidar.Profile");
-                    assert_eq!(m.encoding, "json");
+                    assert_eq!(m.schema, "ros2msg std_msgs/msg/String");
+                    assert_eq!(m.encoding, "cdr");
                 }
                 "/gaze_lidar/scene" => {
-                    assert_eq!(m.schema, "jsonschema foxglove.SceneUpdate");
-                    let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
-                    assert!(!v["entities"][0]["triangles"][0]["points"]
-                        .as_array()
-                        .unwrap()
-                        .is_empty());
+                    assert_eq!(m.schema, "ros2msg visualization_msgs/msg/MarkerArray");
+                    assert_eq!(m.encoding, "cdr");
+                    // Two markers; the first (a triangle list) has points.
+                    assert_eq!(&m.data[4..8], &2u32.to_le_bytes());
+                    assert!(m.data.len() > 1000, "{}", m.data.len());
                 }
                 t => {
                     assert!(m.schema.starts_with("ros2msg "), "{t}: {}", m.schema);
@@ -251,7 +250,7 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
             .filter(|m| m.topic == "/gaze_lidar/profile")
             .map(|m| {
                 let p =
-                    Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "profile").unwrap();
+                    Profile::from_json(cdr::decode_string(&m.data).unwrap(), "profile").unwrap();
                 assert!(independent::recheck(&p).is_empty());
                 (m.log_time, certify(p).unwrap())
             })
@@ -525,7 +524,7 @@ fn check_mounting(bag: &[u8], extra: &[&str], yaw_deg: f64) -> String {
         .iter()
         .filter(|m| m.topic == "/gaze_lidar/profile")
         .map(|m| {
-            let p = Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "p").unwrap();
+            let p = Profile::from_json(cdr::decode_string(&m.data).unwrap(), "p").unwrap();
             (m.log_time, certify(p).unwrap())
         })
         .collect();
@@ -753,7 +752,7 @@ fn float64_yaw_gaze_and_a_mounting_yaw() {
         .iter()
         .filter(|m| m.topic == "/gaze_lidar/profile")
         .map(|m| {
-            let p = Profile::from_json(std::str::from_utf8(&m.data).unwrap(), "p").unwrap();
+            let p = Profile::from_json(cdr::decode_string(&m.data).unwrap(), "p").unwrap();
             (m.log_time, certify(p).unwrap())
         })
         .collect();
@@ -1523,4 +1522,453 @@ fn frames_that_fall_back_to_the_baseline_are_reported() {
     let o = run_replay(&input, &out, &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!err.contains("ran the baseline instead"), "{err}");
+}
+
+/// The messages a replay adds, whatever the input's other topics.
+fn added_only(out: &[u8]) -> Vec<(String, u64, Vec<u8>)> {
+    read_all(out)
+        .into_iter()
+        .filter(|m| m.topic.starts_with("/gaze_lidar/") || m.topic == "/lidar/points/adapted")
+        .map(|m| (m.topic, m.log_time, m.data))
+        .collect()
+}
+
+/// `m` moved onto a topic of its own (a new channel, the same schema).
+fn on_topic(m: &mcap::Message<'static>, id: u16, topic: &str) -> mcap::Message<'static> {
+    let mut m = m.clone();
+    m.channel = std::sync::Arc::new(mcap::Channel {
+        id,
+        topic: topic.to_owned(),
+        schema: m.channel.schema.clone(),
+        message_encoding: m.channel.message_encoding.clone(),
+        metadata: BTreeMap::new(),
+    });
+    m
+}
+
+/// Any number of far-future `log_time`s, each on an unrelated topic of its
+/// own, early in the file: the reorder window still puts two pairs of
+/// swapped clouds back in order, so the output is the one without them.
+#[test]
+fn any_number_of_far_future_stamps_on_unrelated_topics_do_not_change_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = bag(None);
+    let t0 = read_all(&plain).iter().map(|m| m.log_time).min().unwrap();
+    let run = |name: &str, bytes: &[u8]| {
+        let (i, o) = (
+            dir.path().join(format!("{name}.mcap")),
+            dir.path().join(format!("{name}-out.mcap")),
+        );
+        std::fs::write(&i, bytes).unwrap();
+        let r = run_replay(&i, &o, &[]);
+        assert_eq!(r.status.code(), Some(0), "{}", message(&r));
+        added_only(&std::fs::read(&o).unwrap())
+    };
+    let want = run("plain", &plain);
+    assert_eq!(
+        want.iter()
+            .filter(|m| m.0 == "/lidar/points/adapted")
+            .count(),
+        30
+    );
+    for n in [1usize, 2, 5] {
+        let far = rewrite(
+            &plain,
+            |m| {
+                let clouds: Vec<usize> = (0..m.len())
+                    .filter(|&i| m[i].channel.topic == CLOUD)
+                    .collect();
+                m.swap(clouds[3], clouds[4]);
+                m.swap(clouds[10], clouds[11]);
+                let other = m.iter().find(|x| x.channel.topic == OTHER).unwrap().clone();
+                for k in 0..n {
+                    let mut x = on_topic(&other, 100 + k as u16, &format!("/far/{k}"));
+                    x.log_time = t0 + 1_000_000_000_000 * (k as u64 + 1);
+                    m.insert(5 + 3 * k, x);
+                }
+            },
+            |_| {},
+        );
+        let have = run(&format!("far{n}"), &far);
+        assert_eq!(want.len(), have.len(), "{n} far-future stamps");
+        for (k, (w, h)) in want.iter().zip(&have).enumerate() {
+            assert!(
+                w == h,
+                "{n} far-future stamps: message {k} on {} differs",
+                w.0
+            );
+        }
+    }
+}
+
+/// `--out -` into a pipe whose reader has gone: the reader left, so
+/// nothing is owed to it; as every command of the CLI does (the stdout
+/// rule), exit 0, and no panic.
+#[test]
+fn out_dash_into_a_closed_pipe_is_exit_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let mut child = bin()
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD, "--out", "-"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    common::no_panic(&o, "closed pipe");
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+}
+
+/// A bag written without chunks (each message a top-level record).
+fn unchunked(bag: &[u8]) -> Vec<u8> {
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .use_chunks(false)
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    for m in mcap::MessageStream::new(bag).unwrap() {
+        w.write(&m.unwrap()).unwrap();
+    }
+    w.finish().unwrap();
+    drop(w);
+    buf
+}
+
+/// A bad message is named by its topic and the byte offset of its record
+/// (the sequence field, which writers may leave 0 or repeat, only as
+/// "sequence N"); in a chunk, by the chunk's offset and the record's index.
+#[test]
+fn a_bad_message_is_named_by_its_offset_and_topic() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = bag(None);
+    // Every sequence 0; the 30th gaze message cut short.
+    let broken = rewrite(
+        &plain,
+        |m| {
+            for x in m.iter_mut() {
+                x.sequence = 0;
+            }
+            let g = (0..m.len())
+                .filter(|&i| m[i].channel.topic == GAZE)
+                .nth(30)
+                .unwrap();
+            m[g].data = std::borrow::Cow::Owned(m[g].data[..20].to_vec());
+        },
+        |_| {},
+    );
+    let flat = unchunked(&broken);
+    // The record of the cut message: the 31st gaze message record.
+    let starts = record_starts(&flat);
+    let gaze_id = mcap::Summary::read(&flat)
+        .unwrap()
+        .unwrap()
+        .channels
+        .values()
+        .find(|c| c.topic == GAZE)
+        .unwrap()
+        .id;
+    let at = starts
+        .iter()
+        .copied()
+        .filter(|&s| flat[s] == 0x05 && u16::from_le_bytes([flat[s + 9], flat[s + 10]]) == gaze_id)
+        .nth(30)
+        .unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    std::fs::write(&input, &flat).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.starts_with(&format!(
+            "{GAZE}: message at byte {at} (sequence 0, log_time "
+        )),
+        "record at {at}: {err}"
+    );
+    assert!(!err.contains("message 0 "), "{err}");
+    // Chunked: the chunk's offset and the record's index in it.
+    std::fs::write(&input, &broken).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let chunk_at: usize = err
+        .strip_prefix(&format!("{GAZE}: message in the chunk at byte "))
+        .and_then(|r| r.split(',').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!(record_starts(&broken).contains(&chunk_at), "{err}");
+    assert_eq!(broken[chunk_at], 0x06, "{err}");
+    assert!(err.contains(", record "), "{err}");
+    assert!(!out.exists());
+}
+
+/// A small chunked bag: 40 gaze samples, 4 clouds of 30 points, 2 other
+/// messages, with a summary.
+fn small_bag() -> Vec<u8> {
+    let plain = bag(None);
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .chunk_size(Some(1024))
+        .compression(None)
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    let (mut g, mut c, mut o) = (0, 0, 0);
+    for m in mcap::MessageStream::new(&plain).unwrap() {
+        let mut m = m.unwrap();
+        let keep = match m.channel.topic.as_str() {
+            GAZE => {
+                g += 1;
+                g <= 40
+            }
+            CLOUD => {
+                c += 1;
+                let t = m.log_time;
+                m.data = std::borrow::Cow::Owned(cloud_msg(
+                    (t / 1_000_000_000) as i32,
+                    (t % 1_000_000_000) as u32,
+                    c,
+                    30,
+                ));
+                c <= 4
+            }
+            _ => {
+                o += 1;
+                o <= 2
+            }
+        };
+        if keep {
+            w.write(&m).unwrap();
+        }
+    }
+    w.finish().unwrap();
+    drop(w);
+    buf
+}
+
+/// A file cut at every 97th byte: exit 2, and the offset named is inside
+/// the file (at most its size).
+#[test]
+fn truncated_files_name_an_offset_inside_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = small_bag();
+    assert!(full.len() > 5000, "{}", full.len());
+    let (input, out) = (dir.path().join("cut.mcap"), dir.path().join("out.mcap"));
+    let mut cut = 1;
+    while cut < full.len() {
+        std::fs::write(&input, &full[..cut]).unwrap();
+        let o = run_replay(&input, &out, &[]);
+        let err = message(&o);
+        assert_eq!(o.status.code(), Some(2), "cut at {cut}: {err}");
+        let at: usize = err
+            .split("at byte ")
+            .nth(1)
+            .and_then(|r| r.split(':').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("cut at {cut}: {err}"));
+        assert!(at <= cut, "cut at {cut}: {err}");
+        assert!(!out.exists());
+        cut += 97;
+    }
+}
+
+/// A write that fails (the file-size limit here, as a full disk would)
+/// names `--out`'s path.
+#[test]
+fn a_failed_write_names_the_output_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let out = dir.path().join("out.mcap");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 64 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_gaze-lidar"))
+        .arg("replay")
+        .arg(&input)
+        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD, "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with(&format!("output: {}: ", out.display())),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}
+
+/// A channel (and its schema) without a single message is copied too.
+#[test]
+fn a_channel_without_messages_is_copied() {
+    let dir = tempfile::tempdir().unwrap();
+    // The bag's messages, and a channel /imu that has none.
+    let mut with_empty = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .create(Cursor::new(&mut with_empty))
+        .unwrap();
+    let s = w
+        .add_schema(
+            "sensor_msgs/msg/Imu",
+            schemas::ROS2MSG,
+            b"std_msgs/Header header\n",
+        )
+        .unwrap();
+    let mut meta = BTreeMap::new();
+    meta.insert("offered_qos_profiles".to_owned(), "- history: 3".to_owned());
+    w.add_channel(s, "/imu", schemas::CDR, &meta).unwrap();
+    let mut ids: BTreeMap<u16, u16> = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bag(None)).unwrap() {
+        let m = m.unwrap();
+        let id = match ids.get(&m.channel.id) {
+            Some(&id) => id,
+            None => {
+                let sc = m.channel.schema.as_ref().unwrap();
+                let s = w.add_schema(&sc.name, &sc.encoding, &sc.data).unwrap();
+                let id = w
+                    .add_channel(
+                        s,
+                        &m.channel.topic,
+                        &m.channel.message_encoding,
+                        &BTreeMap::new(),
+                    )
+                    .unwrap();
+                ids.insert(m.channel.id, id);
+                id
+            }
+        };
+        w.write_to_known_channel(
+            &MessageHeader {
+                channel_id: id,
+                sequence: m.sequence,
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+            },
+            &m.data,
+        )
+        .unwrap();
+    }
+    w.finish().unwrap();
+    drop(w);
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    std::fs::write(&input, &with_empty).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    let got = std::fs::read(&out).unwrap();
+    let summary = mcap::Summary::read(&got).unwrap().unwrap();
+    let imu = summary
+        .channels
+        .values()
+        .find(|c| c.topic == "/imu")
+        .expect("the /imu channel is in the output");
+    assert_eq!(imu.message_encoding, schemas::CDR);
+    assert_eq!(
+        imu.metadata.get("offered_qos_profiles").map(String::as_str),
+        Some("- history: 3")
+    );
+    let s = imu.schema.as_ref().expect("its schema");
+    assert_eq!(
+        (s.name.as_str(), s.encoding.as_str(), &s.data[..]),
+        (
+            "sensor_msgs/msg/Imu",
+            schemas::ROS2MSG,
+            &b"std_msgs/Header header\n"[..]
+        )
+    );
+}
+
+/// A cloud whose x field has `count` 0 holds no x: refused by name.
+#[test]
+fn a_point_field_with_count_0_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let zero = rewrite(
+        &bag(None),
+        |m| {
+            let c = (0..m.len()).find(|&i| m[i].channel.topic == CLOUD).unwrap();
+            let mut d = m[c].data.to_vec();
+            // The first field's count: the u32 after "x\0", its offset and
+            // its datatype (header 4 + stamp 8 + "lidar" 4+6 → 24 (pad),
+            // height, width, field count 4+4+4 → 36, name 4+2 → 42, pad
+            // 44, offset → 48, datatype → 49, pad → 52).
+            assert_eq!(&d[40..42], b"x\0");
+            assert_eq!(u32::from_le_bytes(d[52..56].try_into().unwrap()), 1);
+            d[52..56].copy_from_slice(&0u32.to_le_bytes());
+            m[c].data = std::borrow::Cow::Owned(d);
+        },
+        |_| {},
+    );
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    std::fs::write(&input, &zero).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    let err = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("fields: field x has count 0"), "{err}");
+    assert!(!out.exists());
+}
+
+/// A first gaze sample at `log_time` 0 (the clock then jumps to the real
+/// stamps, far from it): the frames after the jump start exactly where the
+/// bag without that sample has them, to the nanosecond, and every adapted
+/// cloud's header stamp is its input's.
+#[test]
+fn stamps_are_exact_when_the_first_gaze_is_at_log_time_0() {
+    let dir = tempfile::tempdir().unwrap();
+    // Stamps off the microsecond grid, so a rounding shows.
+    let shifted = rewrite(
+        &bag(None),
+        |m| {
+            for x in m.iter_mut() {
+                x.log_time += 123_456_789;
+                x.publish_time = x.log_time;
+            }
+        },
+        |_| {},
+    );
+    let zero = rewrite(
+        &shifted,
+        |m| {
+            let mut g = m.iter().find(|x| x.channel.topic == GAZE).unwrap().clone();
+            g.log_time = 0;
+            g.publish_time = 0;
+            m.insert(0, g);
+        },
+        |_| {},
+    );
+    let run = |name: &str, bytes: &[u8]| {
+        let (i, o) = (
+            dir.path().join(format!("{name}.mcap")),
+            dir.path().join(format!("{name}-out.mcap")),
+        );
+        std::fs::write(&i, bytes).unwrap();
+        let r = run_replay(&i, &o, &[]);
+        assert_eq!(r.status.code(), Some(0), "{}", message(&r));
+        std::fs::read(&o).unwrap()
+    };
+    let (want, have) = (run("shifted", &shifted), run("zero", &zero));
+    let t_first = read_all(&shifted).iter().map(|m| m.log_time).min().unwrap();
+    let stamps = |b: &[u8]| -> Vec<u64> {
+        read_all(b)
+            .iter()
+            .filter(|m| m.topic == "/gaze_lidar/profile" && m.log_time >= t_first)
+            .map(|m| m.log_time)
+            .collect()
+    };
+    assert_eq!(stamps(&have), stamps(&want));
+    assert!(stamps(&want).len() > 20);
+    let headers = |b: &[u8], topic: &str| -> Vec<(i32, u32, u64)> {
+        read_all(b)
+            .iter()
+            .filter(|m| m.topic == topic)
+            .map(|m| {
+                let c = PointCloud2::decode(&m.data).unwrap();
+                (c.header.sec, c.header.nanosec, m.log_time)
+            })
+            .collect()
+    };
+    let input = headers(&zero, CLOUD);
+    assert_eq!(input.len(), 30);
+    assert_eq!(headers(&have, "/lidar/points/adapted"), input);
 }

@@ -443,8 +443,8 @@ def replay(
     and writes out_path, as `gaze-lidar replay` does (same Rust code, same
     options): every input message copied, one adapted cloud per cloud on
     adapted_topic (default cloud_topic + "/adapted"), one profile@1 document
-    per frame on profile_topic and a foxglove.SceneUpdate per frame on
-    scene_topic. out_path is replaced only when the replay succeeds.
+    per frame on profile_topic (std_msgs/msg/String) and a
+    visualization_msgs/msg/MarkerArray per frame on scene_topic. out_path is replaced only when the replay succeeds.
     Returns the counters (messages, clouds, points_in, points_kept,
     late_clouds, late_gaze, clouds_without_tf, transforms, attachments,
     metadata, plan_fallbacks (frames that ran the baseline because no

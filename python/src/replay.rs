@@ -47,8 +47,8 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64) -> PyResult<f64> {
 /// Replays the ROS 2 bag (MCAP) at in_path through the gaze pipeline and
 /// writes out_path: every input message copied, one adapted cloud per
 /// cloud on adapted_topic (default cloud_topic + "/adapted"), one
-/// profile@1 document per frame on profile_topic and a foxglove.SceneUpdate
-/// per frame on scene_topic (the options and rules of `gaze-lidar replay`;
+/// profile@1 document per frame on profile_topic (std_msgs/msg/String) and
+/// a visualization_msgs/msg/MarkerArray per frame on scene_topic (the options and rules of `gaze-lidar replay`;
 /// out_path is replaced only when the replay succeeds; input messages keep
 /// their sequence numbers, attachments and metadata are copied). Returns
 /// the counters (messages, clouds, points_in, points_kept, attachments,

@@ -167,9 +167,14 @@ def test_replay_of_an_independently_written_bag(
     assert key == sorted((m[0], m[2], m[3]) for m in got if m[0] in (GAZE, CLOUD, OTHER))
     # The profiles: one per frame, each certified by `gaze-lidar check`,
     # fail-safe (no gaze) through the gap, adaptive (gaze left) before it.
-    profiles = [(m[2], m[3].decode()) for m in got if m[0] == "/gaze_lidar/profile"]
-    assert {m[1] for m in got if m[0] == "/gaze_lidar/profile"} == {"gaze_lidar.Profile"}
-    assert {m[1] for m in got if m[0] == "/gaze_lidar/scene"} == {"foxglove.SceneUpdate"}
+    profiles = [(m[2], m[4].data) for m in got if m[0] == "/gaze_lidar/profile"]
+    assert {m[1] for m in got if m[0] == "/gaze_lidar/profile"} == {"std_msgs/msg/String"}
+    scenes = [m[4] for m in got if m[0] == "/gaze_lidar/scene"]
+    assert {m[1] for m in got if m[0] == "/gaze_lidar/scene"} == {
+        "visualization_msgs/msg/MarkerArray"}
+    assert len(scenes) == len(profiles)
+    assert all([mk.type for mk in s.markers] == [11, 9] and len(s.markers[0].points) > 0
+               for s in scenes)
     assert len(profiles) >= 55
     for i, text in enumerate(sorted({p for _, p in profiles})):
         f = tmp_path / f"p{i}.json"
@@ -205,7 +210,7 @@ def test_replay_of_an_independently_written_bag(
 def adapted_vs_rule(inp: list[Any], got: list[Any], sensor_yaw_deg: float) -> int:
     """Checks each adapted cloud against apply_profile on its input cloud
     (the sensor turned by sensor_yaw_deg); returns the adaptive clouds."""
-    parsed = [(m[2], gl.Profile.from_json(m[3].decode())) for m in got
+    parsed = [(m[2], gl.Profile.from_json(m[4].data)) for m in got
               if m[0] == "/gaze_lidar/profile"]
     clouds = [m for m in inp if m[0] == CLOUD]
     adapted = [m for m in got if m[0] == CLOUD + "/adapted"]
@@ -362,3 +367,36 @@ def test_attachments_metadata_and_sequences_of_an_independent_bag_are_copied(
         ("calibration.yaml", "application/yaml", b"lidar: {yaw: 0}\n")]
     assert [(m.name, m.metadata) for m in metadata] == [("rosbag2", {"vehicle": "car 7"})]
     assert got == sorted(sequences)
+
+
+def test_rosbags_anyreader_reads_every_message_of_the_output(
+    repo: pathlib.Path, tmp_path: pathlib.Path
+) -> None:
+    """Every output channel (copied, adapted, profile, picture) is ros2msg +
+    CDR: the rosbags package (an independent reader) opens the file and
+    decodes every message; the profiles are profile@1 documents."""
+    anyreader = pytest.importorskip("rosbags.highlevel")
+    bag, out = tmp_path / "drive.mcap", tmp_path / "out.mcap"
+    write_fixture(bag, "NONE", mount=yaw_quaternion(30.0))
+    subprocess.run(
+        [str(cli(repo)), "replay", str(bag), "--gaze-topic", GAZE, "--cloud-topic", CLOUD,
+         "--out", str(out)],
+        check=True, capture_output=True,
+    )
+    want = read(out)
+    got: list[tuple[str, int]] = []
+    profiles = 0
+    with anyreader.AnyReader([out]) as reader:
+        for connection, t, raw in reader.messages():
+            msg = reader.deserialize(raw, connection.msgtype)
+            got.append((connection.topic, t))
+            if connection.topic == "/gaze_lidar/profile":
+                assert gl.Profile.from_json(msg.data).frame_rate_hz > 0
+                profiles += 1
+            if connection.topic == "/gaze_lidar/scene":
+                assert [m.type for m in msg.markers] == [11, 9]
+                assert msg.markers[0].header.frame_id == "lidar"
+            if connection.topic == CLOUD + "/adapted":
+                assert msg.point_step == 16 and len(msg.data) == 16 * msg.width
+    assert profiles >= 55
+    assert sorted(got) == sorted((m[0], m[2]) for m in want)

@@ -93,10 +93,10 @@ pub struct Args {
     /// Topic of the adapted clouds [default: <cloud-topic>/adapted].
     #[arg(long)]
     adapted_topic: Option<String>,
-    /// Topic of the per-frame profile@1 documents (JSON).
+    /// Topic of the per-frame profile@1 documents (JSON in a std_msgs/msg/String).
     #[arg(long, default_value = "/gaze_lidar/profile")]
     profile_topic: String,
-    /// Topic of the per-frame foxglove.SceneUpdate picture (JSON).
+    /// Topic of the per-frame picture (visualization_msgs/msg/MarkerArray).
     #[arg(long, default_value = "/gaze_lidar/scene")]
     scene_topic: String,
     /// Output chunk compression.

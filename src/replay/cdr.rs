@@ -181,6 +181,12 @@ impl Writer {
         self.buf.extend_from_slice(&v.to_le_bytes());
     }
 
+    /// An `f32`.
+    pub fn f32(&mut self, v: f32) {
+        self.align(4);
+        self.buf.extend_from_slice(&v.to_le_bytes());
+    }
+
     /// An `f64`.
     pub fn f64(&mut self, v: f64) {
         self.align(8);
@@ -282,6 +288,19 @@ pub fn encode_float64(v: f64) -> Vec<u8> {
     let mut w = Writer::new(8);
     w.f64(v);
     w.finish()
+}
+
+/// A `std_msgs/msg/String`.
+#[must_use]
+pub fn encode_string(s: &str) -> Vec<u8> {
+    let mut w = Writer::new(s.len() + 8);
+    w.string(s);
+    w.finish()
+}
+
+/// The text of a `std_msgs/msg/String`.
+pub fn decode_string(buf: &[u8]) -> Result<&str, ReplayError> {
+    Reader::new(buf)?.string("data")
 }
 
 /// `sensor_msgs/msg/PointField.datatype` values.
@@ -413,6 +432,12 @@ impl<'a> PointCloud2<'a> {
                     ))
                 }
             };
+            if f.count == 0 {
+                return Err(bad(
+                    "fields",
+                    format!("field {axis} has count 0: it holds no value"),
+                ));
+            }
             let size = if wide { 8 } else { 4 };
             if (f.offset as usize) + size > self.point_step as usize {
                 return Err(bad(

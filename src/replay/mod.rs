@@ -28,16 +28,18 @@
 //!   0, in the order written: `log_time`) is thinned with seed `seed + k`
 //!   (wrapping).
 //! - every message is copied to the output unchanged, on its own topic,
-//!   with its sequence number; attachments and metadata records too.
+//!   with its sequence number; every channel and schema (one without a
+//!   single message too), attachments and metadata records too.
 //!
-//! The output adds, with their schemas embedded: the adapted cloud (the kept
-//! points' bytes, same header, fields and point step, one row) on
-//! [`ReplayOptions::adapted_topic`]; one `gaze-lidar/profile@1` JSON
-//! document per frame on [`ReplayOptions::profile_topic`] (`log_time` the
-//! frame start); and a `foxglove.SceneUpdate` (JSON) per frame on
-//! [`ReplayOptions::scene_topic`]: a ring around the sensor, one sector per
-//! run of equal power, coloured and sized by `P/P̄`, drawn in the cloud's
-//! frame.
+//! The output adds, with their schemas embedded (all `ros2msg` + CDR): the
+//! adapted cloud (the kept points' bytes, same header, fields and point
+//! step, one row) on [`ReplayOptions::adapted_topic`]; one
+//! `gaze-lidar/profile@1` JSON document per frame, as a
+//! `std_msgs/msg/String`, on [`ReplayOptions::profile_topic`] (`log_time`
+//! the frame start); and a `visualization_msgs/msg/MarkerArray` per frame
+//! on [`ReplayOptions::scene_topic`]: a ring around the sensor, one sector
+//! per run of equal power, coloured and sized by `P/P̄`, drawn in the
+//! cloud's frame ([`scene`]).
 
 pub mod cdr;
 pub mod scene;
@@ -133,8 +135,13 @@ impl ReplayError {
     }
 }
 
-fn write_err(e: impl std::fmt::Display) -> ReplayError {
-    ReplayError::Write(e.to_string())
+/// A write error with its cause (the mcap crate's I/O error says only
+/// "I/O error from writing"; the system's reason is its source).
+fn write_err(e: impl std::error::Error) -> ReplayError {
+    match e.source() {
+        Some(cause) => ReplayError::Write(format!("{e}: {cause}")),
+        None => ReplayError::Write(e.to_string()),
+    }
 }
 
 /// The gaze topic's message type.
@@ -173,7 +180,7 @@ pub struct ReplayOptions {
     pub adapted_topic: String,
     /// Topic of the per-frame profile@1 documents.
     pub profile_topic: String,
-    /// Topic of the per-frame `foxglove.SceneUpdate` picture.
+    /// Topic of the per-frame picture (`visualization_msgs/msg/MarkerArray`).
     pub scene_topic: String,
     /// The cloud frame's x axis, degrees counter-clockwise (ISO 8855) from
     /// the vehicle's: a point at azimuth β in the cloud is at β + yaw in
@@ -196,9 +203,10 @@ pub struct ReplayOptions {
     /// are ISO 8855, REP 103).
     pub cloud: CloudOptions,
     /// Messages are processed in `log_time` order once they are this much
-    /// older than the window's clock, ns: the second-newest of the topics'
-    /// newest `log_time`s, so one far-future stamp does not move it (and
-    /// at most 96 MiB are held, each message counted with its
+    /// older than the window's clock, ns: the older of the gaze and cloud
+    /// topics' newest `log_time`s, so no stamp on another topic moves it,
+    /// and a far-future stamp on one of the two is held back by the other
+    /// (at most 32 MiB are held, each message counted with its
     /// bookkeeping). A message later than that is processed late (a late
     /// gaze sample is dropped, a late cloud gets the profile of the frame
     /// it fell in, or the baseline).
@@ -277,7 +285,28 @@ struct Pending {
     log_time: u64,
     /// Order read (ties on `log_time` keep file order).
     seq: u64,
+    /// Where its record is: the top-level record's byte offset, and the
+    /// record's index when that is a chunk.
+    at: RecordAt,
     msg: mcap::Message<'static>,
+}
+
+/// Where a record is in the input file.
+#[derive(Debug, Clone, Copy)]
+struct RecordAt {
+    /// Byte offset of the top-level record (the message, or its chunk).
+    offset: u64,
+    /// Index of the record inside the chunk, for a chunk.
+    in_chunk: Option<usize>,
+}
+
+impl std::fmt::Display for RecordAt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.in_chunk {
+            None => write!(f, "at byte {}", self.offset),
+            Some(k) => write!(f, "in the chunk at byte {}, record {k}", self.offset),
+        }
+    }
 }
 
 impl PartialEq for Pending {
@@ -302,7 +331,7 @@ impl Ord for Pending {
 /// data plus [`HELD_OVERHEAD_BYTES`]; past this the oldest message is
 /// processed whatever its age (memory stays bounded, however small the
 /// messages).
-const MAX_WINDOW_BYTES: usize = 96 << 20;
+const MAX_WINDOW_BYTES: usize = 32 << 20;
 
 /// What one held message costs besides its data, bytes: its entry in the
 /// heap (twice over: the heap's vector grows by doubling) and the data's
@@ -320,20 +349,27 @@ const RECORD_HEAD_BYTES: u64 = 9;
 /// window older than the release clock, or when the held bytes pass
 /// [`MAX_WINDOW_BYTES`].
 ///
-/// The release clock is the second-newest of the topics' newest
-/// `log_time`s (the newest when a single topic has been read): a topic
-/// whose clock runs ahead, or one far-future stamp on any topic, does not
-/// move it, so it cannot turn the window off for the others.
+/// The release clock is the older of the gaze and cloud topics' newest
+/// `log_time`s (of those read so far; 0 before either): the two topics
+/// that drive the output. Stamps on any other topic never move it, however
+/// many and however far ahead; a far-future stamp on one of the two is
+/// held back by the other. (A driving topic that stops holds the clock:
+/// messages then leave by the byte bound, still oldest first.)
 struct Window {
     heap: BinaryHeap<Pending>,
     window_ns: u64,
     held_bytes: usize,
     seq: u64,
-    /// Newest `log_time` per channel.
-    newest: HashMap<u16, u64>,
-    /// The newest of those and its channel; the newest of the others.
-    first: Option<(u64, u16)>,
-    second: u64,
+    /// Newest `log_time` read on the gaze topic and on the cloud topic.
+    newest: [Option<u64>; 2],
+}
+
+/// Which of the topics driving the output a message is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Drives {
+    Gaze,
+    Cloud,
+    No,
 }
 
 impl Window {
@@ -343,9 +379,7 @@ impl Window {
             window_ns,
             held_bytes: 0,
             seq: 0,
-            newest: HashMap::new(),
-            first: None,
-            second: 0,
+            newest: [None; 2],
         }
     }
 
@@ -353,24 +387,21 @@ impl Window {
         msg.data.len() + HELD_OVERHEAD_BYTES
     }
 
-    fn push(&mut self, msg: mcap::Message<'static>) {
-        let (ch, t) = (msg.channel.id, msg.log_time);
-        let slot = self.newest.entry(ch).or_insert(t);
-        *slot = (*slot).max(t);
-        let t_ch = *slot;
-        match self.first {
-            None => self.first = Some((t_ch, ch)),
-            Some((_, c)) if c == ch => self.first = Some((t_ch, ch)),
-            Some((f, _)) if t_ch > f => {
-                self.second = f;
-                self.first = Some((t_ch, ch));
-            }
-            Some(_) => self.second = self.second.max(t_ch),
+    fn push(&mut self, msg: mcap::Message<'static>, at: RecordAt, drives: Drives) {
+        let t = msg.log_time;
+        let slot = match drives {
+            Drives::Gaze => Some(&mut self.newest[0]),
+            Drives::Cloud => Some(&mut self.newest[1]),
+            Drives::No => None,
+        };
+        if let Some(slot) = slot {
+            *slot = Some(slot.map_or(t, |n| n.max(t)));
         }
         self.held_bytes += Self::cost(&msg);
         self.heap.push(Pending {
             log_time: t,
             seq: self.seq,
+            at,
             msg,
         });
         self.seq += 1;
@@ -378,11 +409,7 @@ impl Window {
 
     /// The release clock (see the type's documentation).
     fn clock(&self) -> u64 {
-        if self.newest.len() < 2 {
-            self.first.map_or(0, |f| f.0)
-        } else {
-            self.second
-        }
+        self.newest.iter().flatten().copied().min().unwrap_or(0)
     }
 
     /// The oldest message, if it is due.
@@ -407,9 +434,20 @@ impl Window {
 /// Frames remembered for clouds that arrive late.
 const FRAME_HISTORY: usize = 64;
 
-/// Longest record (or chunk) read, bytes: 256 MiB, a cloud of ten million
-/// points.
-const MAX_RECORD_BYTES: usize = 256 << 20;
+/// Longest record read (a chunk packed or unpacked, an attachment), bytes:
+/// 64 MiB.
+const MAX_RECORD_BYTES: usize = 64 << 20;
+
+/// Longest message, bytes: 32 MiB (a cloud of 1.5 million 22-byte points;
+/// a 128-channel sensor's is some 5 MB). Held at most four times over
+/// (the chunk read, the message, the output chunk, the adapted cloud), so
+/// with the window peak memory stays under 200 MB.
+const MAX_MESSAGE_BYTES: usize = 32 << 20;
+
+/// Most bytes of schemas and channels (names, definitions, metadata) a bag
+/// may declare: 16 MiB, held about three times over (read, output, its
+/// summary).
+const MAX_DECLARED_BYTES: usize = 16 << 20;
 
 /// Input bytes read per call.
 const READ_BYTES: usize = 1 << 20;
@@ -436,15 +474,22 @@ impl<I: Iterator> Iterator for Counted<I> {
 
 impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
-/// Gaze azimuth (degrees, `[0, 360)`) of a direction vector in the vehicle
-/// frame; `None` when its horizontal part is zero or not finite.
+/// Gaze azimuth (degrees, `[0, 360)`, never subnormal) of a direction
+/// vector in the vehicle frame; `None` when a component is not finite or
+/// the horizontal part is zero. The horizontal part is scaled by its larger
+/// component first (as quaternions are), so every finite non-zero one, at
+/// any scale, gives its azimuth; an angle below the smallest normal number
+/// (a component some 10³⁰⁸ times the other) is 0.
 #[must_use]
 pub fn vector_azimuth_deg(v: [f64; 3]) -> Option<f64> {
     let [x, y, z] = v;
     if !(x.is_finite() && y.is_finite() && z.is_finite()) || (x == 0.0 && y == 0.0) {
         return None;
     }
-    Some(crate::model::angle::wrap_deg(y.atan2(x).to_degrees()))
+    let m = x.abs().max(y.abs());
+    let a = (y / m).atan2(x / m).to_degrees();
+    let a = if a.abs() < f64::MIN_POSITIVE { 0.0 } else { a };
+    Some(crate::model::angle::wrap_deg(a))
 }
 
 struct Out<W: Write + Seek> {
@@ -546,6 +591,11 @@ struct Replayer<'o, P: FramePlanner, W: Write + Seek> {
     /// stamps written back are exact to the nanosecond even when another
     /// topic starts at `log_time` 0).
     t0_ns: Option<u64>,
+    /// The frame clock's origin: the time the gaze stream was given (s
+    /// since t0) when it started or last resynchronized, and the same time
+    /// in integer ns since t0. A frame starts a whole number of µs after
+    /// it; its stamp is computed from the integer, never from seconds.
+    origin: Option<(f64, u64)>,
     /// Newest `log_time` processed (the frame clock is never run backwards).
     now_ns: u64,
     /// Recent frames: (start, ns since t0; state; profile).
@@ -560,22 +610,52 @@ struct Replayer<'o, P: FramePlanner, W: Write + Seek> {
 }
 
 impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
-    fn rel_s(&self, t_ns: u64) -> f64 {
-        t_ns.saturating_sub(self.t0_ns.unwrap_or(t_ns)) as f64 * 1e-9
+    /// ns since t0.
+    fn rel_ns(&self, t_ns: u64) -> u64 {
+        t_ns.saturating_sub(self.t0_ns.unwrap_or(t_ns))
     }
 
-    fn emit(&mut self, frames: Vec<Frame>) -> Result<(), ReplayError> {
+    fn rel_s(&self, t_ns: u64) -> f64 {
+        self.rel_ns(t_ns) as f64 * 1e-9
+    }
+
+    /// Runs the gaze stream to the message at `t_ns` (`log_time`), with its
+    /// gaze sample if it is one, and writes the frames that fell due.
+    fn advance(&mut self, t_ns: u64, sample: Option<&GazeSample>) -> Result<(), ReplayError> {
+        let rel_ns = self.rel_ns(t_ns);
+        let t_s = self.rel_s(t_ns);
+        let frames = match sample {
+            Some(s) => self.stream.push(s)?,
+            None => self.stream.tick(t_s)?,
+        };
+        // The stream's first call set its frame clock's origin here.
+        self.origin.get_or_insert((t_s, rel_ns));
         // What `stream` tells the user, counted for the summary.
         for n in self.stream.take_notices() {
             match n {
                 Notice::PlanFallback { .. } => self.stats.plan_fallbacks += 1,
-                Notice::Resync { .. } => self.stats.resyncs += 1,
+                Notice::Resync { .. } => {
+                    // The frame clock restarted at this call's time; every
+                    // frame of the call is on the new clock (a jump is
+                    // found before any frame is due).
+                    self.stats.resyncs += 1;
+                    self.origin = Some((t_s, rel_ns));
+                }
                 Notice::Late { .. } => {}
             }
         }
+        self.emit(frames)
+    }
+
+    fn emit(&mut self, frames: Vec<Frame>) -> Result<(), ReplayError> {
         let t0 = self.t0_ns.unwrap_or(0);
+        let (origin_s, origin_ns) = self.origin.unwrap_or((0.0, 0));
         for f in frames {
-            let start_ns = (f.t_s.max(0.0) * 1e9).round() as u64;
+            // The stream's frame time is the origin plus whole µs; the µs
+            // are recovered exactly (the rounding error of `t_s` is below
+            // 0.5 µs for times below 2³³ s) and the stamp is integer ns.
+            let start_us = ((f.t_s - origin_s) * 1e6).round().max(0.0) as u64;
+            let start_ns = origin_ns.saturating_add(start_us.saturating_mul(1000));
             let t_ns = t0.saturating_add(start_ns);
             let json = f
                 .profile
@@ -583,7 +663,8 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
                 .to_json()
                 .map_err(|e| ReplayError::Write(e.to_string()))?;
             let profile_ch = self.out.profile;
-            self.out.write(profile_ch, t_ns, t_ns, json.as_bytes())?;
+            self.out
+                .write(profile_ch, t_ns, t_ns, &cdr::encode_string(&json))?;
             let scene = scene::scene_update(
                 f.profile.profile(),
                 f.state,
@@ -592,7 +673,7 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
                 self.yaw_deg,
             );
             let scene_ch = self.out.scene;
-            self.out.write(scene_ch, t_ns, t_ns, scene.as_bytes())?;
+            self.out.write(scene_ch, t_ns, t_ns, &scene)?;
             if self.frames.len() == FRAME_HISTORY {
                 self.frames.pop_front();
             }
@@ -623,13 +704,11 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
                 return Ok(());
             }
             self.now_ns = p.log_time;
-            let frames = self.stream.push(&sample)?;
-            self.emit(frames)?;
+            self.advance(p.log_time, Some(&sample))?;
         } else if topic == self.opts.cloud_topic {
             if !late {
                 self.now_ns = p.log_time;
-                let frames = self.stream.tick(self.rel_s(p.log_time))?;
-                self.emit(frames)?;
+                self.advance(p.log_time, None)?;
             }
             self.cloud(&p).map_err(|e| in_message(e, topic, &p))?;
         } else {
@@ -997,20 +1076,23 @@ fn check_schema(ch: &mcap::Channel<'_>, want: &str) -> Result<(), ReplayError> {
     Ok(())
 }
 
+/// Names the message a decoding error is in: its topic and where its
+/// record is (the MCAP sequence field, which writers may leave 0 or repeat,
+/// only as "sequence N").
 fn in_message(e: ReplayError, topic: &str, p: &Pending) -> ReplayError {
+    let named = |field: &str| {
+        format!(
+            "{topic}: message {} (sequence {}, log_time {} ns): {field}",
+            p.at, p.msg.sequence, p.log_time
+        )
+    };
     match e {
         ReplayError::Message { field, reason } => ReplayError::Message {
-            field: format!(
-                "{topic}: message {} (log_time {} ns): {field}",
-                p.msg.sequence, p.log_time
-            ),
+            field: named(&field),
             reason,
         },
         ReplayError::Cloud(c) => ReplayError::Message {
-            field: format!(
-                "{topic}: message {} (log_time {} ns): {}",
-                p.msg.sequence, p.log_time, c.field
-            ),
+            field: named(&c.field),
             reason: c.reason,
         },
         e => e,
@@ -1064,26 +1146,18 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
         .library(concat!("gaze-lidar ", env!("CARGO_PKG_VERSION")))
         .create(output)
         .map_err(write_err)?;
-    let ps = mcap
-        .add_schema(
-            schemas::PROFILE,
-            schemas::JSONSCHEMA,
-            schemas::PROFILE_JSONSCHEMA.as_bytes(),
-        )
-        .map_err(write_err)?;
-    let profile = mcap
-        .add_channel(ps, &opts.profile_topic, schemas::JSON, &BTreeMap::new())
-        .map_err(write_err)?;
-    let ss = mcap
-        .add_schema(
-            schemas::SCENE_UPDATE,
-            schemas::JSONSCHEMA,
-            schemas::SCENE_UPDATE_JSONSCHEMA.as_bytes(),
-        )
-        .map_err(write_err)?;
-    let scene = mcap
-        .add_channel(ss, &opts.scene_topic, schemas::JSON, &BTreeMap::new())
-        .map_err(write_err)?;
+    // Both ros2msg + CDR (a JSON-schema channel makes rosbags refuse the
+    // whole file): the profile@1 JSON inside a std_msgs/msg/String.
+    let mut ros_channel = |ty: &str, topic: &str| {
+        let def = schemas::ros2msg(ty).unwrap_or_default();
+        let s = mcap
+            .add_schema(ty, schemas::ROS2MSG, def.as_bytes())
+            .map_err(write_err)?;
+        mcap.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
+            .map_err(write_err)
+    };
+    let profile = ros_channel(schemas::STRING, &opts.profile_topic)?;
+    let scene = ros_channel(schemas::MARKER_ARRAY, &opts.scene_topic)?;
     let mut r = Replayer {
         opts,
         stream,
@@ -1098,6 +1172,7 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
             sequences: HashMap::new(),
         },
         t0_ns: None,
+        origin: None,
         now_ns: 0,
         frames: VecDeque::new(),
         period_ns,
@@ -1121,9 +1196,26 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     );
     // Start of the next top-level record (after the 8-byte magic).
     let mut next_record: u64 = MAGIC_BYTES;
-    let mut footer_end: Option<u64> = None;
+    // The footer's start, and the end of the magic after it.
+    let mut footer_end: Option<(u64, u64)> = None;
     let mut past_data_end = false;
     let mut messages_read: u64 = 0;
+    // Bytes of the schemas and channels declared so far (their names,
+    // definitions and metadata), bounded by `MAX_DECLARED_BYTES`.
+    let mut declared_bytes: usize = 0;
+    let check_declared = |bytes: usize, at: u64| {
+        if bytes > MAX_DECLARED_BYTES {
+            return Err(ReplayError::Mcap {
+                path: path.to_owned(),
+                offset: at,
+                reason: format!(
+                    "the schemas and channels declared so far take more than {} MiB (names, definitions and metadata; memory stays bounded)",
+                    MAX_DECLARED_BYTES >> 20
+                ),
+            });
+        }
+        Ok(())
+    };
     let mut links = mcap::read::ChannelAccumulator::<'static>::default();
     let mut window = Window::new(opts.reorder_window_ns);
     let input_bytes = std::cell::Cell::new(0u64);
@@ -1152,12 +1244,18 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
     };
     while let Some(event) = reader.next_event() {
         let event = event.map_err(|e| {
+            // Always a byte inside the file: the start magic (a file
+            // shorter than it, or not an MCAP file), the footer's start (a
+            // file cut inside the end magic), the byte after the end magic
+            // (data after it), else the start of the record being read.
             let at = match (&e, footer_end) {
                 (mcap::McapError::BadMagic, _) if next_record == MAGIC_BYTES => 0,
-                (_, Some(end)) => end,
+                (mcap::McapError::UnexpectedEof, _) if input_bytes.get() < MAGIC_BYTES => 0,
+                (mcap::McapError::UnexpectedEof, Some((footer_at, _))) => footer_at,
+                (_, Some((_, end))) => end,
                 _ => next_record,
             };
-            mcap_err(at, "", e)
+            mcap_err(at.min(input_bytes.get()), "", e)
         })?;
         match event {
             LinearReadEvent::ReadRequest(want) => {
@@ -1182,7 +1280,7 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                 next_record += RECORD_HEAD_BYTES + data.len() as u64;
                 if opcode == mcap::records::op::FOOTER {
                     // The end magic follows; anything after it is an error.
-                    footer_end = Some(next_record + MAGIC_BYTES);
+                    footer_end = Some((at, next_record + MAGIC_BYTES));
                 }
                 let record = mcap::parse_record(opcode, data).map_err(|e| mcap_err(at, "", e))?;
                 if past_data_end {
@@ -1195,7 +1293,25 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                     }
                     continue;
                 }
+                let chunked = matches!(record, mcap::records::Record::Chunk { .. });
                 let records = match record {
+                    // Written from the reader's buffer, never copied (an
+                    // attachment is a top-level record, at most
+                    // `MAX_RECORD_BYTES`).
+                    mcap::records::Record::Attachment { header, data, .. } => {
+                        r.out
+                            .mcap
+                            .attach(&mcap::Attachment {
+                                log_time: header.log_time,
+                                create_time: header.create_time,
+                                name: header.name,
+                                media_type: header.media_type,
+                                data,
+                            })
+                            .map_err(write_err)?;
+                        r.stats.attachments += 1;
+                        continue;
+                    }
                     mcap::records::Record::DataEnd(_) => {
                         past_data_end = true;
                         continue;
@@ -1223,12 +1339,27 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                     let inside = |e| mcap_err(at, &format!("record {k} of this chunk: "), e);
                     match record {
                         mcap::records::Record::Schema { header, data } => {
+                            declared_bytes += header.name.len() + data.len();
+                            check_declared(declared_bytes, at)?;
                             links
                                 .add_schema(header, std::borrow::Cow::Owned(data.into_owned()))
                                 .map_err(inside)?;
                         }
                         mcap::records::Record::Channel(c) => {
+                            // Copied when read: a channel without a single
+                            // message (and its schema) is in the output too.
+                            let id = c.id;
+                            declared_bytes += c.topic.len()
+                                + c.message_encoding.len()
+                                + c.metadata
+                                    .iter()
+                                    .map(|(k, v)| k.len() + v.len())
+                                    .sum::<usize>();
+                            check_declared(declared_bytes, at)?;
                             links.add_channel(c).map_err(inside)?;
+                            if let Some(channel) = links.get(id) {
+                                r.out.channel_for(&channel, opts)?;
+                            }
                         }
                         mcap::records::Record::Message { header, data } => {
                             messages_read += 1;
@@ -1238,29 +1369,44 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                                     header.channel_id,
                                 )));
                             };
-                            window.push(mcap::Message {
-                                channel,
-                                sequence: header.sequence,
-                                log_time: header.log_time,
-                                publish_time: header.publish_time,
-                                data: std::borrow::Cow::Owned(data.into_owned()),
-                            });
+                            let record_at = RecordAt {
+                                offset: at,
+                                in_chunk: chunked.then_some(k),
+                            };
+                            if data.len() > MAX_MESSAGE_BYTES {
+                                return Err(ReplayError::Message {
+                                    field: format!(
+                                        "{}: message {record_at} (sequence {}, log_time {} ns)",
+                                        channel.topic, header.sequence, header.log_time
+                                    ),
+                                    reason: format!(
+                                        "{} bytes, more than the {} MiB a message may have (memory stays bounded)",
+                                        data.len(),
+                                        MAX_MESSAGE_BYTES >> 20
+                                    ),
+                                });
+                            }
+                            let drives = if channel.topic == opts.gaze_topic {
+                                Drives::Gaze
+                            } else if channel.topic == opts.cloud_topic {
+                                Drives::Cloud
+                            } else {
+                                Drives::No
+                            };
+                            window.push(
+                                mcap::Message {
+                                    channel,
+                                    sequence: header.sequence,
+                                    log_time: header.log_time,
+                                    publish_time: header.publish_time,
+                                    data: std::borrow::Cow::Owned(data.into_owned()),
+                                },
+                                record_at,
+                                drives,
+                            );
                             while let Some(p) = window.pop_due() {
                                 r.process(p)?;
                             }
-                        }
-                        mcap::records::Record::Attachment { header, data, .. } => {
-                            r.out
-                                .mcap
-                                .attach(&mcap::Attachment {
-                                    log_time: header.log_time,
-                                    create_time: header.create_time,
-                                    name: header.name,
-                                    media_type: header.media_type,
-                                    data,
-                                })
-                                .map_err(write_err)?;
-                            r.stats.attachments += 1;
                         }
                         mcap::records::Record::Metadata(m) => {
                             r.out.mcap.write_metadata(&m).map_err(write_err)?;
@@ -1437,7 +1583,12 @@ pub fn replay_file_staged<P: FramePlanner>(
     let written = (|| {
         let reader = std::io::BufReader::with_capacity(1 << 20, file);
         let mut writer = std::io::BufWriter::with_capacity(1 << 20, tmp);
-        let stats = replay(reader, &origin, &mut writer, planner, pipeline, opts)?;
+        // A write that fails (a full disk) names the output file.
+        let stats =
+            replay(reader, &origin, &mut writer, planner, pipeline, opts).map_err(|e| match e {
+                ReplayError::Write(m) => ReplayError::Write(format!("{}: {m}", output.display())),
+                e => e,
+            })?;
         let tmp = writer.into_inner().map_err(|e| out_err(e.error()))?;
         tmp.as_file().sync_all().map_err(|e| out_err(&e))?;
         Ok((stats, tmp))

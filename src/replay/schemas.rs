@@ -1,16 +1,13 @@
 //! Schemas embedded in the output (and used to write test bags): ROS 2
 //! message definitions (`ros2msg`: the type's definition, then each
 //! dependency after a line of 80 `=` and `MSG: pkg/Type`, as rosbag2 writes
-//! them), and JSON schemas (`jsonschema`) for the profile and the picture.
+//! them). Every output channel is `ros2msg` + CDR, so ROS tools (rosbags,
+//! `mcap-ros2-support`, Foxglove, `ros2 bag play`) read all of it.
 
 /// `ros2msg` schema encoding.
 pub const ROS2MSG: &str = "ros2msg";
 /// `cdr` message encoding.
 pub const CDR: &str = "cdr";
-/// `jsonschema` schema encoding.
-pub const JSONSCHEMA: &str = "jsonschema";
-/// `json` message encoding.
-pub const JSON: &str = "json";
 
 const SEP: &str =
     "================================================================================\n";
@@ -38,12 +35,11 @@ pub const FLOAT64: &str = "std_msgs/msg/Float64";
 pub const POINT_CLOUD2: &str = "sensor_msgs/msg/PointCloud2";
 /// `tf2_msgs/msg/TFMessage` (`/tf_static`: the sensor's mounting).
 pub const TF_MESSAGE: &str = "tf2_msgs/msg/TFMessage";
-/// `std_msgs/msg/String` (tests: an unrelated topic).
+/// `std_msgs/msg/String`: the profile channel (one profile@1 JSON
+/// document a message).
 pub const STRING: &str = "std_msgs/msg/String";
-/// The profile channel's schema name.
-pub const PROFILE: &str = "gaze_lidar.Profile";
-/// Foxglove's 3D scene message.
-pub const SCENE_UPDATE: &str = "foxglove.SceneUpdate";
+/// `visualization_msgs/msg/MarkerArray`: the picture of the profile.
+pub const MARKER_ARRAY: &str = "visualization_msgs/msg/MarkerArray";
 
 /// The `ros2msg` definition of one of the ROS types above.
 #[must_use]
@@ -92,97 +88,34 @@ pub fn ros2msg(name: &str) -> Option<String> {
                 ),
             ],
         ),
+        // As ROS 2 Humble defines it (the texture and mesh-file fields of
+        // later distributions absent: readers decode by this schema).
+        MARKER_ARRAY => with_deps(
+            "Marker[] markers\n",
+            &[
+                (
+                    "visualization_msgs/Marker",
+                    "int32 ARROW=0\nint32 CUBE=1\nint32 SPHERE=2\nint32 CYLINDER=3\nint32 LINE_STRIP=4\nint32 LINE_LIST=5\nint32 CUBE_LIST=6\nint32 SPHERE_LIST=7\nint32 POINTS=8\nint32 TEXT_VIEW_FACING=9\nint32 MESH_RESOURCE=10\nint32 TRIANGLE_LIST=11\nint32 ADD=0\nint32 MODIFY=0\nint32 DELETE=2\nint32 DELETEALL=3\nstd_msgs/Header header\nstring ns\nint32 id\nint32 type\nint32 action\ngeometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\nbuiltin_interfaces/Duration lifetime\nbool frame_locked\ngeometry_msgs/Point[] points\nstd_msgs/ColorRGBA[] colors\nstring text\nstring mesh_resource\nbool mesh_use_embedded_materials\n",
+                ),
+                std_header,
+                time,
+                (
+                    "geometry_msgs/Pose",
+                    "Point position\nQuaternion orientation\n",
+                ),
+                ("geometry_msgs/Point", "float64 x\nfloat64 y\nfloat64 z\n"),
+                (
+                    "geometry_msgs/Quaternion",
+                    "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n",
+                ),
+                ("geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"),
+                (
+                    "std_msgs/ColorRGBA",
+                    "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n",
+                ),
+                ("builtin_interfaces/Duration", TIME),
+            ],
+        ),
         _ => return None,
     })
 }
-
-/// JSON schema of the profile channel: a `gaze-lidar/profile@1` document
-/// (DESIGN §3) as `gaze-lidar check` reads it.
-pub const PROFILE_JSONSCHEMA: &str = r#"{
-  "$schema": "https://json-schema.org/draft/2020-12/schema",
-  "title": "gaze-lidar/profile@1",
-  "type": "object",
-  "required": ["format", "frame_rate_hz", "pulse_rate_hz", "average_power_w", "power_accounting", "gaze_deg", "limits", "bins"],
-  "properties": {
-    "format": {"const": "gaze-lidar/profile@1"},
-    "frame_rate_hz": {"type": "number"},
-    "pulse_rate_hz": {"type": "number"},
-    "average_power_w": {"type": "number"},
-    "power_accounting": {"enum": ["time", "angle"]},
-    "gaze_deg": {"type": ["number", "null"]},
-    "limits": {"type": "object"},
-    "bins": {
-      "type": "array",
-      "items": {
-        "type": "object",
-        "required": ["start_deg", "width_deg", "power_w", "spin_start_rad_s", "spin_end_rad_s"],
-        "properties": {
-          "start_deg": {"type": "number"},
-          "width_deg": {"type": "number"},
-          "power_w": {"type": "number"},
-          "spin_start_rad_s": {"type": "number"},
-          "spin_end_rad_s": {"type": "number"}
-        }
-      }
-    }
-  }
-}"#;
-
-/// JSON schema of the subset of `foxglove.SceneUpdate` the picture uses
-/// (Foxglove picks its 3D panel by the schema name; the field names are
-/// Foxglove's schema's).
-pub const SCENE_UPDATE_JSONSCHEMA: &str = r##"{
-  "$schema": "https://json-schema.org/draft/2020-12/schema",
-  "title": "foxglove.SceneUpdate",
-  "type": "object",
-  "properties": {
-    "deletions": {"type": "array", "items": {"type": "object"}},
-    "entities": {
-      "type": "array",
-      "items": {
-        "type": "object",
-        "properties": {
-          "timestamp": {"$ref": "#/$defs/time"},
-          "frame_id": {"type": "string"},
-          "id": {"type": "string"},
-          "lifetime": {"$ref": "#/$defs/time"},
-          "frame_locked": {"type": "boolean"},
-          "metadata": {"type": "array", "items": {"type": "object", "properties": {"key": {"type": "string"}, "value": {"type": "string"}}}},
-          "triangles": {
-            "type": "array",
-            "items": {
-              "type": "object",
-              "properties": {
-                "pose": {"$ref": "#/$defs/pose"},
-                "points": {"type": "array", "items": {"$ref": "#/$defs/point"}},
-                "color": {"$ref": "#/$defs/color"},
-                "colors": {"type": "array", "items": {"$ref": "#/$defs/color"}},
-                "indices": {"type": "array", "items": {"type": "integer"}}
-              }
-            }
-          },
-          "texts": {
-            "type": "array",
-            "items": {
-              "type": "object",
-              "properties": {
-                "pose": {"$ref": "#/$defs/pose"},
-                "billboard": {"type": "boolean"},
-                "font_size": {"type": "number"},
-                "scale_invariant": {"type": "boolean"},
-                "color": {"$ref": "#/$defs/color"},
-                "text": {"type": "string"}
-              }
-            }
-          }
-        }
-      }
-    }
-  },
-  "$defs": {
-    "time": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
-    "point": {"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}}},
-    "pose": {"type": "object", "properties": {"position": {"$ref": "#/$defs/point"}, "orientation": {"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}, "w": {"type": "number"}}}}},
-    "color": {"type": "object", "properties": {"r": {"type": "number"}, "g": {"type": "number"}, "b": {"type": "number"}, "a": {"type": "number"}}}
-  }
-}"##;

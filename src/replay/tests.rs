@@ -336,7 +336,7 @@ fn the_window_bounds_many_empty_messages_by_their_bookkeeping() {
     let mut w = super::Window::new(200_000_000);
     let mut released = 0u64;
     for _ in 0..2_000_000u64 {
-        w.push(empty_message(&ch, 5));
+        w.push(empty_message(&ch, 5), AT, super::Drives::No);
         while w.pop_due().is_some() {
             released += 1;
         }
@@ -347,24 +347,106 @@ fn the_window_bounds_many_empty_messages_by_their_bookkeeping() {
     assert!(released >= 2_000_000 - cap as u64);
 }
 
+const AT: super::RecordAt = super::RecordAt {
+    offset: 8,
+    in_chunk: None,
+};
+
 #[test]
-fn one_far_future_stamp_does_not_move_the_windows_clock() {
-    let (a, b, c) = (channel(1, "/a"), channel(2, "/b"), channel(3, "/c"));
+fn far_future_stamps_do_not_move_the_windows_clock() {
+    use super::Drives::{Cloud, Gaze, No};
+    let (g, c, x, y) = (
+        channel(1, "/gaze"),
+        channel(2, "/cloud"),
+        channel(3, "/x"),
+        channel(4, "/y"),
+    );
     let mut w = super::Window::new(200_000_000);
-    w.push(empty_message(&a, 1_000_000_000));
+    w.push(empty_message(&g, 1_000_000_000), AT, Gaze);
     assert_eq!(w.clock(), 1_000_000_000);
-    w.push(empty_message(&c, u64::MAX / 2));
-    w.push(empty_message(&b, 1_100_000_000));
-    assert_eq!(w.clock(), 1_100_000_000);
-    // Nothing is 200 ms older than the clock yet: nothing is due.
+    // Far-future stamps on other topics, any number: the clock stays.
+    w.push(empty_message(&x, u64::MAX / 2), AT, No);
+    w.push(empty_message(&y, u64::MAX / 3), AT, No);
+    assert_eq!(w.clock(), 1_000_000_000);
+    w.push(empty_message(&c, 1_100_000_000), AT, Cloud);
+    assert_eq!(w.clock(), 1_000_000_000);
+    // A far-future stamp on the cloud topic: held back by the gaze's.
+    w.push(empty_message(&c, u64::MAX / 4), AT, Cloud);
     assert!(w.pop_due().is_none());
-    w.push(empty_message(&a, 1_350_000_000));
+    w.push(empty_message(&g, 1_350_000_000), AT, Gaze);
     assert_eq!(w.clock(), 1_350_000_000);
     // The clock is 1.35 s: the messages at 1.0 and 1.1 s are more than
-    // 200 ms older, due; the far one is released only at the end.
+    // 200 ms older, due; the far ones are released only at the end.
     assert_eq!(w.pop_due().map(|p| p.log_time), Some(1_000_000_000));
     assert_eq!(w.pop_due().map(|p| p.log_time), Some(1_100_000_000));
     assert!(w.pop_due().is_none());
     assert_eq!(w.pop().map(|p| p.log_time), Some(1_350_000_000));
+    assert_eq!(w.pop().map(|p| p.log_time), Some(u64::MAX / 4));
+    assert_eq!(w.pop().map(|p| p.log_time), Some(u64::MAX / 3));
     assert_eq!(w.pop().map(|p| p.log_time), Some(u64::MAX / 2));
+}
+
+/// The azimuth of `v` by the reference rule: the horizontal part scaled by
+/// a power of two (exact) until its larger component lies in [1, 2), then
+/// `atan2`; a subnormal angle is 0.
+fn reference_azimuth_deg(v: [f64; 3]) -> f64 {
+    let (mut x, mut y) = (v[0], v[1]);
+    while x.abs().max(y.abs()) < 1.0 {
+        x *= 2.0;
+        y *= 2.0;
+    }
+    while x.abs().max(y.abs()) >= 2.0 {
+        x *= 0.5;
+        y *= 0.5;
+    }
+    let a = y.atan2(x).to_degrees();
+    crate::model::angle::wrap_deg(if a.abs() < f64::MIN_POSITIVE { 0.0 } else { a })
+}
+
+#[test]
+fn a_tiny_component_still_gives_a_valid_azimuth() {
+    for v in [
+        [1.0, 1e-320, 0.0],
+        [1.0, -1e-320, 0.0],
+        [-1.0, 1e-320, 0.0],
+        [1e-320, 1e-320, 0.0],
+        [5e-324, 0.0, 1.0],
+        [f64::MAX, f64::MAX, 0.0],
+        [1e-310, 1.0, 0.0],
+    ] {
+        let a = vector_azimuth_deg(v).unwrap_or_else(|| panic!("{v:?} is a valid direction"));
+        assert!(crate::model::valid::finite(a).is_ok(), "{v:?}: {a:e}");
+        assert!((0.0..360.0).contains(&a), "{v:?}: {a}");
+        assert_eq!(a, reference_azimuth_deg(v), "{v:?}");
+    }
+}
+
+proptest::proptest! {
+    /// Every finite vector with a non-zero horizontal part, at any scale,
+    /// gives the azimuth the reference gives: finite, not subnormal, in
+    /// [0, 360).
+    #[test]
+    fn scaled_vectors_keep_their_azimuth(
+        az_deg in 0.0f64..360.0,
+        z in -10.0f64..10.0,
+        exp in -1074i32..=1023,
+    ) {
+        let (s, c) = az_deg.to_radians().sin_cos();
+        let scale = 2f64.powi(exp);
+        let v = [c * scale, s * scale, z * scale];
+        proptest::prop_assume!(v.iter().all(|x| x.is_finite()) && (v[0] != 0.0 || v[1] != 0.0));
+        let a = vector_azimuth_deg(v);
+        proptest::prop_assert!(a.is_some(), "{:?}", v);
+        let a = a.unwrap_or(f64::NAN);
+        proptest::prop_assert!(crate::model::valid::finite(a).is_ok(), "{:?}: {:e}", v, a);
+        proptest::prop_assert!((0.0..360.0).contains(&a), "{:?}: {}", v, a);
+        let want = reference_azimuth_deg(v);
+        let d = (a - want).abs();
+        proptest::prop_assert!(d.min(360.0 - d) <= 1e-9, "{:?}: {} vs {}", v, a, want);
+        // Where the scaled vector kept its bits, the azimuth is the unscaled one.
+        if exp > -1000 && exp < 1000 {
+            let d = (a - reference_azimuth_deg([c, s, z])).abs();
+            proptest::prop_assert!(d.min(360.0 - d) <= 1e-9, "{:?}", v);
+        }
+    }
 }
