@@ -1972,3 +1972,288 @@ fn stamps_are_exact_when_the_first_gaze_is_at_log_time_0() {
     assert_eq!(input.len(), 30);
     assert_eq!(headers(&have, "/lidar/points/adapted"), input);
 }
+
+/// The variable that makes [`rss_probe_helper`] run a replay: the
+/// arguments, separated by the byte 0x1F (unit separator).
+const RSS_ARGS: &str = "GAZE_LIDAR_TEST_RSS_ARGS";
+
+/// Not a test of its own: with [`RSS_ARGS`] set, runs `gaze-lidar` with
+/// those arguments, its stderr into the file `GAZE_LIDAR_TEST_RSS_ERR`,
+/// and prints `rss <bytes> code <exit code>` (`wait4`'s `ru_maxrss` of that
+/// child alone). A fresh process does it because a child's peak memory
+/// counts the memory of the process it was spawned from (Linux carries the
+/// old memory's peak across `exec`), and the test process holds the bags.
+#[test]
+fn rss_probe_helper() {
+    let Some(args) = std::env::var_os(RSS_ARGS) else {
+        return;
+    };
+    use std::os::unix::ffi::OsStrExt;
+    let args: Vec<std::ffi::OsString> = args
+        .as_bytes()
+        .split(|&b| b == 0x1f)
+        .map(|a| std::ffi::OsStr::from_bytes(a).to_owned())
+        .collect();
+    let err = std::fs::File::create(std::env::var_os("GAZE_LIDAR_TEST_RSS_ERR").unwrap()).unwrap();
+    let child = bin()
+        .args(&args)
+        .stdout(std::process::Stdio::null())
+        .stderr(err)
+        .spawn()
+        .unwrap();
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
+    // SAFETY: a zeroed rusage is valid; wait4 fills it for our own child.
+    let mut ru: libc::rusage = unsafe { std::mem::zeroed() };
+    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut ru) };
+    assert_eq!(r, pid);
+    let code = if libc::WIFEXITED(status) {
+        libc::WEXITSTATUS(status)
+    } else {
+        -1
+    };
+    println!("rss {} code {code}", ru.ru_maxrss as u64 * 1024);
+}
+
+/// Runs `gaze-lidar args` through [`rss_probe_helper`] in a fresh test
+/// process; returns (exit code, stderr, peak resident memory in bytes).
+fn run_measured(args: &[&std::ffi::OsStr]) -> (i32, String, u64) {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let err = dir.path().join("stderr");
+    let joined: Vec<u8> = args
+        .iter()
+        .map(|a| a.as_bytes())
+        .collect::<Vec<_>>()
+        .join(&0x1fu8);
+    let o = Command::new(std::env::current_exe().unwrap())
+        .args([
+            "rss_probe_helper",
+            "--exact",
+            "--nocapture",
+            "--test-threads",
+            "1",
+        ])
+        .env(RSS_ARGS, std::ffi::OsStr::from_bytes(&joined))
+        .env("GAZE_LIDAR_TEST_RSS_ERR", &err)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    let line = out
+        .lines()
+        .find_map(|l| l.find("rss ").map(|k| &l[k..]))
+        .unwrap_or_else(|| panic!("{out}{}", String::from_utf8_lossy(&o.stderr)));
+    let f: Vec<&str> = line.split(' ').collect();
+    let stderr = std::fs::read_to_string(&err).unwrap();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    (f[3].parse().unwrap(), stderr, f[1].parse().unwrap())
+}
+
+fn replay_measured(input: &std::path::Path, out: &std::path::Path) -> (i32, String, u64) {
+    let mut args: Vec<&std::ffi::OsStr> = vec!["replay".as_ref(), input.as_os_str()];
+    for a in ["--gaze-topic", GAZE, "--cloud-topic", CLOUD] {
+        args.push(a.as_ref());
+    }
+    for a in ["--preset", "paper", "--mode", "range", "--out"] {
+        args.push(a.as_ref());
+    }
+    args.push(out.as_os_str());
+    run_measured(&args)
+}
+
+/// stderr without the program's `gaze-lidar: error: ` prefix.
+fn strip(e: &str) -> String {
+    e.strip_prefix("gaze-lidar: error: ")
+        .unwrap_or(e)
+        .to_owned()
+}
+
+/// Peak memory, as the issue bounds it.
+const PEAK_BYTES: u64 = 200 << 20;
+
+/// The bag with its 6th cloud replaced by one of `n` points.
+fn bag_with_a_huge_cloud(n: usize) -> Vec<u8> {
+    rewrite(
+        &bag(None),
+        |m| {
+            let c = (0..m.len())
+                .filter(|&i| m[i].channel.topic == CLOUD)
+                .nth(5)
+                .unwrap();
+            let t = m[c].log_time;
+            m[c].data = std::borrow::Cow::Owned(cloud_msg(
+                (t / 1_000_000_000) as i32,
+                (t % 1_000_000_000) as u32,
+                5,
+                n,
+            ));
+        },
+        |_| {},
+    )
+}
+
+/// One huge cloud: up to 32 MiB it is replayed in under 200 MB; beyond,
+/// it is refused by its topic and offset (exit 2, no output).
+#[test]
+fn one_huge_message_is_replayed_in_bounded_memory_or_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    // 31 MiB of points (16 bytes each).
+    std::fs::write(&input, bag_with_a_huge_cloud(31 << 16)).unwrap();
+    let (code, err, peak) = replay_measured(&input, &out);
+    assert_eq!(code, 0, "{err}");
+    assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
+    eprintln!("one 31 MiB cloud: peak {} MiB", peak >> 20);
+    std::fs::remove_file(&out).unwrap();
+    // 40 MiB: refused, naming the topic and where the message is.
+    let big = bag_with_a_huge_cloud(40 << 16);
+    std::fs::write(&input, &big).unwrap();
+    let (code, err, peak) = replay_measured(&input, &out);
+    let err = strip(&err);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.starts_with(&format!("{CLOUD}: message in the chunk at byte ")),
+        "{err}"
+    );
+    assert!(
+        err.contains("more than the 32 MiB a message may have"),
+        "{err}"
+    );
+    assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
+    assert!(!out.exists());
+}
+
+/// A 60 MiB attachment is copied in under 200 MB; one past the 64 MiB a
+/// record may have is refused at its offset.
+#[test]
+fn a_large_attachment_is_copied_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    let with = |bytes: usize| {
+        rewrite(
+            &bag(None),
+            |_| {},
+            |w| {
+                w.attach(&mcap::Attachment {
+                    log_time: 1,
+                    create_time: 2,
+                    name: "video.bin".into(),
+                    media_type: "application/octet-stream".into(),
+                    data: std::borrow::Cow::Owned(vec![7u8; bytes]),
+                })
+                .unwrap();
+            },
+        )
+    };
+    std::fs::write(&input, with(60 << 20)).unwrap();
+    let (code, err, peak) = replay_measured(&input, &out);
+    assert_eq!(code, 0, "{err}");
+    eprintln!("one 60 MiB attachment: peak {} MiB", peak >> 20);
+    assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
+    let got = std::fs::read(&out).unwrap();
+    let summary = mcap::Summary::read(&got).unwrap().unwrap();
+    let a = mcap::read::attachment(&got, &summary.attachment_indexes[0]).unwrap();
+    assert_eq!((a.name.as_str(), a.data.len()), ("video.bin", 60 << 20));
+    std::fs::remove_file(&out).unwrap();
+    let bag = with(65 << 20);
+    std::fs::write(&input, &bag).unwrap();
+    let (code, err, peak) = replay_measured(&input, &out);
+    let err = strip(&err);
+    assert_eq!(code, 2, "{err}");
+    let at = record_starts(&bag)
+        .into_iter()
+        .find(|&s| bag[s] == 0x09)
+        .unwrap();
+    assert!(err.contains(&format!("at byte {at}:")), "{err}");
+    assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
+    assert!(!out.exists());
+}
+
+/// `n` channels on topics of their own, each with `meta` bytes of
+/// metadata and one message, besides the bag's.
+fn bag_with_channels(n: usize, meta: usize) -> Vec<u8> {
+    let mut buf = Vec::new();
+    let mut w = mcap::WriteOptions::new()
+        .create(Cursor::new(&mut buf))
+        .unwrap();
+    let s = w
+        .add_schema(
+            schemas::STRING,
+            schemas::ROS2MSG,
+            schemas::ros2msg(schemas::STRING).unwrap().as_bytes(),
+        )
+        .unwrap();
+    let mut meta_map = BTreeMap::new();
+    meta_map.insert("offered_qos_profiles".to_owned(), "q".repeat(meta));
+    for k in 0..n {
+        let ch = w
+            .add_channel(s, &format!("/many/{k}"), schemas::CDR, &meta_map)
+            .unwrap();
+        w.write_to_known_channel(
+            &MessageHeader {
+                channel_id: ch,
+                sequence: 0,
+                log_time: 1_700_000_000_000_000_000 + k as u64,
+                publish_time: 0,
+            },
+            &cdr::encode_string("x"),
+        )
+        .unwrap();
+    }
+    let mut ids: BTreeMap<u16, u16> = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bag(None)).unwrap() {
+        let m = m.unwrap();
+        let id = *ids.entry(m.channel.id).or_insert_with(|| {
+            let sc = m.channel.schema.as_ref().unwrap();
+            let s = w.add_schema(&sc.name, &sc.encoding, &sc.data).unwrap();
+            w.add_channel(
+                s,
+                &m.channel.topic,
+                &m.channel.message_encoding,
+                &BTreeMap::new(),
+            )
+            .unwrap()
+        });
+        w.write_to_known_channel(
+            &MessageHeader {
+                channel_id: id,
+                sequence: m.sequence,
+                log_time: m.log_time,
+                publish_time: m.publish_time,
+            },
+            &m.data,
+        )
+        .unwrap();
+    }
+    w.finish().unwrap();
+    drop(w);
+    buf
+}
+
+/// Many channels: 12,000 with 1 KB of metadata each are copied in under
+/// 200 MB; a bag declaring more than 16 MiB of schemas and channels is
+/// refused (exit 2) at the record that passes it.
+#[test]
+fn many_channels_are_copied_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
+    std::fs::write(&input, bag_with_channels(12_000, 1000)).unwrap();
+    let (code, err, peak) = replay_measured(&input, &out);
+    assert_eq!(code, 0, "{err}");
+    eprintln!("12,000 channels: peak {} MiB", peak >> 20);
+    assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
+    let got = std::fs::read(&out).unwrap();
+    let summary = mcap::Summary::read(&got).unwrap().unwrap();
+    assert_eq!(summary.channels.len(), 12_000 + 3 + 3);
+    std::fs::remove_file(&out).unwrap();
+    std::fs::write(&input, bag_with_channels(9_000, 2000)).unwrap();
+    let (code, err, peak) = replay_measured(&input, &out);
+    let err = strip(&err);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("schemas and channels declared so far take more than 16 MiB"),
+        "{err}"
+    );
+    assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
+    assert!(!out.exists());
+}
