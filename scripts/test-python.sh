@@ -27,9 +27,10 @@ echo "== python: pip install ./python into a fresh venv ($venv)"
 # pandas (optional for users): the to_pandas() tests and push_many's
 # nullable-type cases (pandas "boolean", "Float64") run with it.
 "$venv/bin/python" -m pip install -q pandas
-# An independent MCAP writer and reader for the replay test, and
+# Independent MCAP writers and readers for the replay tests (mcap,
+# mcap-ros2-support, rosbags), and
 # dask.distributed for examples/python/replay_many.py (pure Python, ~15 s).
-"$venv/bin/python" -m pip install -q mcap mcap-ros2-support "dask[distributed]"
+"$venv/bin/python" -m pip install -q mcap mcap-ros2-support rosbags "dask[distributed]"
 
 echo "== python: pytest"
 # From outside the source tree, so the installed package is what is tested.

@@ -1995,6 +1995,9 @@ fn rss_probe_helper() {
         .map(|a| std::ffi::OsStr::from_bytes(a).to_owned())
         .collect();
     let err = std::fs::File::create(std::env::var_os("GAZE_LIDAR_TEST_RSS_ERR").unwrap()).unwrap();
+    // Reaped by `wait4` below (which `Child::wait` cannot replace: it
+    // gives no resource usage).
+    #[allow(clippy::zombie_processes)]
     let child = bin()
         .args(&args)
         .stdout(std::process::Stdio::null())
