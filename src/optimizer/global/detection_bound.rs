@@ -45,7 +45,7 @@ use super::super::detection;
 use super::super::lp::Grid;
 use super::super::settings::S;
 use super::super::Problem;
-use super::Boxes;
+use super::{golden, Boxes};
 use crate::model::lidar::PowerAccounting;
 
 /// Power cells of the finest grid (nodes evenly spaced in `√x`).
@@ -360,31 +360,6 @@ fn minimise(f: impl Fn(f64) -> f64, start: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// Golden-section minimum of a convex `f` on `[lo, hi]`, `steps` steps.
-fn golden(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize) -> f64 {
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut a, mut b) = (lo, hi);
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..steps {
-        if fc <= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    0.5 * (a + b)
 }
 
 /// `b` if `f(b) <= f(a)`, else `a`.
