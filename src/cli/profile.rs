@@ -104,7 +104,11 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         outputs.folder(
             "--certificate",
             dir,
-            &["problem.mps".to_owned(), "certificate.json".to_owned()],
+            &[
+                "problem.mps".to_owned(),
+                "certificate.json".to_owned(),
+                "detection_bound.json".to_owned(),
+            ],
         );
     }
     outputs.check()?;
@@ -181,10 +185,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             accounting,
             mode: a.mode,
         };
-        let (c, cert, b) = optimized(a, &preset, gaze, &overrides)?;
+        let (c, cert, b, detection) = optimized(a, &preset, gaze, &overrides)?;
         basis = b;
         if let Some(dir) = &a.certificate {
             extra = certificate_files(dir, cert)?;
+            if let Some(json) = detection {
+                extra.push((dir.join("detection_bound.json"), json?.into_bytes()));
+            }
         }
         c
     } else {
@@ -313,6 +320,7 @@ fn optimized(
             gaze_lidar::optimizer::CertificateError,
         >,
         Basis,
+        Option<Result<String, CliError>>,
     ),
     CliError,
 > {
@@ -349,6 +357,9 @@ fn optimized(
         }
     };
     let (c, cert) = optimize_with_certificate(&problem, gaze).map_err(err)?;
+    let detection = (a.certificate.is_some()
+        && problem.objective.kind == gaze_lidar::optimizer::ObjectiveKind::Detection)
+        .then(|| detection_bound_file(&problem, gaze));
     let c = gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels.clone());
     let basis = Basis {
         preset: gaze_lidar::optimizer::figures::closed_form_basis(&problem, named.levels),
@@ -356,7 +367,25 @@ fn optimized(
         bins: problem.bins,
         optimized: true,
     };
-    Ok((c, cert, basis))
+    Ok((c, cert, basis, detection))
+}
+
+/// `detection_bound.json`: the detection bound's certificate, checked
+/// exactly before it is written.
+#[cfg(feature = "solver")]
+fn detection_bound_file(
+    problem: &gaze_lidar::optimizer::Problem,
+    gaze: f64,
+) -> Result<String, CliError> {
+    use gaze_lidar::optimizer::global::{check_detection_certificate, detection_certificate};
+    let fail = |e: gaze_lidar::optimizer::global::DetectionCertificateError| {
+        CliError::infeasible(format!("--certificate: {e}"))
+    };
+    let cert = detection_certificate(problem, gaze).map_err(fail)?;
+    check_detection_certificate(problem, gaze, &cert).map_err(fail)?;
+    let json = serde_json::to_string(&cert)
+        .map_err(|e| CliError::output(format!("detection_bound.json: {e}")))?;
+    Ok(json + "\n")
 }
 
 #[cfg(not(feature = "solver"))]
@@ -365,7 +394,15 @@ fn optimized(
     _preset: &gaze_lidar::model::presets::Preset,
     _gaze: Option<f64>,
     _overrides: &Overrides<'_>,
-) -> Result<(CertifiedProfile, Result<(), String>, Basis), CliError> {
+) -> Result<
+    (
+        CertifiedProfile,
+        Result<(), String>,
+        Basis,
+        Option<Result<String, CliError>>,
+    ),
+    CliError,
+> {
     Err(super::config::no_solver("--optimize/--config"))
 }
 

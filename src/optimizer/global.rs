@@ -93,6 +93,12 @@
 use std::f64::consts::TAU;
 
 mod detection_bound;
+mod detection_certificate;
+
+pub use detection_certificate::{
+    ClassCertificate, DetectionCertificate, DetectionCertificateError, EnvelopePoint,
+    TableCertificate,
+};
 
 use super::certificate::{check, next_down, to_f64_up};
 use super::lp::{grid, Grid};
@@ -459,6 +465,58 @@ pub fn upper_bound(problem: &Problem, gaze_deg: f64) -> Result<f64, OptError> {
     // The smaller of two valid bounds (the Lagrangian's constants are the
     // same floats the rows were built from: objective_margin as above).
     Ok(lp_bound.min(lag * (1.0 + S.objective_margin)))
+}
+
+/// The certificate of the detection bound ([`upper_bound`] under
+/// `objective.kind = "detection"`): its multipliers, nodes, envelope points
+/// and cells, its sum checked exactly ([`check_detection_certificate`]).
+pub fn detection_certificate(
+    problem: &Problem,
+    gaze_deg: f64,
+) -> Result<DetectionCertificate, DetectionCertificateError> {
+    let (g, b) = detection_setup(problem, gaze_deg)?;
+    detection_bound::solve(problem, &g, &b, |tables, mu, nu, classes| {
+        detection_certificate::build(problem, &g, &b, gaze_deg, (tables, mu, nu, classes))
+    })
+    .unwrap_or_else(|| {
+        Err(DetectionCertificateError::NoBound(
+            "the detection Lagrangian has no finite value".into(),
+        ))
+    })
+}
+
+/// Checks a detection certificate for `problem` at `gaze_deg` in exact
+/// rational arithmetic (the grid, boxes and rows recomputed from the
+/// problem); returns the exact bound it proves.
+pub fn check_detection_certificate(
+    problem: &Problem,
+    gaze_deg: f64,
+    cert: &DetectionCertificate,
+) -> Result<num_rational::BigRational, DetectionCertificateError> {
+    let (g, b) = detection_setup(problem, gaze_deg)?;
+    if cert.gaze_deg.to_bits() != gaze_deg.to_bits() {
+        return Err(DetectionCertificateError::Rejected {
+            field: "gaze_deg".into(),
+            reason: format!("{} is not the gaze checked, {gaze_deg}", cert.gaze_deg),
+        });
+    }
+    detection_certificate::check(problem, &g, &b, cert)
+}
+
+/// The grid and boxes of a detection problem.
+fn detection_setup(
+    problem: &Problem,
+    gaze_deg: f64,
+) -> Result<(Grid, Boxes), DetectionCertificateError> {
+    if problem.objective.kind != super::ObjectiveKind::Detection {
+        return Err(DetectionCertificateError::NoBound(
+            "objective.kind is not \"detection\"".into(),
+        ));
+    }
+    let no = |e: OptError| DetectionCertificateError::NoBound(e.to_string());
+    let g = grid(problem, gaze_deg).map_err(no)?;
+    let b = boxes(problem, &g).map_err(no)?;
+    Ok((g, b))
 }
 
 /// The relaxation's boxes: normalised power `x ∈ [x_lo, x_hi]` and spin
