@@ -479,7 +479,12 @@ impl ReturnModel {
                 (0.5 * libm::erfc(z) * (1.0 + ERFC_REL_ERR) + f64::MIN_POSITIVE).min(1.0)
             }
         };
-        pulses * p
+        // No return at all is none at any pulse count (at `R = 0` too).
+        if p == 0.0 {
+            0.0
+        } else {
+            pulses * p
+        }
     }
 
     /// Whether no range beyond `range_m` detects in the real-number model of
@@ -509,8 +514,10 @@ impl ReturnModel {
 
     /// A proven upper bound of the detection range (of the real-number
     /// model and of [`Self::detection_range_m`]'s floating-point answer):
-    /// from that answer (at least 1 cm), stepped up by a relative 1e-9,
-    /// 4e-9, 1.6e-8, … until [`Self::detects_nothing_beyond`] holds.
+    /// 0 where no range at all detects (`argus` below its threshold at
+    /// `R = 0`), else from that answer (at least 1 cm), stepped up by a
+    /// relative 1e-9, 4e-9, 1.6e-8, … until
+    /// [`Self::detects_nothing_beyond`] holds.
     #[must_use]
     pub fn detection_range_upper_m(
         &self,
@@ -524,6 +531,9 @@ impl ReturnModel {
         let holds = |r: f64| {
             self.detects_nothing_beyond(power_ratio, reflectivity, width_m, spacing_rad, detect, r)
         };
+        if found == 0.0 && holds(0.0) {
+            return 0.0;
+        }
         let mut r = found.max(0.01);
         let mut step = 1e-9;
         while !holds(r) {
@@ -693,7 +703,7 @@ mod tests {
                     assert!(m.detects_nothing_beyond(x, 0.1, 1.8, spacing, 1.0, up));
                     // A brute-force scan beyond it finds no detecting range.
                     for j in 1..=200 {
-                        let r = up * (1.0 + f64::from(j) * 0.01);
+                        let r = up.max(1e-3) * (1.0 + f64::from(j) * 0.01);
                         assert!(m.expected_returns(x, 0.1, 1.8, spacing, r) < 1.0 || r > 10_000.0);
                     }
                 }
