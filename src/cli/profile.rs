@@ -306,24 +306,24 @@ fn certificate_files(
     Err(CliError::input("--certificate: this build has no solver"))
 }
 
+/// The optimizer's answer: the profile, the final step's certificate, the
+/// figures' basis and, for a detection objective under `--certificate`,
+/// `detection_bound.json`.
+#[cfg(feature = "solver")]
+type Optimized = (
+    CertifiedProfile,
+    Result<gaze_lidar::optimizer::certificate::Certified, gaze_lidar::optimizer::CertificateError>,
+    Basis,
+    Option<Result<String, CliError>>,
+);
+
 #[cfg(feature = "solver")]
 fn optimized(
     a: &Args,
     preset: &gaze_lidar::model::presets::Preset,
     gaze: Option<f64>,
     overrides: &Overrides<'_>,
-) -> Result<
-    (
-        CertifiedProfile,
-        Result<
-            gaze_lidar::optimizer::certificate::Certified,
-            gaze_lidar::optimizer::CertificateError,
-        >,
-        Basis,
-        Option<Result<String, CliError>>,
-    ),
-    CliError,
-> {
+) -> Result<Optimized, CliError> {
     use gaze_lidar::optimizer::{optimize_with_certificate, OptError, Problem};
     let err = |e: OptError| {
         if e.is_input_error() {
