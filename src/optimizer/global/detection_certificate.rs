@@ -52,7 +52,7 @@ pub const FORMAT: &str = "gaze-lidar/detection-bound@1";
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DetectionCertificate {
-    /// Always [`FORMAT`].
+    /// Always `gaze-lidar/detection-bound@1`.
     pub format: String,
     /// What the file proves, in one paragraph.
     pub claim: String,
