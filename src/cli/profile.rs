@@ -88,7 +88,9 @@ pub struct Args {
     power_w_per_code: Option<f64>,
     /// With the optimizer: write the final power step's program to
     /// DIR/problem.mps (free MPS) and its exact certificate to
-    /// DIR/certificate.json (created if missing; all files or none).
+    /// DIR/certificate.json; under objective.kind = "detection" also the
+    /// global bound's exact certificate to DIR/detection_bound.json
+    /// (created if missing; all files or none).
     #[arg(long, value_name = "DIR")]
     certificate: Option<PathBuf>,
 }
@@ -181,10 +183,17 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             accounting,
             mode: a.mode,
         };
-        let (c, cert, b) = optimized(a, &preset, gaze, &overrides)?;
+        let (c, cert, b, detection) = optimized(a, &preset, gaze, &overrides)?;
         basis = b;
         if let Some(dir) = &a.certificate {
             extra = certificate_files(dir, cert)?;
+            if let Some(json) = detection {
+                // Declared once known (a detection objective only); the
+                // commit checks it with the rest.
+                let path = dir.join("detection_bound.json");
+                outputs.file_opt("--certificate", Some(&path));
+                extra.push((path, json?.into_bytes()));
+            }
         }
         c
     } else {
@@ -299,23 +308,24 @@ fn certificate_files(
     Err(CliError::input("--certificate: this build has no solver"))
 }
 
+/// The optimizer's answer: the profile, the final step's certificate, the
+/// figures' basis and, for a detection objective under `--certificate`,
+/// `detection_bound.json`.
+#[cfg(feature = "solver")]
+type Optimized = (
+    CertifiedProfile,
+    Result<gaze_lidar::optimizer::certificate::Certified, gaze_lidar::optimizer::CertificateError>,
+    Basis,
+    Option<Result<String, CliError>>,
+);
+
 #[cfg(feature = "solver")]
 fn optimized(
     a: &Args,
     preset: &gaze_lidar::model::presets::Preset,
     gaze: Option<f64>,
     overrides: &Overrides<'_>,
-) -> Result<
-    (
-        CertifiedProfile,
-        Result<
-            gaze_lidar::optimizer::certificate::Certified,
-            gaze_lidar::optimizer::CertificateError,
-        >,
-        Basis,
-    ),
-    CliError,
-> {
+) -> Result<Optimized, CliError> {
     use gaze_lidar::optimizer::{optimize_with_certificate, OptError, Problem};
     let err = |e: OptError| {
         if e.is_input_error() {
@@ -349,6 +359,9 @@ fn optimized(
         }
     };
     let (c, cert) = optimize_with_certificate(&problem, gaze).map_err(err)?;
+    let detection = (a.certificate.is_some()
+        && problem.objective.kind == gaze_lidar::optimizer::ObjectiveKind::Detection)
+        .then(|| detection_bound_file(&problem, gaze));
     let c = gaze_lidar::optimizer::figures::attach_to_optimum(c, &problem, named.levels.clone());
     let basis = Basis {
         preset: gaze_lidar::optimizer::figures::closed_form_basis(&problem, named.levels),
@@ -356,7 +369,25 @@ fn optimized(
         bins: problem.bins,
         optimized: true,
     };
-    Ok((c, cert, basis))
+    Ok((c, cert, basis, detection))
+}
+
+/// `detection_bound.json`: the detection bound's certificate, checked
+/// exactly before it is written.
+#[cfg(feature = "solver")]
+fn detection_bound_file(
+    problem: &gaze_lidar::optimizer::Problem,
+    gaze: f64,
+) -> Result<String, CliError> {
+    use gaze_lidar::optimizer::global::{check_detection_certificate, detection_certificate};
+    let fail = |e: gaze_lidar::optimizer::global::DetectionCertificateError| {
+        CliError::infeasible(format!("--certificate: {e}"))
+    };
+    let cert = detection_certificate(problem, gaze).map_err(fail)?;
+    check_detection_certificate(problem, gaze, &cert).map_err(fail)?;
+    let json = serde_json::to_string(&cert)
+        .map_err(|e| CliError::output(format!("detection_bound.json: {e}")))?;
+    Ok(json + "\n")
 }
 
 #[cfg(not(feature = "solver"))]
@@ -365,7 +396,15 @@ fn optimized(
     _preset: &gaze_lidar::model::presets::Preset,
     _gaze: Option<f64>,
     _overrides: &Overrides<'_>,
-) -> Result<(CertifiedProfile, Result<(), String>, Basis), CliError> {
+) -> Result<
+    (
+        CertifiedProfile,
+        Result<(), String>,
+        Basis,
+        Option<Result<String, CliError>>,
+    ),
+    CliError,
+> {
     Err(super::config::no_solver("--optimize/--config"))
 }
 

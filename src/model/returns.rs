@@ -421,6 +421,129 @@ impl ReturnModel {
     }
 }
 
+/// Relative error allowed for `libm::erfc` in [`ReturnModel::expected_returns_upper`]:
+/// musl's `erfc` (which `libm` ports) is accurate to about one ulp
+/// (1.1e-16); the margin is 10⁴ times that, tested against 40-digit values
+/// (mpmath) from `z = −5.9` to `26.5`.
+pub const ERFC_REL_ERR: f64 = 1e-12;
+
+impl ReturnModel {
+    /// An upper bound of the real-number value of
+    /// [`Self::expected_returns`] at `range_m` (the model evaluated without
+    /// rounding), from one floating-point evaluation rounded outward:
+    /// - the pulses `W/(R·Δφ)` (two divisions, each within ε) raised by a
+    ///   relative 1e-12 (which also covers the final product's rounding and
+    ///   the few ε by which a caller's `Δφ = θ/(f_p·t)` misses its exact value);
+    /// - `physical`: the amplitude `A` raised by a relative
+    ///   `1e-12 + 16ε·(|2αR| + |2α₀R₀| + 8)` (the exponent's absolute
+    ///   rounding is at most `4ε` of its terms' magnitudes, which `exp`
+    ///   turns into a relative error; six products and `exp`'s own ulp on
+    ///   top), then `P_D = ½·erfc(z)` at `z = (T − A)/√2` lowered by
+    ///   `1e-12·(|T| + A)` (erfc falls, so a lower `z` is a higher `P_D`),
+    ///   raised by [`ERFC_REL_ERR`] and by `f64::MIN_POSITIVE` (erfc's
+    ///   subnormal results carry an absolute error below it), capped at 1;
+    /// - `argus`: 1 where the intensity raised by a relative 1e-12 reaches
+    ///   the threshold within 100 m, else 0.
+    #[must_use]
+    pub fn expected_returns_upper(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        width_m: f64,
+        spacing_rad: f64,
+        range_m: f64,
+    ) -> f64 {
+        let pulses = width_m / (range_m * spacing_rad) * (1.0 + 1e-12);
+        let p = match *self {
+            Self::Argus {
+                fog_factor,
+                threshold,
+            } => {
+                let intensity = power_ratio * self.range_factor(range_m) * fog_factor;
+                if range_m <= ARGUS_RANGE_M && intensity * (1.0 + 1e-12) >= threshold {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            Self::Physical {
+                params,
+                extinction_per_m,
+            } => {
+                let exponent = (2.0 * extinction_per_m * range_m).abs()
+                    + (2.0 * params.clear_extinction_per_m * params.rated_range_m).abs();
+                let rel = 1e-12 + 16.0 * f64::EPSILON * (exponent + 8.0);
+                let a = self.amplitude_sigma(power_ratio, reflectivity, 1.0, range_m) * (1.0 + rel);
+                let t = params.threshold_sigma;
+                let z = (t - a) / std::f64::consts::SQRT_2 - 1e-12 * (t.abs() + a.abs());
+                (0.5 * libm::erfc(z) * (1.0 + ERFC_REL_ERR) + f64::MIN_POSITIVE).min(1.0)
+            }
+        };
+        // No return at all is none at any pulse count (at `R = 0` too).
+        if p == 0.0 {
+            0.0
+        } else {
+            pulses * p
+        }
+    }
+
+    /// Whether no range beyond `range_m` detects in the real-number model of
+    /// [`Self::detection_range_m`] (so its detection range is at most
+    /// `range_m`): `range_m` is at or beyond one of its caps (10⁴ m,
+    /// `argus`'s 100 m, or `W/(Δφ·detect)` raised by a relative 1e-12,
+    /// where even `P_D = 1` leaves fewer than `detect` pulses), or
+    /// [`Self::expected_returns_upper`] there is below `detect` (the expected
+    /// returns fall with the range, so every farther range detects less).
+    #[must_use]
+    pub fn detects_nothing_beyond(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        width_m: f64,
+        spacing_rad: f64,
+        detect: f64,
+        range_m: f64,
+    ) -> bool {
+        let cap = width_m / (spacing_rad * detect) * (1.0 + 1e-12);
+        range_m >= 10_000.0
+            || (matches!(self, Self::Argus { .. }) && range_m >= ARGUS_RANGE_M)
+            || range_m >= cap
+            || self.expected_returns_upper(power_ratio, reflectivity, width_m, spacing_rad, range_m)
+                < detect
+    }
+
+    /// A proven upper bound of the detection range (of the real-number
+    /// model and of [`Self::detection_range_m`]'s floating-point answer):
+    /// 0 where no range at all detects (`argus` below its threshold at
+    /// `R = 0`), else from that answer (at least 1 cm), stepped up by a
+    /// relative 1e-9, 4e-9, 1.6e-8, … until
+    /// [`Self::detects_nothing_beyond`] holds.
+    #[must_use]
+    pub fn detection_range_upper_m(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        width_m: f64,
+        spacing_rad: f64,
+        detect: f64,
+    ) -> f64 {
+        let found = self.detection_range_m(power_ratio, reflectivity, width_m, spacing_rad, detect);
+        let holds = |r: f64| {
+            self.detects_nothing_beyond(power_ratio, reflectivity, width_m, spacing_rad, detect, r)
+        };
+        if found == 0.0 && holds(0.0) {
+            return 0.0;
+        }
+        let mut r = found.max(0.01);
+        let mut step = 1e-9;
+        while !holds(r) {
+            r *= 1.0 + step;
+            step *= 4.0;
+        }
+        r
+    }
+}
+
 /// Width of the range buckets of [`Saturation`], m (a power of two: the
 /// bucket index `⌊r / w⌋` is exact).
 pub(crate) const RANGE_BUCKET_M: f64 = 0.25;
@@ -519,6 +642,75 @@ mod tests {
                 (r - range).abs() <= tol,
                 "fog {fog} %, power {power}: {r} m"
             );
+        }
+    }
+
+    /// `libm::erfc` against 40-digit values (mpmath 1.3,
+    /// `erfc(mpf(z))` at the double `z`): within [`ERFC_REL_ERR`] (in fact
+    /// within a few ulp), the premise of the enclosure.
+    #[test]
+    // The oracle's 20 digits as printed (the compiler rounds each to the
+    // nearest double).
+    #[allow(clippy::excessive_precision)]
+    fn erfc_is_within_its_stated_error() {
+        let table = [
+            (-5.9, 1.999_999_999_999_999_928_1),
+            (-3.5, 1.999_999_256_901_627_658_6),
+            (-1.25, 1.922_900_128_256_458_230_1),
+            (-0.3, 1.328_626_759_459_127_416_2),
+            (0.0, 1.0),
+            (0.4, 5.716_076_449_533_315_235_5e-1),
+            (1.0, 1.572_992_070_502_851_306_6e-1),
+            (1.7, 1.620_954_140_922_543_915_9e-2),
+            (2.5, 4.069_520_174_449_589_395_6e-4),
+            (3.3, 3.057_709_796_438_165_198_8e-6),
+            (4.2, 2.855_494_179_592_184_240_2e-9),
+            (5.0, 1.537_459_794_428_034_850_2e-12),
+            (6.5, 3.842_148_327_120_647_469_9e-20),
+            (8.0, 1.122_429_717_298_292_708e-29),
+            (10.5, 7.035_928_090_177_522_686_7e-50),
+            (13.0, 1.739_557_315_466_724_521_8e-75),
+            (16.0, 2.328_485_751_571_530_693_4e-113),
+            (19.5, 2.090_954_147_922_729_460_5e-167),
+            (23.0, 4.441_265_948_088_057_244_1e-232),
+            (26.0, 5.663_192_408_856_142_846_5e-296),
+            (26.5, 2.210_907_664_263_734_275_9e-307),
+        ];
+        for (z, want) in table {
+            let got = libm::erfc(z);
+            let rel = (got - want).abs() / want;
+            assert!(rel <= 1e-15, "erfc({z}) = {got:e}, want {want:e} ({rel:e})");
+            assert!(rel * 1e3 <= ERFC_REL_ERR);
+        }
+    }
+
+    /// The enclosure against the plain model, and the proven range against
+    /// the bisection: above both, and only a little.
+    #[test]
+    fn the_upper_range_is_above_the_model_and_proven() {
+        for kind in [ModelKind::Argus, ModelKind::Physical] {
+            for fog in [0, 25, 50] {
+                let m = model(kind, fog);
+                for (x, spacing) in [(0.3, 1e-3), (1.0, 3e-3), (1.7, 1e-4), (0.05, 1e-2)] {
+                    for r in [0.5, 7.0, 40.0, 99.0, 150.0] {
+                        let e = m.expected_returns(x, 0.1, 1.8, spacing, r);
+                        let up = m.expected_returns_upper(x, 0.1, 1.8, spacing, r);
+                        assert!(up >= e && up <= e * (1.0 + 1e-9) + 1e-300, "{up} vs {e}");
+                    }
+                    let found = m.detection_range_m(x, 0.1, 1.8, spacing, 1.0);
+                    let up = m.detection_range_upper_m(x, 0.1, 1.8, spacing, 1.0);
+                    assert!(
+                        up >= found && up <= found.max(0.01) * (1.0 + 1e-6),
+                        "{up} {found}"
+                    );
+                    assert!(m.detects_nothing_beyond(x, 0.1, 1.8, spacing, 1.0, up));
+                    // A brute-force scan beyond it finds no detecting range.
+                    for j in 1..=200 {
+                        let r = up.max(1e-3) * (1.0 + f64::from(j) * 0.01);
+                        assert!(m.expected_returns(x, 0.1, 1.8, spacing, r) < 1.0 || r > 10_000.0);
+                    }
+                }
+            }
         }
     }
 

@@ -192,6 +192,75 @@ pub fn value(problem: &Problem, theta_rad: f64, dwell_s: f64, power_ratio: f64) 
         .sum()
 }
 
+/// A proven upper bound of `u(x, t)` (of the real-number model and of
+/// [`value`]'s floating-point answer) and the ranges it rests on: per
+/// condition (in [`condition_weights`]' order) a range beyond which nothing
+/// detects ([`ReturnModel::detection_range_upper_m`]), and their weighted
+/// sum over `R₀` rounded up (a relative 1e-12, far above the few ε of the
+/// sum). [`value_upper_holds`] re-checks both.
+pub fn value_upper(
+    problem: &Problem,
+    theta_rad: f64,
+    dwell_s: f64,
+    power_ratio: f64,
+) -> (f64, Vec<f64>) {
+    let d = &problem.objective.detection;
+    let spacing = spacing_rad(problem, theta_rad, dwell_s);
+    let conditions = d.conditions(problem);
+    let ranges: Vec<f64> = conditions
+        .iter()
+        .map(|(_, m)| {
+            m.detection_range_upper_m(
+                power_ratio,
+                d.reflectivity,
+                d.target_width_m,
+                spacing,
+                d.detect,
+            )
+        })
+        .collect();
+    let sum: f64 = conditions
+        .iter()
+        .zip(&ranges)
+        .map(|((w, _), r)| w * r)
+        .sum();
+    (sum / problem.lidar.rated_range_m * (1.0 + 1e-12), ranges)
+}
+
+/// Whether every range of `ranges` bounds its condition's detection range
+/// at `(x, t)` ([`ReturnModel::detects_nothing_beyond`]: a floating-point
+/// evaluation with its stated outward margins). The caller checks the sum.
+pub fn value_upper_holds(
+    problem: &Problem,
+    theta_rad: f64,
+    dwell_s: f64,
+    power_ratio: f64,
+    ranges: &[f64],
+) -> bool {
+    let d = &problem.objective.detection;
+    let spacing = spacing_rad(problem, theta_rad, dwell_s);
+    let conditions = d.conditions(problem);
+    conditions.len() == ranges.len()
+        && conditions.iter().zip(ranges).all(|((_, m), &r)| {
+            r.is_finite()
+                && m.detects_nothing_beyond(
+                    power_ratio,
+                    d.reflectivity,
+                    d.target_width_m,
+                    spacing,
+                    d.detect,
+                    r,
+                )
+        })
+}
+
+/// The conditions' weights `π_c` (summing to 1 up to rounding), in the
+/// order of [`value_upper`]'s ranges.
+pub fn condition_weights(problem: &Problem) -> Vec<f64> {
+    let d = &problem.objective.detection;
+    d.conditions(problem).iter().map(|(w, _)| *w).collect()
+}
+
 /// Pulse spacing in a bin, rad: `θ/(f_p·t)`.
 fn spacing_rad(problem: &Problem, theta_rad: f64, dwell_s: f64) -> f64 {
     theta_rad / (problem.lidar.pulse_rate_hz * dwell_s)

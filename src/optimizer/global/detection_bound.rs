@@ -31,11 +31,14 @@
 //! they are searched (golden section, coordinate-wise, on a coarser grid)
 //! because the function is convex in them.
 //!
-//! **Rounding**: `u` at a node is the return model's bisection end on the
-//! detecting side, within a relative `1e-12` of the true crossing; it is
-//! raised by a relative [`VALUE_MARGIN`] (`1e-9`, far above that and the
-//! float evaluation of the returns). The sum is raised by
-//! `1e-12 + 2·(terms)·ε` of its terms' magnitudes, as the `√` Lagrangians.
+//! **Rounding**: `u` at a node is a proven upper bound
+//! ([`detection::value_upper`]): per condition a range beyond which the
+//! model's expected returns, evaluated with outward margins
+//! ([`crate::model::returns::ReturnModel::expected_returns_upper`]), stay
+//! below `detect`. The sum is raised by `1e-12 + 2·(terms)·ε` of its terms'
+//! magnitudes, as the `√` Lagrangians. The same cells, nodes and
+//! multipliers are exported as a certificate checked in exact rational
+//! arithmetic ([`super::detection_certificate`]).
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -45,7 +48,7 @@ use super::super::detection;
 use super::super::lp::Grid;
 use super::super::settings::S;
 use super::super::Problem;
-use super::Boxes;
+use super::{golden, Boxes};
 use crate::model::lidar::PowerAccounting;
 
 /// Power cells of the finest grid (nodes evenly spaced in `√x`).
@@ -64,21 +67,22 @@ const SEARCH_STRIDE: (usize, usize) = (64, 8);
 /// [`MAX_SPLITS`] splits (either way the bound stays valid).
 const REFINE_TOL: f64 = 1e-6;
 const MAX_SPLITS: usize = 64;
-/// Relative margin on every value of `u` (module docs, "rounding").
-pub(super) const VALUE_MARGIN: f64 = 1e-9;
 
 /// Nodes of the finest grid for one bin width, and the raised values of
 /// `u` on them, computed when first asked for.
-struct Table<'a> {
+pub(super) struct Table<'a> {
     problem: &'a Problem,
-    theta: f64,
+    pub(super) theta: f64,
     unit: f64,
     /// `x` holds the hardware levels (each a cell of its own), not a grid.
-    discrete: bool,
-    x: Vec<f64>,
-    tau: Vec<f64>,
-    /// `u` at `(x[k], tau[l])` raised by [`VALUE_MARGIN`], row-major.
+    pub(super) discrete: bool,
+    pub(super) x: Vec<f64>,
+    pub(super) tau: Vec<f64>,
+    /// The proven upper bound of `u` at `(x[k], tau[l])`, row-major (NaN
+    /// until computed).
     u: RefCell<Vec<f64>>,
+    /// The ranges each computed bound rests on (empty until computed).
+    ranges: RefCell<Vec<Vec<f64>>>,
 }
 
 impl<'a> Table<'a> {
@@ -93,6 +97,7 @@ impl<'a> Table<'a> {
         let (tl, th) = b.tau(theta);
         let tau = nodes(tl, th, DWELL_CELLS, |v| v, |v| v);
         let u = RefCell::new(vec![f64::NAN; x.len() * tau.len()]);
+        let ranges = RefCell::new(vec![Vec::new(); x.len() * tau.len()]);
         Table {
             problem,
             theta,
@@ -101,6 +106,7 @@ impl<'a> Table<'a> {
             x,
             tau,
             u,
+            ranges,
         }
     }
 
@@ -110,17 +116,34 @@ impl<'a> Table<'a> {
         if !v.is_nan() {
             return v;
         }
-        let v = detection::value(self.problem, self.theta, self.tau[l] * self.unit, self.x[k])
-            * (1.0 + VALUE_MARGIN);
+        let (v, ranges) =
+            detection::value_upper(self.problem, self.theta, self.tau[l] * self.unit, self.x[k]);
         self.u.borrow_mut()[i] = v;
+        self.ranges.borrow_mut()[i] = ranges;
         v
+    }
+
+    /// The nodes whose bound was computed: `(k, l, u, ranges)`.
+    pub(super) fn points(&self) -> Vec<(usize, usize, f64, Vec<f64>)> {
+        let (u, ranges) = (self.u.borrow(), self.ranges.borrow());
+        (0..u.len())
+            .filter(|&i| !u[i].is_nan())
+            .map(|i| {
+                (
+                    i / self.tau.len(),
+                    i % self.tau.len(),
+                    u[i],
+                    ranges[i].clone(),
+                )
+            })
+            .collect()
     }
 }
 
 /// The hardware power levels a moving power may take (power ratios, inside
 /// the limits and under the box's Rule 1 cap), or `None` for a continuous
 /// power: with levels the power part of each bin's maximum is exact.
-fn levels(problem: &Problem, b: &Boxes) -> Option<Vec<f64>> {
+pub(super) fn levels(problem: &Problem, b: &Boxes) -> Option<Vec<f64>> {
     let l = &problem.lidar.limits;
     let p_mean = problem.lidar.average_power_w;
     if !problem.objective.mode.controls_range() || problem.levels.power_w.is_empty() {
@@ -177,7 +200,7 @@ struct Bin<'t, 'a> {
 }
 
 /// A cell of one bin: node ranges `[k0, k1] × [l0, l1]`.
-type Cell = (usize, usize, usize, usize);
+pub(super) type Cell = (usize, usize, usize, usize);
 
 struct Lagrangian<'t, 'a> {
     bins: Vec<Bin<'t, 'a>>,
@@ -214,8 +237,9 @@ impl Lagrangian<'_, '_> {
     }
 
     /// One bin's maximum bounded over the coarse cells, each refined (best
-    /// bound first) if `refine`.
-    fn bin_bound(&self, b: &Bin, mu: f64, nu: f64, refine: bool) -> (f64, f64) {
+    /// bound first) if `refine`: (bound, magnitude, the cells covering the
+    /// box).
+    fn bin_bound(&self, b: &Bin, mu: f64, nu: f64, refine: bool) -> (f64, f64, Vec<Cell>) {
         let t = b.table;
         let mut leaves: Vec<(f64, f64, Cell)> = Vec::new();
         for &(l0, l1) in &cells(t.tau.len(), COARSE.1) {
@@ -264,7 +288,8 @@ impl Lagrangian<'_, '_> {
             }
         }
         let i = top(&leaves);
-        (leaves[i].0, leaves[i].1)
+        let (v, m) = (leaves[i].0, leaves[i].1);
+        (v, m, leaves.into_iter().map(|l| l.2).collect())
     }
 
     /// The search grid's cells of one bin's table (every
@@ -314,23 +339,47 @@ impl Lagrangian<'_, '_> {
         total + (1e-12 + 2.0 * terms * f64::EPSILON) * magnitude
     }
 
-    /// The bound at `(mu, nu)`: on the coarse cells, or refined.
-    fn at(&self, mu: f64, nu: f64, refine: bool) -> f64 {
+    /// The bound at `(mu, nu)`, refined, and its cells: per class of bins
+    /// (equal weight and width: equal maxima) the index of its first bin
+    /// and its cells, and per bin its class.
+    fn at(&self, mu: f64, nu: f64) -> Classes {
         let mut total = mu * self.budget + nu * self.frame;
         let mut magnitude = total.abs();
-        // Bins of equal weight and width have equal maxima.
-        let mut seen: HashMap<(u64, u64), (f64, f64)> = HashMap::new();
-        for b in &self.bins {
-            let (v, m) = *seen
+        let mut seen: HashMap<(u64, u64), usize> = HashMap::new();
+        let mut classes: Vec<(usize, f64, f64, Vec<Cell>)> = Vec::new();
+        let mut of_bin = Vec::with_capacity(self.bins.len());
+        for (i, b) in self.bins.iter().enumerate() {
+            let class = *seen
                 .entry((b.c.to_bits(), b.theta.to_bits()))
-                .or_insert_with(|| self.bin_bound(b, mu, nu, refine));
-            total += v;
-            magnitude += m;
+                .or_insert_with(|| {
+                    let (v, m, cells) = self.bin_bound(b, mu, nu, true);
+                    classes.push((i, v, m, cells));
+                    classes.len() - 1
+                });
+            total += classes[class].1;
+            magnitude += classes[class].2;
+            of_bin.push(class);
         }
         let terms = (self.bins.len() + 2) as f64;
-        total + (1e-12 + 2.0 * terms * f64::EPSILON) * magnitude
+        Classes {
+            bound: total + (1e-12 + 2.0 * terms * f64::EPSILON) * magnitude,
+            cells: classes.into_iter().map(|(i, _, _, c)| (i, c)).collect(),
+            of_bin,
+        }
     }
 }
+
+/// [`Lagrangian::at`]'s answer.
+pub(super) struct Classes {
+    /// The bound (floating point, raised as the module docs say).
+    pub(super) bound: f64,
+    /// Per class: its first bin and its cells `(k0, k1, l0, l1)`.
+    pub(super) cells: Vec<(usize, Vec<Cell>)>,
+    /// Per bin: its class.
+    pub(super) of_bin: Vec<usize>,
+}
+
+impl Lagrangian<'_, '_> {}
 
 /// Golden-section minimum of a convex `f` on `[0, ∞)`: bracketed by
 /// doubling from `start`, then 40 steps.
@@ -362,31 +411,6 @@ fn minimise(f: impl Fn(f64) -> f64, start: f64) -> f64 {
     }
 }
 
-/// Golden-section minimum of a convex `f` on `[lo, hi]`, `steps` steps.
-fn golden(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize) -> f64 {
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut a, mut b) = (lo, hi);
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..steps {
-        if fc <= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    0.5 * (a + b)
-}
-
 /// `b` if `f(b) <= f(a)`, else `a`.
 fn keep_better(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     if f(b) <= f(a) {
@@ -398,19 +422,43 @@ fn keep_better(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 
 /// The bound (module docs), or `None` if it is not finite.
 pub(super) fn bound(problem: &Problem, g: &Grid, b: &Boxes) -> Option<f64> {
-    let o = &problem.objective;
-    let mut tables: HashMap<u64, Table> = HashMap::new();
+    solve(problem, g, b, |_, _, _, classes| classes.bound)
+}
+
+/// The tables of a grid: one per distinct bin width (by its bits), in the
+/// order first met.
+pub(super) fn tables<'a>(problem: &'a Problem, g: &Grid, b: &Boxes) -> Vec<Table<'a>> {
+    let mut out: Vec<Table> = Vec::new();
     for &theta in &g.theta {
-        tables
-            .entry(theta.to_bits())
-            .or_insert_with(|| Table::new(problem, b, theta));
+        if !out.iter().any(|t| t.theta.to_bits() == theta.to_bits()) {
+            out.push(Table::new(problem, b, theta));
+        }
     }
+    out
+}
+
+/// Runs the bound and hands `finish` the tables, the multipliers and the
+/// refined answer (`None` if the bound is not finite).
+pub(super) fn solve<R>(
+    problem: &Problem,
+    g: &Grid,
+    b: &Boxes,
+    finish: impl FnOnce(&[Table], f64, f64, &Classes) -> R,
+) -> Option<R> {
+    let o = &problem.objective;
+    let tables = tables(problem, g, b);
+    let table_of = |theta: f64| {
+        tables
+            .iter()
+            .find(|t| t.theta.to_bits() == theta.to_bits())
+            .expect("a table per width")
+    };
     let bins = (0..g.n)
         .map(|i| Bin {
             c: g.theta[i] * g.weight[i],
             theta: g.theta[i],
             k: b.unit * TAU / (g.theta[i] * b.period),
-            table: &tables[&g.theta[i].to_bits()],
+            table: table_of(g.theta[i]),
         })
         .collect();
     let widen = 1.0 + S.global_widen;
@@ -458,8 +506,12 @@ pub(super) fn bound(problem: &Problem, g: &Grid, b: &Boxes) -> Option<f64> {
             golden(|v| at(mu, v), 0.7 * nu, 1.4 * nu, 20),
         );
     }
-    let v = lag.at(mu, nu, true);
-    (v.is_finite()).then_some(v * (1.0 + S.objective_margin))
+    let mut classes = lag.at(mu, nu);
+    if !classes.bound.is_finite() {
+        return None;
+    }
+    classes.bound *= 1.0 + S.objective_margin;
+    Some(finish(&tables, mu, nu, &classes))
 }
 
 #[cfg(test)]
