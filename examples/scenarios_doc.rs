@@ -10,7 +10,7 @@ use std::path::Path;
 
 use gaze_lidar::gaze::{Format, PipelineConfig};
 use gaze_lidar::sim::gaze_drive::{self, Behaviour, GazeDrive, GazeSource, Trace};
-use gaze_lidar::sim::{self, stats, GridResult, ModelKind, Scenario, SimConfig, Variant};
+use gaze_lidar::sim::{self, report, stats, GridResult, ModelKind, Scenario, SimConfig, Variant};
 
 const SEED: u64 = 1;
 
@@ -23,91 +23,8 @@ fn num(x: Option<f64>) -> String {
     x.map_or_else(|| "–".to_owned(), |x| format!("{x:.2}"))
 }
 
-/// `median [lo, hi]` of `values` with a bootstrap interval seeded by the cell's label.
-fn interval(values: &[f64], label: &str) -> String {
-    match stats::bootstrap_median(
-        values,
-        stats::BOOTSTRAP_RESAMPLES,
-        stats::derive_seed(SEED, label),
-    ) {
-        Some(m) => format!("{:.2} [{:.2}, {:.2}]", m.median, m.lo, m.hi),
-        None => "–".to_owned(),
-    }
-}
-
-/// Modes of a TTA sample: `share × median` per mode.
-fn modes(values: &[f64]) -> String {
-    let m = stats::modes(values, stats::MODE_GAP_S);
-    if m.len() <= 1 {
-        return "1".to_owned();
-    }
-    m.iter()
-        .map(|x| format!("{:.0} % at {:.2}", 100.0 * x.share, x.median))
-        .collect::<Vec<_>>()
-        .join("; ")
-}
-
-/// Right-car TTA per trial of one cell, in trial order.
-fn tta(r: &GridResult, variant: &str, fog: u32, car: usize) -> Vec<Option<f64>> {
-    r.trials
-        .iter()
-        .filter(|t| t.variant == variant && t.fog_pct == fog)
-        .map(|t| t.outcome.tta_s[car])
-        .collect()
-}
-
-/// Paired comparison with the baseline over trials detected by both.
-fn paired(variant: &[Option<f64>], baseline: &[Option<f64>]) -> String {
-    let (a, b): (Vec<f64>, Vec<f64>) = variant
-        .iter()
-        .zip(baseline)
-        .filter_map(|(a, b)| Some(((*a)?, (*b)?)))
-        .unzip();
-    match stats::paired(&a, &b) {
-        Some(p) if p.median_difference != 0.0 || p.rank_biserial != 0.0 => format!(
-            "{:+.2} s, p = {:.2e}, r = {:+.2}",
-            p.median_difference, p.wilcoxon.p_value, p.rank_biserial
-        ),
-        Some(_) => "identical".to_owned(),
-        None => "–".to_owned(),
-    }
-}
-
 fn flat(v: &[Option<f64>]) -> Vec<f64> {
     v.iter().flatten().copied().collect()
-}
-
-fn scenario_table(out: &mut String, name: &str, r: &GridResult) {
-    out.push_str(
-        "| variant | fog % | detected | TTA median [95 % CI], s | modes | vs baseline (Δ median, Wilcoxon p, r) | watched side: detected, TTA [CI] | hybrid TTA, s | false alarms / frame | early false |\n",
-    );
-    out.push_str("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
-    for row in &r.rows {
-        let right = tta(r, row.variant, row.fog_pct, 1);
-        let left = tta(r, row.variant, row.fog_pct, 0);
-        let base = tta(r, "baseline", row.fog_pct, 1);
-        let label = format!("{name}/{}/{}", row.variant, row.fog_pct);
-        let _ = writeln!(
-            out,
-            "| {} | {} | {}/{} | {} | {} | {} | {}, {} | {} | {:.4} | {} |",
-            row.variant,
-            row.fog_pct,
-            row.detected,
-            row.trials,
-            interval(&flat(&right), &label),
-            modes(&flat(&right)),
-            if row.variant == "baseline" {
-                "–".to_owned()
-            } else {
-                paired(&right, &base)
-            },
-            row.left_detected,
-            interval(&flat(&left), &format!("{label}/left")),
-            num(row.hybrid_tta_median_s),
-            row.false_alarms_per_frame,
-            row.early_false,
-        );
-    }
 }
 
 fn gaze_table(out: &mut String, name: &str, r: &GridResult) {
@@ -116,8 +33,8 @@ fn gaze_table(out: &mut String, name: &str, r: &GridResult) {
     );
     out.push_str("| --- | --- | --- | --- | --- | --- | --- | --- |\n");
     for row in &r.rows {
-        let right = tta(r, row.variant, row.fog_pct, 1);
-        let base = tta(r, "baseline", row.fog_pct, 1);
+        let right = report::tta_of(r, row.variant, row.fog_pct, 1);
+        let base = report::tta_of(r, "baseline", row.fog_pct, 1);
         let in_fail_safe = r
             .trials
             .iter()
@@ -130,12 +47,12 @@ fn gaze_table(out: &mut String, name: &str, r: &GridResult) {
             row.variant,
             row.detected,
             row.trials,
-            interval(&flat(&right), &format!("{name}/{}", row.variant)),
-            modes(&flat(&right)),
+            report::median_interval(&flat(&right), SEED, &format!("{name}/{}", row.variant)),
+            report::modes_text(&flat(&right)),
             if row.variant == "baseline" {
                 "–".to_owned()
             } else {
-                paired(&right, &base)
+                report::paired_text(&right, &base)
             },
             num(row.hybrid_tta_median_s),
             100.0 * row.fail_safe_frame_share,
@@ -192,17 +109,12 @@ fn main() {
         };
         let r = sim::run(&config, &|| {}).unwrap_or_else(|e| fail(&e.to_string()));
         let _ = writeln!(out, "## {name}\n");
-        for line in text.lines().filter_map(|l| l.strip_prefix('#')) {
-            let line = line.trim();
-            if !line.is_empty() && !line.starts_with("`gaze-lidar") {
-                let _ = writeln!(out, "{line}");
-            }
-        }
+        out.push_str(&report::scenario_description(&text));
         let _ = writeln!(
             out,
             "\n`gaze-lidar simulate --scenario examples/scenarios/{name}.toml --model physical --trials {trials} --seed {SEED}`\n"
         );
-        scenario_table(&mut out, &name, &r);
+        out.push_str(&report::scenario_table(&name, &r, SEED));
         out.push('\n');
     }
     out.push_str(

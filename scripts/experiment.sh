@@ -10,7 +10,8 @@
 #     pipeline swept over mount height, grid phase, tick, spawn distance and
 #     fog threshold, five values each (SWEEP_TRIALS per cell, default 30: fewer
 #     than the main run, to keep the script's run time to a few minutes), with
-#     one figure per key in $OUT/plots/.
+#     one figure per key in $OUT/plots/; and the pedestrian and two-car
+#     scenario files' tables (physical model, TRIALS per cell).
 # Outputs go to $OUT (default: out/); the report to docs/reproduction.md.
 # CHECK=1: fail unless the regenerated report equals the committed one byte
 # for byte (git diff --exit-code).
@@ -35,7 +36,9 @@ $B simulate --trials "$TRIALS" --seed 1 --plots "$OUT/plots" --trials-csv "$OUT/
   --sweep grid_phase=0,0.2,0.4,0.6,0.8 \
   --sweep tick=0.025,0.04,0.05,0.075,0.1 \
   --sweep spawn_distance=100,105,110,115,120 \
-  --sweep fog_threshold=0.5,0.75,1,1.5,2
+  --sweep fog_threshold=0.5,0.75,1,1.5,2 \
+  --report-scenario examples/scenarios/pedestrian.toml \
+  --report-scenario examples/scenarios/second_car.toml
 echo "results: $OUT/results.json, $OUT/results.csv, $OUT/trials.csv; plots: $OUT/plots/; report: docs/reproduction.md" >&2
 if [ "${CHECK:-0}" = 1 ]; then
   git diff --exit-code -- docs/reproduction.md

@@ -311,3 +311,106 @@ fn cli_gaze_options() {
         "right.csv:1",
     );
 }
+
+#[test]
+fn the_report_tabulates_its_scenario_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("r.md");
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/scenarios/second_car.toml"
+    );
+    let o = run(
+        &[
+            "simulate",
+            "--trials",
+            "3",
+            "--seed",
+            "4",
+            "--model",
+            "physical",
+            "--fog",
+            "0",
+            "--report",
+            report.to_str().unwrap(),
+            "--report-scenario",
+            file,
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let md = std::fs::read_to_string(&report).unwrap();
+    // The section holds the table the library computes for the same run
+    // (every variant and fog level, 3 trials, seed 4), and the file's own
+    // description.
+    let expected = sim::run(
+        &SimConfig {
+            models: vec![ModelKind::Physical],
+            trials: 3,
+            seed: 4,
+            scenario: scenario("second_car.toml"),
+            ..SimConfig::default()
+        },
+        &|| {},
+    )
+    .unwrap();
+    assert_eq!(expected.rows.len(), 12);
+    let table = sim::report::scenario_table("second_car", &expected, 4);
+    let section = md.split("### second_car\n").nth(1).expect("the section");
+    assert!(section.contains(&table), "{section}");
+    assert!(section.contains("Two cars arriving together"), "{section}");
+    assert!(section.contains(&format!(
+        "--scenario {file} --model physical --trials 3 --seed 4"
+    )));
+    // Without --report it is refused; a bad file is named, and nothing is written.
+    assert_bad_input(
+        &run(&["simulate", "--report-scenario", file], None),
+        "--report-scenario",
+    );
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "speed_kmh = -3.0\n").unwrap();
+    let fresh = dir.path().join("fresh.md");
+    assert_bad_input(
+        &run(
+            &[
+                "simulate",
+                "--trials",
+                "2",
+                "--report",
+                fresh.to_str().unwrap(),
+                "--report-scenario",
+                bad.to_str().unwrap(),
+            ],
+            None,
+        ),
+        "speed_kmh",
+    );
+    assert!(!fresh.exists());
+}
+
+#[test]
+fn the_committed_report_and_scenarios_doc_show_the_same_tables() {
+    // docs/reproduction.md (scripts/experiment.sh) and docs/scenarios.md
+    // (scripts/scenarios.sh) tabulate the pedestrian and two-car scenarios
+    // with the same code, trials and seed: the tables agree byte for byte.
+    let root = env!("CARGO_MANIFEST_DIR");
+    let report = std::fs::read_to_string(format!("{root}/docs/reproduction.md")).unwrap();
+    let doc = std::fs::read_to_string(format!("{root}/docs/scenarios.md")).unwrap();
+    let table_after = |text: &str, heading: &str| -> String {
+        let rest = text
+            .split(heading)
+            .nth(1)
+            .unwrap_or_else(|| panic!("{heading}"));
+        rest.lines()
+            .skip_while(|l| !l.starts_with('|'))
+            .take_while(|l| l.starts_with('|'))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    for name in ["pedestrian", "second_car"] {
+        let a = table_after(&report, &format!("### {name}\n"));
+        let b = table_after(&doc, &format!("## {name}\n"));
+        assert_eq!(a.lines().count(), 14, "{name}: {a}");
+        assert_eq!(a, b, "{name}");
+    }
+}

@@ -111,6 +111,12 @@ pub struct Args {
     /// (default: `--paper-pipeline-trials`).
     #[arg(long, allow_hyphen_values = true)]
     sweep_trials: Option<i64>,
+    /// With `--report`: also run this scenario file (repeatable; the
+    /// `physical` model, the paper's four variants, every fog level,
+    /// `--trials` and `--seed`) and tabulate it in the report's "Other
+    /// scenarios" section, with intervals, modes and paired tests.
+    #[arg(long)]
+    report_scenario: Vec<PathBuf>,
     /// Disable ray culling (reference path; results are identical).
     #[arg(long, hide = true)]
     brute_force: bool,
@@ -152,6 +158,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         .input_opt("--scenario", a.scenario.as_deref())
         .input_opt("--gaze", a.gaze.as_deref())
         .input_opt("--optimizer-config", a.optimizer_config.as_deref());
+    for path in &a.report_scenario {
+        outputs.input_opt("--report-scenario", Some(path));
+    }
     let scenario = match &a.scenario {
         Some(path) => {
             let text = read_text(path, MAX_CONFIG_BYTES)?;
@@ -261,6 +270,37 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     }
     if a.sweep_trials.is_some() && sweeps.is_empty() {
         return Err(CliError::input("--sweep-trials needs --sweep"));
+    }
+    if !a.report_scenario.is_empty() && a.report.is_none() {
+        return Err(CliError::input(
+            "--report-scenario adds a scenario to the report: add --report FILE (or run it with --scenario)",
+        ));
+    }
+    // The report's scenario files: read and checked before anything runs.
+    let mut report_scenarios = Vec::new();
+    for path in &a.report_scenario {
+        let text = read_text(path, MAX_CONFIG_BYTES)?;
+        let shown = path.display().to_string();
+        let scenario = Scenario::from_toml(&text, &shown)
+            .map_err(|e| CliError::input(format!("--report-scenario: {e}")))?;
+        let name = path
+            .file_stem()
+            .map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
+        let sc_config = SimConfig {
+            models: vec![ModelKind::Physical],
+            variants: Variant::PAPER.to_vec(),
+            fog_pcts: FOG_LEVELS_PCT.to_vec(),
+            trials,
+            seed,
+            scenario,
+            ..SimConfig::default()
+        };
+        report_scenarios.push((
+            name,
+            shown,
+            sim::report::scenario_description(&text),
+            sc_config,
+        ));
     }
     // Every output path is checked before the run — against the others
     // (the plots' file names included) and against the inputs: a bad one
@@ -412,6 +452,32 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             .iter()
             .find(|(_, c)| c.fog_pcts == [25])
             .map(|(r, c)| (r, c));
+        let scenario_results = report_scenarios
+            .iter()
+            .map(|(_, path, _, c)| {
+                sim::run(c, &|| {}).map_err(|e| {
+                    let message = format!("--report-scenario {path}: {e}");
+                    if e.is_input_error() {
+                        CliError::input(message)
+                    } else {
+                        CliError::infeasible(message)
+                    }
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let scenario_runs: Vec<sim::report::ScenarioRun<'_>> = report_scenarios
+            .iter()
+            .zip(&scenario_results)
+            .map(
+                |((name, path, description, config), result)| sim::report::ScenarioRun {
+                    name,
+                    path,
+                    description,
+                    result,
+                    config,
+                },
+            )
+            .collect();
         let md = sim::report::render_with_pipelines(
             &result,
             &config,
@@ -420,6 +486,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 other_samplings: &others,
                 lifted,
                 sensitivity: &sensitivity,
+                scenarios: &scenario_runs,
             },
         );
         outputs.set(path, md);

@@ -618,6 +618,73 @@ impl Saturation {
     }
 }
 
+/// The `argus` model's range factor `e^(−0.004·r)` bounded per range
+/// bucket `[i·w, (i + 1)·w)` up to its 100 m: the factor falls with `r`,
+/// so the value at the bucket's far end (less a relative 1e-12, far above
+/// libm's half-ulp rounding) bounds it from below and the value at its near
+/// end (plus 1e-12) from above. Floating-point products are monotone in
+/// each factor, so `P·lower·fog ≥ threshold` proves the model's
+/// `(P·factor)·fog ≥ threshold` (`P_D = 1`) and `P·upper·fog < threshold`
+/// proves `P_D = 0`, without the `exp`; between the two the caller
+/// evaluates the model.
+#[derive(Debug, Clone)]
+pub(crate) struct ArgusBuckets {
+    /// Per bucket: (lower, upper) bound of the range factor.
+    bounds: Vec<(f64, f64)>,
+}
+
+impl ArgusBuckets {
+    /// The table (computed once).
+    pub(crate) fn get() -> &'static Self {
+        static TABLE: std::sync::OnceLock<ArgusBuckets> = std::sync::OnceLock::new();
+        TABLE.get_or_init(Self::new)
+    }
+
+    pub(crate) fn new() -> Self {
+        let factor = |r: f64| (-CARLA_ATTENUATION_PER_M * r).exp();
+        let buckets = (ARGUS_RANGE_M / RANGE_BUCKET_M).ceil() as usize + 1;
+        Self {
+            bounds: (0..buckets)
+                .map(|i| {
+                    let (near, far) = (i as f64 * RANGE_BUCKET_M, (i + 1) as f64 * RANGE_BUCKET_M);
+                    (factor(far) * (1.0 - 1e-12), factor(near) * (1.0 + 1e-12))
+                })
+                .collect(),
+        }
+    }
+
+    /// `P_D` of `model` (an `argus` model; `None` for another) at power ratio
+    /// `power` for a hit at `range_m` in range bucket `bucket` (`⌊r / w⌋`),
+    /// if the bucket decides it: the value
+    /// [`ReturnModel::detection_probability`] returns, bit for bit.
+    pub(crate) fn decided(
+        &self,
+        model: &ReturnModel,
+        range_m: f64,
+        bucket: usize,
+        power: f64,
+    ) -> Option<f64> {
+        let ReturnModel::Argus {
+            fog_factor,
+            threshold,
+        } = *model
+        else {
+            return None;
+        };
+        if range_m > ARGUS_RANGE_M {
+            return Some(0.0);
+        }
+        let &(lower, upper) = self.bounds.get(bucket)?;
+        if power * lower * fog_factor >= threshold {
+            Some(1.0)
+        } else if power * upper * fog_factor < threshold {
+            Some(0.0)
+        } else {
+            None
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -625,6 +692,43 @@ mod tests {
 
     fn model(kind: ModelKind, fog: u32) -> ReturnModel {
         ReturnModel::new(kind, FogLevel::of(fog).unwrap(), 100.0, 0.1)
+    }
+
+    #[test]
+    fn argus_buckets_decide_as_the_model_does() {
+        // Every fog level, powers of the closed forms and between, ranges
+        // across every bucket (their edges included) and beyond 100 m.
+        let table = ArgusBuckets::new();
+        let mut decided = 0;
+        for fog in FOG_LEVELS_PCT {
+            let m = model(ModelKind::Argus, fog);
+            for power in [0.0, 0.25, 0.5, 0.9, 1.0, 1.1, 1.2, 2.0] {
+                for k in 0..=41_000u32 {
+                    let r = f64::from(k) * (101.0 / 41_000.0) + 1e-3;
+                    let bucket = (r * (1.0 / RANGE_BUCKET_M)) as usize;
+                    let exact = m.detection_probability(power, 0.3, 0.7, r);
+                    if let Some(p) = table.decided(&m, r, bucket, power) {
+                        assert_eq!(p.to_bits(), exact.to_bits(), "fog {fog} P {power} r {r}");
+                        decided += 1;
+                    }
+                }
+                for i in 0..=400u32 {
+                    let r = f64::from(i) * RANGE_BUCKET_M;
+                    let bucket = (r * (1.0 / RANGE_BUCKET_M)) as usize;
+                    for r in [r, r.next_up(), (r + RANGE_BUCKET_M).next_down()] {
+                        let exact = m.detection_probability(power, 0.3, 0.7, r);
+                        if let Some(p) = table.decided(&m, r, bucket, power) {
+                            assert_eq!(p.to_bits(), exact.to_bits(), "fog {fog} P {power} r {r}");
+                        }
+                    }
+                }
+            }
+        }
+        // It decides nearly everything (the undecided: ranges near a
+        // threshold crossing).
+        assert!(decided > 3 * 8 * 40_000, "{decided}");
+        let physical = model(ModelKind::Physical, 0);
+        assert_eq!(table.decided(&physical, 10.0, 40, 1.0), None);
     }
 
     #[test]

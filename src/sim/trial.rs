@@ -17,7 +17,7 @@ use crate::model::angle::{diff_deg, wrap_deg, Arc, CircularSet};
 use crate::profile::kinematics::Timeline;
 use crate::profile::Profile;
 
-use super::returns::{ReturnModel, Saturation, RANGE_BUCKET_M};
+use super::returns::{ArgusBuckets, ReturnModel, Saturation, RANGE_BUCKET_M};
 use super::scene::{Aabb, Scenario};
 
 /// Padding of the culling arcs, degrees (far above `f64` rounding of atan2).
@@ -189,6 +189,28 @@ pub fn false_alarms(
         .filter(|&t| t <= t_arrive_s && detected_at.is_none_or(|d| t < d))
         .map(|t| t_arrive_s - t);
     (count, early)
+}
+
+/// `arc.contains(az_deg)`, inlined into the pulse loop for an azimuth in
+/// `[0, 360)` (a pulse's): the same arithmetic as [`Arc::contains`] and
+/// [`wrap_deg`] on that domain (`az − start` lies in `(−360, 360)`).
+#[inline]
+fn arc_contains(arc: &Arc, az_deg: f64) -> bool {
+    if arc.width_deg >= 360.0 || !(0.0..360.0).contains(&az_deg) {
+        return arc.contains(az_deg);
+    }
+    let off = az_deg - arc.start_deg;
+    let off = if off >= 0.0 {
+        off
+    } else {
+        let w = off + 360.0;
+        if w >= 360.0 {
+            0.0
+        } else {
+            w
+        }
+    };
+    off < arc.width_deg
 }
 
 /// The smallest arc containing the directions to `points` (none may be the origin).
@@ -698,7 +720,17 @@ impl PulseCache {
         while k < n {
             let t = k as f64 / pulse_rate;
             let tau_total = t + phase_s;
-            let frame = (tau_total / period).floor() as u64;
+            let q = tau_total / period;
+            // `⌊q⌋` without the libm call while the frame lasts (frame
+            // numbers are exact in `f64`).
+            let frame = if current_frame != u64::MAX
+                && current_frame as f64 <= q
+                && q < (current_frame + 1) as f64
+            {
+                current_frame
+            } else {
+                q.floor() as u64
+            };
             let tau = (tau_total - frame as f64 * period).clamp(0.0, period);
             if frame != current_frame {
                 current_frame = frame;
@@ -775,6 +807,7 @@ pub fn run_group_with(
         })
         .collect();
     let any_decimates = cells.iter().any(|c| c.rof_keep < 1.0);
+    let argus = ArgusBuckets::get();
     // Cells sharing a model's range factor share its value per pulse.
     let mut factor_keys: Vec<[u64; 4]> = Vec::new();
     let factor_slot: Vec<usize> = cells
@@ -907,9 +940,18 @@ pub fn run_group_with(
             fact.statics
         };
         for (j, arc) in car_arcs.iter().enumerate() {
-            mask |= u64::from(setup.brute_force || arc.contains(az)) << (62 + j);
+            mask |= u64::from(setup.brute_force || arc_contains(arc, az)) << (62 + j);
         }
         if mask == 0 {
+            continue;
+        }
+        let in_rof = any_decimates && fact.rof.unwrap_or_else(|| setup.regions.rof.contains(az));
+        let dens = super::carla::argus::in_density_region(az, setup.gaze_deg, setup.ego_yaw_deg);
+        // A pulse that cannot reach a car changes a cell only through its
+        // RoI count, ARGUS's density count or the RoF decimation: outside
+        // all three its return is never looked at, so it is not cast (the
+        // brute-force path casts it all the same).
+        if !setup.brute_force && mask >> 62 == 0 && !in_roi && !dens && !in_rof {
             continue;
         }
         let (s, c) = *pulse.dir.get_or_insert_with(|| az.to_radians().sin_cos());
@@ -920,8 +962,6 @@ pub fn run_group_with(
         let surface = usize::from(car.is_some());
         let bucket = (range * (1.0 / RANGE_BUCKET_M)) as usize;
         let mut noise: Option<f64> = None;
-        let in_rof = any_decimates && fact.rof.unwrap_or_else(|| setup.regions.rof.contains(az));
-        let dens = super::carla::argus::in_density_region(az, setup.gaze_deg, setup.ego_yaw_deg);
         for ((st, cell), &slot) in states.iter_mut().zip(cells).zip(&factor_slot) {
             let power = st.power_ratio[bin];
             let p_d = if cell
@@ -929,6 +969,8 @@ pub fn run_group_with(
                 .is_some_and(|x| x.saturated(surface, bucket, power, cos_i))
             {
                 1.0
+            } else if let Some(p) = argus.decided(cell.model, range, bucket, power) {
+                p
             } else {
                 cell.model
                     .detection_probability_with(power, refl, cos_i, range, || {
@@ -1016,6 +1058,41 @@ mod tests {
     use super::*;
     use crate::model::presets;
     use crate::planner::{closed_form, Mode};
+
+    #[test]
+    fn arc_contains_is_arc_contains() {
+        let mut key = 0u64;
+        let mut next = || {
+            key += 1;
+            unit(key)
+        };
+        let edges = [
+            0.0,
+            1e-300,
+            59.999_999_999_999_99,
+            60.0,
+            180.0,
+            359.999_999_999_999_94,
+        ];
+        for _ in 0..20_000 {
+            let start = wrap_deg(next() * 360.0);
+            let width = [next() * 360.0, 360.0, 0.0, 1e-9][(next() * 4.0) as usize];
+            let arc = Arc {
+                start_deg: start,
+                width_deg: width,
+            };
+            let az = wrap_deg(next() * 360.0);
+            let near = [
+                az,
+                start,
+                wrap_deg(start + width),
+                wrap_deg(start + width).next_down(),
+            ];
+            for a in near.into_iter().chain(edges).chain([360.0, -1.0, f64::NAN]) {
+                assert_eq!(arc_contains(&arc, a), arc.contains(a), "{arc:?} {a}");
+            }
+        }
+    }
 
     #[test]
     fn bin_facts_hold_for_every_azimuth_of_their_bin() {
