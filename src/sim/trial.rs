@@ -303,6 +303,89 @@ pub fn run_trial(setup: &TrialSetup<'_>, draw: &TrialDraw) -> TrialOutcome {
     run_trial_frames(setup, draw, &|_| view).0
 }
 
+/// The two cars of one trial as every ray cast sees them: where each
+/// starts, which way it drives, when it reaches the conflict zone, and its
+/// box at any time (one straight run at the scenario's speed).
+#[derive(Debug, Clone, Copy)]
+struct Traffic {
+    /// Speed of both cars, m/s.
+    v_m_s: f64,
+    /// Lane centre of each car, m.
+    lane_x_m: [f64; 2],
+    /// Half the vehicle width, m.
+    half_w_m: f64,
+    /// Vehicle length, m.
+    len_m: f64,
+    /// Front position of each car at t = 0, m.
+    front0_m: [f64; 2],
+    /// Direction of travel of each car along its lane (±1).
+    dir: [f64; 2],
+    /// When each car reaches the conflict zone, s.
+    t_conflict: [f64; 2],
+    /// When the later of the two does, s: the trial ends there.
+    t_end: f64,
+}
+
+impl Traffic {
+    fn of(setup: &TrialSetup<'_>, draw: &TrialDraw) -> Self {
+        let sc = setup.scenario;
+        let v_m_s = sc.speed_m_s();
+        let len_m = sc.vehicle_length_m;
+        let Crossing {
+            front0_m,
+            dir,
+            t_arrive_s: t_conflict,
+        } = draw.crossing(
+            sc.bend_distance_m,
+            sc.conflict_half_width_m,
+            setup.arrival.extra_distance_m(len_m),
+            v_m_s,
+        );
+        Self {
+            v_m_s,
+            lane_x_m: sc.lane_x_m(),
+            half_w_m: 0.5 * sc.vehicle_width_m,
+            len_m,
+            front0_m,
+            dir,
+            t_conflict,
+            t_end: t_conflict[0].max(t_conflict[1]),
+        }
+    }
+
+    /// Car `j`'s front centre (x, y) at time `t` (s), m.
+    fn front_centre(&self, j: usize, t: f64) -> (f64, f64) {
+        (self.lane_x_m[j], self.front_m(j, t))
+    }
+
+    /// Car `j`'s front position along its lane at time `t` (s), m.
+    fn front_m(&self, j: usize, t: f64) -> f64 {
+        self.front0_m[j] + self.dir[j] * self.v_m_s * t
+    }
+
+    /// Car `j`'s box at time `t` (s).
+    fn car_box(&self, j: usize, t: f64) -> Aabb {
+        let front = self.front_m(j, t);
+        let back = front - self.dir[j] * self.len_m;
+        Aabb::new(
+            self.lane_x_m[j] - self.half_w_m,
+            self.lane_x_m[j] + self.half_w_m,
+            front,
+            back,
+        )
+    }
+}
+
+impl TrialSetup<'_> {
+    /// The culling arc of each static box, in `statics` order.
+    fn static_arcs(&self) -> Vec<Arc> {
+        self.statics
+            .iter()
+            .map(|b| cull_arc(std::slice::from_ref(b)))
+            .collect()
+    }
+}
+
 /// [`run_trial`] with the profile chosen per frame: `view_of(frame)` is
 /// what the sensor runs in frame `frame` (numbered from the trial's first,
 /// 0, which starts `phase_frac` of a period before t = 0). Every view's
@@ -319,32 +402,12 @@ pub fn run_trial_frames<'v>(
     let mut view = view_of(0);
     let period = view.timeline.period_s();
     let pulse_rate = view.profile.pulse_rate_hz;
-    let v = sc.speed_m_s();
-    let lane_x = sc.lane_x_m();
-    let half_w = 0.5 * sc.vehicle_width_m;
-    let len = sc.vehicle_length_m;
-    let ch = sc.conflict_half_width_m;
-    let Crossing {
-        front0_m: front0,
-        dir,
-        t_arrive_s: t_conflict,
-    } = draw.crossing(
-        sc.bend_distance_m,
-        ch,
-        setup.arrival.extra_distance_m(len),
-        v,
-    );
-    let t_end = t_conflict[0].max(t_conflict[1]);
-    let car_box = |j: usize, t: f64| -> Aabb {
-        let front = front0[j] + dir[j] * v * t;
-        let back = front - dir[j] * len;
-        Aabb::new(lane_x[j] - half_w, lane_x[j] + half_w, front, back)
-    };
-    let static_arcs: Vec<Arc> = setup
-        .statics
-        .iter()
-        .map(|b| cull_arc(std::slice::from_ref(b)))
-        .collect();
+    let traffic = Traffic::of(setup, draw);
+    let Traffic {
+        t_conflict, t_end, ..
+    } = traffic;
+    let car_box = |j: usize, t: f64| traffic.car_box(j, t);
+    let static_arcs = setup.static_arcs();
     let phase = draw.phase_frac * period;
 
     let mut detected_at: [Option<f64>; 2] = [None, None];
@@ -408,7 +471,7 @@ pub fn run_trial_frames<'v>(
             // The driver: looks at each car's front centre at the frame start.
             for j in 0..2 {
                 if driver_at[j].is_none() && t0 <= t_conflict[j] {
-                    let (x, y) = (lane_x[j], front0[j] + dir[j] * v * t0);
+                    let (x, y) = traffic.front_centre(j, t0);
                     let az = y.atan2(x).to_degrees();
                     let dist = x.hypot(y);
                     if view.driver.is_some_and(|r| r.rof.contains(az))
@@ -762,32 +825,12 @@ pub fn run_group_with(
     let tl = Timeline::new(setup.profile);
     let period = tl.period_s();
     let pulse_rate = setup.profile.pulse_rate_hz;
-    let v = sc.speed_m_s();
-    let lane_x = sc.lane_x_m();
-    let half_w = 0.5 * sc.vehicle_width_m;
-    let len = sc.vehicle_length_m;
-    let ch = sc.conflict_half_width_m;
-    let Crossing {
-        front0_m: front0,
-        dir,
-        t_arrive_s: t_conflict,
-    } = draw.crossing(
-        sc.bend_distance_m,
-        ch,
-        setup.arrival.extra_distance_m(len),
-        v,
-    );
-    let t_end = t_conflict[0].max(t_conflict[1]);
-    let car_box = |j: usize, t: f64| -> Aabb {
-        let front = front0[j] + dir[j] * v * t;
-        let back = front - dir[j] * len;
-        Aabb::new(lane_x[j] - half_w, lane_x[j] + half_w, front, back)
-    };
-    let static_arcs: Vec<Arc> = setup
-        .statics
-        .iter()
-        .map(|b| cull_arc(std::slice::from_ref(b)))
-        .collect();
+    let traffic = Traffic::of(setup, draw);
+    let Traffic {
+        t_conflict, t_end, ..
+    } = traffic;
+    let car_box = |j: usize, t: f64| traffic.car_box(j, t);
+    let static_arcs = setup.static_arcs();
     let phase = draw.phase_frac * period;
     let mut states: Vec<GroupState> = cells
         .iter()
@@ -907,7 +950,7 @@ pub fn run_group_with(
                 if t0 > t_conflict[j] {
                     continue;
                 }
-                let (x, y) = (lane_x[j], front0[j] + dir[j] * v * t0);
+                let (x, y) = traffic.front_centre(j, t0);
                 let az = y.atan2(x).to_degrees();
                 let dist = x.hypot(y);
                 if !setup.regions.rof.contains(az) {
