@@ -16,8 +16,8 @@
 //! wall time are printed. The test asserts every request's CPU time
 //! within 2 s times a slack factor for a loaded machine
 //! (`GAZE_LIDAR_FAMILY_CPU_SLACK`, default 1.5: on a shared 2-core machine
-//! at load 3–6 the same request's CPU time varies by up to ~1.4×, cache
-//! and frequency contention), every certificate's relative gap within 1 %
+//! the same request's CPU time varied 1.5× between runs at load 1.5 and
+//! 16, cache and frequency contention), every certificate's relative gap within 1 %
 //! (`GAZE_LIDAR_FAMILY_MAX_GAP`, default 0.01), and a generous wall bound
 //! (`GAZE_LIDAR_FAMILY_MAX_WALL_S`, default 20 s).
 //! `GAZE_LIDAR_FAMILY_ONLY=K` runs member `K` alone and prints its file.

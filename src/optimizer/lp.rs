@@ -682,6 +682,9 @@ fn level_ring(
     bins: &[PowerBin],
     budget_row: usize,
 ) -> Option<LevelRing> {
+    if !bins.iter().all(|b| matches!(b, PowerBin::Levels(_))) {
+        return None;
+    }
     let p_mean = problem.lidar.average_power_w;
     let (w, budget) = budget_weights(problem, g, t);
     let mut cols = Vec::with_capacity(bins.len());
