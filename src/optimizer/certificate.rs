@@ -309,6 +309,12 @@ pub fn check(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Exact {
 
 /// The first column bound, integrality or row that `x` breaks exactly (or a
 /// `y` of the wrong length).
+/// Whether `x` meets every bound, integrality and row of `lp` exactly.
+#[must_use]
+pub fn primal_feasible(lp: &LinearProgram, x: &[f64]) -> bool {
+    x.len() == lp.cost.len() && primal_violation(lp, x, &vec![0.0; lp.rows.len()]).is_none()
+}
+
 fn primal_violation(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Option<String> {
     use super::exact::Sum;
     use std::cmp::Ordering::{Greater, Less};

@@ -11,7 +11,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::certificate::{Certified, LinearProgram, Step};
-use super::program::{Program, SolveOptions};
+use super::level_choice::{Level, Ring};
+use super::program::{Heuristic, Program, SolveOptions};
 use super::utility::{sqrt_segments_n, SqrtSegments};
 use good_lp::{Expression, IntoAffineExpression, Variable};
 use std::f64::consts::TAU;
@@ -331,12 +332,19 @@ fn power_step(
     let mut round = 0;
     loop {
         let program = power_program(problem, g, eye, t, pool, &factor)?;
-        let solved = program.lp.solve("power").map_err(|err| match (err, eye) {
-            (OptError::Infeasible(_), Some(_)) => {
-                Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
-            }
-            (other, _) => other,
-        })?;
+        let opts = SolveOptions {
+            heuristic: program.ring.as_ref().map(|r| r as &dyn Heuristic),
+            ..SolveOptions::default()
+        };
+        let solved = program
+            .lp
+            .solve_with("power", &opts)
+            .map_err(|err| match (err, eye) {
+                (OptError::Infeasible(_), Some(_)) => {
+                    Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
+                }
+                (other, _) => other,
+            })?;
         let p = powers(problem, g, t, &program, &solved.x);
         let checkpoint = match eye {
             None => Checkpoint::Certified,
@@ -480,6 +488,134 @@ struct PowerProgram {
     bins: Vec<PowerBin>,
     /// The column fixed at 1 that carries the utilities' constants.
     one: Option<usize>,
+    /// With hardware levels (and no eye-safety row over several bins), the
+    /// level choice as a ring, for the primal heuristic.
+    ring: Option<LevelRing>,
+}
+
+/// The power step's level choice as a [`Ring`] over the program's columns.
+struct LevelRing {
+    ring: Ring,
+    /// Per bin, the column of each of its levels (the ring's order).
+    cols: Vec<Vec<usize>>,
+    /// The budget row.
+    budget_row: usize,
+    columns: usize,
+}
+
+impl Heuristic for LevelRing {
+    fn start(&self, relaxed: &[f64], duals: &[f64]) -> Option<Vec<f64>> {
+        if relaxed.len() != self.columns {
+            return None;
+        }
+        // The relaxation's point rounded down: per bin, of its levels with
+        // the largest binary, the first (the lowest index).
+        let rounded = self
+            .cols
+            .iter()
+            .map(|cs| {
+                let mut best = 0;
+                for (k, &c) in cs.iter().enumerate() {
+                    if relaxed[c] > relaxed[cs[best]] {
+                        best = k;
+                    }
+                }
+                best
+            })
+            .collect();
+        let choice = self.ring.heuristic(duals[self.budget_row], Some(rounded))?;
+        let mut x = vec![0.0; self.columns];
+        for (cs, k) in self.cols.iter().zip(choice) {
+            x[cs[k]] = 1.0;
+        }
+        Some(x)
+    }
+}
+
+/// Per bin, the hardware levels (W) the power step offers: within the
+/// power limits and the bin's eye-safety cap, less those no level choice
+/// within the budget and the slew limit can use ([`Ring::probe`]); `None`
+/// without levels, or where a bin has none (the program says why).
+fn offered_levels(problem: &Problem, g: &Grid, t: &[f64], caps: &[f64]) -> Option<Vec<Vec<f64>>> {
+    let l = &problem.lidar.limits;
+    if problem.levels.power_w.is_empty() {
+        return None;
+    }
+    let allowed: Vec<Vec<f64>> = caps
+        .iter()
+        .map(|&cap| {
+            let hi = l.power_w_max.min(cap.max(l.power_w_min));
+            (problem.levels.power_w.iter().copied())
+                .filter(|&lv| lv >= l.power_w_min && lv <= hi)
+                .collect()
+        })
+        .collect();
+    if allowed.iter().any(Vec::is_empty) {
+        return None;
+    }
+    let p_mean = problem.lidar.average_power_w;
+    let (w, budget) = budget_weights(problem, g, t);
+    let ring = Ring {
+        bins: allowed
+            .iter()
+            .zip(&w)
+            .map(|(lvs, &wi)| {
+                lvs.iter()
+                    .map(|&lv| Level {
+                        x: lv / p_mean,
+                        spend: wi * (lv / p_mean),
+                        value: 0.0,
+                    })
+                    .collect()
+            })
+            .collect(),
+        budget,
+        reach: slew_reach(problem, g),
+    };
+    let keep = ring.probe();
+    Some(
+        allowed
+            .into_iter()
+            .zip(keep)
+            .map(|(lvs, k)| {
+                lvs.into_iter()
+                    .zip(k)
+                    .filter(|x| x.1)
+                    .map(|x| x.0)
+                    .collect()
+            })
+            .collect(),
+    )
+}
+
+/// The budget row's weight per bin (of `x = p/P̄`) and its side, for
+/// hardware levels (`budget`'s row, with `level_budget_slack`).
+fn budget_weights(problem: &Problem, g: &Grid, t: &[f64]) -> (Vec<f64>, f64) {
+    let slack = 1.0 + S.level_budget_slack;
+    match problem.lidar.power_accounting {
+        PowerAccounting::Angle => (g.theta.clone(), TAU * slack),
+        PowerAccounting::Time => {
+            let period: f64 = t.iter().sum();
+            (t.iter().map(|ti| ti / period).collect(), slack)
+        }
+    }
+}
+
+/// Per bin `i`, the largest `|x_next − x_i|` the `slew` rows allow, with a
+/// relative 10⁻⁹ of head-room; `None` without a slew limit.
+fn slew_reach(problem: &Problem, g: &Grid) -> Option<Vec<f64>> {
+    let s = problem.lidar.limits.power_slew_w_per_deg_max?;
+    let p_mean = problem.lidar.average_power_w;
+    Some(
+        (0..g.n)
+            .map(|i| {
+                let j = next_index(i, g.n);
+                s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean
+                    * (1.0 - S.margin)
+                    * (1.0 + 1e-9)
+            })
+            .collect(),
+    )
 }
 
 /// Builds the power step's program: per bin its columns and utility (and
@@ -495,12 +631,15 @@ fn power_program(
     factor: &[f64; 2],
 ) -> Result<PowerProgram, OptError> {
     let (caps, bare) = eye_caps(problem, g, eye, pool, factor);
+    let offered = offered_levels(problem, g, t, &caps);
     let mut lp = Program::default();
     let mut x = Vec::with_capacity(g.n);
     let mut bins = Vec::with_capacity(g.n);
     let mut utility_constant = 0.0;
     for i in 0..g.n {
-        let (form, bin, constant) = power_bin(&mut lp, problem, g, i, t[i], caps[i], bare[i])?;
+        let offer = offered.as_ref().map(|o| &o[i][..]);
+        let (form, bin, constant) =
+            power_bin(&mut lp, problem, g, (i, t[i]), (caps[i], bare[i]), offer)?;
         x.push(form);
         bins.push(bin);
         utility_constant += constant;
@@ -510,6 +649,7 @@ fn power_program(
         let v = lp.column(1.0, 1.0, utility_constant, false);
         lp.col(v)
     });
+    let budget_row = lp.rows();
     budget(&mut lp, problem, g, t, &x);
     if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
         slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
@@ -517,10 +657,63 @@ fn power_program(
             slew_levels(&mut lp, g, &x, s, problem.lidar.average_power_w);
         }
     }
+    let rows_before_cuts = lp.rows();
     if let Some(e) = eye {
         eye_cuts(&mut lp, problem, e, pool, factor, &x)?;
     }
-    Ok(PowerProgram { lp, x, bins, one })
+    let ring = (lp.rows() == rows_before_cuts && one.is_none())
+        .then(|| level_ring(problem, g, t, &lp, &bins, budget_row))
+        .flatten();
+    Ok(PowerProgram {
+        lp,
+        x,
+        bins,
+        one,
+        ring,
+    })
+}
+
+/// The level choice of a program whose columns are all level binaries.
+fn level_ring(
+    problem: &Problem,
+    g: &Grid,
+    t: &[f64],
+    lp: &Program,
+    bins: &[PowerBin],
+    budget_row: usize,
+) -> Option<LevelRing> {
+    if !bins.iter().all(|b| matches!(b, PowerBin::Levels(_))) {
+        return None;
+    }
+    let p_mean = problem.lidar.average_power_w;
+    let (w, budget) = budget_weights(problem, g, t);
+    let mut cols = Vec::with_capacity(bins.len());
+    let mut ring_bins = Vec::with_capacity(bins.len());
+    for (b, &wi) in bins.iter().zip(&w) {
+        let PowerBin::Levels(zs) = b else {
+            return None;
+        };
+        cols.push(zs.iter().map(|z| z.1).collect());
+        ring_bins.push(
+            zs.iter()
+                .map(|&(lv, c)| Level {
+                    x: lv / p_mean,
+                    spend: wi * (lv / p_mean),
+                    value: lp.cost(c),
+                })
+                .collect(),
+        );
+    }
+    Some(LevelRing {
+        ring: Ring {
+            bins: ring_bins,
+            budget,
+            reach: slew_reach(problem, g),
+        },
+        columns: cols.iter().map(Vec::len).sum(),
+        cols,
+        budget_row,
+    })
 }
 
 /// Per bin, the eye-safety caps of the single-bin cuts in `pool` as column
@@ -561,10 +754,9 @@ fn power_bin(
     lp: &mut Program,
     problem: &Problem,
     g: &Grid,
-    i: usize,
-    dwell_s: f64,
-    cap_w: f64,
-    bare_w: f64,
+    (i, dwell_s): (usize, f64),
+    (cap_w, bare_w): (f64, f64),
+    offered: Option<&[f64]>,
 ) -> Result<(LinearForm, PowerBin, f64), OptError> {
     let l = &problem.lidar.limits;
     let p_mean = problem.lidar.average_power_w;
@@ -581,7 +773,7 @@ fn power_bin(
     let c = problem.objective.range_weight * g.theta[i] * g.weight[i];
     if !problem.levels.power_w.is_empty() {
         let value = |x: f64| super::detection::level_value(problem, g.theta[i], dwell_s, x);
-        let (form, bin) = levels(lp, problem, i, hi, c, value)?;
+        let (form, bin) = levels(lp, problem, (i, hi), offered, c, value)?;
         return Ok((form, bin, 0.0));
     }
     let lo_x = l.power_w_min / p_mean;
@@ -605,20 +797,21 @@ fn power_bin(
 fn levels(
     lp: &mut Program,
     problem: &Problem,
-    i: usize,
-    hi_w: f64,
+    (i, hi_w): (usize, f64),
+    offered: Option<&[f64]>,
     c: f64,
     value: impl Fn(f64) -> f64,
 ) -> Result<(LinearForm, PowerBin), OptError> {
     let floor = problem.lidar.limits.power_w_min;
     let p_mean = problem.lidar.average_power_w;
-    let allowed: Vec<f64> = problem
-        .levels
-        .power_w
-        .iter()
-        .copied()
-        .filter(|&lv| lv >= floor && lv <= hi_w)
-        .collect();
+    let allowed: Vec<f64> = offered.map_or_else(
+        || {
+            (problem.levels.power_w.iter().copied())
+                .filter(|&lv| lv >= floor && lv <= hi_w)
+                .collect()
+        },
+        <[f64]>::to_vec,
+    );
     if allowed.is_empty() {
         return Err(Infeasible::NoLevelFits {
             power_w_min: floor,
@@ -998,6 +1191,7 @@ fn dwell_step(
         &SolveOptions {
             initial: Some(&d.start),
             primal_feasibility_tolerance: S.dwell_feasibility_tol,
+            ..SolveOptions::default()
         },
     )?;
     let view = d.lp.view();
@@ -1039,6 +1233,7 @@ fn answer_dwell_certificate(
             &SolveOptions {
                 initial: Some(&d.start),
                 primal_feasibility_tolerance: S.dwell_feasibility_tol,
+                ..SolveOptions::default()
             },
         )
         .map_err(solver)?;

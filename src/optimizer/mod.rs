@@ -49,6 +49,7 @@ mod exact;
 pub mod fast;
 pub mod figures;
 pub mod global;
+mod level_choice;
 mod lp;
 pub mod program;
 mod setpoints;

@@ -98,6 +98,12 @@ impl Program {
         (self.columns[j].lo, self.columns[j].hi)
     }
 
+    /// The objective coefficient of column `j`.
+    #[must_use]
+    pub fn cost(&self, j: usize) -> f64 {
+        self.columns[j].cost
+    }
+
     /// Number of constraints (rows) so far: the next one's index.
     #[must_use]
     pub fn rows(&self) -> usize {
@@ -364,12 +370,45 @@ impl Program {
             let obj = relaxed.objective_value();
             (x, obj, Some(obj))
         } else {
-            let main = self.run_limited(false, what, opts)?;
-            (
-                main.get_solution().columns().to_vec(),
-                main.objective_value(),
-                main.double_info_value(c"mip_dual_bound").ok(),
-            )
+            let bound = relaxed.objective_value();
+            // A primal heuristic's point, kept only if it meets every bound,
+            // row and integrality exactly.
+            let start = opts
+                .heuristic
+                .and_then(|h| h.start(rsol.columns(), &y))
+                .filter(|x0| super::certificate::primal_feasible(&self.view(), x0))
+                .map(|x0| {
+                    let obj: f64 = x0.iter().zip(&self.columns).map(|(v, c)| v * c.cost).sum();
+                    (x0, obj)
+                });
+            match start {
+                // Within `mip_heuristic_gap` of the relaxation's optimum (a
+                // bound of the MILP's): no branch and bound could improve
+                // it by more.
+                Some((x0, obj))
+                    if bound - obj <= S.mip_heuristic_gap * bound.abs().max(f64::MIN_POSITIVE) =>
+                {
+                    (x0, obj, Some(bound))
+                }
+                start => {
+                    // HiGHS's search, from the heuristic's point when there
+                    // is one; the better of the two.
+                    let with_start = SolveOptions {
+                        initial: start.as_ref().map(|s| &s.0[..]).or(opts.initial),
+                        ..*opts
+                    };
+                    let main = self.run_limited(false, what, &with_start)?;
+                    let found = (
+                        main.get_solution().columns().to_vec(),
+                        main.objective_value(),
+                        main.double_info_value(c"mip_dual_bound").ok(),
+                    );
+                    match start {
+                        Some((x0, obj)) if obj > found.1 => (x0, obj, found.2),
+                        _ => found,
+                    }
+                }
+            }
         };
         Ok(Solved {
             x,
@@ -437,13 +476,35 @@ fn nonzero(e: Expression) -> Expression {
     out + IntoAffineExpression::constant(&e)
 }
 
+/// A MILP's primal heuristic: from the LP relaxation's point and row
+/// duals, a point of the MILP (one value per column), or `None`.
+pub trait Heuristic {
+    /// The point; the caller checks it exactly before using it.
+    fn start(&self, relaxed: &[f64], duals: &[f64]) -> Option<Vec<f64>>;
+}
+
 /// How HiGHS is run on a program.
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct SolveOptions<'a> {
     /// A starting point (one value per column), passed as a hot start.
     pub initial: Option<&'a [f64]>,
     /// HiGHS's `primal_feasibility_tolerance` (its default is 1e-7).
     pub primal_feasibility_tolerance: f64,
+    /// A MILP's primal heuristic, run when the relaxation is fractional.
+    pub heuristic: Option<&'a dyn Heuristic>,
+}
+
+impl std::fmt::Debug for SolveOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SolveOptions")
+            .field("initial", &self.initial)
+            .field(
+                "primal_feasibility_tolerance",
+                &self.primal_feasibility_tolerance,
+            )
+            .field("heuristic", &self.heuristic.is_some())
+            .finish()
+    }
 }
 
 impl Default for SolveOptions<'_> {
@@ -451,6 +512,7 @@ impl Default for SolveOptions<'_> {
         Self {
             initial: None,
             primal_feasibility_tolerance: S.primal_feasibility_tol,
+            heuristic: None,
         }
     }
 }

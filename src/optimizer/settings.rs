@@ -98,6 +98,16 @@ pub struct OptimizerSettings {
     /// A node count, unlike a time limit, keeps answers deterministic; the
     /// exact gap is reported.
     pub mip_max_nodes: i32,
+    /// A MILP's branch and bound is skipped when the primal heuristic's
+    /// point (hardware power levels: `level_choice`) is within this
+    /// relative distance of the LP relaxation's optimum (default 1e-3, a
+    /// tenth of the 1 % the power step's gap may be): the relaxation bounds
+    /// the MILP, so the search could gain no more, and the certificate's
+    /// bound comes from the relaxation's duals either way. Measured on the
+    /// random family (seed 30): HiGHS's 100 nodes at 360–720 bins took
+    /// 2.5–6.5 s of CPU per power step and ended 1.3·10⁻⁵–2.2·10⁻⁴ below
+    /// the relaxation; the heuristic, in milliseconds, 2.8·10⁻⁵–2.2·10⁻⁴.
+    pub mip_heuristic_gap: f64,
     /// The search's second limit when the first ended without a feasible
     /// point (default 5,000; an equality knapsack: spin set-points meeting
     /// the frame period); without one there either, the step reports that
@@ -169,6 +179,7 @@ impl OptimizerSettings {
         dwell_feasibility_tol: 1e-9,
         setpoint_search_steps: 50_000_000,
         mip_max_nodes: 100,
+        mip_heuristic_gap: 1e-3,
         mip_max_nodes_without_incumbent: 5000,
         mip_feasibility_tol: 1e-10,
         relaxation_integrality_tol: 1e-9,
