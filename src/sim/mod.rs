@@ -867,6 +867,43 @@ impl<'c> Prepared<'c> {
     }
 }
 
+impl Prepared<'_> {
+    /// Trial `trial`'s draw and every cell's plan for its gaze.
+    fn trial_plans(&self, trial: usize) -> Result<(TrialDraw, Vec<Plan>), SimError> {
+        let config = self.config;
+        let d = draw(config.seed, trial, &config.scenario);
+        let sensor_of = |v: Variant| self.sensor_of(v);
+        let plans = plan_trial(
+            config,
+            &self.fogs,
+            self.table.as_ref(),
+            &sensor_of,
+            d.gaze_deg,
+        )?;
+        Ok((d, plans))
+    }
+}
+
+/// One record per cell key and its outcome, in key order, ticking once each.
+fn push_records(
+    out: &mut Vec<TrialRecord>,
+    keys: Vec<(ModelKind, Variant, u32)>,
+    outcomes: Vec<TrialOutcome>,
+    trial: usize,
+    tick: &(dyn Fn() + Sync),
+) {
+    for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
+        tick();
+        out.push(TrialRecord {
+            model,
+            variant: variant.name(),
+            fog_pct,
+            trial,
+            outcome,
+        });
+    }
+}
+
 /// Range of the planar saturation tables, m (hits beyond take the model).
 const PLANAR_SATURATION_RANGE_M: f64 = 400.0;
 
@@ -880,15 +917,7 @@ fn planar_trial(
     tick: &(dyn Fn() + Sync),
 ) -> Result<Vec<TrialRecord>, SimError> {
     let config = prep.config;
-    let d = draw(config.seed, trial, &config.scenario);
-    let sensor_of = |v: Variant| prep.sensor_of(v);
-    let plans = plan_trial(
-        config,
-        &prep.fogs,
-        prep.table.as_ref(),
-        &sensor_of,
-        d.gaze_deg,
-    )?;
+    let (d, plans) = prep.trial_plans(trial)?;
     // Group the plans by timeline and regions (first-seen order).
     let groups = group_plans(&plans, |a, b| a.regions == b.regions);
     let mut out = Vec::new();
@@ -924,16 +953,7 @@ fn planar_trial(
             gaze_deg: d.gaze_deg,
         };
         let outcomes = trial::run_group_with(&setup, &cells, &d, pulses);
-        for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
-            tick();
-            out.push(TrialRecord {
-                model,
-                variant: variant.name(),
-                fog_pct,
-                trial,
-                outcome,
-            });
-        }
+        push_records(&mut out, keys, outcomes, trial, tick);
     }
     Ok(out)
 }
@@ -1074,15 +1094,7 @@ fn carla_trial(
     tick: &(dyn Fn() + Sync),
 ) -> Result<Vec<TrialRecord>, SimError> {
     let config = prep.config;
-    let d = draw(config.seed, trial, &config.scenario);
-    let sensor_of = |v: Variant| prep.sensor_of(v);
-    let plans = plan_trial(
-        config,
-        &prep.fogs,
-        prep.table.as_ref(),
-        &sensor_of,
-        d.gaze_deg,
-    )?;
+    let (d, plans) = prep.trial_plans(trial)?;
     // Group the plans by timeline (first-seen order).
     let groups = group_plans(&plans, |_, _| true);
     let mut out = Vec::new();
@@ -1114,16 +1126,7 @@ fn carla_trial(
             sampling: config.sampling(),
         };
         let outcomes = carla::run_group_with(&setup, &d, rays);
-        for ((model, variant, fog_pct), outcome) in keys.into_iter().zip(outcomes) {
-            tick();
-            out.push(TrialRecord {
-                model,
-                variant: variant.name(),
-                fog_pct,
-                trial,
-                outcome,
-            });
-        }
+        push_records(&mut out, keys, outcomes, trial, tick);
     }
     Ok(out)
 }
