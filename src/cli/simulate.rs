@@ -29,10 +29,10 @@ pub enum Format {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Return model(s); default both.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<ModelKind>())]
     model: Vec<ModelKind>,
     /// Variants; default the paper's four (`optimized` adds the optimizer's profile).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<Variant>())]
     variant: Vec<Variant>,
     /// Optimizer configuration (TOML) for the `optimized` variant (no priors).
     #[arg(long)]
@@ -51,22 +51,22 @@ pub struct Args {
     scenario: Option<PathBuf>,
     /// Sensor geometry: `planar` (one horizontal channel, the lightweight
     /// default) or `carla` (CARLA's 64-channel 3D ray-cast LiDAR over a road).
-    #[arg(long, value_enum, default_value_t = Geometry::Planar)]
+    #[arg(long, value_parser = super::args::named::<Geometry>(), default_value_t = Geometry::Planar)]
     geometry: Geometry,
     /// Detector of the car from the right: `first-return` (any point on it)
     /// or `argus` (the paper code's road-mask rule; needs `--geometry carla`).
-    #[arg(long, value_enum, default_value_t = Detector::FirstReturn)]
+    #[arg(long, value_parser = super::args::named::<Detector>(), default_value_t = Detector::FirstReturn)]
     detector: Detector,
     /// Arrival: `front` (the front reaches the conflict line) or
     /// `argus-centre` (the centre does, as the paper's code).
-    #[arg(long, value_enum, default_value_t = Arrival::Front)]
+    #[arg(long, value_parser = super::args::named::<Arrival>(), default_value_t = Arrival::Front)]
     arrival: Arrival,
     /// How the LiDAR fires (`--geometry carla` only; default `carla`):
     /// `carla` (CARLA's fixed tick: round(rate·tick) points per laser per
     /// tick over the tick's rotation), `carla-async` (the same with each
     /// tick's length jittered by `[carla] async_tick_jitter_frac`, assumed)
     /// or `drift` (pulses at k / pulse rate, the planar geometry's clock).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<Sampling>())]
     sampling: Option<Sampling>,
     /// Detection rule k-of-n frames, e.g. `2/3` (paper: first return, `1/1`).
     #[arg(long, default_value = "1/1", allow_hyphen_values = true)]
@@ -119,7 +119,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "gaze_behaviour")]
     gaze: Option<PathBuf>,
     /// Format of --gaze.
-    #[arg(long, value_enum, default_value_t = gaze_lidar::gaze::Format::Jsonl)]
+    #[arg(long, value_parser = super::args::named::<gaze_lidar::gaze::Format>(), default_value_t = gaze_lidar::gaze::Format::Jsonl)]
     gaze_format: gaze_lidar::gaze::Format,
     /// Drive the profile from a named gaze behaviour, seeded per trial:
     /// `fixate[:gaze_deg=G]`, `scan[:left_deg=L,right_deg=R,rate_hz=F,step_deg=S]`,

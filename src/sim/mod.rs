@@ -97,9 +97,7 @@ impl From<crate::optimizer::OptError> for SimError {
 }
 
 /// A LiDAR variant of the experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variant {
     /// Uniform (the non-adaptive LiDAR).
     Baseline,
@@ -124,15 +122,6 @@ impl Variant {
         Variant::Joint,
     ];
 
-    /// Lower-case name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Optimized => "optimized",
-            other => other.mode().map_or("optimized", Mode::name),
-        }
-    }
-
     /// The closed-form controller, if any.
     #[must_use]
     pub fn mode(self) -> Option<Mode> {
@@ -147,9 +136,7 @@ impl Variant {
 }
 
 /// The sensor geometry of the simulation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Geometry {
     /// One horizontal channel in a top view, scaled by the channel count
     /// (the lightweight default).
@@ -161,9 +148,7 @@ pub enum Geometry {
 }
 
 /// When the car from the right counts as detected.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Detector {
     /// Any returned point on the car (k-of-n frames; `carla`: ticks).
     #[default]
@@ -174,9 +159,7 @@ pub enum Detector {
 }
 
 /// When a car arrives (TTA is measured to this moment).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Arrival {
     /// Its front reaches |y| = `conflict_half_width_m`.
     #[default]
@@ -186,38 +169,30 @@ pub enum Arrival {
     ArgusCentre,
 }
 
-impl Geometry {
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Planar => "planar",
-            Self::Carla => "carla",
-        }
-    }
-}
+crate::names::named_enum!(Variant {
+    Baseline => "baseline", "Uniform (the non-adaptive LiDAR)";
+    Range => "range", "Range control (closed form)";
+    Resolution => "resolution", "Resolution control (closed form; in `argus`, the paper code's variant)";
+    Joint => "joint", "Both (closed form)";
+    Optimized => "optimized", "The optimizer's profile (needs the `solver` feature): by default the paper's sensor with Levi's E2 acuity (60° region of focus), joint, continuous levels; or `SimConfig::optimizer`";
+});
 
-impl Detector {
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::FirstReturn => "first-return",
-            Self::Argus => "argus",
-        }
-    }
-}
+crate::names::named_enum!(Geometry {
+    Planar => "planar", "One horizontal channel in a top view, scaled by the channel count (the lightweight default)";
+    Carla => "carla", "CARLA's 3D ray-cast LiDAR: every channel over the vertical field of view, a mount above a flat road, boxes with heights, CARLA's drop-off";
+});
+
+crate::names::named_enum!(Detector {
+    FirstReturn => "first-return", "Any returned point on the car (k-of-n frames; `carla`: ticks)";
+    Argus => "argus", "ARGUS's rule: road mask from ground returns, a vehicle point above a road cell in its region (`carla` geometry only)";
+});
+
+crate::names::named_enum!(Arrival {
+    Front => "front", "Its front reaches |y| = `conflict_half_width_m`";
+    ArgusCentre => "argus-centre", "Its centre reaches |y| = `conflict_half_width_m` (ARGUS: the actor's location reaching world x ≤ 1.75 m)";
+});
 
 impl Arrival {
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Front => "front",
-            Self::ArgusCentre => "argus-centre",
-        }
-    }
-
     /// Distance the car travels after its front reaches the conflict line
     /// before it arrives, m.
     #[must_use]
