@@ -997,7 +997,8 @@ fn history_labels(text: &str, strict: bool) -> Vec<String> {
         if b[i] == b'#' && (i == 0 || b" \t\n(".contains(&b[i - 1])) {
             let end = digits_from(i + 1, b"")?;
             let cited_pr = b[..i].ends_with(b"pr ");
-            return (!cited_pr && !(end < b.len() && alnum(end))).then_some(end);
+            let longer_word = end < b.len() && alnum(end);
+            return (!cited_pr && !longer_word).then_some(end);
         }
         if !strict {
             return None;
