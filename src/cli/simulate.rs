@@ -299,13 +299,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         Some(g) => sim::gaze_drive::run(&config, g, &|| bar.inc(1)),
         None => sim::run(&config, &|| bar.inc(1)),
     }
-    .map_err(|e| {
-        if e.is_input_error() {
-            CliError::input(e.to_string())
-        } else {
-            CliError::infeasible(e.to_string())
-        }
-    });
+    .map_err(sim_error);
     bar.finish_and_clear();
     let result = result?;
     let render = |e: csv::Error| CliError::input(e.to_string());
@@ -342,7 +336,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 arrival: Arrival::ArgusCentre,
                 ..config.clone()
             };
-            let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
+            let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(sim_message(&e)))?;
             // Clear air under the other samplings, and the fog-25 % baseline
             // with cars above ARGUS's road threshold, for the comparisons.
             let mut extras = Vec::new();
@@ -382,7 +376,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 .into_iter()
                 .map(|c| sim::run(&c, &|| {}).map(|r| (r, c)))
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| CliError::input(e.to_string()))?;
+                .map_err(|e| CliError::input(sim_message(&e)))?;
             Some(((r, pc), runs, swept))
         } else {
             None
@@ -509,9 +503,27 @@ fn render_plots(
 /// A simulation error as the CLI reports it (input: exit 2; else exit 1).
 fn sim_error(e: sim::SimError) -> CliError {
     if e.is_input_error() {
-        CliError::input(e.to_string())
+        CliError::input(sim_message(&e))
     } else {
-        CliError::infeasible(e.to_string())
+        CliError::infeasible(sim_message(&e))
+    }
+}
+
+/// A simulation error's message, with options that do not go together
+/// named by their flags.
+fn sim_message(e: &sim::SimError) -> String {
+    use sim::Conflict as C;
+    const GAZE: &str = "--gaze/--gaze-behaviour: only";
+    match e {
+        sim::SimError::Conflict(c) => match c {
+            C::DetectorNeedsCarla => "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)".to_owned(),
+            C::FalseAlarmsNeedPlanar => "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)".to_owned(),
+            C::SamplingNeedsCarla(s) => format!("--sampling {s} needs --geometry carla (the planar geometry has only the drift pulse clock)"),
+            C::GazeNeedsPlanar => format!("{GAZE} the planar geometry is driven by the gaze stream"),
+            C::GazeNeedsPhysical => format!("{GAZE} --model physical is driven (the argus model's resolution variant is a fixed decimation, not a per-frame profile)"),
+            C::GazeNeedsClosedForm => format!("{GAZE} the closed-form variants (baseline, range, resolution, joint) are driven"),
+        },
+        e => e.to_string(),
     }
 }
 
@@ -521,7 +533,16 @@ fn parse_sweeps(specs: &[String]) -> Result<Vec<sim::sweep::Sweep>, CliError> {
         .iter()
         .map(|s| sim::sweep::parse(s))
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| CliError::input(e.to_string()))
+        .map_err(sweep_error)
+}
+
+/// A sweep error as the CLI words it: `--sweep: …`, or `--sweep KEY=V: …`
+/// for a value.
+fn sweep_error(e: sim::sweep::SweepError) -> CliError {
+    match e {
+        sim::sweep::SweepError::Value { .. } => CliError::input(format!("--sweep {e}")),
+        _ => CliError::input(format!("--sweep: {e}")),
+    }
 }
 
 /// One configuration per value of `sweep` (every value validated).
@@ -533,8 +554,8 @@ fn sweep_configs(
         .values
         .iter()
         .map(|&v| {
-            let scenario = sim::sweep::apply(&config.scenario, &sweep.key, v)
-                .map_err(|e| CliError::input(e.to_string()))?;
+            let scenario =
+                sim::sweep::apply(&config.scenario, &sweep.key, v).map_err(sweep_error)?;
             Ok(SimConfig {
                 scenario,
                 ..config.clone()

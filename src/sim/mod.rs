@@ -64,6 +64,9 @@ pub enum SimError {
     /// Bad argument.
     #[error("{0}")]
     Argument(String),
+    /// Options of the run that do not go together.
+    #[error(transparent)]
+    Conflict(#[from] Conflict),
     /// The optimized variant's problem is invalid (`input`) or infeasible.
     #[error("optimized variant: {message}")]
     Optimizer {
@@ -72,6 +75,34 @@ pub enum SimError {
         /// A configuration fault (exit 2) rather than infeasibility (exit 1).
         input: bool,
     },
+}
+
+/// Options of a run that do not go together, named as [`SimConfig`]'s
+/// fields and the scenario's keys (a front end words them as its own options).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+pub enum Conflict {
+    /// The ARGUS detector outside the `carla` geometry.
+    #[error(
+        "detector argus needs geometry carla (ARGUS's road mask is built from ground returns)"
+    )]
+    DetectorNeedsCarla,
+    /// False alarms per frame in the `carla` geometry.
+    #[error("scenario.false_alarms_per_frame needs geometry planar (the carla geometry has no frame-based detector)")]
+    FalseAlarmsNeedPlanar,
+    /// A sampling other than `drift` outside the `carla` geometry.
+    #[error(
+        "sampling {0} needs geometry carla (the planar geometry has only the drift pulse clock)"
+    )]
+    SamplingNeedsCarla(Sampling),
+    /// A gaze-driven run outside the planar geometry.
+    #[error("a gaze-driven run: only the planar geometry is driven by the gaze stream")]
+    GazeNeedsPlanar,
+    /// A gaze-driven run with the `argus` return model.
+    #[error("a gaze-driven run: only model physical is driven (the argus model's resolution variant is a fixed decimation, not a per-frame profile)")]
+    GazeNeedsPhysical,
+    /// A gaze-driven run with the optimized variant.
+    #[error("a gaze-driven run: only the closed-form variants (baseline, range, resolution, joint) are driven")]
+    GazeNeedsClosedForm,
 }
 
 impl SimError {
@@ -753,24 +784,15 @@ impl<'c> Prepared<'c> {
             )));
         }
         if config.detector == Detector::Argus && config.geometry != Geometry::Carla {
-            return Err(SimError::Argument(
-                "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)"
-                    .into(),
-            ));
+            return Err(Conflict::DetectorNeedsCarla.into());
         }
         if config.geometry == Geometry::Carla && config.scenario.false_alarms_per_frame > 0.0 {
-            return Err(SimError::Argument(
-                "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)"
-                    .into(),
-            ));
+            return Err(Conflict::FalseAlarmsNeedPlanar.into());
         }
         if config.geometry == Geometry::Carla {
             config.scenario.validate_carla()?;
         } else if config.sampling() != Sampling::Drift {
-            return Err(SimError::Argument(format!(
-                "--sampling {} needs --geometry carla (the planar geometry has only the drift pulse clock)",
-                config.sampling().name()
-            )));
+            return Err(Conflict::SamplingNeedsCarla(config.sampling()).into());
         }
         let fogs: Vec<FogLevel> = config
             .fog_pcts
