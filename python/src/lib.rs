@@ -1655,7 +1655,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_gaze, m)?)?;
     m.add(
         "GAZE_FORMATS",
-        PyList::new(py, <gaze_lidar::gaze::Format as Named>::NAMES.iter().copied())?,
+        PyList::new(
+            py,
+            <gaze_lidar::gaze::Format as Named>::NAMES.iter().copied(),
+        )?,
     )?;
     m.add_function(wrap_pyfunction!(replay::replay, m)?)?;
     m.add(
