@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The detection objective's table (issue 30 step 2, specs/optimizer.md,
+# The detection objective's table (specs/optimizer.md,
 # "The detection objective: measured"): for every shipped config
 # (examples/configs/), `simulate --variant optimized --optimizer-config C`
 # with objective.kind = "sqrt" and = "detection", both return models,

@@ -37,6 +37,7 @@
 pub use gaze_lidar_core::{checker, eye_safety, firmware};
 pub mod gaze;
 pub mod model;
+pub mod names;
 #[cfg(feature = "solver")]
 pub mod optimizer;
 pub mod planner;

@@ -72,7 +72,7 @@ fn set_key(toml: &str, key: &str, value: &str) -> String {
     out.join("\n") + "\n"
 }
 
-/// Issue 21, item 3: `frame_rate_hz: 5e-324` (and 4e-309) in an otherwise
+/// Guards the rate boundary: `frame_rate_hz: 5e-324` (and 4e-309) in an otherwise
 /// certified profile was certified ("frame period 0.050000000 s"): its
 /// period 1/f overflows to infinity, which matched any dwell sum within a
 /// relative tolerance. Now every subnormal or unphysical rate is rejected,
@@ -148,7 +148,7 @@ fn subnormal_flags_are_bad_input() {
     }
 }
 
-/// Issue 21, item 2: `power_w_max = nan` in a sensor file certified a
+/// Guards the sensor file's boundary: `power_w_max = nan` in a sensor file certified a
 /// profile declaring 2 mW (the paper sensor allows 1.25 mW); a negative
 /// budget or `power_w_min > power_w_max` was blamed on the profile (exit 1).
 /// Now every such sensor file is refused as bad input (exit 2), naming the

@@ -1,4 +1,4 @@
-//! Issue 24 items 2 and 4: every power and dwell step's program comes with a
+//! Every power and dwell step's program comes with a
 //! certificate checked in exact rational arithmetic, and
 //! `profile --certificate DIR` exports it. The exported files are checked
 //! here from the outside: `problem.mps` is read back by HiGHS itself (its
@@ -250,7 +250,7 @@ fn the_mps_export_round_trips_through_highs() {
     assert!(e.upper_bound.unwrap() >= BigRational::from_integer(4.into()));
 }
 
-/// Issue 24 item 3: the global bound is an upper bound of the model
+/// The global bound is an upper bound of the model
 /// objective over every point its constraints allow. On a small instance
 /// (12 bins) of each shipped config, the optimizer's answer and thousands
 /// of feasible perturbations of it (box, budget, frame and slew kept;
@@ -533,7 +533,7 @@ fn small_smooth() -> (
     (problem, answer, ub)
 }
 
-/// Issue 24 item 3: under an acceleration limit the bound keeps the spin
+/// Under an acceleration limit the bound keeps the spin
 /// box that the limit and the frame leave (`specs/optimizer.md`). On the
 /// 12-bin `smooth` problem, spin profiles that push the limit (every bin
 /// at ±2aθ in ω², or random closed walks scaled to it), lifted onto the

@@ -1,4 +1,4 @@
-//! Issue 2 acceptance: the paper's closed-form profiles through the binary.
+//! The paper's closed-form profiles through the binary.
 
 mod common;
 mod independent;
@@ -296,7 +296,7 @@ fn output_is_deterministic() {
     );
 }
 
-/// Issue 30, step 4: `profile --preset P --mode M --optimize` answers for
+/// `profile --preset P --mode M --optimize` answers for
 /// every preset × mode; where a finite acceleration limit forbids the
 /// closed form's spin set-points they are dropped (ramps instead) with one
 /// line on stderr; the text summary labels every gap.
@@ -348,7 +348,7 @@ fn every_preset_and_mode_optimizes_from_the_command_line() {
     }
 }
 
-/// Issue 30, step 4: a closed form the sensor's limits reject says so in one
+/// A closed form the sensor's limits reject says so in one
 /// line: the first violated limit, the count of the rest, and a command
 /// that works (run here).
 #[cfg(feature = "solver")]

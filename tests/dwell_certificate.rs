@@ -1,4 +1,4 @@
-//! Issue 24 item 2 for the dwell step: every dwell program the optimizer
+//! The dwell step's certificates: every dwell program the optimizer
 //! solves (continuous spin, spin set-points, acceleration limits, eye
 //! safety's binding cuts, time accounting) comes with a certificate checked
 //! in exact rational arithmetic (`optimality.dwell_step`), on problems

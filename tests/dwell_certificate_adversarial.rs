@@ -1,4 +1,4 @@
-//! Adversarial review (helper "breaker3") of the dwell step's certificate,
+//! Attacks on the dwell step's certificate,
 //! the MILP node limit and `--certificate` export (`specs/optimizer.md`,
 //! "The dwell step's certificate", "MILPs: a node limit, not a time
 //! limit"). Each `#[ignore = "finding: …"]` test is a minimal reproducer of
@@ -31,13 +31,13 @@ fn highs_objective_of_file(path: &Path) -> f64 {
 }
 
 /// Exploration helper, not a test of a claim: for every certificate
-/// directory named in `BREAKER3_CERT_DIRS` (whitespace separated), HiGHS
+/// directory named in `GAZE_LIDAR_CERT_DIRS` (whitespace separated), HiGHS
 /// re-solves `problem.mps` at 1e-10 and the result is printed beside the
 /// certified `objective` and `upper_bound`.
 #[test]
-#[ignore = "exploration helper (BREAKER3_CERT_DIRS)"]
+#[ignore = "exploration helper (GAZE_LIDAR_CERT_DIRS)"]
 fn explore_resolve_exported_programs() {
-    let Ok(dirs) = std::env::var("BREAKER3_CERT_DIRS") else {
+    let Ok(dirs) = std::env::var("GAZE_LIDAR_CERT_DIRS") else {
         return;
     };
     for d in dirs.split_whitespace() {
@@ -60,7 +60,7 @@ fn explore_resolve_exported_programs() {
 use gaze_lidar::optimizer::{optimize_with_certificate, OptError, OptimizerConfig};
 
 fn problem_from_toml(text: &str) -> gaze_lidar::optimizer::Problem {
-    OptimizerConfig::from_toml(text, "breaker3")
+    OptimizerConfig::from_toml(text, "attack")
         .unwrap()
         .problem()
         .unwrap()
@@ -306,7 +306,7 @@ fn a_spin_fixed_by_its_limits_is_not_infeasible() {
 fn a_huge_objective_weight_is_bad_input_naming_the_field() {
     let text = "bins = 24\n[lidar]\npreset = \"paper\"\n[objective]\nmode = \"joint\"\nresolution_weight = 1e19\n";
     // From a config file: refused as bad input naming the key.
-    let e = OptimizerConfig::from_toml(text, "breaker3")
+    let e = OptimizerConfig::from_toml(text, "attack")
         .unwrap()
         .problem()
         .unwrap_err();

@@ -1,6 +1,6 @@
 //! The optimizer's eye-safety constraints are the core's cuts, and its
-//! power step is optimal under the bound that decides (issue 24, item 1;
-//! `specs/optimizer.md`, "Eye safety as cuts").
+//! power step is optimal under the bound that decides
+//! (`specs/optimizer.md`, "Eye safety as cuts").
 
 use gaze_lidar::checker::certify;
 use gaze_lidar::eye_safety::{cuts::cuts, exposure};
@@ -18,7 +18,7 @@ fn shipped(name: &str) -> Problem {
 }
 
 /// `vls128_eye` as it was before the `vls128` preset gained its 128-channel
-/// head (issue 29): one channel, an 8 mm beam, a 1.5 mW budget, limits
+/// head: one channel, an 8 mm beam, a 1.5 mW budget, limits
 /// 0.2–4.5 mW. The tests below pin the single-channel optimizer's answers
 /// and its exact optimality under the bound; with the head, the bound's
 /// energy rules are a minimum over candidate channel weights (not linear
@@ -38,9 +38,9 @@ fn vls128_eye_one_channel() -> Problem {
 }
 
 /// Where eye safety binds, the answer the checker certifies is at least as
-/// good (exact √ utilities) as the first round's: its LP with surrogate caps
+/// good (exact √ utilities) as the surrogate-cap method's: an LP with caps
 /// 0.1 % under the single-pulse limit, rescaled uniformly onto the bound
-/// (recorded from a9ed401, the last commit with it).
+/// (its answers recorded while the optimizer still had that method).
 #[test]
 fn vls128_eye_beats_the_rescaled_answer_and_certifies() {
     let problem = vls128_eye_one_channel();

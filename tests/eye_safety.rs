@@ -1,4 +1,4 @@
-//! Issue 3 acceptance: AEL figures, per-azimuth exposure, check integration.
+//! AEL figures, per-azimuth exposure, check integration.
 
 mod common;
 #[path = "../crates/core/tests/reference/mod.rs"]

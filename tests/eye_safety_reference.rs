@@ -110,7 +110,7 @@ fn check_rejects_constructed_cases_naming_eye_safety() {
     );
 }
 
-/// `gaze-lidar check` on the two issue-21 profiles (a window longer than
+/// `gaze-lidar check` on the two AEL step-down profiles (a window longer than
 /// the pulses it holds, across a step-down of Table 3): exit 1 naming eye
 /// safety; their true ratios (by hand, `eye_cases::ael_step_cases`) are
 /// over 1, where the AEL at the pulses' span put them below.

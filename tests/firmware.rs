@@ -1,4 +1,4 @@
-//! Issue 6 acceptance: firmware tables of the paper's profiles.
+//! Firmware tables of the paper's profiles.
 
 mod common;
 mod independent;
@@ -121,7 +121,7 @@ fn binary_tables_round_trip_and_tampering_is_caught() {
 }
 
 // ---------------------------------------------------------------------------
-// Eye safety of a table as it will run: the integer check (issue 10, Build 6).
+// Eye safety of a table as it will run: the integer check.
 
 use gaze_lidar::checker::certify;
 use gaze_lidar::eye_safety::{evaluate_profile, EyeSafetyParams};

@@ -1,4 +1,4 @@
-//! Adversarial review (breaker4) of the optimizer's global bound
+//! Attacks on the optimizer's global bound
 //! (`src/optimizer/global.rs`): the claim is that
 //! `optimality.global.upper_bound` ≥ `model_objective` of EVERY profile the
 //! checker (`gaze_lidar::checker::certify`) accepts for the problem. Each

@@ -1,7 +1,7 @@
-//! Issue 29 (steps 2, 5, 6): the real heads' presets certified for the
-//! whole head, everywhere a profile is certified (closed form, `--config`
-//! and `--optimize`, the stream, the optimizer's fast path), with the
-//! figures the issue asks to see, and output that names the head.
+//! The real heads' presets certified for the whole head, everywhere a
+//! profile is certified (closed form, `--config` and `--optimize`, the
+//! stream, the optimizer's fast path), with the head's figures, and output
+//! that names the head.
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! Issue 4 acceptance: the optimizer (HiGHS).
+//! The optimizer (HiGHS) through the library and the binary.
 #![cfg(feature = "solver")]
 
 mod common;

@@ -1,4 +1,4 @@
-//! Issue 30, step 1: the optimizer's refactor (good_lp, one loop, typed
+//! The optimizer's refactor (good_lp, one loop, typed
 //! errors) keeps its outputs byte-identical. The files under
 //! `tests/data/optimizer_golden/` were written by the binary *before* the
 //! refactor (`profile --config examples/configs/C.toml --gaze-deg G

@@ -1,4 +1,4 @@
-//! Issue 30, step 3: a request whose spin set-points cannot make one turn
+//! A request whose spin set-points cannot make one turn
 //! take the frame period on N equal bins is refused before any solve with
 //! `Infeasible::FrameUnreachable { limit: SpinLimit::SetPoints { .. } }`,
 //! whose message names the frame period; every other request of the family

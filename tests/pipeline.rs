@@ -1,4 +1,4 @@
-//! Issue 23 items 7–8 and issue 22 item 14: the paper's pipeline sampled as
+//! The paper's pipeline sampled as
 //! CARLA samples, cars with ground clearance, the planar grid's shared
 //! casts, and the ARGUS road mask's memory.
 
@@ -197,7 +197,7 @@ fn sampling_needs_the_carla_geometry() {
 
 #[test]
 fn fine_road_mask_over_a_long_trace_runs_in_4_gib() {
-    // Issue 22 item 14: `argus_cell_m = 0.05`, `range_m = 1000` allocated a
+    // Guards the road mask's memory: `argus_cell_m = 0.05`, `range_m = 1000` allocated a
     // dense 1.6 GB mask per detector and aborted under a 4 GiB cap.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("fine.toml");

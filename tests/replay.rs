@@ -1,4 +1,4 @@
-//! Issue 33: `gaze-lidar replay` on a bag written here with the mcap crate
+//! `gaze-lidar replay` on a bag written here with the mcap crate
 //! (no Python needed), read back with the mcap crate.
 
 mod common;

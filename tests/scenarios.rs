@@ -1,4 +1,4 @@
-//! Issue 32 items 3–4: gaze behaviour from the stream drives `simulate`, and
+//! Gaze behaviour from the stream drives `simulate`, and
 //! the scenario files under `examples/scenarios/`.
 
 mod common;

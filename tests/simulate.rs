@@ -1,4 +1,4 @@
-//! Issue 5 acceptance: the intersection experiment.
+//! The intersection experiment through the library and the binary.
 
 mod common;
 
@@ -269,7 +269,7 @@ fn optimized_variant_runs_on_shared_phase_solutions() {
     assert_eq!(sim::run(&config, &|| {}).unwrap().rows, r.rows);
 }
 
-// ---- The `carla` geometry (issue 12). ----
+// ---- The `carla` geometry. ----
 
 use gaze_lidar::sim::carla::geometry::{
     carla_elevations_deg, ground_hit, PosedBox, Sensor, Surface,

@@ -1,4 +1,4 @@
-//! Issue 7 acceptance: the gaze pipeline through the binary.
+//! The gaze pipeline through the binary.
 
 mod common;
 mod independent;
@@ -192,7 +192,7 @@ fn stream_with_the_optimizer_fast_path() {
 }
 
 // ---------------------------------------------------------------------------
-// Issue 11: the frame clock drives the fail-safe.
+// The frame clock drives the fail-safe.
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};

@@ -945,3 +945,161 @@ fn citation_scanner_finds_design_style_citations() {
         ]
     );
 }
+
+/// Labels of past work in a text, each as `line: label`: issue numbers
+/// (the word, an optional `s`, then a number after spaces, `#` or `-`; or a
+/// bare `#` and a number after a space or `(`, except a cited pull request),
+/// review rounds (the word and a number that is not a decimal), work
+/// sessions and reviewers' numbered handles. With `strict` (specs and the
+/// README) also dates (`YYYY-MM-DD`) and commit hashes (a backticked run of
+/// 7–12 hex digits with a letter and a digit, or a hash after `commit`).
+/// History goes in `CHANGELOG.md`; everything else states what is.
+fn history_labels(text: &str, strict: bool) -> Vec<String> {
+    let lower = text.to_ascii_lowercase();
+    let b = lower.as_bytes();
+    let alnum = |i: usize| b[i].is_ascii_alphanumeric();
+    let digits_from = |mut i: usize, sep: &[u8]| -> Option<usize> {
+        while i < b.len() && sep.contains(&b[i]) {
+            i += 1;
+        }
+        let start = i;
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        (i > start).then_some(i)
+    };
+    let hex_run = |i: usize| {
+        let n = b[i..]
+            .iter()
+            .take_while(|c| c.is_ascii_digit() || (b'a'..=b'f').contains(c))
+            .count();
+        let run = &b[i..i + n];
+        (run.iter().any(u8::is_ascii_digit) && run.iter().any(u8::is_ascii_alphabetic)).then_some(n)
+    };
+    // The label starting at byte `i`, as its end.
+    let label_at = |i: usize| -> Option<usize> {
+        let after_word = i == 0 || !alnum(i - 1);
+        let at = |w: &str| after_word && b[i..].starts_with(w.as_bytes());
+        if at("issue") {
+            let j = i + 5 + usize::from(b.get(i + 5) == Some(&b's'));
+            return digits_from(j, b" #-");
+        }
+        if at("round") || at("session") {
+            let j = i + if b[i] == b'r' { 5 } else { 7 };
+            let end = digits_from(j, b" _-")?;
+            let decimal =
+                b.get(end) == Some(&b'.') && b.get(end + 1).is_some_and(u8::is_ascii_digit);
+            return (!decimal).then_some(end);
+        }
+        if at("breaker") {
+            return digits_from(i + 7, b"");
+        }
+        if b[i] == b'#' && (i == 0 || b" \t\n(".contains(&b[i - 1])) {
+            let end = digits_from(i + 1, b"")?;
+            let cited_pr = b[..i].ends_with(b"pr ");
+            let longer_word = end < b.len() && alnum(end);
+            return (!cited_pr && !longer_word).then_some(end);
+        }
+        if !strict {
+            return None;
+        }
+        if at("20") && i + 10 <= b.len() {
+            let shape = b[i..i + 10].iter().enumerate().all(|(k, c)| {
+                if k == 4 || k == 7 {
+                    *c == b'-'
+                } else {
+                    c.is_ascii_digit()
+                }
+            });
+            let ends = !(i + 10 < b.len() && b[i + 10].is_ascii_digit());
+            return (shape && ends).then_some(i + 10);
+        }
+        if b[i] == b'`' && i + 1 < b.len() {
+            let n = hex_run(i + 1)?;
+            return ((7..=12).contains(&n) && b.get(i + 1 + n) == Some(&b'`')).then_some(i + n + 2);
+        }
+        if at("commit ") {
+            let n = hex_run(i + 7)?;
+            return (n >= 7).then_some(i + 7 + n);
+        }
+        None
+    };
+    let mut found: Vec<(usize, usize)> = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        match label_at(i) {
+            Some(end) => {
+                found.push((i, end));
+                i = end;
+            }
+            None => i += 1,
+        }
+    }
+    found
+        .into_iter()
+        .map(|(s, e)| format!("{}: {}", text[..s].matches('\n').count() + 1, &text[s..e]))
+        .collect()
+}
+
+#[test]
+fn specs_readme_and_sources_state_what_is_without_history_labels() {
+    let root = root();
+    let mut files = Vec::new();
+    text_files(&root, &mut files);
+    let mut labelled = Vec::new();
+    for f in files {
+        let rel = f.strip_prefix(&root).unwrap_or(&f).to_path_buf();
+        if rel == Path::new("CHANGELOG.md") {
+            continue;
+        }
+        let Ok(text) = std::fs::read_to_string(&f) else {
+            continue;
+        };
+        let strict = rel == Path::new("README.md") || rel.starts_with("specs");
+        for label in history_labels(&text, strict) {
+            labelled.push(format!("{}:{label}", rel.display()));
+        }
+    }
+    assert!(
+        labelled.is_empty(),
+        "history labels outside CHANGELOG.md (state what is instead): {labelled:#?}"
+    );
+}
+
+#[test]
+fn history_scanner_finds_every_kind_of_label() {
+    // The labels are written with a `~` inside, removed at run time, so that
+    // this file carries none of the labels it tests.
+    let unmark = |s: &str| s.replace('~', "");
+    let text = unmark(
+        "A (Iss~ue 21) b; iss~ues #~4; iss~ue-29\nfixed in (#~12), hostile_rou~nd3, \
+         Rou~nd 2, sess~ion 7, break~er4\n20~26-11-22 at `b14~eeb0`, com~mit 5a~59f87.\n",
+    );
+    let expected = [
+        "1: Iss~ue 21",
+        "1: iss~ues #~4",
+        "1: iss~ue-29",
+        "2: #~12",
+        "2: rou~nd3",
+        "2: Rou~nd 2",
+        "2: sess~ion 7",
+        "2: break~er4",
+        "3: 20~26-11-22",
+        "3: `b14~eeb0`",
+        "3: com~mit 5a~59f87",
+    ];
+    assert_eq!(history_labels(&text, true), expected.map(unmark).to_vec());
+    assert_eq!(history_labels(&text, false).len(), 8);
+    // What is not a label: a decimal after the word, a cited pull request,
+    // an attribute, a Markdown heading, a family member in backticks, a
+    // word that only contains one of the keywords.
+    let clean = unmark(
+        "one rou~nd 8.91094 in 4 ms; PR #~518; #[test]\n## Layout\n\
+         the `#~48` member; roundabout 3; tissue 5; at 1e-9 ",
+    );
+    assert!(
+        history_labels(&clean, true).is_empty(),
+        "{:?}",
+        history_labels(&clean, true)
+    );
+}

@@ -1,4 +1,4 @@
-//! Issue 24 item 5, units people use: every optimized profile reports the
+//! Units people use: every optimized profile reports the
 //! range (m) and the points per degree inside the region of focus and
 //! outside it, next to the paper's closed form's, in profile@1's
 //! `optimality.figures` and in `profile --format text`. Checked here from

@@ -6,24 +6,10 @@
 
 use gaze_lidar::gaze::{Format, GazeError, LineError, Parser};
 
-/// The formats `gaze-lidar stream --format` reads, by the CLI's names.
-pub const FORMATS: &[(&str, Format)] = &[
-    ("jsonl", Format::Jsonl),
-    ("csv", Format::Csv),
-    ("varjo", Format::Varjo),
-    ("neon", Format::Neon),
-];
-
-/// The named format, or a message listing the known ones.
+/// The named format (the names `gaze-lidar stream --format` takes, from
+/// the library's one table), or a message listing the known ones.
 pub fn format_of(name: &str) -> Result<Format, String> {
-    FORMATS
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|&(_, f)| f)
-        .ok_or_else(|| {
-            let names: Vec<&str> = FORMATS.iter().map(|(n, _)| *n).collect();
-            format!("format: '{name}' is not one of {}", names.join(", "))
-        })
+    name.parse().map_err(|e| format!("format: {e}"))
 }
 
 /// A gaze track as columns: times (s), azimuths (degrees, ISO 8855) and

@@ -29,6 +29,7 @@ use gaze_lidar::gaze::{
 use gaze_lidar::model::angle::wrap_deg;
 use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::model::presets::{self, Preset};
+use gaze_lidar::names::Named;
 use gaze_lidar::planner::{closed_form, validate_gaze, Mode, PlanError};
 use gaze_lidar::pointcloud::{keep_mask, CloudFrame, CloudOptions};
 use gaze_lidar::profile::kinematics::{BinMotion, Timeline};
@@ -146,14 +147,7 @@ fn preset_of(name: &str) -> PyResult<Preset> {
 }
 
 fn mode_of(name: &str) -> PyResult<Mode> {
-    Mode::ALL
-        .into_iter()
-        .find(|m| m.name() == name)
-        .ok_or_else(|| {
-            value_error(format!(
-                "mode: '{name}' is not one of baseline, range, resolution, joint"
-            ))
-        })
+    name.parse().map_err(|e| value_error(format!("mode: {e}")))
 }
 
 fn seed_of(seed: i128) -> PyResult<u64> {
@@ -1329,13 +1323,7 @@ impl PyGazeStream {
 }
 
 fn model_of(name: &str) -> PyResult<ModelKind> {
-    match name {
-        "physical" => Ok(ModelKind::Physical),
-        "argus" => Ok(ModelKind::Argus),
-        other => Err(value_error(format!(
-            "model: '{other}' is not one of physical, argus"
-        ))),
-    }
+    name.parse().map_err(|e| value_error(format!("model: {e}")))
 }
 
 fn cloud_frame(frame: &str) -> PyResult<CloudFrame> {
@@ -1534,12 +1522,8 @@ fn simulate<'py>(
                         config.variants = names
                             .iter()
                             .map(|n| {
-                                [Variant::Baseline, Variant::Range, Variant::Resolution, Variant::Joint, Variant::Optimized]
-                                    .into_iter()
-                                    .find(|x| x.name() == n)
-                                    .ok_or_else(|| value_error(format!(
-                                        "variants: '{n}' is not one of baseline, range, resolution, joint, optimized"
-                                    )))
+                                n.parse::<Variant>()
+                                    .map_err(|e| value_error(format!("variants: {e}")))
                             })
                             .collect::<PyResult<_>>()?;
                     }
@@ -1671,7 +1655,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_gaze, m)?)?;
     m.add(
         "GAZE_FORMATS",
-        PyList::new(py, gaze_io::FORMATS.iter().map(|(n, _)| *n))?,
+        PyList::new(
+            py,
+            <gaze_lidar::gaze::Format as Named>::NAMES.iter().copied(),
+        )?,
     )?;
     m.add_function(wrap_pyfunction!(replay::replay, m)?)?;
     m.add(

@@ -7,7 +7,7 @@
 //! work gets a rayon pool of its own, built for the call and dropped after
 //! it: rayon's global pool is a set of threads that a `fork`ed child does
 //! not inherit, so a child that used it after the parent had would wait
-//! forever for threads that do not exist (issue 32: `ProcessPoolExecutor`
+//! forever for threads that do not exist (a `ProcessPoolExecutor`
 //! with the `fork` start method).
 //!
 //! On a signal the call raises at once and sets the work's [`Cancel`]

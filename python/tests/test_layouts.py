@@ -1,6 +1,6 @@
 """Every layout numpy can hand over reads as the same points.
 
-The regression of issue 23: a Fortran-ordered array passed the native
+Guards against a regression: a Fortran-ordered array passed the native
 layer's contiguity test and was read row-major (`azimuth_deg` gave
 [0, 90, 0, 315] for points at [0, 90, 180, 270]).
 """

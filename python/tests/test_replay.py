@@ -1,4 +1,4 @@
-"""`gaze-lidar replay` (issue 33) checked by a writer and a reader no one
+"""`gaze-lidar replay` checked by a writer and a reader no one
 here wrote: the fixture bag is written with the `mcap` + `mcap-ros2-support`
 packages (real sensor_msgs/PointCloud2 and geometry_msgs/Vector3Stamped from
 their ROS 2 message definitions), the binary replays it, and the output is

@@ -1,4 +1,4 @@
-"""The package where researchers run it (issue 32, item 4): process pools,
+"""The package where researchers run it: process pools,
 Ctrl-C, pickling, gaze files, per-trial results, DataFrames, figures,
 defined terms, CARLA's default range."""
 

@@ -4,10 +4,24 @@
 //! its range (never clap's "unexpected argument '-1' found"). Every float
 //! goes through the one numeric boundary (`model::valid`).
 
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use gaze_lidar::model::valid;
+use gaze_lidar::names::{self, Named};
 use gaze_lidar::text::Num;
 
 use super::CliError;
+
+/// The value parser of an option whose values are a library enum's names:
+/// its possible values and their help come from the enum's one table
+/// ([`Named::TABLE`]), as a `ValueEnum` derive would list them.
+pub fn named<T: Named + Clone + Send + Sync>() -> impl TypedValueParser<Value = T> {
+    PossibleValuesParser::new(
+        T::TABLE
+            .iter()
+            .map(|&(_, name, help)| PossibleValue::new(name).help(help)),
+    )
+    .try_map(|name| names::parse::<T>(&name))
+}
 
 /// An integer option within `lo..=hi`.
 pub fn int_in<T: TryFrom<i128>>(

@@ -23,7 +23,7 @@ pub struct PlanArgs {
     #[arg(long)]
     pub preset: Option<String>,
     /// Controller for the closed form (default range); with --config, replaces the file's objective mode.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<Mode>())]
     pub mode: Option<Mode>,
     /// Equal bins (4..=36000; with --config 4..=1440) [default: 360, or the
     /// --config file's].

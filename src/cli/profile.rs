@@ -54,7 +54,7 @@ pub struct Args {
     preset: Option<String>,
     /// Controller: the paper's closed forms (default range); with --optimize
     /// or --config, the optimizer's objective mode (replaces the file's).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<Mode>())]
     mode: Option<Mode>,
     /// Derive the profile with the optimizer (HiGHS) instead of the closed form;
     /// with a preset: its paper-equivalent problem (two power levels, two spin set-points).

@@ -73,7 +73,7 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     rated_range_m: Option<f64>,
     /// Return model that turns power into range.
-    #[arg(long, value_enum, default_value_t = ModelKind::Physical)]
+    #[arg(long, value_parser = super::args::named::<ModelKind>(), default_value_t = ModelKind::Physical)]
     model: ModelKind,
     /// Fog as a meteorological optical range, m (default clear air).
     #[arg(long, allow_hyphen_values = true)]

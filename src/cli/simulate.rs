@@ -29,10 +29,10 @@ pub enum Format {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Return model(s); default both.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<ModelKind>())]
     model: Vec<ModelKind>,
     /// Variants; default the paper's four (`optimized` adds the optimizer's profile).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<Variant>())]
     variant: Vec<Variant>,
     /// Optimizer configuration (TOML) for the `optimized` variant (no priors).
     #[arg(long)]
@@ -51,22 +51,22 @@ pub struct Args {
     scenario: Option<PathBuf>,
     /// Sensor geometry: `planar` (one horizontal channel, the lightweight
     /// default) or `carla` (CARLA's 64-channel 3D ray-cast LiDAR over a road).
-    #[arg(long, value_enum, default_value_t = Geometry::Planar)]
+    #[arg(long, value_parser = super::args::named::<Geometry>(), default_value_t = Geometry::Planar)]
     geometry: Geometry,
     /// Detector of the car from the right: `first-return` (any point on it)
     /// or `argus` (the paper code's road-mask rule; needs `--geometry carla`).
-    #[arg(long, value_enum, default_value_t = Detector::FirstReturn)]
+    #[arg(long, value_parser = super::args::named::<Detector>(), default_value_t = Detector::FirstReturn)]
     detector: Detector,
     /// Arrival: `front` (the front reaches the conflict line) or
     /// `argus-centre` (the centre does, as the paper's code).
-    #[arg(long, value_enum, default_value_t = Arrival::Front)]
+    #[arg(long, value_parser = super::args::named::<Arrival>(), default_value_t = Arrival::Front)]
     arrival: Arrival,
     /// How the LiDAR fires (`--geometry carla` only; default `carla`):
     /// `carla` (CARLA's fixed tick: round(rate·tick) points per laser per
     /// tick over the tick's rotation), `carla-async` (the same with each
     /// tick's length jittered by `[carla] async_tick_jitter_frac`, assumed)
     /// or `drift` (pulses at k / pulse rate, the planar geometry's clock).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::args::named::<Sampling>())]
     sampling: Option<Sampling>,
     /// Detection rule k-of-n frames, e.g. `2/3` (paper: first return, `1/1`).
     #[arg(long, default_value = "1/1", allow_hyphen_values = true)]
@@ -125,7 +125,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "gaze_behaviour")]
     gaze: Option<PathBuf>,
     /// Format of --gaze.
-    #[arg(long, value_enum, default_value_t = gaze_lidar::gaze::Format::Jsonl)]
+    #[arg(long, value_parser = super::args::named::<gaze_lidar::gaze::Format>(), default_value_t = gaze_lidar::gaze::Format::Jsonl)]
     gaze_format: gaze_lidar::gaze::Format,
     /// Drive the profile from a named gaze behaviour, seeded per trial:
     /// `fixate[:gaze_deg=G]`, `scan[:left_deg=L,right_deg=R,rate_hz=F,step_deg=S]`,
@@ -339,13 +339,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         Some(g) => sim::gaze_drive::run(&config, g, &|| bar.inc(1)),
         None => sim::run(&config, &|| bar.inc(1)),
     }
-    .map_err(|e| {
-        if e.is_input_error() {
-            CliError::input(e.to_string())
-        } else {
-            CliError::infeasible(e.to_string())
-        }
-    });
+    .map_err(sim_error);
     bar.finish_and_clear();
     let result = result?;
     let render = |e: csv::Error| CliError::input(e.to_string());
@@ -382,7 +376,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 arrival: Arrival::ArgusCentre,
                 ..config.clone()
             };
-            let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(e.to_string()))?;
+            let r = sim::run(&pc, &|| {}).map_err(|e| CliError::input(sim_message(&e)))?;
             // Clear air under the other samplings, and the fog-25 % baseline
             // with cars above ARGUS's road threshold, for the comparisons.
             let mut extras = Vec::new();
@@ -422,7 +416,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 .into_iter()
                 .map(|c| sim::run(&c, &|| {}).map(|r| (r, c)))
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| CliError::input(e.to_string()))?;
+                .map_err(|e| CliError::input(sim_message(&e)))?;
             Some(((r, pc), runs, swept))
         } else {
             None
@@ -576,9 +570,27 @@ fn render_plots(
 /// A simulation error as the CLI reports it (input: exit 2; else exit 1).
 fn sim_error(e: sim::SimError) -> CliError {
     if e.is_input_error() {
-        CliError::input(e.to_string())
+        CliError::input(sim_message(&e))
     } else {
-        CliError::infeasible(e.to_string())
+        CliError::infeasible(sim_message(&e))
+    }
+}
+
+/// A simulation error's message, with options that do not go together
+/// named by their flags.
+fn sim_message(e: &sim::SimError) -> String {
+    use sim::Conflict as C;
+    const GAZE: &str = "--gaze/--gaze-behaviour: only";
+    match e {
+        sim::SimError::Conflict(c) => match c {
+            C::DetectorNeedsCarla => "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)".to_owned(),
+            C::FalseAlarmsNeedPlanar => "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)".to_owned(),
+            C::SamplingNeedsCarla(s) => format!("--sampling {s} needs --geometry carla (the planar geometry has only the drift pulse clock)"),
+            C::GazeNeedsPlanar => format!("{GAZE} the planar geometry is driven by the gaze stream"),
+            C::GazeNeedsPhysical => format!("{GAZE} --model physical is driven (the argus model's resolution variant is a fixed decimation, not a per-frame profile)"),
+            C::GazeNeedsClosedForm => format!("{GAZE} the closed-form variants (baseline, range, resolution, joint) are driven"),
+        },
+        e => e.to_string(),
     }
 }
 
@@ -588,7 +600,16 @@ fn parse_sweeps(specs: &[String]) -> Result<Vec<sim::sweep::Sweep>, CliError> {
         .iter()
         .map(|s| sim::sweep::parse(s))
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| CliError::input(e.to_string()))
+        .map_err(sweep_error)
+}
+
+/// A sweep error as the CLI words it: `--sweep: …`, or `--sweep KEY=V: …`
+/// for a value.
+fn sweep_error(e: sim::sweep::SweepError) -> CliError {
+    match e {
+        sim::sweep::SweepError::Value { .. } => CliError::input(format!("--sweep {e}")),
+        _ => CliError::input(format!("--sweep: {e}")),
+    }
 }
 
 /// One configuration per value of `sweep` (every value validated).
@@ -600,8 +621,8 @@ fn sweep_configs(
         .values
         .iter()
         .map(|&v| {
-            let scenario = sim::sweep::apply(&config.scenario, &sweep.key, v)
-                .map_err(|e| CliError::input(e.to_string()))?;
+            let scenario =
+                sim::sweep::apply(&config.scenario, &sweep.key, v).map_err(sweep_error)?;
             Ok(SimConfig {
                 scenario,
                 ..config.clone()

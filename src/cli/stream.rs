@@ -26,7 +26,7 @@ pub struct Args {
     #[command(flatten)]
     plan: PlanArgs,
     /// Input format.
-    #[arg(long, value_enum, default_value_t = Format::Jsonl)]
+    #[arg(long, value_parser = super::args::named::<Format>(), default_value_t = Format::Jsonl)]
     format: Format,
     /// Read a recorded file instead of stdin (a malformed line is then an
     /// error; on stdin it is reported with its number and skipped).

@@ -46,7 +46,6 @@ impl GazeSample {
 
 /// Input formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Format {
     /// JSON lines.
     Jsonl,
@@ -57,6 +56,13 @@ pub enum Format {
     /// Pupil Neon `gaze.csv`.
     Neon,
 }
+
+crate::names::named_enum!(Format {
+    Jsonl => "jsonl", "JSON lines";
+    Csv => "csv", "CSV with `t_s,gaze_deg[,valid]`";
+    Varjo => "varjo", "Varjo Base gaze CSV";
+    Neon => "neon", "Pupil Neon `gaze.csv`";
+});
 
 /// A line that is not a sample.
 #[derive(Debug, Error, Clone, PartialEq)]

@@ -2,12 +2,10 @@
 //! optimizer's objective modes (the same names). A model notion both the
 //! planner and the optimizer use, so it lives below both.
 
-use serde::{Deserialize, Serialize};
+use crate::names::named_enum;
 
 /// Which of the paper's controllers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
     /// Uniform power and spin (the non-adaptive LiDAR; also the fail-safe).
     Baseline,
@@ -19,20 +17,16 @@ pub enum Mode {
     Joint,
 }
 
+named_enum!(Mode {
+    Baseline => "baseline", "Uniform power and spin (the non-adaptive LiDAR; also the fail-safe)";
+    Range => "range", "Range control: `P_low` in the RoF, `P_high` in the RoI (eq. 3–4)";
+    Resolution => "resolution", "Resolution control: `ω_high` in the RoF, `ω_low` in the RoI (eq. 5–6)";
+    Joint => "joint", "Both";
+});
+
 impl Mode {
     /// All modes, in the paper's order.
     pub const ALL: [Mode; 4] = [Mode::Baseline, Mode::Range, Mode::Resolution, Mode::Joint];
-
-    /// Lower-case name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Baseline => "baseline",
-            Self::Range => "range",
-            Self::Resolution => "resolution",
-            Self::Joint => "joint",
-        }
-    }
 
     /// Whether the power is modulated.
     #[must_use]

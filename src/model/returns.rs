@@ -21,15 +21,13 @@
 //! would give 3.912 / V, Koschmieder). Fog extinction is nearly
 //! wavelength-independent for V < 0.5 km, so one α serves 905 nm.
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use thiserror::Error;
 
 use crate::model::range::{self, RangeEquation};
 
 /// The two return models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ModelKind {
     /// The paper code's intensity model (reproduces the published setup).
     Argus,
@@ -37,16 +35,10 @@ pub enum ModelKind {
     Physical,
 }
 
-impl ModelKind {
-    /// Lower-case name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Argus => "argus",
-            Self::Physical => "physical",
-        }
-    }
-}
+crate::names::named_enum!(ModelKind {
+    Argus => "argus", "The paper code's intensity model (reproduces the published setup)";
+    Physical => "physical", "Range equation with fog extinction and SNR detection";
+});
 
 /// The paper's fog levels.
 pub const FOG_LEVELS_PCT: [u32; 3] = [0, 25, 50];

@@ -154,7 +154,7 @@ fn nonneg(field: &str, v: f64) -> Result<f64, OptError> {
 
 /// Largest objective weight accepted. Weights are relative (only their
 /// ratios move the optimum), and they become the programs' coefficients:
-/// HiGHS fails on coefficients near 1e19 (found by breaker3), so a weight
+/// HiGHS fails on coefficients near 1e19, so a weight
 /// beyond any sensible ratio is refused as bad input instead.
 pub const MAX_WEIGHT: f64 = 1e6;
 

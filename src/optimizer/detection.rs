@@ -1,4 +1,4 @@
-//! The detection objective (`objective.kind = "detection"`, issue 30 step 2).
+//! The detection objective (`objective.kind = "detection"`).
 //!
 //! The value of a bin at power ratio `x = p/P̄` and dwell `t` is the
 //! probability-weighted **detection range** it buys, relative to the rated

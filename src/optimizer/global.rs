@@ -1,4 +1,4 @@
-//! A global upper bound of the joint problem (issue 24 item 3).
+//! A global upper bound of the joint problem.
 //!
 //! Block-coordinate ascent stops at a stationary point of a bilinear
 //! problem. This module bounds the true optimum from above with one LP, a
@@ -404,7 +404,7 @@ pub fn model_objective(
             reason: format!("{} bins, the problem has {}", profile.bins.len(), g.n),
         });
     }
-    // The bound is over the problem's own grid (breaker4: narrower bins
+    // The bound is over the problem's own grid (narrower bins
     // elsewhere can score above it); a profile on another grid is refused.
     for (i, b) in profile.bins.iter().enumerate() {
         if (b.start_deg - g.start_deg[i]).abs() > 1e-9

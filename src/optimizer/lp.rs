@@ -1015,8 +1015,7 @@ fn powers(problem: &Problem, g: &Grid, t: &[f64], program: &PowerProgram, sol: &
 /// slew allowance along the circle between them (sweeps both ways until
 /// nothing moves). HiGHS meets those rows only to its absolute tolerance
 /// (1e-7 of `P̄`), more than the limit itself when the limit is tiny or 0
-/// (found by breaker3: a 0 W/deg limit gave a profile the checker
-/// rejected). Lowering never breaks the budget or an eye-safety cut (their
+/// (a 0 W/deg limit gave a profile the checker rejected). Lowering never breaks the budget or an eye-safety cut (their
 /// coefficients are nonnegative) nor the floor (a power is only ever set to
 /// a neighbour's plus a nonnegative allowance); a no-op where HiGHS kept
 /// the rows.
@@ -1735,8 +1734,8 @@ fn joint_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
         let step = match dwell_step(ctx.problem, ctx.g, &binding, f_p, &it.p, &it.t) {
             // A later round's program (re-linearised acceleration rows,
             // trust region, the budget at the new powers) can have no point
-            // even though the iterate is a certified profile's (found by
-            // breaker3 at 10⁴ rad/s²): the sequential LP cannot move from
+            // even though the iterate is a certified profile's (seen at
+            // 10⁴ rad/s²): the sequential LP cannot move from
             // it, so it stops there.
             Err(OptError::Infeasible(_)) if round > 0 => break,
             r => r?,

@@ -252,7 +252,7 @@ impl Program {
             // HiGHS accepts a MILP's rows (and integrality) to this
             // tolerance, absolute; its default, 1e-6, lets a level choice
             // overspend the budget by far more than the checker's relative
-            // 1e-9 (found by breaker3). Its minimum.
+            // 1e-9. Its minimum.
             m.set_option("mip_feasibility_tolerance", S.mip_feasibility_tol);
         }
         // Measured on the shipped configs' power steps and global bound

@@ -122,8 +122,7 @@ pub struct OptimizerSettings {
     pub setpoint_search_steps: u64,
     /// HiGHS's `mip_feasibility_tolerance` for every MILP (default 1e-10,
     /// its minimum): its default, 1e-6, lets a level choice overspend the
-    /// budget by far more than the checker's relative 1e-9 (found by
-    /// breaker3).
+    /// budget by far more than the checker's relative 1e-9.
     pub mip_feasibility_tol: f64,
     /// Distance from an integer within which a relaxation's value counts as
     /// integral (default 1e-9; HiGHS's own `mip_feasibility_tolerance` is

@@ -485,24 +485,17 @@ pub fn run(
         )));
     }
     if config.geometry != Geometry::Planar {
-        return Err(SimError::Argument(
-            "--gaze/--gaze-behaviour: only the planar geometry is driven by the gaze stream".into(),
-        ));
+        return Err(super::Conflict::GazeNeedsPlanar.into());
     }
     if config.models.iter().any(|&m| m != ModelKind::Physical) {
-        return Err(SimError::Argument(
-            "--gaze/--gaze-behaviour: only --model physical is driven (the argus model's resolution variant is a fixed decimation, not a per-frame profile)".into(),
-        ));
+        return Err(super::Conflict::GazeNeedsPhysical.into());
     }
     let modes: Vec<Mode> = config
         .variants
         .iter()
         .map(|v| {
-            v.mode().ok_or_else(|| {
-                SimError::Argument(
-                    "--gaze/--gaze-behaviour: only the closed-form variants (baseline, range, resolution, joint) are driven".into(),
-                )
-            })
+            v.mode()
+                .ok_or_else(|| SimError::from(super::Conflict::GazeNeedsClosedForm))
         })
         .collect::<Result<_, _>>()?;
     let fogs: Vec<FogLevel> = config

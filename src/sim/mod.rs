@@ -64,6 +64,9 @@ pub enum SimError {
     /// Bad argument.
     #[error("{0}")]
     Argument(String),
+    /// Options of the run that do not go together.
+    #[error(transparent)]
+    Conflict(#[from] Conflict),
     /// The optimized variant's problem is invalid (`input`) or infeasible.
     #[error("optimized variant: {message}")]
     Optimizer {
@@ -72,6 +75,34 @@ pub enum SimError {
         /// A configuration fault (exit 2) rather than infeasibility (exit 1).
         input: bool,
     },
+}
+
+/// Options of a run that do not go together, named as [`SimConfig`]'s
+/// fields and the scenario's keys (a front end words them as its own options).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+pub enum Conflict {
+    /// The ARGUS detector outside the `carla` geometry.
+    #[error(
+        "detector argus needs geometry carla (ARGUS's road mask is built from ground returns)"
+    )]
+    DetectorNeedsCarla,
+    /// False alarms per frame in the `carla` geometry.
+    #[error("scenario.false_alarms_per_frame needs geometry planar (the carla geometry has no frame-based detector)")]
+    FalseAlarmsNeedPlanar,
+    /// A sampling other than `drift` outside the `carla` geometry.
+    #[error(
+        "sampling {0} needs geometry carla (the planar geometry has only the drift pulse clock)"
+    )]
+    SamplingNeedsCarla(Sampling),
+    /// A gaze-driven run outside the planar geometry.
+    #[error("a gaze-driven run: only the planar geometry is driven by the gaze stream")]
+    GazeNeedsPlanar,
+    /// A gaze-driven run with the `argus` return model.
+    #[error("a gaze-driven run: only model physical is driven (the argus model's resolution variant is a fixed decimation, not a per-frame profile)")]
+    GazeNeedsPhysical,
+    /// A gaze-driven run with the optimized variant.
+    #[error("a gaze-driven run: only the closed-form variants (baseline, range, resolution, joint) are driven")]
+    GazeNeedsClosedForm,
 }
 
 impl SimError {
@@ -97,9 +128,7 @@ impl From<crate::optimizer::OptError> for SimError {
 }
 
 /// A LiDAR variant of the experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variant {
     /// Uniform (the non-adaptive LiDAR).
     Baseline,
@@ -124,15 +153,6 @@ impl Variant {
         Variant::Joint,
     ];
 
-    /// Lower-case name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Optimized => "optimized",
-            other => other.mode().map_or("optimized", Mode::name),
-        }
-    }
-
     /// The closed-form controller, if any.
     #[must_use]
     pub fn mode(self) -> Option<Mode> {
@@ -147,9 +167,7 @@ impl Variant {
 }
 
 /// The sensor geometry of the simulation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Geometry {
     /// One horizontal channel in a top view, scaled by the channel count
     /// (the lightweight default).
@@ -161,9 +179,7 @@ pub enum Geometry {
 }
 
 /// When the car from the right counts as detected.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Detector {
     /// Any returned point on the car (k-of-n frames; `carla`: ticks).
     #[default]
@@ -174,9 +190,7 @@ pub enum Detector {
 }
 
 /// When a car arrives (TTA is measured to this moment).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Arrival {
     /// Its front reaches |y| = `conflict_half_width_m`.
     #[default]
@@ -186,38 +200,30 @@ pub enum Arrival {
     ArgusCentre,
 }
 
-impl Geometry {
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Planar => "planar",
-            Self::Carla => "carla",
-        }
-    }
-}
+crate::names::named_enum!(Variant {
+    Baseline => "baseline", "Uniform (the non-adaptive LiDAR)";
+    Range => "range", "Range control (closed form)";
+    Resolution => "resolution", "Resolution control (closed form; in `argus`, the paper code's variant)";
+    Joint => "joint", "Both (closed form)";
+    Optimized => "optimized", "The optimizer's profile (needs the `solver` feature): by default the paper's sensor with Levi's E2 acuity (60° region of focus), joint, continuous levels; or `SimConfig::optimizer`";
+});
 
-impl Detector {
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::FirstReturn => "first-return",
-            Self::Argus => "argus",
-        }
-    }
-}
+crate::names::named_enum!(Geometry {
+    Planar => "planar", "One horizontal channel in a top view, scaled by the channel count (the lightweight default)";
+    Carla => "carla", "CARLA's 3D ray-cast LiDAR: every channel over the vertical field of view, a mount above a flat road, boxes with heights, CARLA's drop-off";
+});
+
+crate::names::named_enum!(Detector {
+    FirstReturn => "first-return", "Any returned point on the car (k-of-n frames; `carla`: ticks)";
+    Argus => "argus", "ARGUS's rule: road mask from ground returns, a vehicle point above a road cell in its region (`carla` geometry only)";
+});
+
+crate::names::named_enum!(Arrival {
+    Front => "front", "Its front reaches |y| = `conflict_half_width_m`";
+    ArgusCentre => "argus-centre", "Its centre reaches |y| = `conflict_half_width_m` (ARGUS: the actor's location reaching world x ≤ 1.75 m)";
+});
 
 impl Arrival {
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Front => "front",
-            Self::ArgusCentre => "argus-centre",
-        }
-    }
-
     /// Distance the car travels after its front reaches the conflict line
     /// before it arrives, m.
     #[must_use]
@@ -778,24 +784,15 @@ impl<'c> Prepared<'c> {
             )));
         }
         if config.detector == Detector::Argus && config.geometry != Geometry::Carla {
-            return Err(SimError::Argument(
-                "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)"
-                    .into(),
-            ));
+            return Err(Conflict::DetectorNeedsCarla.into());
         }
         if config.geometry == Geometry::Carla && config.scenario.false_alarms_per_frame > 0.0 {
-            return Err(SimError::Argument(
-                "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)"
-                    .into(),
-            ));
+            return Err(Conflict::FalseAlarmsNeedPlanar.into());
         }
         if config.geometry == Geometry::Carla {
             config.scenario.validate_carla()?;
         } else if config.sampling() != Sampling::Drift {
-            return Err(SimError::Argument(format!(
-                "--sampling {} needs --geometry carla (the planar geometry has only the drift pulse clock)",
-                config.sampling().name()
-            )));
+            return Err(Conflict::SamplingNeedsCarla(config.sampling()).into());
         }
         let fogs: Vec<FogLevel> = config
             .fog_pcts

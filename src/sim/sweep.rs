@@ -54,17 +54,18 @@ pub struct Sweep {
     pub values: Vec<f64>,
 }
 
-/// A sweep specification is invalid.
+/// A sweep specification is invalid. The messages name the specification,
+/// not where it came from (the CLI prefixes its flag).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SweepError {
     /// Not `KEY=V1,V2,…`.
-    #[error("--sweep: '{0}' is not KEY=V1,V2,… (at least one number, at most 50)")]
+    #[error("'{0}' is not KEY=V1,V2,… (at least one number, at most 50)")]
     Syntax(String),
     /// The key is not a numeric scenario key.
-    #[error("--sweep: '{0}' is not a numeric scenario key (e.g. speed_kmh, carla.mount_height_m, mount_height, tick, spawn_distance, grid_phase, fog_threshold)")]
+    #[error("'{0}' is not a numeric scenario key (e.g. speed_kmh, carla.mount_height_m, mount_height, tick, spawn_distance, grid_phase, fog_threshold)")]
     Key(String),
     /// A value is rejected by the scenario.
-    #[error("--sweep {key}={value}: {reason}")]
+    #[error("{key}={value}: {reason}")]
     Value {
         /// Key.
         key: String,
@@ -123,7 +124,7 @@ pub fn apply(scenario: &Scenario, key: &str, value: f64) -> Result<Scenario, Swe
         _ => return Err(bad_key()),
     }
     let text = toml::to_string(&doc).map_err(|_| bad_key())?;
-    Scenario::from_toml(&text, "--sweep").map_err(|e| SweepError::Value {
+    Scenario::from_toml(&text, "sweep").map_err(|e| SweepError::Value {
         key: key.to_owned(),
         value,
         reason: match e {

@@ -19,6 +19,12 @@
 //! the `json` feature). The planner, optimizer, gaze pipeline, simulator and
 //! CLI live in the `gaze-lidar` crate, which depends on this one.
 //!
+//! Features: `std` (everything but the integer firmware checker and codec),
+//! `json` (profile@1 and firmware@1 files) and `optimizer` (`eye_safety::cuts`,
+//! the linear constraints the optimizer builds from the bound); all on by
+//! default. A vendor who only certifies takes `default-features = false,
+//! features = ["json"]`; without `std` the firmware checker builds `no_std`.
+//!
 //! ## Start here
 //!
 //! A vendor needs the names re-exported at this root: read a profile

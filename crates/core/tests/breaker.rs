@@ -1,4 +1,4 @@
-//! Breaker's regression cases: profiles the checker certifies whose Class 1
+//! Open readings of the standard: profiles the checker certifies whose Class 1
 //! ratio, computed by hand from IEC 60825-1:2014's definitions, exceeds 1
 //! under a stated reading of the standard. Ignored so the suite stays green
 //! until the reading is settled against a licensed copy of the standard.
@@ -29,7 +29,7 @@ fn load(name: &str) -> Profile {
 /// only applicable to pulse durations shorter than 0.25 s" has it, the
 /// single-pulse ratio is 2.0736e-7 / (2.1813e-7 · 0.7467) = 1.273.
 #[test]
-#[ignore = "breaker: depends on C5 for T_i < τ < 0.25 s (checker: C5 = 1); settle against the standard"]
+#[ignore = "open reading: depends on C5 for T_i < τ < 0.25 s (checker: C5 = 1); settle against the standard"]
 fn c5_for_pulses_longer_than_ti_905() {
     let p = load("breaker_c5_pulse_longer_than_ti_905.json");
     let params = p.limits.eye_safety.clone().expect("eye-safety parameters");

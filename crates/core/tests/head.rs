@@ -54,7 +54,7 @@ fn profiles() -> Vec<(String, Profile)> {
     out
 }
 
-/// Every committed eye-safety profile (the audit counterexamples, the two
+/// Every committed eye-safety profile (the counterexamples, the two
 /// AEL step-down profiles, the regression profiles) and the optimizer's
 /// shipped profile: with a 1-channel head of the single-channel shape the
 /// report is today's, bit for bit (the head's figures only added), so every

@@ -16,7 +16,7 @@
 //!   in `tests/data/head_golden/presets.json`) on a 360-bin accelerating
 //!   profile and on random profiles inside the preset's spin limits;
 //! - one channel (no head): every committed eye-safety profile
-//!   (`tests/data/eye_safety/`, `tests/data/optimizer/`: the audit
+//!   (`tests/data/eye_safety/`, `tests/data/optimizer/`: the
 //!   counterexamples, the AEL step-down and regression profiles), each also
 //!   with the 1-channel head of the single-channel shape, and random
 //!   single-channel profiles of 1–200 bins.

@@ -149,7 +149,7 @@ fn verdict(h: &Head) -> Result<(), String> {
 }
 
 /// Kills the mutants of `Head::validate` (`head/mod.rs`) that move its one
-/// numeric boundary. Issue 29's head sample drew seven (lines of `b14eeb0`):
+/// numeric boundary. The head sample drew seven (lines as sampled):
 /// 121:60 `>` → `>=` (512 channels refused), 139:13 `||` → `&&` (a crossing
 /// point at or beyond the aperture accepted), 164:83 `<` → `>` (elevation),
 /// 170:64 `delete !` (azimuth offset), 177:55 `delete !` and 177:66 `<` →

@@ -69,9 +69,7 @@
 use super::super::trial::mix64;
 
 /// How the LiDAR is sampled in the `carla` geometry.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Sampling {
     /// CARLA's fixed tick: `round(rate · dt)` points per laser per tick,
     /// evenly over the tick's rotation, the start angle advancing by it.
@@ -85,17 +83,11 @@ pub enum Sampling {
     Drift,
 }
 
-impl Sampling {
-    /// Name as on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Carla => "carla",
-            Self::CarlaAsync => "carla-async",
-            Self::Drift => "drift",
-        }
-    }
-}
+crate::names::named_enum!(Sampling {
+    Carla => "carla", "CARLA's fixed tick: `round(rate · dt)` points per laser per tick, evenly over the tick's rotation, the start angle advancing by it";
+    CarlaAsync => "carla-async", "CARLA in asynchronous mode: the same per tick, with each tick's length jittered (`carla.async_tick_jitter_frac`, assumed)";
+    Drift => "drift", "The free-running pulse clock `k / pulse_rate_hz` (the planar geometry's, and the `carla` geometry's before sampling existed)";
+});
 
 /// CARLA's points per laser per tick: `RoundHalfFromZero(PointsPerSecond ·
 /// DeltaTime / float(ChannelCount))`, in `float` as CARLA computes it

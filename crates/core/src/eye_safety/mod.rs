@@ -3,8 +3,9 @@
 //! - [`ael`]: the accessible emission limits and correction factors.
 //! - [`bound`]: the sound bound every rule is evaluated by.
 //! - [`report`]: the figures of the `ael` command, from the same model.
-//! - [`cuts`]: concrete exposures as linear constraints on the bin powers,
-//!   for the optimizer (lower bounds of the true ratio, never a verdict).
+//! - `cuts` (feature `optimizer`, on by default): concrete exposures as
+//!   linear constraints on the bin powers, for the optimizer (lower bounds
+//!   of the true ratio, never a verdict).
 //! - [`exposure`]: the exposure of a stationary measurement aperture placed
 //!   at every azimuth around a spinning head running a profile, against
 //!   those limits. Concentrating power or slowing the spin in a sector raises
@@ -17,7 +18,7 @@
 pub mod ael;
 #[cfg(feature = "std")]
 pub mod bound;
-#[cfg(feature = "std")]
+#[cfg(feature = "optimizer")]
 pub mod cuts;
 #[cfg(feature = "std")]
 pub mod exposure;

@@ -1,6 +1,6 @@
 //! The figures the `ael` command reports, computed by the one model:
 //! Table 3 from [`ael`], the stationary-beam limit from
-//! [`Laser::stationary_ratio`] (the same code that bounds a stalled rotor in
+//! `Laser::stationary_ratio` (the same code that bounds a stalled rotor in
 //! every certificate), pulse counts as maxima ([`max_pulses_in`]).
 
 use serde::Serialize;
@@ -58,7 +58,7 @@ pub struct StationaryBeam {
     /// Per-pulse AEL with C5, J (a group's AEL shared by its pulses).
     pub per_pulse_ael_j: f64,
     /// Highest mean power meeting every rule, W: `1 / ratio(1 W)` of
-    /// [`Laser::stationary_ratio`] (every ratio is linear in power).
+    /// `Laser::stationary_ratio` (every ratio is linear in power).
     pub max_average_power_w: f64,
 }
 

@@ -171,7 +171,7 @@ pub fn constructed() -> Vec<Constructed> {
 /// Table 10's largest aperture for 1400–4000 nm, the bound's (mm).
 pub const APERTURE_IR_MODEL_MM: f64 = 3.557_060_558_492_482_4;
 
-/// An issue-21 profile and its true ratios.
+/// An AEL step-down profile and its true ratios.
 pub struct AelStepCase {
     pub name: &'static str,
     /// Sup over clock phases, under the model's aperture.
@@ -186,7 +186,7 @@ pub struct AelStepCase {
     pub how: String,
 }
 
-/// The two issue-21 profiles.
+/// The two AEL step-down profiles.
 pub fn ael_step_cases() -> Vec<AelStepCase> {
     let mut v = Vec::new();
     // (a) 1550 nm, 1 kHz, uniform 10.1 mW, spin 0.00701 rad/s: one pass of

@@ -77,12 +77,12 @@
 /// The absolute rounding slack of every duration the bound computes, per
 /// second of frame period (see "Times from 0°" in the module docs):
 /// `64·ε`, twice the proven `32·ε`.
-pub const TIME_ROUNDING: f64 = 64.0 * f64::EPSILON;
+pub(crate) const TIME_ROUNDING: f64 = 64.0 * f64::EPSILON;
 
 /// The bound on the rounding of any duration the bound computes on a frame
 /// of `frame_s`, s: [`TIME_ROUNDING`]` · T_f`.
 #[must_use]
-pub fn time_rounding_s(frame_s: f64) -> f64 {
+pub(crate) fn time_rounding_s(frame_s: f64) -> f64 {
     TIME_ROUNDING * frame_s
 }
 
@@ -94,13 +94,13 @@ pub fn time_rounding_s(frame_s: f64) -> f64 {
 /// sums at both ends). Raised by [`COUNT_MARGIN`] for the rounding of this
 /// very expression.
 #[must_use]
-pub fn energy_rounding_j(frame_s: f64, variation_w: f64, p_hat_w: f64, turn_j: f64) -> f64 {
+pub(crate) fn energy_rounding_j(frame_s: f64, variation_w: f64, p_hat_w: f64, turn_j: f64) -> f64 {
     let e = (variation_w + 2.0 * p_hat_w) * time_rounding_s(frame_s) + 32.0 * f64::EPSILON * turn_j;
     e * (1.0 + COUNT_MARGIN)
 }
 
 /// Relative margin by which every floor-count is rounded up (see module docs).
-pub const COUNT_MARGIN: f64 = 1e-9;
+pub(crate) const COUNT_MARGIN: f64 = 1e-9;
 
 /// Relative margin every rule's ratio is raised by before the verdict, so
 /// float rounding in the bound can never land it below the true supremum.
@@ -122,7 +122,7 @@ pub(super) const TOUCH_SNAP_DEG: f64 = 1e-9;
 
 /// `⌊x⌋` rounded up when `x` is within [`COUNT_MARGIN`] of the next integer.
 #[must_use]
-pub fn floor_up(x: f64) -> f64 {
+pub(crate) fn floor_up(x: f64) -> f64 {
     floor(x * (1.0 + COUNT_MARGIN) + COUNT_MARGIN)
 }
 

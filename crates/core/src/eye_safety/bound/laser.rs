@@ -101,7 +101,7 @@ impl Laser {
     /// this long, or is covered there. The within-pass rules take the AEL
     /// infimum up to it.
     #[must_use]
-    pub fn one_pass_window_max_s(&self, frame_s: f64, tau_max_s: f64) -> f64 {
+    pub(crate) fn one_pass_window_max_s(&self, frame_s: f64, tau_max_s: f64) -> f64 {
         let delta = 1.0 / self.pulse_rate_hz;
         (frame_s - tau_max_s.max(delta)).clamp(0.0, ael::TIME_BASE_S)
     }
@@ -151,7 +151,12 @@ impl Laser {
     /// pulses in any pass and `passes_t2` passes meeting any T2 window:
     /// `pulse_energy_j ×` [`Self::single_pulse_ratio_per_j`].
     #[must_use]
-    pub fn single_pulse_ratio(&self, pulse_energy_j: f64, per_pass: f64, passes_t2: f64) -> f64 {
+    pub(crate) fn single_pulse_ratio(
+        &self,
+        pulse_energy_j: f64,
+        per_pass: f64,
+        passes_t2: f64,
+    ) -> f64 {
         pulse_energy_j * self.single_pulse_ratio_per_j(per_pass, passes_t2)
     }
 
@@ -273,7 +278,12 @@ impl Laser {
     /// in `(m − 1)·T_f + r` with `P̂·r` below one capped pass (found by the
     /// differential test: 9 passes of 3 pulses at 2049 Hz in 0.3563 s).
     #[must_use]
-    pub fn multi_pass_ratio(&self, frame_s: f64, pass: PassFigures, p_hat_w: f64) -> (f64, f64) {
+    pub(crate) fn multi_pass_ratio(
+        &self,
+        frame_s: f64,
+        pass: PassFigures,
+        p_hat_w: f64,
+    ) -> (f64, f64) {
         let delta = 1.0 / self.pulse_rate_hz;
         let tb = ael::TIME_BASE_S;
         let t_start = (frame_s - pass.duration_s.max(delta)).max(0.0);
@@ -302,7 +312,7 @@ impl Laser {
     /// columns of channels. Returns (ratio, window duration); 0 when no
     /// window of the range is within the time base.
     #[must_use]
-    pub fn windows_from_ratio(
+    pub(crate) fn windows_from_ratio(
         &self,
         frame_s: f64,
         pass: PassFigures,
@@ -325,7 +335,7 @@ impl Laser {
     /// The time-base figure: the smaller of the two multi-pass energy
     /// bounds over a window of the time base, over its AEL.
     #[must_use]
-    pub fn time_base_ratio(&self, frame_s: f64, pass: PassFigures, p_hat_w: f64) -> f64 {
+    pub(crate) fn time_base_ratio(&self, frame_s: f64, pass: PassFigures, p_hat_w: f64) -> f64 {
         let delta = 1.0 / self.pulse_rate_hz;
         let tb = ael::TIME_BASE_S;
         let e = pass
@@ -439,7 +449,7 @@ impl Laser {
     /// Ratio of a stationary beam (every pulse enters the aperture: a
     /// stalled rotor, or the `ael` report) of power `power_w`.
     #[must_use]
-    pub fn stationary_ratio(&self, power_w: f64) -> (f64, Rule) {
+    pub(crate) fn stationary_ratio(&self, power_w: f64) -> (f64, Rule) {
         let delta = 1.0 / self.pulse_rate_hz;
         let t2 = ael::T2_S.min(ael::TIME_BASE_S);
         // All pulses of T2 in one "pass".
@@ -481,7 +491,13 @@ impl PassFigures {
     /// of `t_s`, from the envelope's periodicity: `q·E + min(E, P̂·r)`,
     /// `L = T + Δ = q·T_f + r`.
     #[must_use]
-    pub fn envelope_energy(&self, t_s: f64, frame_s: f64, delta_s: f64, p_hat_w: f64) -> f64 {
+    pub(crate) fn envelope_energy(
+        &self,
+        t_s: f64,
+        frame_s: f64,
+        delta_s: f64,
+        p_hat_w: f64,
+    ) -> f64 {
         let l = t_s + delta_s;
         let q = (l / frame_s).floor();
         let r = (l - q * frame_s).max(0.0);
@@ -491,7 +507,7 @@ impl PassFigures {
     /// Bound C: at most [`passes_in_window`] passes meet a window of `t_s`,
     /// each with at most [`Self::pulses_j`].
     #[must_use]
-    pub fn count_energy(&self, t_s: f64, frame_s: f64) -> f64 {
+    pub(crate) fn count_energy(&self, t_s: f64, frame_s: f64) -> f64 {
         passes_in_window(t_s, self.duration_s.max(0.0), frame_s) * self.pulses_j
     }
 }

@@ -47,7 +47,7 @@
 //! **Rounding.** Every count that is a floor is taken as
 //! `⌊x·(1 + 1e-9) + 1e-9⌋`, so a count that sits on an integer is taken
 //! as the larger one and a perturbation of the inputs by 1e-12 cannot
-//! lower it ([`COUNT_MARGIN`]).
+//! lower it (`COUNT_MARGIN`, in the margin table of `bound/count.rs`).
 //!
 //! **Modules**, in the order of the argument (`specs/eye_safety.md`):
 //! [`seg`] (the bins, runs merged), [`envelope`] (`P̄`), [`count`]
@@ -73,9 +73,9 @@ mod sliding;
 mod walks;
 mod whole_pass;
 
-pub use count::{floor_up, max_pulses_in, passes_in_window, COUNT_MARGIN, RATIO_MARGIN};
+pub(crate) use count::{floor_up, COUNT_MARGIN};
+pub use count::{max_pulses_in, passes_in_window, RATIO_MARGIN};
 pub use laser::{Laser, PassFigures, Rule};
-pub use pulse_cap::PULSE_CAP_MAX_BINS;
 pub use seg::Seg;
 pub use walks::WALK_MAX_PIECES;
 

@@ -8,7 +8,7 @@ use super::count::{max_pulses_in, TOUCH_SNAP_DEG};
 
 /// Most bins a cell's union arc may touch for the per-bin pulse cap of a
 /// pass to be evaluated (beyond, the cap `K·P_max·Δ` is used).
-pub const PULSE_CAP_MAX_BINS: i64 = 64;
+pub(crate) const PULSE_CAP_MAX_BINS: i64 = 64;
 
 /// Sub-cells per cell for the per-bin pulse caps (`Cells::pulse_capped_split`).
 const PULSE_CAP_SPLIT: usize = 8;

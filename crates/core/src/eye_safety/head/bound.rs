@@ -190,7 +190,7 @@ fn separations(fps: &[Footprint], scales: &[f64], r_mm: f64, cycle_s: f64) -> Ve
 /// head by at most `L`, so only the channels whose passes a turn of `L`
 /// reaches contribute (`W(L) ×` each single-channel figure), and every
 /// longer window is bounded by `W_v ×` the multi-pass bounds from
-/// `L/ω_max` on ([`Laser::windows_from_ratio`]). The smallest of these
+/// `L/ω_max` on (`Laser::windows_from_ratio`). The smallest of these
 /// maxima over the separations is returned, with the longer windows'
 /// figure reported under the rule of its duration.
 #[must_use]

@@ -1,4 +1,4 @@
-// Independent brute-force Class 1 evaluator (breaker). Uses no gaze-lidar code.
+// Independent brute-force Class 1 evaluator: a witness search. Uses no gaze-lidar code.
 // Model: aperture at azimuth psi, 100 mm from the scan centre; beam overlaps it
 // while |beta - psi| <= (D_a(T) + D_b)/2/100 mm; the whole pulse energy P/f counts.
 // Pulses t_k = phi + k/f. Rules: (1) every pulse (and every greedy T_i group in

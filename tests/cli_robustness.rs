@@ -1,8 +1,9 @@
-//! Issue 22 (reliability, round 3): one test per kind of hostile input the
-//! round found (kinds 1–13 and 15–18; kind 14, the ARGUS road-mask memory,
-//! is tested with the simulator), through the real binary. Each failed on
-//! the main branch the issue was filed against (11a69c7); the comment on
-//! each test says how.
+//! The binary under hostile input and conditions: one test per kind of
+//! failure (bad bytes and huge lines on stdin, stale gaze, pacing, option
+//! ranges, contradictory files, outputs that would replace inputs, plots,
+//! exit codes, message wording, byte-order marks, beam widths); the ARGUS
+//! road mask's memory is tested with the simulator (`tests/pipeline.rs`).
+//! Each test failed before its fix; the comment on each says how.
 
 mod common;
 
@@ -85,9 +86,9 @@ fn skips_line(bad: &[u8], bad_line: usize, needle: &str) {
     assert!(err.contains("60 samples"), "{err}");
 }
 
-/// Kind 1 — main: `<stdin>:31: stream did not contain valid UTF-8`, exit 2.
+/// Regression: before the fix, `<stdin>:31: stream did not contain valid UTF-8`, exit 2.
 #[test]
-fn kind_01_a_non_utf8_line_on_stdin_is_skipped() {
+fn a_non_utf8_line_on_stdin_is_skipped() {
     skips_line(b"\xff\xfe\x00garbage\n", 31, "not UTF-8");
     // Invalid UTF-8 inside an otherwise valid-looking sample, too.
     skips_line(
@@ -97,9 +98,9 @@ fn kind_01_a_non_utf8_line_on_stdin_is_skipped() {
     );
 }
 
-/// Kind 2 — main: "line longer than 65536 bytes", exit 2.
+/// Regression: before the fix, "line longer than 65536 bytes", exit 2.
 #[test]
-fn kind_02_a_10_mib_line_on_stdin_is_skipped() {
+fn a_10_mib_line_on_stdin_is_skipped() {
     let mut bad = vec![b'x'; 10 << 20];
     bad.push(b'\n');
     skips_line(&bad, 31, "line longer than 65536 bytes");
@@ -111,10 +112,10 @@ fn kind_02_a_10_mib_line_on_stdin_is_skipped() {
     assert!(stderr(&o).contains("<stdin>:31: skipped"), "{}", stderr(&o));
 }
 
-/// Kind 3 — main: after the silence, frames 2.05 and 2.1 are adaptive
+/// Regression: before the fix, after the silence, frames 2.05 and 2.1 are adaptive
 /// (the run of 61 valid samples before the loss still counted).
 #[test]
-fn kind_03_staleness_resets_the_recovery_run_in_replay() {
+fn staleness_resets_the_recovery_run_in_replay() {
     let mut input = samples(0, 60); // 0 … 0.3 s
     input.push_str(&sample(2.0, 90.0));
     input.push_str(&sample(2.2, 90.0));
@@ -198,10 +199,10 @@ fn wait_exit(child: &mut Child, within: Duration) -> std::process::ExitStatus {
     }
 }
 
-/// Kind 3, live — main: after a 0.8 s pause one sample made the next
+/// Regression (live): before the fix, after a 0.8 s pause one sample made the next
 /// frames adaptive.
 #[test]
-fn kind_03_staleness_resets_the_recovery_run_live() {
+fn staleness_resets_the_recovery_run_live() {
     let (mut child, rx, reader) = live_child(&["--bins", "36"]);
     let mut stdin = child.stdin.take().unwrap();
     feed_paced(&mut stdin, Instant::now(), 0, 20, 0.0);
@@ -229,10 +230,10 @@ fn kind_03_staleness_resets_the_recovery_run_live() {
     );
 }
 
-/// Kind 4 — main: `--max-gap-frames 0 --realtime --input` finished a 1 s
+/// Regression: before the fix, `--max-gap-frames 0 --realtime --input` finished a 1 s
 /// recording in 24 ms with one frame.
 #[test]
-fn kind_04_max_gap_frames_0_keeps_realtime_pacing() {
+fn max_gap_frames_0_keeps_realtime_pacing() {
     let d = Dir::new();
     let rec = d.file("rec.jsonl", samples(0, 200)); // 0 … 1.0 s
     for gap in ["0", "200"] {
@@ -267,7 +268,7 @@ fn kind_04_max_gap_frames_0_keeps_realtime_pacing() {
 /// argument '-1' found" for `stream --recover-samples`, `--max-gap-frames`,
 /// `--bins`, and "unexpected argument '-i' found" for `--timeout-ms -inf`.
 #[test]
-fn kind_05_negative_numbers_reach_the_range_check_and_name_the_option() {
+fn negative_numbers_reach_the_range_check_and_name_the_option() {
     let gaze = ["profile", "--gaze-deg", "90"];
     let fw = ["profile", "--gaze-deg", "90", "--format", "firmware"];
     let ael = [
@@ -349,11 +350,11 @@ fn kind_05_negative_numbers_reach_the_range_check_and_name_the_option() {
     }
 }
 
-/// Kind 6 — main: `stream --config` whose limits have power_w_min >
+/// Regression: before the fix, `stream --config` whose limits have power_w_min >
 /// power_w_max exited 1 (as infeasible).
 #[cfg(feature = "solver")]
 #[test]
-fn kind_06_contradictory_limits_in_a_config_are_bad_input() {
+fn contradictory_limits_in_a_config_are_bad_input() {
     let d = Dir::new();
     let c = d.file(
         "c.toml",
@@ -384,11 +385,11 @@ fn kind_06_contradictory_limits_in_a_config_are_bad_input() {
     }
 }
 
-/// Kind 7 — main: live, a tracker clock running backwards was reported as
+/// Regression: before the fix, live, a tracker clock running backwards was reported as
 /// "one fail-safe frame, frame clock restarted at 0 s" (the replay message;
 /// neither happens live).
 #[test]
-fn kind_07_the_live_clock_restart_message_says_what_happens_live() {
+fn the_live_clock_restart_message_says_what_happens_live() {
     let (mut child, rx, reader) = live_child(&["--bins", "36"]);
     let mut stdin = child.stdin.take().unwrap();
     feed_paced(&mut stdin, Instant::now(), 0, 20, 100.0);
@@ -422,13 +423,13 @@ fn kind_07_the_live_clock_restart_message_says_what_happens_live() {
 // ---------------------------------------------------------------------------
 // Flags with `--config`
 
-/// Kind 8 — main: `profile --config c.toml --accounting time` gave
+/// Regression: before the fix, `profile --config c.toml --accounting time` gave
 /// `power_accounting: "angle"`; `--bins` and `--preset` were ignored too.
 /// A flag now replaces the file's value: the output equals that of the file
 /// edited to say the same.
 #[cfg(feature = "solver")]
 #[test]
-fn kind_08_profile_flags_given_with_config_replace_the_file_values() {
+fn profile_flags_given_with_config_replace_the_file_values() {
     let d = Dir::new();
     let base = "bins = 72\n[lidar]\npreset = \"paper\"\n";
     let c = d.file("c.toml", base);
@@ -479,10 +480,10 @@ fn kind_08_profile_flags_given_with_config_replace_the_file_values() {
     expect(&o, 2, &["--bins"], "--bins 3");
 }
 
-/// Kind 9 — main: `stream --config c.toml --preset nope --bins 3` exited 0.
+/// Regression: before the fix, `stream --config c.toml --preset nope --bins 3` exited 0.
 #[cfg(feature = "solver")]
 #[test]
-fn kind_09_stream_flags_given_with_config_are_checked_and_honoured() {
+fn stream_flags_given_with_config_are_checked_and_honoured() {
     let d = Dir::new();
     let c = d.file("c.toml", "bins = 72\n");
     let input = samples(0, 40);
@@ -510,11 +511,11 @@ fn kind_09_stream_flags_given_with_config_are_checked_and_honoured() {
 // ---------------------------------------------------------------------------
 // Outputs
 
-/// Kind 10 — main: `profile --config c.toml --out c.toml` replaced the
+/// Regression: before the fix, `profile --config c.toml --out c.toml` replaced the
 /// config; `simulate --scenario s.toml --export-json s.toml` the scenario.
 /// Refused now, through symbolic and hard links too, nothing changed.
 #[test]
-fn kind_10_an_output_never_replaces_an_input() {
+fn an_output_never_replaces_an_input() {
     let d = Dir::new();
     let scenario = d.file("s.toml", "speed_kmh = 50.0\n");
     let link = d.path("s-link.json");
@@ -634,11 +635,11 @@ fn run_sim(extra: &[&str]) -> std::process::Output {
     run(&refs, None)
 }
 
-/// Kind 11 — main: with `pl/density_argus.svg` a folder, the run exited 1
+/// Regression: before the fix, with `pl/density_argus.svg` a folder, the run exited 1
 /// only after `rows.json` and `pl/tta_argus.svg/.png` were replaced.
 /// Now every plot file is checked before the run: nothing is replaced.
 #[test]
-fn kind_11_plots_are_all_or_nothing_with_the_other_outputs() {
+fn plots_are_all_or_nothing_with_the_other_outputs() {
     let d = Dir::new();
     let pl = d.path("pl");
     std::fs::create_dir(&pl).unwrap();
@@ -701,10 +702,10 @@ fn kind_11_plots_are_all_or_nothing_with_the_other_outputs() {
     expect(&o, 2, &["--plots", "not a directory"], "plots under a file");
 }
 
-/// Kind 12 — main: `--plots pl --export-json pl/tta_argus.svg` exited 0 and
+/// Regression: before the fix, `--plots pl --export-json pl/tta_argus.svg` exited 0 and
 /// the JSON export was silently overwritten by the plot.
 #[test]
-fn kind_12_an_output_named_like_a_plot_is_refused() {
+fn an_output_named_like_a_plot_is_refused() {
     let d = Dir::new();
     for existing in [true, false] {
         let pl = d.path(if existing { "pl" } else { "fresh" });
@@ -737,11 +738,11 @@ fn kind_12_an_output_named_like_a_plot_is_refused() {
     assert_eq!(std::fs::read_to_string(&a).unwrap(), "keep");
 }
 
-/// Kind 13 — main: the exit code of a failed write (full disk: 1) was
+/// Regression: before the fix, the exit code of a failed write (full disk: 1) was
 /// documented nowhere a user looks. The README's CLI reference and
 /// `gaze-lidar --help` both state every exit code.
 #[test]
-fn kind_13_exit_codes_are_documented_where_a_user_looks() {
+fn exit_codes_are_documented_where_a_user_looks() {
     let readme =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
     let help = stdout(&run(&["--help"], None));
@@ -795,10 +796,10 @@ fn compact(o: &std::process::Output, what: &str) {
     assert!(longest <= 17, "{what}: a {longest}-digit number in: {err}");
 }
 
-/// Kind 15 — main: `ael --pulse-duration-s 1e300` and a sensor limit of
+/// Regression: before the fix, `ael --pulse-duration-s 1e300` and a sensor limit of
 /// 1e300 ("looser than the sensor's 1000…0") printed 301 digits.
 #[test]
-fn kind_15_numbers_in_messages_are_compact() {
+fn numbers_in_messages_are_compact() {
     let d = Dir::new();
     let ael = ["ael", "--wavelength-nm", "905", "--pulse-duration-s"];
     let mut cases: Vec<Vec<String>> = Vec::new();
@@ -868,10 +869,10 @@ fn kind_15_numbers_in_messages_are_compact() {
     );
 }
 
-/// Kind 16 — main: toml's ASCII-art snippet (`  |`, `^^^`) was flattened
+/// Regression: before the fix, toml's ASCII-art snippet (`  |`, `^^^`) was flattened
 /// into the one-line error of a bad `--sensor` file.
 #[test]
-fn kind_16_toml_errors_are_line_column_and_message() {
+fn toml_errors_are_line_column_and_message() {
     let d = Dir::new();
     let good = d.file(
         "good.json",
@@ -917,10 +918,10 @@ fn kind_16_toml_errors_are_line_column_and_message() {
     }
 }
 
-/// Kind 17 — main: a profile starting with a UTF-8 BOM got "1:1: expected
+/// Regression: before the fix, a profile starting with a UTF-8 BOM got "1:1: expected
 /// value" without naming the BOM. Every text input names it.
 #[test]
-fn kind_17_a_byte_order_mark_is_named() {
+fn a_byte_order_mark_is_named() {
     let d = Dir::new();
     let good = run(&["profile", "--gaze-deg", "90", "--bins", "36"], None).stdout;
     let mut bom = b"\xEF\xBB\xBF".to_vec();
@@ -963,10 +964,10 @@ fn kind_17_a_byte_order_mark_is_named() {
     assert!(stderr(&o).contains("<stdin>:1: skipped: starts with a UTF-8 byte-order mark"));
 }
 
-/// Kind 18 — main: `ael --beam-diameter-mm 1e300` exited 0 with a scan
+/// Regression: before the fix, `ael --beam-diameter-mm 1e300` exited 0 with a scan
 /// pass angle above 360°.
 #[test]
-fn kind_18_a_beam_wider_than_a_turn_is_refused() {
+fn a_beam_wider_than_a_turn_is_refused() {
     let ael = |d: &str| {
         run(
             &[

@@ -1,4 +1,4 @@
-//! Issue 11: a corpus of hostile input and hostile conditions, through the
+//! A corpus of hostile input and hostile conditions, through the
 //! real binary, for every subcommand and every file format (profile JSON,
 //! scenario TOML, optimizer TOML). Each case asserts the exit code (2 bad
 //! input, 1 infeasible / rejected / failed write), one message line naming

@@ -2,7 +2,7 @@ import json, math, os, random, subprocess, sys
 HERE=os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0,HERE)
 GL=os.environ.get('GAZE_LIDAR',os.path.join(HERE,'..','..','target','release','gaze-lidar'))
-ORACLE=os.environ.get('ORACLE',os.path.join(HERE,'target','release','breaker-oracle'))
+ORACLE=os.environ.get('ORACLE',os.path.join(HERE,'target','release','class1-witness'))
 OUT=os.environ.get('OUT','/tmp')
 from gen import prof
 seed=int(sys.argv[1]); N=int(sys.argv[2]); random.seed(seed)
