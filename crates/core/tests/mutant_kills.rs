@@ -309,3 +309,53 @@ fn head_file_defaults_are_the_description_s() {
     assert_eq!(h.aperture_distance_mm, 100.0);
     h.validate().unwrap();
 }
+
+/// Kills `bound/mod.rs` `evaluate_with`: `pulses_j: best.e_max.0 + e_pad` →
+/// `best.e_max.0 - e_pad` (the pass energy handed to the multi-pass rules
+/// loses the bound on the rounding of the envelope integrals instead of
+/// gaining it), and its two neighbours on the other pass figures
+/// (`envelope_j: e_env_max + e_pad`, `duration_s: τ_max + t_pad`).
+///
+/// Every energy the bound computes is a difference of integrals from 0°, so
+/// it may be off by `energy_rounding_j` ≥ `2·P̂·64ε·T_f` (the margin table
+/// in `bound/count.rs`), and every duration by `64ε·T_f`: the pass figures
+/// the multi-pass rules use must exceed the largest pass energy and the
+/// longest pass by at least those. On the near-stopped frame of
+/// `tests/time_rounding.rs` (905 nm, 152 kHz, 16.2 mW over 20° at
+/// 600 rad/s, 340° dark at 2.6e-6 rad/s) by hand: `T_f` =
+/// `0.349066/600 + 5.934119/2.6e-6` = 2.282353·10⁶ s, so the pads are at
+/// least `2 · 16.2e-3 W · 64ε · T_f` = 1.0509·10⁻⁹ J (1 % of one pulse's
+/// 1.0658·10⁻⁷ J) and `64ε · T_f` = 3.2434·10⁻⁸ s.
+#[test]
+fn multi_pass_figures_carry_the_rounding_pads() {
+    use gaze_lidar_core::eye_safety::bound;
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let (f_p, p) = (152e3, 16.2e-3);
+    let segs = vec![seg(0.0, 340.0, 0.0, 2.6e-6), seg(340.0, 20.0, p, 600.0)];
+    let frame_s = 20f64.to_radians() / 600.0 + 340f64.to_radians() / 2.6e-6;
+    assert!((frame_s / 2.282_353e6 - 1.0).abs() < 1e-6, "{frame_s}");
+    let t_pad = 64.0 * f64::EPSILON * frame_s;
+    let e_pad = 2.0 * p * t_pad;
+    assert!((e_pad / 1.0509e-9 - 1.0).abs() < 1e-4, "{e_pad}");
+    let prm = params(905.0, 0.5);
+    let l = laser(&prm, f_p).unwrap();
+    let b = bound::evaluate(&segs, 0.5 * pass_angle_deg(&prm, &l), &l);
+    assert!(
+        b.pass.pulses_j >= b.max_pass_energy_j + e_pad,
+        "{:?} over {}",
+        b.pass,
+        b.max_pass_energy_j
+    );
+    assert!(
+        b.pass.envelope_j >= b.max_pass_energy_j + e_pad,
+        "{:?} over {}",
+        b.pass,
+        b.max_pass_energy_j
+    );
+    assert!(
+        b.pass.duration_s >= b.max_pass_duration_s + t_pad,
+        "{:?} over {}",
+        b.pass,
+        b.max_pass_duration_s
+    );
+}
