@@ -359,3 +359,68 @@ fn multi_pass_figures_carry_the_rounding_pads() {
         b.max_pass_duration_s
     );
 }
+
+/// Kills two mutants of `bound/cells.rs` `Cells::sweep`'s Rule 1 at a cell
+/// end that touches a hot bin: `tau_touch = 8s/ω_min + t_slack` →
+/// `8s/ω_min · t_slack` (the touching pass's duration without the growth
+/// over the `2s` the cut may be off, `s` = `TOUCH_SNAP_DEG` = 1e-9°), and
+/// `p_near`'s arc end `θ + h + 3s` → `(θ + h)·3s` (the hottest bin near a
+/// cut read from the pass's left end only, so a hot bin touched by the
+/// right edge is missed there).
+///
+/// The bound snaps every pass edge by `s` (the cuts are computed, so an
+/// aperture within `2s` of a touch cut may be the one that touches): Rule 1
+/// covers every aperture within `2s` of a cut with the bins touched there.
+/// 905 nm, beam 0.5 mm: `2h` = 0.075 rad (4.2972°). A dark bin
+/// `[0°, 10°)` at `ω_S` = 1e-3 rad/s, a dark bin `[10°, 10° + a)` and a hot
+/// one (`p`) of 5° after it at `ω_A` = 100 rad/s, the rest dark at
+/// `ω_A`; `a = 2h − δ`, `δ` = 5e-4°. The aperture at `θ_c = 10° + a − h`
+/// touches the hot bin with its right edge while its left edge is `δ`
+/// inside the slow bin: `τ_c = δ/ω_S + a/ω_A` = 9.47652e-3 s (passes to
+/// the right, into the hot bin, are shorter: the left edge leaves the slow
+/// bin). `f_p` puts `τ_c·f_p` at 948 − 1.5e-3: 948 pulses. The aperture
+/// `2s` before the cut: `τ = τ_c + 2s·(1/ω_S − 1/ω_A)` = τ_c + 3.4906e-8 s,
+/// `τ·f_p` = 948.0020: 949 pulses for some phase, one pass within T2
+/// (`T_f` = 174.6 s), so C5 = `5·949^-0.25` = 0.900852 and Rule 1 =
+/// `p·Δ / (7.7e-8 J·C4·C5)`, C4 = `10^0.41`. At `p·Δ` set for 1.0001 the
+/// mutants count 948 pulses there (C5 `5·948^-0.25`): 0.99984.
+#[test]
+fn rule_one_counts_the_touching_pass_within_the_snap() {
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let prm = params(905.0, 0.5);
+    let two_h = 0.075;
+    let two_h_deg = f64::to_degrees(two_h);
+    let (w_s, w_a) = (1e-3, 100.0);
+    let delta_deg = 5e-4;
+    let a_deg = two_h_deg - delta_deg;
+    let tau_c = delta_deg.to_radians() / w_s + a_deg.to_radians() / w_a;
+    assert!((tau_c / 9.47652e-3 - 1.0).abs() < 1e-5, "{tau_c}");
+    let f_p = (948.0 - 1.5e-3) / tau_c;
+    assert!(f_p < 2e5, "one pulse per T_i group: {f_p}");
+    let s_rad = 1e-9f64.to_radians();
+    let tau = tau_c + 2.0 * s_rad * (1.0 / w_s - 1.0 / w_a);
+    let pulses = (tau * f_p).floor() + 1.0;
+    assert_eq!(pulses, 949.0);
+    let c5 = 5.0 * pulses.powf(-0.25);
+    assert!((c5 - 0.900_852).abs() < 1e-6, "{c5}");
+    let ael_j = 7.7e-8 * 10f64.powf(0.41) * c5;
+    let e_pulse = 1.0001 * ael_j;
+    let p = e_pulse * f_p;
+    let hot = 10.0 + a_deg;
+    let segs = vec![
+        seg(0.0, 10.0, 0.0, w_s),
+        seg(10.0, a_deg, 0.0, w_a),
+        seg(hot, 5.0, p, w_a),
+        seg(hot + 5.0, 355.0 - hot, 0.0, w_a),
+    ];
+    let l = laser(&prm, f_p).unwrap();
+    assert!((pass_angle_deg(&prm, &l) / two_h_deg - 1.0).abs() < 1e-12);
+    let truth = e_pulse / ael_j;
+    let r = evaluate_segments(&segs, &prm, f_p).unwrap();
+    assert!(
+        r.rule_ratios[0] >= truth,
+        "Rule 1 {} below {truth} ({:?})",
+        r.rule_ratios[0],
+        r.rule_ratios
+    );
+}
