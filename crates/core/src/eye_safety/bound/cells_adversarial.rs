@@ -162,9 +162,9 @@ proptest! {
 }
 
 /// Kills `cells.rs` `Cells::sweep`, the curved cells' midpoint sample of the
-/// right edge's envelope piece: `env.power_at(tl.time_at_unwrapped_s(mid + h)
-/// + delta)` → `... * delta)` (reads `P̄` near time 0 instead of the piece
-/// under the right edge inside the cell). This generator's case (shrunk by
+/// right edge's envelope piece: `t(mid + h) + delta` → `t(mid + h) * delta`
+/// in `pr_mid = env.power_at(..)` (reads `P̄` near time 0 instead of the
+/// piece under the right edge inside the cell). This generator's case (shrunk by
 /// proptest from a failure of the mutant): cell 78 is curved and its right
 /// edge's inside piece is hotter than both end samples; with the mutant
 /// its `e_ub` (1.34106e-3 J) is below the exact figure of the cell
