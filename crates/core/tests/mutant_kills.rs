@@ -424,3 +424,42 @@ fn rule_one_counts_the_touching_pass_within_the_snap() {
         r.rule_ratios
     );
 }
+
+/// Kills `bound/laser.rs` `Laser::time_base_ratio`: `e / self.ael_j(tb)` →
+/// `e * self.ael_j(tb)` (the time-base figure, energy times the AEL
+/// instead of over it: at 905 nm, where `AEL(100 s)` = 0.1 J, a hundredth
+/// of the figure). It is the reported `rule_ratios[3]` whenever the
+/// multi-pass rule binds at a window of at most T2 (then its figure is
+/// `rule_ratios[2]`), as here.
+///
+/// By hand: 905 nm, beam 0.5 mm (`2h` = 0.075 rad), 0.2 Hz at constant
+/// spin (`ω` = 0.4π rad/s), 1 mW throughout, 100 kHz. Every pass lasts
+/// `0.075/0.4π` = 0.0596831 s, so it holds at least `⌊5968.31⌋` = 5968
+/// pulses of 1e-8 J for any clock phase; a 100 s window holds at least
+/// `⌊(100 − τ)/5⌋` = 19 whole passes. `AEL(100 s)` = `3.9e-4 · C4 · 100`
+/// = 0.100246 J (C4 = `10^0.41`): the time-base ratio is at least
+/// `19 · 5968 · 1e-8 / 0.100246` = 0.011311. (The multi-pass rule binds
+/// at two passes in a window just under one frame, `2/T^0.75` against the
+/// time base's `≈ T/T_f`: T2 train.)
+#[test]
+fn time_base_ratio_is_energy_over_the_ael() {
+    let (f_p, p) = (1e5, 1e-3);
+    let w = 0.4 * std::f64::consts::PI;
+    let segs = vec![seg(0.0, 180.0, p, w), seg(180.0, 180.0, p, w)];
+    let tau = 0.075 / w;
+    let per_pass = (tau * f_p).floor();
+    assert_eq!(per_pass, 5968.0);
+    let passes = ((100.0 - tau) / 5.0).floor();
+    assert_eq!(passes, 19.0);
+    let ael_tb = 3.9e-4 * 10f64.powf(0.41) * 100.0;
+    assert!((ael_tb - 0.100_246).abs() < 1e-6, "{ael_tb}");
+    let truth_lb = passes * per_pass * p / f_p / ael_tb;
+    assert!((truth_lb - 0.011_311).abs() < 1e-6, "{truth_lb}");
+    let r = evaluate_segments(&segs, &params(905.0, 0.5), f_p).unwrap();
+    assert!(
+        r.rule_ratios[3] >= truth_lb,
+        "time base {} below {truth_lb} ({:?})",
+        r.rule_ratios[3],
+        r.rule_ratios
+    );
+}
