@@ -309,3 +309,157 @@ fn head_file_defaults_are_the_description_s() {
     assert_eq!(h.aperture_distance_mm, 100.0);
     h.validate().unwrap();
 }
+
+/// Kills `bound/mod.rs` `evaluate_with`: `pulses_j: best.e_max.0 + e_pad` →
+/// `best.e_max.0 - e_pad` (the pass energy handed to the multi-pass rules
+/// loses the bound on the rounding of the envelope integrals instead of
+/// gaining it), and its two neighbours on the other pass figures
+/// (`envelope_j: e_env_max + e_pad`, `duration_s: τ_max + t_pad`).
+///
+/// Every energy the bound computes is a difference of integrals from 0°, so
+/// it may be off by `energy_rounding_j` ≥ `2·P̂·64ε·T_f` (the margin table
+/// in `bound/count.rs`), and every duration by `64ε·T_f`: the pass figures
+/// the multi-pass rules use must exceed the largest pass energy and the
+/// longest pass by at least those. On the near-stopped frame of
+/// `tests/time_rounding.rs` (905 nm, 152 kHz, 16.2 mW over 20° at
+/// 600 rad/s, 340° dark at 2.6e-6 rad/s) by hand: `T_f` =
+/// `0.349066/600 + 5.934119/2.6e-6` = 2.282353·10⁶ s, so the pads are at
+/// least `2 · 16.2e-3 W · 64ε · T_f` = 1.0509·10⁻⁹ J (1 % of one pulse's
+/// 1.0658·10⁻⁷ J) and `64ε · T_f` = 3.2434·10⁻⁸ s.
+#[test]
+fn multi_pass_figures_carry_the_rounding_pads() {
+    use gaze_lidar_core::eye_safety::bound;
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let (f_p, p) = (152e3, 16.2e-3);
+    let segs = vec![seg(0.0, 340.0, 0.0, 2.6e-6), seg(340.0, 20.0, p, 600.0)];
+    let frame_s = 20f64.to_radians() / 600.0 + 340f64.to_radians() / 2.6e-6;
+    assert!((frame_s / 2.282_353e6 - 1.0).abs() < 1e-6, "{frame_s}");
+    let t_pad = 64.0 * f64::EPSILON * frame_s;
+    let e_pad = 2.0 * p * t_pad;
+    assert!((e_pad / 1.0509e-9 - 1.0).abs() < 1e-4, "{e_pad}");
+    let prm = params(905.0, 0.5);
+    let l = laser(&prm, f_p).unwrap();
+    let b = bound::evaluate(&segs, 0.5 * pass_angle_deg(&prm, &l), &l);
+    assert!(
+        b.pass.pulses_j >= b.max_pass_energy_j + e_pad,
+        "{:?} over {}",
+        b.pass,
+        b.max_pass_energy_j
+    );
+    assert!(
+        b.pass.envelope_j >= b.max_pass_energy_j + e_pad,
+        "{:?} over {}",
+        b.pass,
+        b.max_pass_energy_j
+    );
+    assert!(
+        b.pass.duration_s >= b.max_pass_duration_s + t_pad,
+        "{:?} over {}",
+        b.pass,
+        b.max_pass_duration_s
+    );
+}
+
+/// Kills two mutants of `bound/cells.rs` `Cells::sweep`'s Rule 1 at a cell
+/// end that touches a hot bin: `tau_touch = 8s/ω_min + t_slack` →
+/// `8s/ω_min · t_slack` (the touching pass's duration without the growth
+/// over the `2s` the cut may be off, `s` = `TOUCH_SNAP_DEG` = 1e-9°), and
+/// `p_near`'s arc end `θ + h + 3s` → `(θ + h)·3s` (the hottest bin near a
+/// cut read from the pass's left end only, so a hot bin touched by the
+/// right edge is missed there).
+///
+/// The bound snaps every pass edge by `s` (the cuts are computed, so an
+/// aperture within `2s` of a touch cut may be the one that touches): Rule 1
+/// covers every aperture within `2s` of a cut with the bins touched there.
+/// 905 nm, beam 0.5 mm: `2h` = 0.075 rad (4.2972°). A dark bin
+/// `[0°, 10°)` at `ω_S` = 1e-3 rad/s, a dark bin `[10°, 10° + a)` and a hot
+/// one (`p`) of 5° after it at `ω_A` = 100 rad/s, the rest dark at
+/// `ω_A`; `a = 2h − δ`, `δ` = 5e-4°. The aperture at `θ_c = 10° + a − h`
+/// touches the hot bin with its right edge while its left edge is `δ`
+/// inside the slow bin: `τ_c = δ/ω_S + a/ω_A` = 9.47652e-3 s (passes to
+/// the right, into the hot bin, are shorter: the left edge leaves the slow
+/// bin). `f_p` puts `τ_c·f_p` at 948 − 1.5e-3: 948 pulses. The aperture
+/// `2s` before the cut: `τ = τ_c + 2s·(1/ω_S − 1/ω_A)` = τ_c + 3.4906e-8 s,
+/// `τ·f_p` = 948.0020: 949 pulses for some phase, one pass within T2
+/// (`T_f` = 174.6 s), so C5 = `5·949^-0.25` = 0.900852 and Rule 1 =
+/// `p·Δ / (7.7e-8 J·C4·C5)`, C4 = `10^0.41`. At `p·Δ` set for 1.0001 the
+/// mutants count 948 pulses there (C5 `5·948^-0.25`): 0.99984.
+#[test]
+fn rule_one_counts_the_touching_pass_within_the_snap() {
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let prm = params(905.0, 0.5);
+    let two_h = 0.075;
+    let two_h_deg = f64::to_degrees(two_h);
+    let (w_s, w_a) = (1e-3, 100.0);
+    let delta_deg = 5e-4;
+    let a_deg = two_h_deg - delta_deg;
+    let tau_c = delta_deg.to_radians() / w_s + a_deg.to_radians() / w_a;
+    assert!((tau_c / 9.47652e-3 - 1.0).abs() < 1e-5, "{tau_c}");
+    let f_p = (948.0 - 1.5e-3) / tau_c;
+    assert!(f_p < 2e5, "one pulse per T_i group: {f_p}");
+    let s_rad = 1e-9f64.to_radians();
+    let tau = tau_c + 2.0 * s_rad * (1.0 / w_s - 1.0 / w_a);
+    let pulses = (tau * f_p).floor() + 1.0;
+    assert_eq!(pulses, 949.0);
+    let c5 = 5.0 * pulses.powf(-0.25);
+    assert!((c5 - 0.900_852).abs() < 1e-6, "{c5}");
+    let ael_j = 7.7e-8 * 10f64.powf(0.41) * c5;
+    let e_pulse = 1.0001 * ael_j;
+    let p = e_pulse * f_p;
+    let hot = 10.0 + a_deg;
+    let segs = vec![
+        seg(0.0, 10.0, 0.0, w_s),
+        seg(10.0, a_deg, 0.0, w_a),
+        seg(hot, 5.0, p, w_a),
+        seg(hot + 5.0, 355.0 - hot, 0.0, w_a),
+    ];
+    let l = laser(&prm, f_p).unwrap();
+    assert!((pass_angle_deg(&prm, &l) / two_h_deg - 1.0).abs() < 1e-12);
+    let truth = e_pulse / ael_j;
+    let r = evaluate_segments(&segs, &prm, f_p).unwrap();
+    assert!(
+        r.rule_ratios[0] >= truth,
+        "Rule 1 {} below {truth} ({:?})",
+        r.rule_ratios[0],
+        r.rule_ratios
+    );
+}
+
+/// Kills `bound/laser.rs` `Laser::time_base_ratio`: `e / self.ael_j(tb)` →
+/// `e * self.ael_j(tb)` (the time-base figure, energy times the AEL
+/// instead of over it: at 905 nm, where `AEL(100 s)` = 0.1 J, a hundredth
+/// of the figure). It is the reported `rule_ratios[3]` whenever the
+/// multi-pass rule binds at a window of at most T2 (then its figure is
+/// `rule_ratios[2]`), as here.
+///
+/// By hand: 905 nm, beam 0.5 mm (`2h` = 0.075 rad), 0.2 Hz at constant
+/// spin (`ω` = 0.4π rad/s), 1 mW throughout, 100 kHz. Every pass lasts
+/// `0.075/0.4π` = 0.0596831 s, so it holds at least `⌊5968.31⌋` = 5968
+/// pulses of 1e-8 J for any clock phase; a 100 s window holds at least
+/// `⌊(100 − τ)/5⌋` = 19 whole passes. `AEL(100 s)` = `3.9e-4 · C4 · 100`
+/// = 0.100246 J (C4 = `10^0.41`): the time-base ratio is at least
+/// `19 · 5968 · 1e-8 / 0.100246` = 0.011311. (The multi-pass rule binds
+/// at two passes in a window just under one frame, `2/T^0.75` against the
+/// time base's `≈ T/T_f`: T2 train.)
+#[test]
+fn time_base_ratio_is_energy_over_the_ael() {
+    let (f_p, p) = (1e5, 1e-3);
+    let w = 0.4 * std::f64::consts::PI;
+    let segs = vec![seg(0.0, 180.0, p, w), seg(180.0, 180.0, p, w)];
+    let tau = 0.075 / w;
+    let per_pass = (tau * f_p).floor();
+    assert_eq!(per_pass, 5968.0);
+    let passes = ((100.0 - tau) / 5.0).floor();
+    assert_eq!(passes, 19.0);
+    let ael_tb = 3.9e-4 * 10f64.powf(0.41) * 100.0;
+    assert!((ael_tb - 0.100_246).abs() < 1e-6, "{ael_tb}");
+    let truth_lb = passes * per_pass * p / f_p / ael_tb;
+    assert!((truth_lb - 0.011_311).abs() < 1e-6, "{truth_lb}");
+    let r = evaluate_segments(&segs, &params(905.0, 0.5), f_p).unwrap();
+    assert!(
+        r.rule_ratios[3] >= truth_lb,
+        "time base {} below {truth_lb} ({:?})",
+        r.rule_ratios[3],
+        r.rule_ratios
+    );
+}

@@ -160,3 +160,47 @@ proptest! {
         check(&segs, h, f_p, 32)?;
     }
 }
+
+/// Kills `cells.rs` `Cells::sweep`, the curved cells' midpoint sample of the
+/// right edge's envelope piece: `t(mid + h) + delta` → `t(mid + h) * delta`
+/// in `pr_mid = env.power_at(..)` (reads `P̄` near time 0 instead of the
+/// piece under the right edge inside the cell). This generator's case (shrunk by
+/// proptest from a failure of the mutant): cell 78 is curved and its right
+/// edge's inside piece is hotter than both end samples; with the mutant
+/// its `e_ub` (1.34106e-3 J) is below the exact figure of the cell
+/// (1.34702e-3 J, from its stationary point), so the pruned search could
+/// skip the cell holding the largest pass energy. Fixed here so the kill
+/// does not depend on the random stream.
+#[test]
+fn curved_cell_samples_the_right_edge_piece_at_its_midpoint() {
+    let bins: Vec<BinSpec> = vec![
+        (0.001, 0.003_383_423_190_297_945, 0.005),
+        (
+            0.232_528_118_409_558_25,
+            0.001_359_857_751_943_493_7,
+            0.048_548_613_744_048_16,
+        ),
+        (0.421_150_955_864_305_5, 0.005, 1.0),
+        (0.478_450_448_636_732_7, 0.0, 2.0),
+        (0.001, 0.0, 2.0),
+        (0.001, 0.0, 2.0),
+        (0.985_773_668_528_486_2, 0.002_726_025_142_229_411, 0.001),
+        (0.2, 0.0, 0.005),
+        (0.324_776_198_787_378_35, 0.0, 2.0),
+        (0.871_014_079_579_420_2, 0.0, 2.0),
+        (0.006_621_891_946_327_492_5, 0.0, 2.0),
+        (0.814_538_886_337_845_9, 0.0, 2.0),
+        (0.002_746_435_399_943_662_6, 0.0, 2.0),
+        (0.400_801_769_601_810_2, 0.0, 2.0),
+        (0.006_998_717_675_824_66, 0.0, 2.0),
+        (0.219_892_553_431_059_85, 0.0, 2.0),
+        (0.596_349_073_139_978_1, 0.0, 2.0),
+        (0.994_594_853_615_787_3, 0.0, 2.0),
+        (0.906_022_579_065_936_4, 0.003_168_696_947_349_295_3, 0.005),
+        (0.007_180_317_659_860_826, 0.0, 0.790_780_945_237_944_3),
+    ];
+    let segs = segs_of(&bins);
+    let h = h_of(&segs, (0, 0, 2.629_386_609_927_519_4));
+    let f_p = f_p_of(&segs, h, (2, 58, 1000.0));
+    check(&segs, h, f_p, 32).unwrap();
+}
