@@ -2,7 +2,8 @@
 //! the eye safety of a whole multi-beam head, and its self-tests (each able
 //! to fail). `HEAD_ORACLE_CASES` scales the random runs; `HEAD_ORACLE_SHAPES`
 //! caps the fixed-shape runs (real heads, separated pairs) for quick nets
-//! such as the mutant runs of `specs/mutants.md` (default: all of them).
+//! such as "The quick net for the bound and the head" of `specs/mutants.md`
+//! (default: all of them).
 
 mod head_oracle_defs;
 mod reference_defs;

@@ -1,5 +1,6 @@
 //! Tests that pin two parts of the bound no other core test reached
-//! (`specs/mutants.md`): a window walk over more than `WALK_MAX_PIECES`
+//! (`specs/mutants.md`, "`eye_safety/bound/*.rs` (the split bound)" and
+//! "`eye_safety/head/*.rs`"): a window walk over more than `WALK_MAX_PIECES`
 //! envelope pieces inside one pass, and the multi-pass pass-count rule on a
 //! pass longer than half a frame. Each names the mutant it kills.
 
