@@ -2260,3 +2260,46 @@ fn many_channels_are_copied_in_bounded_memory() {
     assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
     assert!(!out.exists());
 }
+
+/// Single-byte corruptions of a zstd and an lz4 bag (every k-th byte, some
+/// 150 positions each): exit 0, 1 or 2, never a signal (an abort on a huge
+/// allocation from a corrupt inner length was one), never a leftover
+/// temporary file, and no output unless the exit is 0.
+#[test]
+fn single_byte_corruptions_of_compressed_bags_never_abort_or_leave_a_temp_file() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let out = dir.path().join("out.mcap");
+    for compression in [mcap::Compression::Zstd, mcap::Compression::Lz4] {
+        let good = bag(Some(compression));
+        let step = (good.len() / 150).max(1);
+        // Offsets spread over the whole file, shifted so that not only the
+        // multiples of `step` are hit.
+        for (n, at) in (8..good.len() - 8).step_by(step).enumerate() {
+            let mut b = good.clone();
+            b[at] ^= [0xff, 0x01, 0x80, 0x55][n % 4];
+            std::fs::write(&input, &b).unwrap();
+            let _ = std::fs::remove_file(&out);
+            let o = replay_cli(&input, &out);
+            let stderr = String::from_utf8_lossy(&o.stderr);
+            assert!(
+                matches!(o.status.code(), Some(0..=2)),
+                "{compression:?} byte {at}: {:?} (signal {:?}): {stderr}",
+                o.status,
+                o.status.signal()
+            );
+            assert!(!stderr.contains("panicked"), "byte {at}: {stderr}");
+            let left: Vec<String> = std::fs::read_dir(dir.path())
+                .unwrap()
+                .map(|e| e.unwrap().file_name().into_string().unwrap())
+                .filter(|n| n != "in.mcap" && n != "out.mcap")
+                .collect();
+            assert!(left.is_empty(), "{compression:?} byte {at}: {left:?}");
+            if o.status.code() != Some(0) {
+                assert!(!out.exists(), "{compression:?} byte {at}: output left");
+                assert_eq!(stderr.lines().count(), 1, "byte {at}: {stderr}");
+            }
+        }
+    }
+}

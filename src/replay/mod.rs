@@ -42,6 +42,7 @@
 //! cloud's frame ([`scene`]).
 
 pub mod cdr;
+mod chunk;
 pub mod scene;
 pub mod schemas;
 pub mod tf;
@@ -1326,12 +1327,11 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                         }
                         // Unpacked and its CRC checked before any of its
                         // messages is used.
-                        mcap::read::ChunkReader::new(header, &data)
-                            .and_then(|c| {
-                                c.map(|r| r.map(mcap::records::Record::into_owned))
-                                    .collect::<Result<Vec<_>, _>>()
-                            })
-                            .map_err(|e| mcap_err(at, "in this chunk: ", e))?
+                        chunk::unpack(&header, &data).map_err(|reason| ReplayError::Mcap {
+                            path: path.to_owned(),
+                            offset: at,
+                            reason: format!("in this chunk: {reason}"),
+                        })?
                     }
                     other => vec![other.into_owned()],
                 };
