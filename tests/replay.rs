@@ -1410,7 +1410,17 @@ fn a_signal_removes_the_temporary_output() {
             .filter(|n| n.starts_with(".gaze-lidar-replay"))
             .collect()
     };
-    for (sig, code) in [("INT", 130), ("TERM", 143), ("HUP", 129)] {
+    for (sig, code) in [
+        ("INT", 130),
+        ("TERM", 143),
+        ("HUP", 129),
+        ("QUIT", 131),
+        ("USR1", 138),
+        ("USR2", 140),
+        ("ALRM", 142),
+        ("XFSZ", 153),
+        ("VTALRM", 154),
+    ] {
         let mut child = bin()
             .arg("replay")
             .arg(&input)

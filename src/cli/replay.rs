@@ -122,17 +122,25 @@ fn replay_error(e: ReplayError) -> CliError {
     }
 }
 
-/// On SIGINT, SIGTERM or SIGHUP (a closed terminal), a thread removes the
-/// temporary output file named in the returned [`Staging`] (if any) and
-/// exits 128 + the signal (130, 143, 129), as a shell reports a process the
-/// signal ended. (Devices, FIFOs and
+/// On every catchable signal whose default action ends the process (INT,
+/// TERM, HUP, QUIT, USR1, USR2, ALRM, XFSZ, XCPU, VTALRM, PROF, IO, SYS), a
+/// thread removes the temporary output file named in the returned
+/// [`Staging`] (if any) and exits 128 + the signal (130 for INT, 143 for
+/// TERM, 138 for USR1), as a shell reports a process the signal ended. PIPE
+/// is ignored (a closed stdout is a write error); TRAP is left to debuggers. (Devices, FIFOs and
 /// stdout are staged in an anonymous temporary file, which the system
 /// removes with the process.)
 fn remove_on_signal() -> Result<&'static Staging, CliError> {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    use signal_hook::consts::signal::{
+        SIGALRM, SIGHUP, SIGINT, SIGIO, SIGPROF, SIGQUIT, SIGSYS, SIGTERM, SIGUSR1, SIGUSR2,
+        SIGVTALRM, SIGXCPU, SIGXFSZ,
+    };
     static STAGING: Staging = std::sync::Mutex::new(None);
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
-        .map_err(|e| CliError::output(format!("installing the signal handler: {e}")))?;
+    let mut signals = signal_hook::iterator::Signals::new([
+        SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGXFSZ, SIGXCPU, SIGVTALRM,
+        SIGPROF, SIGIO, SIGSYS,
+    ])
+    .map_err(|e| CliError::output(format!("installing the signal handler: {e}")))?;
     std::thread::spawn(move || {
         if let Some(sig) = signals.forever().next() {
             let staged = STAGING

@@ -48,9 +48,11 @@ pub(crate) fn unpack(header: &ChunkHeader, data: &[u8]) -> Result<Vec<Record<'st
             owned = out;
             &owned
         }
-        other => return Err(format!(
+        other => {
+            return Err(format!(
             "a chunk is compressed with `{other}`; replay reads uncompressed, lz4 and zstd chunks"
-        )),
+        ))
+        }
     };
     if unpacked.len() != declared {
         return Err(format!(

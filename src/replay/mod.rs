@@ -1483,7 +1483,7 @@ pub fn replay_file<P: FramePlanner>(
 pub type Staging = std::sync::Mutex<Option<std::path::PathBuf>>;
 
 /// [`replay_file`], publishing its temporary file in `staging` (see
-/// [`Staging`]; `gaze-lidar replay` removes it on SIGINT and SIGTERM).
+/// [`Staging`]; `gaze-lidar replay` removes it on every catchable terminating signal).
 pub fn replay_file_staged<P: FramePlanner>(
     input: &std::path::Path,
     output: &std::path::Path,
