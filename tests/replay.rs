@@ -2313,3 +2313,83 @@ fn single_byte_corruptions_of_compressed_bags_never_abort_or_leave_a_temp_file()
         }
     }
 }
+
+/// The cloud topic with its schema replaced by (name, encoding, text).
+fn with_cloud_schema(name: &str, encoding: &str, text: &str) -> Vec<u8> {
+    rewrite(
+        &bag(None),
+        |msgs| {
+            let mut channel: Option<std::sync::Arc<mcap::Channel<'static>>> = None;
+            for m in msgs.iter_mut().filter(|m| m.channel.topic == CLOUD) {
+                let c = channel.get_or_insert_with(|| {
+                    std::sync::Arc::new(mcap::Channel {
+                        schema: Some(std::sync::Arc::new(mcap::Schema {
+                            id: 40,
+                            name: name.to_owned(),
+                            encoding: encoding.to_owned(),
+                            data: std::borrow::Cow::Owned(text.as_bytes().to_vec()),
+                        })),
+                        ..(*m.channel).clone()
+                    })
+                });
+                m.channel = c.clone();
+            }
+        },
+        |_| {},
+    )
+}
+
+/// A cloud topic whose schema is not PointCloud2 in `ros2msg` (an IDL
+/// schema, another type, no schema) is refused by name, exit 2; one that
+/// is PointCloud2 in `ros2msg` with an empty or wrong text is decoded, and
+/// the adapted topic carries the tool's own PointCloud2 definition, which
+/// the schema's readers can parse.
+#[test]
+fn a_cloud_schema_that_is_not_point_cloud2_in_ros2msg_is_refused_and_adapted_clouds_carry_the_tools_definition(
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let out = dir.path().join("out.mcap");
+    for (name, encoding, text) in [
+        (
+            schemas::POINT_CLOUD2,
+            "ros2idl",
+            "module sensor_msgs { module msg { struct PointCloud2 { long x; }; }; };",
+        ),
+        ("sensor_msgs/msg/Image", schemas::ROS2MSG, "uint32 height\n"),
+        ("", "", ""),
+    ] {
+        std::fs::write(&input, with_cloud_schema(name, encoding, text)).unwrap();
+        let o = run_replay(&input, &out, &[]);
+        let m = message(&o);
+        assert_eq!(o.status.code(), Some(2), "{name} {encoding}: {m}");
+        assert!(m.contains(CLOUD), "{m}");
+        assert!(m.contains(&format!("{encoding:?}")), "{m}");
+        assert!(m.contains(schemas::POINT_CLOUD2), "{m}");
+        assert!(!out.exists());
+    }
+    let def = schemas::ros2msg(schemas::POINT_CLOUD2).unwrap();
+    for text in ["", "int32 foo\n"] {
+        std::fs::write(
+            &input,
+            with_cloud_schema(schemas::POINT_CLOUD2, schemas::ROS2MSG, text),
+        )
+        .unwrap();
+        let o = run_replay(&input, &out, &[]);
+        assert_eq!(o.status.code(), Some(0), "{text:?}: {}", message(&o));
+        let bytes = std::fs::read(&out).unwrap();
+        let adapted = format!("{CLOUD}/adapted");
+        let mut seen = 0;
+        for m in mcap::MessageStream::new(&bytes).unwrap() {
+            let m = m.unwrap();
+            if m.channel.topic == adapted {
+                let s = m.channel.schema.as_ref().unwrap();
+                assert_eq!(s.name, schemas::POINT_CLOUD2);
+                assert_eq!(s.encoding, schemas::ROS2MSG);
+                assert_eq!(&*s.data, def.as_bytes(), "{text:?}");
+                seen += 1;
+            }
+        }
+        assert_eq!(seen, 30, "{text:?}");
+    }
+}

@@ -872,14 +872,14 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         let adapted = match self.out.adapted {
             Some(id) => id,
             None => {
-                let schema_id = match &p.msg.channel.schema {
-                    Some(s) => self
-                        .out
-                        .mcap
-                        .add_schema(&s.name, &s.encoding, &s.data)
-                        .map_err(write_err)?,
-                    None => 0,
-                };
+                // The tool's own definition, whatever text the input's
+                // schema held (its name and encoding were checked).
+                let def = schemas::ros2msg(schemas::POINT_CLOUD2).unwrap_or_default();
+                let schema_id = self
+                    .out
+                    .mcap
+                    .add_schema(schemas::POINT_CLOUD2, schemas::ROS2MSG, def.as_bytes())
+                    .map_err(write_err)?;
                 let id = self
                     .out
                     .mcap
@@ -1062,15 +1062,23 @@ fn same_type(a: &str, b: &str) -> bool {
     a == b || a.replacen("/msg/", "/", 1) == b.replacen("/msg/", "/", 1)
 }
 
+/// A topic the replay decodes must carry `want` by name, its schema in
+/// `ros2msg` (a ROS 2 message definition) and its messages in CDR; anything
+/// else (an IDL schema, a schemaless channel, JSON) is refused by name
+/// rather than decoded as if it were `want`.
 fn check_schema(ch: &mcap::Channel<'_>, want: &str) -> Result<(), ReplayError> {
     let name = ch.schema.as_ref().map_or("", |s| s.name.as_str());
-    if !same_type(name, want) || ch.message_encoding != schemas::CDR {
+    let encoding = ch.schema.as_ref().map_or("", |s| s.encoding.as_str());
+    if !same_type(name, want) || encoding != schemas::ROS2MSG || ch.message_encoding != schemas::CDR
+    {
         return Err(ReplayError::Topic {
             topic: ch.topic.clone(),
             reason: format!(
-                "carries {} messages encoded as {:?}, not {want} in cdr",
+                "carries {} messages (schema encoding {encoding:?}, message encoding {:?}), not {want} (schema encoding \"{}\", message encoding \"{}\")",
                 if name.is_empty() { "schemaless" } else { name },
-                ch.message_encoding
+                ch.message_encoding,
+                schemas::ROS2MSG,
+                schemas::CDR,
             ),
         });
     }
