@@ -2393,3 +2393,133 @@ fn a_cloud_schema_that_is_not_point_cloud2_in_ros2msg_is_refused_and_adapted_clo
         assert_eq!(seen, 30, "{text:?}");
     }
 }
+
+/// MCAP does not require a sorted data section and replay reads it in
+/// record order: messages more than the reorder window behind newer ones
+/// are late, and a one-line warning names how many (all clouds stored
+/// before all gaze: most gaze is dropped).
+#[test]
+fn messages_late_in_record_order_are_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let out = dir.path().join("out.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    assert!(
+        !message(&o).contains("behind newer ones"),
+        "{}",
+        message(&o)
+    );
+    let clouds_first = rewrite(
+        &bag(None),
+        |msgs| msgs.sort_by_key(|m| m.channel.topic != CLOUD),
+        |_| {},
+    );
+    std::fs::write(&input, clouds_first).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(0), "{m}");
+    let line = m
+        .lines()
+        .find(|l| l.contains("behind newer ones in the file's record order"))
+        .unwrap_or_else(|| panic!("no warning: {m}"));
+    assert!(line.contains("gaze sample(s) dropped"), "{line}");
+    assert!(!line.contains(" 0 gaze sample(s)"), "{line}");
+}
+
+/// The gaze vector's `header.frame_id`: a frame linked to the vehicle
+/// frame by a static transform is turned into it (the same output as the
+/// vehicle-frame gaze); an unlinked frame is named in a warning.
+#[test]
+fn gaze_in_another_frame_is_turned_by_tf_static_or_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let (base, cam) = (dir.path().join("base.mcap"), dir.path().join("cam.mcap"));
+    std::fs::write(&input, bag(None)).unwrap();
+    let o = run_replay(&input, &base, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    // The camera frame's x axis is the vehicle's y axis (yaw 90°): the
+    // vehicle's (x, y, z) is the camera's (y, -x, z).
+    let in_cam = |with_tf: bool| {
+        rewrite(
+            &bag(None),
+            |msgs| {
+                for m in msgs.iter_mut().filter(|m| m.channel.topic == GAZE) {
+                    let v = Vector3Stamped::decode(&m.data).unwrap();
+                    let [x, y, z] = v.xyz;
+                    let turned = Vector3Stamped {
+                        header: Header {
+                            frame_id: "cam",
+                            ..v.header
+                        },
+                        xyz: [y, -x, z],
+                    }
+                    .encode();
+                    m.data = std::borrow::Cow::Owned(turned);
+                }
+                if with_tf {
+                    let tf = cdr::encode_tf_message(&[cdr::TransformStamped {
+                        header: Header {
+                            sec: 0,
+                            nanosec: 0,
+                            frame_id: "base_link",
+                        },
+                        child_frame_id: "cam",
+                        translation: [0.0; 3],
+                        rotation_xyzw: axis_angle([0.0, 0.0, 1.0], 90.0),
+                    }]);
+                    let channel = std::sync::Arc::new(mcap::Channel {
+                        id: 50,
+                        topic: "/tf_static".to_owned(),
+                        schema: Some(std::sync::Arc::new(mcap::Schema {
+                            id: 51,
+                            name: schemas::TF_MESSAGE.to_owned(),
+                            encoding: schemas::ROS2MSG.to_owned(),
+                            data: std::borrow::Cow::Owned(
+                                schemas::ros2msg(schemas::TF_MESSAGE).unwrap().into_bytes(),
+                            ),
+                        })),
+                        message_encoding: schemas::CDR.to_owned(),
+                        metadata: BTreeMap::new(),
+                    });
+                    let t = msgs[0].log_time;
+                    msgs.insert(
+                        0,
+                        mcap::Message {
+                            channel,
+                            sequence: 0,
+                            log_time: t,
+                            publish_time: t,
+                            data: std::borrow::Cow::Owned(tf),
+                        },
+                    );
+                }
+            },
+            |_| {},
+        )
+    };
+    std::fs::write(&input, in_cam(true)).unwrap();
+    let o = run_replay(&input, &cam, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    assert!(!message(&o).contains("gaze vector"), "{}", message(&o));
+    let adapted = |p: &std::path::Path| -> Vec<Vec<u8>> {
+        added(&std::fs::read(p).unwrap())
+            .into_iter()
+            .filter(|(t, _, _)| t == &format!("{CLOUD}/adapted"))
+            .map(|(_, _, d)| d)
+            .collect()
+    };
+    let want = adapted(&base);
+    assert_eq!(want.len(), 30);
+    assert!(adapted(&cam) == want, "turned gaze gives other clouds");
+    std::fs::write(&input, in_cam(false)).unwrap();
+    let o = run_replay(&input, &cam, &[]);
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(0), "{m}");
+    assert!(
+        m.lines()
+            .any(|l| l.contains("gaze vector(s) in frame \"cam\"") && l.contains("/tf_static")),
+        "{m}"
+    );
+}

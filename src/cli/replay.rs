@@ -217,6 +217,18 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     }
     .map_err(replay_error)?;
     let s = stats.stream;
+    if stats.late_gaze > 0 || stats.late_clouds > 0 {
+        super::io::warn(format!(
+            "warning: messages more than --reorder-window-ms ({2} ms) behind newer ones in the file's record order: {0} gaze sample(s) dropped, {1} cloud(s) outside the remembered frames given the baseline (the data section is read in record order; sort the bag by log_time or widen the window)",
+            stats.late_gaze, stats.late_clouds, window_ms
+        ));
+    }
+    if let Some(frame) = &stats.gaze_frame_without_tf {
+        super::io::warn(format!(
+            "warning: {} gaze vector(s) in frame {frame:?} (the first such frame), which no transform on {} links to the vehicle frame {:?}: used as if in the vehicle frame",
+            stats.gaze_without_tf, a.tf_topic, a.vehicle_frame
+        ));
+    }
     if s.samples == 0 {
         super::io::warn(format!(
             "warning: no message on the gaze topic {}: every frame is fail-safe (the uniform baseline)",

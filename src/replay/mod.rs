@@ -247,7 +247,7 @@ impl ReplayOptions {
 pub use crate::gaze::PipelineConfig;
 
 /// What a replay did.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReplayStats {
     /// Messages read (all topics).
     pub messages: u64,
@@ -265,6 +265,12 @@ pub struct ReplayStats {
     /// Clouds in a frame other than the vehicle frame that no static
     /// transform read so far linked to it (no mounting yaw was applied).
     pub clouds_without_tf: u64,
+    /// Gaze vectors in a frame (`header.frame_id`, not empty) other than
+    /// the vehicle frame that no static transform read so far linked to it
+    /// (used as if in the vehicle frame).
+    pub gaze_without_tf: u64,
+    /// The first such frame.
+    pub gaze_frame_without_tf: Option<String>,
     /// Static transforms read.
     pub transforms: u64,
     /// Attachments copied.
@@ -773,13 +779,46 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         Ok(m.yaw_deg)
     }
 
-    fn gaze_sample(&self, p: &Pending) -> Result<GazeSample, ReplayError> {
+    /// A gaze vector in `frame` turned into the vehicle frame by the static
+    /// transforms read so far (the whole rotation: a direction has no
+    /// mounting tilt limit); as it is when `frame` is empty, the vehicle
+    /// frame, or not linked to it (counted, the first such frame named).
+    fn gaze_in_vehicle_frame(
+        &mut self,
+        frame: &str,
+        xyz: [f64; 3],
+    ) -> Result<[f64; 3], ReplayError> {
+        let vehicle = self.opts.vehicle_frame.as_str();
+        if frame.is_empty() || frame == vehicle {
+            return Ok(xyz);
+        }
+        let q = self
+            .tf
+            .rotation(frame, vehicle)
+            .map_err(|e| ReplayError::Topic {
+                topic: self.opts.tf_topic.clone(),
+                reason: e.to_string(),
+            })?;
+        match q.and_then(tf::normalized) {
+            Some(q) => Ok(tf::rotate(q, xyz)),
+            None => {
+                self.stats.gaze_without_tf += 1;
+                if self.stats.gaze_frame_without_tf.is_none() {
+                    self.stats.gaze_frame_without_tf = Some(frame.to_owned());
+                }
+                Ok(xyz)
+            }
+        }
+    }
+
+    fn gaze_sample(&mut self, p: &Pending) -> Result<GazeSample, ReplayError> {
         check_schema(&p.msg.channel, self.opts.gaze_kind_schema())?;
         let t_s = self.rel_s(p.log_time);
         Ok(match self.opts.gaze_kind {
             GazeKind::Vector3 => {
                 let v = cdr::Vector3Stamped::decode(&p.msg.data)?;
-                match vector_azimuth_deg(v.xyz) {
+                let xyz = self.gaze_in_vehicle_frame(v.header.frame_id, v.xyz)?;
+                match vector_azimuth_deg(xyz) {
                     Some(g) => GazeSample {
                         t_s,
                         gaze_deg: g,
