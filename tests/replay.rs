@@ -2523,3 +2523,56 @@ fn gaze_in_another_frame_is_turned_by_tf_static_or_named_in_a_warning() {
         "{m}"
     );
 }
+
+/// Messages for misused outputs and options: `/dev/stdout` into a pipe is
+/// stdout; a missing `--config` names the flag; a missing TMPDIR names the
+/// folder and the variable.
+#[test]
+fn dev_stdout_missing_config_and_missing_tmpdir_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let file = dir.path().join("file.mcap");
+    assert_eq!(run_replay(&input, &file, &[]).status.code(), Some(0));
+    let args = |out: &str| -> Vec<String> {
+        [
+            "replay",
+            input.to_str().unwrap(),
+            "--gaze-topic",
+            GAZE,
+            "--cloud-topic",
+            CLOUD,
+            "--preset",
+            "paper",
+            "--mode",
+            "range",
+            "--out",
+            out,
+        ]
+        .map(str::to_owned)
+        .to_vec()
+    };
+    let o = bin().args(args("/dev/stdout")).output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    assert_eq!(o.stdout, std::fs::read(&file).unwrap());
+    let o = run_replay(
+        &input,
+        &dir.path().join("o.mcap"),
+        &["--config", "nonexist.toml"],
+    );
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{m}");
+    assert!(m.starts_with("--config: nonexist.toml"), "{m}");
+    let o = bin()
+        .env("TMPDIR", "/nonexistent-tmpdir")
+        .args(args("-"))
+        .output()
+        .unwrap();
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(1), "{m}");
+    assert!(
+        m.contains("/nonexistent-tmpdir") && m.contains("TMPDIR"),
+        "{m}"
+    );
+    assert!(o.stdout.is_empty());
+}

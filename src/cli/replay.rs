@@ -168,6 +168,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             "--bins: {b} is more than replay's {MAX_REPLAY_BINS} (each frame's profile is written to the output, ~240 bytes per bin)"
         )));
     }
+    if let Some(config) = &a.plan.config {
+        std::fs::metadata(config)
+            .map_err(|e| CliError::input(format!("--config: {}: {e}", config.display())))?;
+    }
     let (planner, preset_range_m) = a.plan.planner()?;
     let rated_range_m = match a.rated_range_m {
         // (0, 10⁷] as the library and the README have it: 10⁷ itself is fine.
@@ -209,7 +213,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     }
     // Every option checked before anything is read.
     opts.validate().map_err(replay_error)?;
-    let stats = if a.out.as_os_str() == "-" {
+    // `/dev/stdout` (and fd 1's other names) is stdout, whatever it is (a
+    // pipe's link names nothing a path can reach).
+    let to_stdout = ["-", "/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"]
+        .iter()
+        .any(|s| a.out.as_os_str() == *s);
+    let stats = if to_stdout {
         replay_file_to(&a.input, std::io::stdout().lock(), planner, pipeline, &opts)
     } else {
         let staging = remove_on_signal()?;

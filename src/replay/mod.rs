@@ -1700,7 +1700,12 @@ fn stage<P: FramePlanner>(
     opts: &ReplayOptions,
 ) -> Result<Staged, ReplayError> {
     let out_err = |e: std::io::Error| ReplayError::Write(format!("temporary file: {e}"));
-    let staged = tempfile::tempfile().map_err(out_err)?;
+    let staged = tempfile::tempfile().map_err(|e| {
+        ReplayError::Write(format!(
+            "temporary file in {} (the folder TMPDIR names, else /tmp): {e}",
+            std::env::temp_dir().display()
+        ))
+    })?;
     let reader = std::io::BufReader::with_capacity(1 << 20, input);
     let mut writer = std::io::BufWriter::with_capacity(1 << 20, staged);
     let stats = replay(reader, origin, &mut writer, planner, pipeline, opts)?;
