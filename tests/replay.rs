@@ -634,6 +634,7 @@ fn a_tilted_static_transform_is_refused_by_name() {
         "{err}"
     );
     assert!(err.contains("10.000°"), "{err}");
+    assert!(err.contains(&format!("met at {CLOUD}: message")), "{err}");
     assert!(!out.exists());
     // A wider tolerance, or the yaw given, lets it through.
     assert_eq!(run(&["--max-mount-tilt-deg", "12"]).status.code(), Some(0));

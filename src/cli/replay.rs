@@ -127,7 +127,8 @@ fn replay_error(e: ReplayError) -> CliError {
 /// thread removes the temporary output file named in the returned
 /// [`Staging`] (if any) and exits 128 + the signal (130 for INT, 143 for
 /// TERM, 138 for USR1), as a shell reports a process the signal ended. PIPE
-/// is ignored (a closed stdout is a write error); TRAP is left to debuggers. (Devices, FIFOs and
+/// is ignored (a closed stdout is a write error); TRAP is left to debuggers;
+/// a signal ignored at start stays ignored. (Devices, FIFOs and
 /// stdout are staged in an anonymous temporary file, which the system
 /// removes with the process.)
 fn remove_on_signal() -> Result<&'static Staging, CliError> {
@@ -136,11 +137,18 @@ fn remove_on_signal() -> Result<&'static Staging, CliError> {
         SIGVTALRM, SIGXCPU, SIGXFSZ,
     };
     static STAGING: Staging = std::sync::Mutex::new(None);
-    let mut signals = signal_hook::iterator::Signals::new([
+    // A signal ignored when the program started stays ignored (as `nohup`
+    // and a shell's `trap '' XFSZ` mean it: with XFSZ ignored, a write past
+    // the file-size limit fails and is reported as a failed write).
+    let ignored = ignored_signals();
+    let wanted = [
         SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGXFSZ, SIGXCPU, SIGVTALRM,
         SIGPROF, SIGIO, SIGSYS,
-    ])
-    .map_err(|e| CliError::output(format!("installing the signal handler: {e}")))?;
+    ]
+    .into_iter()
+    .filter(|&s| (1..=64).contains(&s) && ignored & (1u64 << (s - 1)) == 0);
+    let mut signals = signal_hook::iterator::Signals::new(wanted)
+        .map_err(|e| CliError::output(format!("installing the signal handler: {e}")))?;
     std::thread::spawn(move || {
         if let Some(sig) = signals.forever().next() {
             let staged = STAGING
@@ -153,6 +161,19 @@ fn remove_on_signal() -> Result<&'static Staging, CliError> {
         }
     });
     Ok(&STAGING)
+}
+
+/// The signals this process ignores (bit n-1 for signal n), from the
+/// `SigIgn` mask in `/proc/self/status`; none where that cannot be read.
+fn ignored_signals() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("SigIgn:"))
+                .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+        })
+        .unwrap_or(0)
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {

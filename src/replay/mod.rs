@@ -817,7 +817,9 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         Ok(match self.opts.gaze_kind {
             GazeKind::Vector3 => {
                 let v = cdr::Vector3Stamped::decode(&p.msg.data)?;
-                let xyz = self.gaze_in_vehicle_frame(v.header.frame_id, v.xyz)?;
+                let xyz = self
+                    .gaze_in_vehicle_frame(v.header.frame_id, v.xyz)
+                    .map_err(|e| found_at(e, &self.opts.gaze_topic, p))?;
                 match vector_azimuth_deg(xyz) {
                     Some(g) => GazeSample {
                         t_s,
@@ -861,7 +863,9 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         if self.frame_id != cloud.header.frame_id {
             cloud.header.frame_id.clone_into(&mut self.frame_id);
         }
-        let yaw_deg = self.mounting_yaw_deg(cloud.header.frame_id)?;
+        let yaw_deg = self
+            .mounting_yaw_deg(cloud.header.frame_id)
+            .map_err(|e| found_at(e, &self.opts.cloud_topic, p))?;
         self.yaw_deg = yaw_deg;
         let yaw = (yaw_deg != 0.0).then(|| {
             let r = yaw_deg.to_radians();
@@ -1122,6 +1126,21 @@ fn check_schema(ch: &mcap::Channel<'_>, want: &str) -> Result<(), ReplayError> {
         });
     }
     Ok(())
+}
+
+/// A transform error (a tilt, a cycle) named by the byte offset of the
+/// message that needed the transform, like other message errors.
+fn found_at(e: ReplayError, topic: &str, p: &Pending) -> ReplayError {
+    match e {
+        ReplayError::Topic { topic: t, reason } => ReplayError::Topic {
+            topic: t,
+            reason: format!(
+                "{reason} (met at {topic}: message {} (sequence {}, log_time {} ns))",
+                p.at, p.msg.sequence, p.log_time
+            ),
+        },
+        e => e,
+    }
 }
 
 /// Names the message a decoding error is in: its topic and where its
