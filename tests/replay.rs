@@ -634,6 +634,7 @@ fn a_tilted_static_transform_is_refused_by_name() {
         "{err}"
     );
     assert!(err.contains("10.000°"), "{err}");
+    assert!(err.contains(&format!("met at {CLOUD}: message")), "{err}");
     assert!(!out.exists());
     // A wider tolerance, or the yaw given, lets it through.
     assert_eq!(run(&["--max-mount-tilt-deg", "12"]).status.code(), Some(0));
@@ -1410,7 +1411,17 @@ fn a_signal_removes_the_temporary_output() {
             .filter(|n| n.starts_with(".gaze-lidar-replay"))
             .collect()
     };
-    for (sig, code) in [("INT", 130), ("TERM", 143), ("HUP", 129)] {
+    for (sig, code) in [
+        ("INT", 130),
+        ("TERM", 143),
+        ("HUP", 129),
+        ("QUIT", 131),
+        ("USR1", 138),
+        ("USR2", 140),
+        ("ALRM", 142),
+        ("XFSZ", 153),
+        ("VTALRM", 154),
+    ] {
         let mut child = bin()
             .arg("replay")
             .arg(&input)
@@ -2259,4 +2270,310 @@ fn many_channels_are_copied_in_bounded_memory() {
     );
     assert!(peak <= PEAK_BYTES, "peak {} MiB", peak >> 20);
     assert!(!out.exists());
+}
+
+/// Single-byte corruptions of a zstd and an lz4 bag (every k-th byte, some
+/// 150 positions each): exit 0, 1 or 2, never a signal (an abort on a huge
+/// allocation from a corrupt inner length was one), never a leftover
+/// temporary file, and no output unless the exit is 0.
+#[test]
+fn single_byte_corruptions_of_compressed_bags_never_abort_or_leave_a_temp_file() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let out = dir.path().join("out.mcap");
+    for compression in [mcap::Compression::Zstd, mcap::Compression::Lz4] {
+        let good = bag(Some(compression));
+        let step = (good.len() / 150).max(1);
+        // Offsets spread over the whole file, shifted so that not only the
+        // multiples of `step` are hit.
+        for (n, at) in (8..good.len() - 8).step_by(step).enumerate() {
+            let mut b = good.clone();
+            b[at] ^= [0xff, 0x01, 0x80, 0x55][n % 4];
+            std::fs::write(&input, &b).unwrap();
+            let _ = std::fs::remove_file(&out);
+            let o = replay_cli(&input, &out);
+            let stderr = String::from_utf8_lossy(&o.stderr);
+            assert!(
+                matches!(o.status.code(), Some(0..=2)),
+                "{compression:?} byte {at}: {:?} (signal {:?}): {stderr}",
+                o.status,
+                o.status.signal()
+            );
+            assert!(!stderr.contains("panicked"), "byte {at}: {stderr}");
+            let left: Vec<String> = std::fs::read_dir(dir.path())
+                .unwrap()
+                .map(|e| e.unwrap().file_name().into_string().unwrap())
+                .filter(|n| n != "in.mcap" && n != "out.mcap")
+                .collect();
+            assert!(left.is_empty(), "{compression:?} byte {at}: {left:?}");
+            if o.status.code() != Some(0) {
+                assert!(!out.exists(), "{compression:?} byte {at}: output left");
+                assert_eq!(stderr.lines().count(), 1, "byte {at}: {stderr}");
+            }
+        }
+    }
+}
+
+/// The cloud topic with its schema replaced by (name, encoding, text).
+fn with_cloud_schema(name: &str, encoding: &str, text: &str) -> Vec<u8> {
+    rewrite(
+        &bag(None),
+        |msgs| {
+            let mut channel: Option<std::sync::Arc<mcap::Channel<'static>>> = None;
+            for m in msgs.iter_mut().filter(|m| m.channel.topic == CLOUD) {
+                let c = channel.get_or_insert_with(|| {
+                    std::sync::Arc::new(mcap::Channel {
+                        schema: Some(std::sync::Arc::new(mcap::Schema {
+                            id: 40,
+                            name: name.to_owned(),
+                            encoding: encoding.to_owned(),
+                            data: std::borrow::Cow::Owned(text.as_bytes().to_vec()),
+                        })),
+                        ..(*m.channel).clone()
+                    })
+                });
+                m.channel = c.clone();
+            }
+        },
+        |_| {},
+    )
+}
+
+/// A cloud topic whose schema is not PointCloud2 in `ros2msg` (an IDL
+/// schema, another type, no schema) is refused by name, exit 2; one that
+/// is PointCloud2 in `ros2msg` with an empty or wrong text is decoded, and
+/// the adapted topic carries the tool's own PointCloud2 definition, which
+/// the schema's readers can parse.
+#[test]
+fn a_cloud_schema_that_is_not_point_cloud2_in_ros2msg_is_refused_and_adapted_clouds_carry_the_tools_definition(
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let out = dir.path().join("out.mcap");
+    for (name, encoding, text) in [
+        (
+            schemas::POINT_CLOUD2,
+            "ros2idl",
+            "module sensor_msgs { module msg { struct PointCloud2 { long x; }; }; };",
+        ),
+        ("sensor_msgs/msg/Image", schemas::ROS2MSG, "uint32 height\n"),
+        ("", "", ""),
+    ] {
+        std::fs::write(&input, with_cloud_schema(name, encoding, text)).unwrap();
+        let o = run_replay(&input, &out, &[]);
+        let m = message(&o);
+        assert_eq!(o.status.code(), Some(2), "{name} {encoding}: {m}");
+        assert!(m.contains(CLOUD), "{m}");
+        assert!(m.contains(&format!("{encoding:?}")), "{m}");
+        assert!(m.contains(schemas::POINT_CLOUD2), "{m}");
+        assert!(!out.exists());
+    }
+    let def = schemas::ros2msg(schemas::POINT_CLOUD2).unwrap();
+    for text in ["", "int32 foo\n"] {
+        std::fs::write(
+            &input,
+            with_cloud_schema(schemas::POINT_CLOUD2, schemas::ROS2MSG, text),
+        )
+        .unwrap();
+        let o = run_replay(&input, &out, &[]);
+        assert_eq!(o.status.code(), Some(0), "{text:?}: {}", message(&o));
+        let bytes = std::fs::read(&out).unwrap();
+        let adapted = format!("{CLOUD}/adapted");
+        let mut seen = 0;
+        for m in mcap::MessageStream::new(&bytes).unwrap() {
+            let m = m.unwrap();
+            if m.channel.topic == adapted {
+                let s = m.channel.schema.as_ref().unwrap();
+                assert_eq!(s.name, schemas::POINT_CLOUD2);
+                assert_eq!(s.encoding, schemas::ROS2MSG);
+                assert_eq!(&*s.data, def.as_bytes(), "{text:?}");
+                seen += 1;
+            }
+        }
+        assert_eq!(seen, 30, "{text:?}");
+    }
+}
+
+/// MCAP does not require a sorted data section and replay reads it in
+/// record order: messages more than the reorder window behind newer ones
+/// are late, and a one-line warning names how many (all clouds stored
+/// before all gaze: most gaze is dropped).
+#[test]
+fn messages_late_in_record_order_are_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let out = dir.path().join("out.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    assert!(
+        !message(&o).contains("behind newer ones"),
+        "{}",
+        message(&o)
+    );
+    let clouds_first = rewrite(
+        &bag(None),
+        |msgs| msgs.sort_by_key(|m| m.channel.topic != CLOUD),
+        |_| {},
+    );
+    std::fs::write(&input, clouds_first).unwrap();
+    let o = run_replay(&input, &out, &[]);
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(0), "{m}");
+    let line = m
+        .lines()
+        .find(|l| l.contains("behind newer ones in the file's record order"))
+        .unwrap_or_else(|| panic!("no warning: {m}"));
+    assert!(line.contains("gaze sample(s) dropped"), "{line}");
+    assert!(!line.contains(" 0 gaze sample(s)"), "{line}");
+}
+
+/// The gaze vector's `header.frame_id`: a frame linked to the vehicle
+/// frame by a static transform is turned into it (the same output as the
+/// vehicle-frame gaze); an unlinked frame is named in a warning.
+#[test]
+fn gaze_in_another_frame_is_turned_by_tf_static_or_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    let (base, cam) = (dir.path().join("base.mcap"), dir.path().join("cam.mcap"));
+    std::fs::write(&input, bag(None)).unwrap();
+    let o = run_replay(&input, &base, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    // The camera frame's x axis is the vehicle's y axis (yaw 90°): the
+    // vehicle's (x, y, z) is the camera's (y, -x, z).
+    let in_cam = |with_tf: bool| {
+        rewrite(
+            &bag(None),
+            |msgs| {
+                for m in msgs.iter_mut().filter(|m| m.channel.topic == GAZE) {
+                    let v = Vector3Stamped::decode(&m.data).unwrap();
+                    let [x, y, z] = v.xyz;
+                    let turned = Vector3Stamped {
+                        header: Header {
+                            frame_id: "cam",
+                            ..v.header
+                        },
+                        xyz: [y, -x, z],
+                    }
+                    .encode();
+                    m.data = std::borrow::Cow::Owned(turned);
+                }
+                if with_tf {
+                    let tf = cdr::encode_tf_message(&[cdr::TransformStamped {
+                        header: Header {
+                            sec: 0,
+                            nanosec: 0,
+                            frame_id: "base_link",
+                        },
+                        child_frame_id: "cam",
+                        translation: [0.0; 3],
+                        rotation_xyzw: axis_angle([0.0, 0.0, 1.0], 90.0),
+                    }]);
+                    let channel = std::sync::Arc::new(mcap::Channel {
+                        id: 50,
+                        topic: "/tf_static".to_owned(),
+                        schema: Some(std::sync::Arc::new(mcap::Schema {
+                            id: 51,
+                            name: schemas::TF_MESSAGE.to_owned(),
+                            encoding: schemas::ROS2MSG.to_owned(),
+                            data: std::borrow::Cow::Owned(
+                                schemas::ros2msg(schemas::TF_MESSAGE).unwrap().into_bytes(),
+                            ),
+                        })),
+                        message_encoding: schemas::CDR.to_owned(),
+                        metadata: BTreeMap::new(),
+                    });
+                    let t = msgs[0].log_time;
+                    msgs.insert(
+                        0,
+                        mcap::Message {
+                            channel,
+                            sequence: 0,
+                            log_time: t,
+                            publish_time: t,
+                            data: std::borrow::Cow::Owned(tf),
+                        },
+                    );
+                }
+            },
+            |_| {},
+        )
+    };
+    std::fs::write(&input, in_cam(true)).unwrap();
+    let o = run_replay(&input, &cam, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    assert!(!message(&o).contains("gaze vector"), "{}", message(&o));
+    let adapted = |p: &std::path::Path| -> Vec<Vec<u8>> {
+        added(&std::fs::read(p).unwrap())
+            .into_iter()
+            .filter(|(t, _, _)| t == &format!("{CLOUD}/adapted"))
+            .map(|(_, _, d)| d)
+            .collect()
+    };
+    let want = adapted(&base);
+    assert_eq!(want.len(), 30);
+    assert!(adapted(&cam) == want, "turned gaze gives other clouds");
+    std::fs::write(&input, in_cam(false)).unwrap();
+    let o = run_replay(&input, &cam, &[]);
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(0), "{m}");
+    assert!(
+        m.lines()
+            .any(|l| l.contains("gaze vector(s) in frame \"cam\"") && l.contains("/tf_static")),
+        "{m}"
+    );
+}
+
+/// Messages for misused outputs and options: `/dev/stdout` into a pipe is
+/// stdout; a missing `--config` names the flag; a missing TMPDIR names the
+/// folder and the variable.
+#[test]
+fn dev_stdout_missing_config_and_missing_tmpdir_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.mcap");
+    std::fs::write(&input, bag(None)).unwrap();
+    let file = dir.path().join("file.mcap");
+    assert_eq!(run_replay(&input, &file, &[]).status.code(), Some(0));
+    let args = |out: &str| -> Vec<String> {
+        [
+            "replay",
+            input.to_str().unwrap(),
+            "--gaze-topic",
+            GAZE,
+            "--cloud-topic",
+            CLOUD,
+            "--preset",
+            "paper",
+            "--mode",
+            "range",
+            "--out",
+            out,
+        ]
+        .map(str::to_owned)
+        .to_vec()
+    };
+    let o = bin().args(args("/dev/stdout")).output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", message(&o));
+    assert_eq!(o.stdout, std::fs::read(&file).unwrap());
+    let o = run_replay(
+        &input,
+        &dir.path().join("o.mcap"),
+        &["--config", "nonexist.toml"],
+    );
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(2), "{m}");
+    assert!(m.starts_with("--config: nonexist.toml"), "{m}");
+    let o = bin()
+        .env("TMPDIR", "/nonexistent-tmpdir")
+        .args(args("-"))
+        .output()
+        .unwrap();
+    let m = message(&o);
+    assert_eq!(o.status.code(), Some(1), "{m}");
+    assert!(
+        m.contains("/nonexistent-tmpdir") && m.contains("TMPDIR"),
+        "{m}"
+    );
+    assert!(o.stdout.is_empty());
 }

@@ -122,16 +122,32 @@ fn replay_error(e: ReplayError) -> CliError {
     }
 }
 
-/// On SIGINT, SIGTERM or SIGHUP (a closed terminal), a thread removes the
-/// temporary output file named in the returned [`Staging`] (if any) and
-/// exits 128 + the signal (130, 143, 129), as a shell reports a process the
-/// signal ended. (Devices, FIFOs and
+/// On every catchable signal whose default action ends the process (INT,
+/// TERM, HUP, QUIT, USR1, USR2, ALRM, XFSZ, XCPU, VTALRM, PROF, IO, SYS), a
+/// thread removes the temporary output file named in the returned
+/// [`Staging`] (if any) and exits 128 + the signal (130 for INT, 143 for
+/// TERM, 138 for USR1), as a shell reports a process the signal ended. PIPE
+/// is ignored (a closed stdout is a write error); TRAP is left to debuggers;
+/// a signal ignored at start stays ignored. (Devices, FIFOs and
 /// stdout are staged in an anonymous temporary file, which the system
 /// removes with the process.)
 fn remove_on_signal() -> Result<&'static Staging, CliError> {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    use signal_hook::consts::signal::{
+        SIGALRM, SIGHUP, SIGINT, SIGIO, SIGPROF, SIGQUIT, SIGSYS, SIGTERM, SIGUSR1, SIGUSR2,
+        SIGVTALRM, SIGXCPU, SIGXFSZ,
+    };
     static STAGING: Staging = std::sync::Mutex::new(None);
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+    // A signal ignored when the program started stays ignored (as `nohup`
+    // and a shell's `trap '' XFSZ` mean it: with XFSZ ignored, a write past
+    // the file-size limit fails and is reported as a failed write).
+    let ignored = ignored_signals();
+    let wanted = [
+        SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGXFSZ, SIGXCPU, SIGVTALRM,
+        SIGPROF, SIGIO, SIGSYS,
+    ]
+    .into_iter()
+    .filter(|&s| (1..=64).contains(&s) && ignored & (1u64 << (s - 1)) == 0);
+    let mut signals = signal_hook::iterator::Signals::new(wanted)
         .map_err(|e| CliError::output(format!("installing the signal handler: {e}")))?;
     std::thread::spawn(move || {
         if let Some(sig) = signals.forever().next() {
@@ -147,6 +163,19 @@ fn remove_on_signal() -> Result<&'static Staging, CliError> {
     Ok(&STAGING)
 }
 
+/// The signals this process ignores (bit n-1 for signal n), from the
+/// `SigIgn` mask in `/proc/self/status`; none where that cannot be read.
+fn ignored_signals() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("SigIgn:"))
+                .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+        })
+        .unwrap_or(0)
+}
+
 pub fn run(a: &Args) -> Result<u8, CliError> {
     let pipeline = a.filter.settings()?;
     let window_ms = finite("--reorder-window-ms", a.reorder_window_ms)?;
@@ -159,6 +188,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         return Err(CliError::input(format!(
             "--bins: {b} is more than replay's {MAX_REPLAY_BINS} (each frame's profile is written to the output, ~240 bytes per bin)"
         )));
+    }
+    if let Some(config) = &a.plan.config {
+        std::fs::metadata(config)
+            .map_err(|e| CliError::input(format!("--config: {}: {e}", config.display())))?;
     }
     let (planner, preset_range_m) = a.plan.planner()?;
     let rated_range_m = match a.rated_range_m {
@@ -201,7 +234,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     }
     // Every option checked before anything is read.
     opts.validate().map_err(replay_error)?;
-    let stats = if a.out.as_os_str() == "-" {
+    // `/dev/stdout` (and fd 1's other names) is stdout, whatever it is (a
+    // pipe's link names nothing a path can reach).
+    let to_stdout = ["-", "/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"]
+        .iter()
+        .any(|s| a.out.as_os_str() == *s);
+    let stats = if to_stdout {
         replay_file_to(&a.input, std::io::stdout().lock(), planner, pipeline, &opts)
     } else {
         let staging = remove_on_signal()?;
@@ -209,6 +247,18 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     }
     .map_err(replay_error)?;
     let s = stats.stream;
+    if stats.late_gaze > 0 || stats.late_clouds > 0 {
+        super::io::warn(format!(
+            "warning: messages more than --reorder-window-ms ({2} ms) behind newer ones in the file's record order: {0} gaze sample(s) dropped, {1} cloud(s) outside the remembered frames given the baseline (the data section is read in record order; sort the bag by log_time or widen the window)",
+            stats.late_gaze, stats.late_clouds, window_ms
+        ));
+    }
+    if let Some(frame) = &stats.gaze_frame_without_tf {
+        super::io::warn(format!(
+            "warning: {} gaze vector(s) in frame {frame:?} (the first such frame), which no transform on {} links to the vehicle frame {:?}: used as if in the vehicle frame",
+            stats.gaze_without_tf, a.tf_topic, a.vehicle_frame
+        ));
+    }
     if s.samples == 0 {
         super::io::warn(format!(
             "warning: no message on the gaze topic {}: every frame is fail-safe (the uniform baseline)",

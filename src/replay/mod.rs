@@ -42,6 +42,7 @@
 //! cloud's frame ([`scene`]).
 
 pub mod cdr;
+mod chunk;
 pub mod scene;
 pub mod schemas;
 pub mod tf;
@@ -246,7 +247,7 @@ impl ReplayOptions {
 pub use crate::gaze::PipelineConfig;
 
 /// What a replay did.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReplayStats {
     /// Messages read (all topics).
     pub messages: u64,
@@ -264,6 +265,12 @@ pub struct ReplayStats {
     /// Clouds in a frame other than the vehicle frame that no static
     /// transform read so far linked to it (no mounting yaw was applied).
     pub clouds_without_tf: u64,
+    /// Gaze vectors in a frame (`header.frame_id`, not empty) other than
+    /// the vehicle frame that no static transform read so far linked to it
+    /// (used as if in the vehicle frame).
+    pub gaze_without_tf: u64,
+    /// The first such frame.
+    pub gaze_frame_without_tf: Option<String>,
     /// Static transforms read.
     pub transforms: u64,
     /// Attachments copied.
@@ -772,13 +779,48 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         Ok(m.yaw_deg)
     }
 
-    fn gaze_sample(&self, p: &Pending) -> Result<GazeSample, ReplayError> {
+    /// A gaze vector in `frame` turned into the vehicle frame by the static
+    /// transforms read so far (the whole rotation: a direction has no
+    /// mounting tilt limit); as it is when `frame` is empty, the vehicle
+    /// frame, or not linked to it (counted, the first such frame named).
+    fn gaze_in_vehicle_frame(
+        &mut self,
+        frame: &str,
+        xyz: [f64; 3],
+    ) -> Result<[f64; 3], ReplayError> {
+        let vehicle = self.opts.vehicle_frame.as_str();
+        if frame.is_empty() || frame == vehicle {
+            return Ok(xyz);
+        }
+        let q = self
+            .tf
+            .rotation(frame, vehicle)
+            .map_err(|e| ReplayError::Topic {
+                topic: self.opts.tf_topic.clone(),
+                reason: e.to_string(),
+            })?;
+        match q.and_then(tf::normalized) {
+            Some(q) => Ok(tf::rotate(q, xyz)),
+            None => {
+                self.stats.gaze_without_tf += 1;
+                if self.stats.gaze_frame_without_tf.is_none() {
+                    self.stats.gaze_frame_without_tf = Some(frame.to_owned());
+                }
+                Ok(xyz)
+            }
+        }
+    }
+
+    fn gaze_sample(&mut self, p: &Pending) -> Result<GazeSample, ReplayError> {
         check_schema(&p.msg.channel, self.opts.gaze_kind_schema())?;
         let t_s = self.rel_s(p.log_time);
         Ok(match self.opts.gaze_kind {
             GazeKind::Vector3 => {
                 let v = cdr::Vector3Stamped::decode(&p.msg.data)?;
-                match vector_azimuth_deg(v.xyz) {
+                let xyz = self
+                    .gaze_in_vehicle_frame(v.header.frame_id, v.xyz)
+                    .map_err(|e| found_at(e, &self.opts.gaze_topic, p))?;
+                match vector_azimuth_deg(xyz) {
                     Some(g) => GazeSample {
                         t_s,
                         gaze_deg: g,
@@ -821,7 +863,9 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         if self.frame_id != cloud.header.frame_id {
             cloud.header.frame_id.clone_into(&mut self.frame_id);
         }
-        let yaw_deg = self.mounting_yaw_deg(cloud.header.frame_id)?;
+        let yaw_deg = self
+            .mounting_yaw_deg(cloud.header.frame_id)
+            .map_err(|e| found_at(e, &self.opts.cloud_topic, p))?;
         self.yaw_deg = yaw_deg;
         let yaw = (yaw_deg != 0.0).then(|| {
             let r = yaw_deg.to_radians();
@@ -871,14 +915,14 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         let adapted = match self.out.adapted {
             Some(id) => id,
             None => {
-                let schema_id = match &p.msg.channel.schema {
-                    Some(s) => self
-                        .out
-                        .mcap
-                        .add_schema(&s.name, &s.encoding, &s.data)
-                        .map_err(write_err)?,
-                    None => 0,
-                };
+                // The tool's own definition, whatever text the input's
+                // schema held (its name and encoding were checked).
+                let def = schemas::ros2msg(schemas::POINT_CLOUD2).unwrap_or_default();
+                let schema_id = self
+                    .out
+                    .mcap
+                    .add_schema(schemas::POINT_CLOUD2, schemas::ROS2MSG, def.as_bytes())
+                    .map_err(write_err)?;
                 let id = self
                     .out
                     .mcap
@@ -1061,19 +1105,42 @@ fn same_type(a: &str, b: &str) -> bool {
     a == b || a.replacen("/msg/", "/", 1) == b.replacen("/msg/", "/", 1)
 }
 
+/// A topic the replay decodes must carry `want` by name, its schema in
+/// `ros2msg` (a ROS 2 message definition) and its messages in CDR; anything
+/// else (an IDL schema, a schemaless channel, JSON) is refused by name
+/// rather than decoded as if it were `want`.
 fn check_schema(ch: &mcap::Channel<'_>, want: &str) -> Result<(), ReplayError> {
     let name = ch.schema.as_ref().map_or("", |s| s.name.as_str());
-    if !same_type(name, want) || ch.message_encoding != schemas::CDR {
+    let encoding = ch.schema.as_ref().map_or("", |s| s.encoding.as_str());
+    if !same_type(name, want) || encoding != schemas::ROS2MSG || ch.message_encoding != schemas::CDR
+    {
         return Err(ReplayError::Topic {
             topic: ch.topic.clone(),
             reason: format!(
-                "carries {} messages encoded as {:?}, not {want} in cdr",
+                "carries {} messages (schema encoding {encoding:?}, message encoding {:?}), not {want} (schema encoding \"{}\", message encoding \"{}\")",
                 if name.is_empty() { "schemaless" } else { name },
-                ch.message_encoding
+                ch.message_encoding,
+                schemas::ROS2MSG,
+                schemas::CDR,
             ),
         });
     }
     Ok(())
+}
+
+/// A transform error (a tilt, a cycle) named by the byte offset of the
+/// message that needed the transform, like other message errors.
+fn found_at(e: ReplayError, topic: &str, p: &Pending) -> ReplayError {
+    match e {
+        ReplayError::Topic { topic: t, reason } => ReplayError::Topic {
+            topic: t,
+            reason: format!(
+                "{reason} (met at {topic}: message {} (sequence {}, log_time {} ns))",
+                p.at, p.msg.sequence, p.log_time
+            ),
+        },
+        e => e,
+    }
 }
 
 /// Names the message a decoding error is in: its topic and where its
@@ -1326,12 +1393,11 @@ pub fn replay<R: Read, W: Write + Seek, P: FramePlanner>(
                         }
                         // Unpacked and its CRC checked before any of its
                         // messages is used.
-                        mcap::read::ChunkReader::new(header, &data)
-                            .and_then(|c| {
-                                c.map(|r| r.map(mcap::records::Record::into_owned))
-                                    .collect::<Result<Vec<_>, _>>()
-                            })
-                            .map_err(|e| mcap_err(at, "in this chunk: ", e))?
+                        chunk::unpack(&header, &data).map_err(|reason| ReplayError::Mcap {
+                            path: path.to_owned(),
+                            offset: at,
+                            reason: format!("in this chunk: {reason}"),
+                        })?
                     }
                     other => vec![other.into_owned()],
                 };
@@ -1483,7 +1549,7 @@ pub fn replay_file<P: FramePlanner>(
 pub type Staging = std::sync::Mutex<Option<std::path::PathBuf>>;
 
 /// [`replay_file`], publishing its temporary file in `staging` (see
-/// [`Staging`]; `gaze-lidar replay` removes it on SIGINT and SIGTERM).
+/// [`Staging`]; `gaze-lidar replay` removes it on every catchable terminating signal).
 pub fn replay_file_staged<P: FramePlanner>(
     input: &std::path::Path,
     output: &std::path::Path,
@@ -1653,7 +1719,12 @@ fn stage<P: FramePlanner>(
     opts: &ReplayOptions,
 ) -> Result<Staged, ReplayError> {
     let out_err = |e: std::io::Error| ReplayError::Write(format!("temporary file: {e}"));
-    let staged = tempfile::tempfile().map_err(out_err)?;
+    let staged = tempfile::tempfile().map_err(|e| {
+        ReplayError::Write(format!(
+            "temporary file in {} (the folder TMPDIR names, else /tmp): {e}",
+            std::env::temp_dir().display()
+        ))
+    })?;
     let reader = std::io::BufReader::with_capacity(1 << 20, input);
     let mut writer = std::io::BufWriter::with_capacity(1 << 20, staged);
     let stats = replay(reader, origin, &mut writer, planner, pipeline, opts)?;

@@ -97,6 +97,17 @@ pub fn label(profile: &Profile, state: State) -> String {
     }
 }
 
+/// `t_ns` as `builtin_interfaces/Time` (sec, nanosec). Stamps past 2038
+/// saturate, both fields together, to the last nanosecond the message
+/// holds (its `sec` is an i32).
+#[must_use]
+pub fn ros_time(t_ns: u64) -> (i32, u32) {
+    match i32::try_from(t_ns / 1_000_000_000) {
+        Ok(sec) => (sec, (t_ns % 1_000_000_000) as u32),
+        Err(_) => (i32::MAX, 999_999_999),
+    }
+}
+
 /// The `visualization_msgs/msg/MarkerArray` (CDR) for one frame at `t_ns`,
 /// drawn in `frame_id` (the cloud's frame, whose x axis is
 /// `sensor_yaw_deg` counter-clockwise of the vehicle's).
@@ -151,10 +162,10 @@ pub fn scene_update(
         }
         i = j;
     }
-    // Stamps past 2038 saturate (`builtin_interfaces/Time.sec` is an i32).
+    let (sec, nanosec) = ros_time(t_ns);
     let header = Header {
-        sec: i32::try_from(t_ns / 1_000_000_000).unwrap_or(i32::MAX),
-        nanosec: (t_ns % 1_000_000_000) as u32,
+        sec,
+        nanosec,
         frame_id,
     };
     let text = label(profile, state);

@@ -450,3 +450,17 @@ proptest::proptest! {
         }
     }
 }
+
+#[test]
+fn marker_stamps_past_2038_saturate_both_fields() {
+    use super::scene::ros_time;
+    assert_eq!(ros_time(0), (0, 0));
+    assert_eq!(ros_time(1_500_000_001), (1, 500_000_001));
+    let last = i32::MAX as u64 * 1_000_000_000 + 999_999_999;
+    assert_eq!(ros_time(last), (i32::MAX, 999_999_999));
+    // One nanosecond later and beyond: the last stamp, never a mix of a
+    // capped sec and the true nanosec.
+    assert_eq!(ros_time(last + 1), (i32::MAX, 999_999_999));
+    assert_eq!(ros_time(last + 123_456_790), (i32::MAX, 999_999_999));
+    assert_eq!(ros_time(u64::MAX), (i32::MAX, 999_999_999));
+}

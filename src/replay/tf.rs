@@ -119,6 +119,28 @@ impl TfTree {
     }
 }
 
+/// `v` turned by the unit quaternion `q`: `v + 2w(u×v) + 2u×(u×v)`, with
+/// `u` the quaternion's vector part.
+#[must_use]
+pub fn rotate(q: Quat, v: [f64; 3]) -> [f64; 3] {
+    let [x, y, z, w] = q;
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let u = [x, y, z];
+    let t = cross(u, v).map(|c| 2.0 * c);
+    let ut = cross(u, t);
+    [
+        v[0] + w * t[0] + ut[0],
+        v[1] + w * t[1] + ut[1],
+        v[2] + w * t[2] + ut[2],
+    ]
+}
+
 /// The mounting read from a rotation `q` (cloud frame → vehicle frame).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Mounting {
