@@ -946,8 +946,8 @@ pub fn run_group_with(
                 *arc = cull_arc(&[car_box(j, t0), car_box(j, t1)]);
             }
             // The driver: looks at each car's front centre at the frame start.
-            for j in 0..2 {
-                if t0 > t_conflict[j] {
+            for (j, &t_conflict_j) in t_conflict.iter().enumerate() {
+                if t0 > t_conflict_j {
                     continue;
                 }
                 let (x, y) = traffic.front_centre(j, t0);
