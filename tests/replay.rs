@@ -647,15 +647,15 @@ fn a_tilted_static_transform_is_refused_by_name() {
     assert!(err.contains("transform lidar in base_link"), "{err}");
 }
 
-/// A full disk (here: the file-size limit, `ulimit -f`, with SIGXFSZ
-/// ignored so the write fails with EFBIG) is exit 1 with no output file
-/// and no temporary file left.
-#[test]
-fn a_full_disk_leaves_no_partial_output() {
-    let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in.mcap");
+/// `bag(None)` replayed from `dir/in.mcap` to `dir/out.mcap` under a
+/// file-size limit (`ulimit -f`, SIGXFSZ ignored, so the write fails with
+/// EFBIG as on a full disk): the output path and the run.
+fn replay_past_the_file_size_limit(
+    dir: &std::path::Path,
+) -> (std::path::PathBuf, std::process::Output) {
+    let input = dir.join("in.mcap");
     std::fs::write(&input, bag(None)).unwrap();
-    let out = dir.path().join("out.mcap");
+    let out = dir.join("out.mcap");
     let o = Command::new("sh")
         .arg("-c")
         // 64 blocks of 512 or 1024 bytes: far less than the output.
@@ -667,6 +667,16 @@ fn a_full_disk_leaves_no_partial_output() {
         .arg(&out)
         .output()
         .unwrap();
+    (out, o)
+}
+
+/// A full disk (here: the file-size limit, `ulimit -f`, with SIGXFSZ
+/// ignored so the write fails with EFBIG) is exit 1 with no output file
+/// and no temporary file left.
+#[test]
+fn a_full_disk_leaves_no_partial_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, o) = replay_past_the_file_size_limit(dir.path());
     common::no_panic(&o, "full disk");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
@@ -1790,19 +1800,7 @@ fn truncated_files_name_an_offset_inside_the_file() {
 #[test]
 fn a_failed_write_names_the_output_path() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in.mcap");
-    std::fs::write(&input, bag(None)).unwrap();
-    let out = dir.path().join("out.mcap");
-    let o = Command::new("sh")
-        .arg("-c")
-        .arg("trap '' XFSZ; ulimit -f 64 && exec \"$0\" \"$@\"")
-        .arg(env!("CARGO_BIN_EXE_gaze-lidar"))
-        .arg("replay")
-        .arg(&input)
-        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD, "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let (out, o) = replay_past_the_file_size_limit(dir.path());
     let err = message(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
