@@ -608,6 +608,28 @@ impl Saturation {
             .get(bucket)
             .is_some_and(|&l| power * cos * l >= self.limit)
     }
+
+    /// Whether [`Self::saturated`] holds for every hit on `surface` in a
+    /// range bucket of `buckets` (inclusive) with incidence cosine at least
+    /// `cos_lo`: each bucket's bound clears the limit at `cos_lo`, and
+    /// `(power·cos)·l` only grows with `cos` (non-negative factors; rounding
+    /// is monotone).
+    pub(crate) fn saturated_over(
+        &self,
+        surface: usize,
+        buckets: (usize, usize),
+        power: f64,
+        cos_lo: f64,
+    ) -> bool {
+        power >= 0.0
+            && cos_lo >= 0.0
+            && buckets.0 <= buckets.1
+            && (buckets.0..=buckets.1).all(|b| {
+                self.rows[surface]
+                    .get(b)
+                    .is_some_and(|&l| l >= 0.0 && power * cos_lo * l >= self.limit)
+            })
+    }
 }
 
 /// The `argus` model's range factor `e^(−0.004·r)` bounded per range
@@ -674,6 +696,38 @@ impl ArgusBuckets {
         } else {
             None
         }
+    }
+
+    /// [`Self::decided`]'s value if it is the same for every hit at a range
+    /// in `range_m` (inclusive) and its buckets `buckets` (inclusive):
+    /// beyond the 100 m all are 0; within them each bucket decides alone
+    /// (the range enters only through the 100 m test).
+    pub(crate) fn decided_over(
+        &self,
+        model: &ReturnModel,
+        range_m: (f64, f64),
+        buckets: (usize, usize),
+        power: f64,
+    ) -> Option<f64> {
+        let ReturnModel::Argus { .. } = *model else {
+            return None;
+        };
+        if range_m.0 > ARGUS_RANGE_M {
+            return Some(0.0);
+        }
+        if range_m.1.is_nan() || range_m.1 > ARGUS_RANGE_M || buckets.0 > buckets.1 {
+            return None;
+        }
+        let mut out = None;
+        for b in buckets.0..=buckets.1 {
+            // Any range within the 100 m stands for all of them here.
+            let p = self.decided(model, range_m.1, b, power)?;
+            if out.is_some_and(|o| o != p) {
+                return None;
+            }
+            out = Some(p);
+        }
+        out
     }
 }
 

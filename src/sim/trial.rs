@@ -663,6 +663,192 @@ fn bin_facts(profile: &Profile, regions: &Regions, static_arcs: &[Arc]) -> Vec<B
         .collect()
 }
 
+/// Margin of [`direction_bounds`] on a ray's direction cosines: far above
+/// libm's error on `sin`/`cos` (under an ulp, 1.1e-16) and the rounding of
+/// the bounds' own endpoints.
+const DIR_PAD: f64 = 1e-9;
+
+/// Bounds of `(cos θ, sin θ)` over `θ ∈ [t0, t1]` (radians, inside
+/// `[0, 2π)`), each padded by [`DIR_PAD`]: the values at the ends, widened
+/// to ±1 where the interval holds an extremum (cos: 0, π, 2π; sin: π/2,
+/// 3π/2); between extrema both are monotone.
+fn direction_bounds(t0: f64, t1: f64) -> ((f64, f64), (f64, f64)) {
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+    let has = |x: f64| t0 - DIR_PAD <= x && x <= t1 + DIR_PAD;
+    let span = |a: f64, b: f64, max_at: &[f64], min_at: &[f64]| {
+        let hi = if max_at.iter().any(|&x| has(x)) {
+            1.0
+        } else {
+            a.max(b)
+        };
+        let lo = if min_at.iter().any(|&x| has(x)) {
+            -1.0
+        } else {
+            a.min(b)
+        };
+        (lo - DIR_PAD, hi + DIR_PAD)
+    };
+    (
+        span(t0.cos(), t1.cos(), &[0.0, TAU], &[PI]),
+        span(t0.sin(), t1.sin(), &[FRAC_PI_2], &[3.0 * FRAC_PI_2]),
+    )
+}
+
+/// Bounds of a slab's entry and exit parameters (as [`Aabb::ray_hit`]'s
+/// slab computes them) for every direction component `d` in `[d.0, d.1]`;
+/// `None` if the ray may run parallel outside the slab (a miss there).
+/// Off zero `x / d` is monotone in `d` (and its rounding monotone), so the
+/// ends bound it; across zero the entry is at most 0 and the exit at least
+/// the nearer end's.
+#[allow(clippy::type_complexity)]
+fn slab_bounds(lo: f64, hi: f64, d: (f64, f64)) -> Option<((f64, f64), (f64, f64))> {
+    let (d0, d1) = d;
+    if d0 > 0.0 || d1 < 0.0 {
+        let ends = |x: f64| {
+            let (a, b) = (x / d0, x / d1);
+            (a.min(b), a.max(b))
+        };
+        let (at_lo, at_hi) = (ends(lo), ends(hi));
+        // d > 0: entry lo/d, exit hi/d; d < 0 the other way round.
+        Some(if d0 > 0.0 {
+            (at_lo, at_hi)
+        } else {
+            (at_hi, at_lo)
+        })
+    } else if lo <= 0.0 && 0.0 <= hi {
+        let mut exit_lo = f64::INFINITY;
+        if d1 > 0.0 {
+            exit_lo = exit_lo.min(hi / d1);
+        }
+        if d0 < 0.0 {
+            exit_lo = exit_lo.min(lo / d0);
+        }
+        Some(((f64::NEG_INFINITY, 0.0), (exit_lo, f64::INFINITY)))
+    } else {
+        None
+    }
+}
+
+/// What a ray cast does for every direction of a bin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum HitBound {
+    /// Not decided: cast the ray.
+    Unknown,
+    /// Never a hit.
+    Miss,
+    /// Always a hit at a range in `range_m` (inclusive) with an incidence
+    /// cosine of at least `cos_lo`.
+    Hit { range_m: (f64, f64), cos_lo: f64 },
+}
+
+/// [`Aabb::ray_hit`] for every direction with `cos` in `c`, `sin` in `s`.
+fn box_bound(b: &Aabb, c: (f64, f64), s: (f64, f64)) -> HitBound {
+    let (Some((x_in, x_out)), Some((y_in, y_out))) =
+        (slab_bounds(b.x0, b.x1, c), slab_bounds(b.y0, b.y1, s))
+    else {
+        return HitBound::Unknown;
+    };
+    let t_in = (x_in.0.max(y_in.0), x_in.1.max(y_in.1));
+    let t_out = (x_out.0.min(y_out.0), x_out.1.min(y_out.1));
+    if t_in.1 <= 0.0 || t_in.0 > t_out.1 {
+        return HitBound::Miss;
+    }
+    if !(t_in.0 > 0.0 && t_in.1 <= t_out.0) {
+        return HitBound::Unknown;
+    }
+    let abs_lo = |(a, b): (f64, f64)| {
+        if a <= 0.0 && 0.0 <= b {
+            0.0
+        } else {
+            a.abs().min(b.abs())
+        }
+    };
+    // The face entered: x when its entry is the later (`tx0 >= ty0`).
+    let cos_lo = if x_in.0 >= y_in.1 {
+        abs_lo(c)
+    } else if x_in.1 < y_in.0 {
+        abs_lo(s)
+    } else {
+        abs_lo(c).min(abs_lo(s))
+    };
+    HitBound::Hit {
+        range_m: t_in,
+        cos_lo,
+    }
+}
+
+/// The nearest static hit of every azimuth of each bin of `profile`, over
+/// the statics of the bin's mask (`facts`), as the pulse loop casts it
+/// (`sin_cos` of `az.to_radians()`, the boxes in order, the nearest kept):
+/// the nearest range lies between the least lower and the least upper
+/// bound, and its cosine is at least that of any box that may be nearest.
+fn static_hit_bounds(profile: &Profile, statics: &[Aabb], facts: &[BinFacts]) -> Vec<HitBound> {
+    profile
+        .bins
+        .iter()
+        .zip(facts)
+        .map(|(b, f)| {
+            let Some((lo, hi)) = padded_bin(b.start_deg, b.width_deg) else {
+                return HitBound::Unknown;
+            };
+            // `to_radians` is one rounded product: monotone.
+            let (c, s) = direction_bounds(lo.to_radians(), hi.to_radians());
+            let mut hits: Vec<((f64, f64), f64)> = Vec::new();
+            for (i, bx) in statics.iter().enumerate().take(62) {
+                if f.statics >> i & 1 == 0 {
+                    continue;
+                }
+                match box_bound(bx, c, s) {
+                    HitBound::Unknown => return HitBound::Unknown,
+                    HitBound::Miss => {}
+                    HitBound::Hit { range_m, cos_lo } => hits.push((range_m, cos_lo)),
+                }
+            }
+            let near_hi = hits.iter().map(|h| h.0 .1).fold(f64::INFINITY, f64::min);
+            let near_lo = hits.iter().map(|h| h.0 .0).fold(f64::INFINITY, f64::min);
+            let cos_lo = hits
+                .iter()
+                .filter(|h| h.0 .0 <= near_hi)
+                .map(|h| h.1)
+                .fold(f64::INFINITY, f64::min);
+            if hits.is_empty() {
+                HitBound::Miss
+            } else {
+                HitBound::Hit {
+                    range_m: (near_lo, near_hi),
+                    cos_lo,
+                }
+            }
+        })
+        .collect()
+}
+
+/// Whether `cell` surely returns (or surely not) a static hit within
+/// `range_m` with an incidence cosine of at least `cos_lo` at power ratio
+/// `power`: the pulse loop's decision ([`Saturation::saturated`], then
+/// [`ArgusBuckets::decided`]) taken over the whole range; `None` if it
+/// may differ, or needs the model.
+fn sure_static_return(
+    cell: &GroupCell<'_>,
+    argus: &ArgusBuckets,
+    power: f64,
+    range_m: (f64, f64),
+    cos_lo: f64,
+) -> Option<bool> {
+    let buckets = (
+        (range_m.0 * (1.0 / RANGE_BUCKET_M)) as usize,
+        (range_m.1 * (1.0 / RANGE_BUCKET_M)) as usize,
+    );
+    match cell.saturation {
+        Some(sat) => sat
+            .saturated_over(0, buckets, power, cos_lo)
+            .then_some(true),
+        None => argus
+            .decided_over(cell.model, range_m, buckets, power)
+            .map(|p| p >= 1.0),
+    }
+}
+
 /// One cell of a planar group: what differs between cells that share a
 /// trial, a timeline and the driver's regions.
 #[derive(Debug, Clone, Copy)]
@@ -690,6 +876,23 @@ struct GroupState {
     roi_points: u64,
     argus_roi_points: u64,
     keep_acc: f64,
+}
+
+impl GroupState {
+    /// Counts a returned point of a pulse (RoI, ARGUS's density); `false`
+    /// if the RoF decimation drops it.
+    fn keep(&mut self, rof_keep: f64, in_rof: bool, in_roi: bool, dens: bool) -> bool {
+        if rof_keep < 1.0 && in_rof {
+            self.keep_acc += rof_keep;
+            if self.keep_acc < 1.0 {
+                return false;
+            }
+            self.keep_acc -= 1.0;
+        }
+        self.roi_points += u64::from(in_roi);
+        self.argus_roi_points += u64::from(dens);
+        true
+    }
 }
 
 /// [`run_trial`] for several cells at once, bit-identical to running each
@@ -871,6 +1074,32 @@ pub fn run_group_with(
     // bits 62 and 63 for the cars.
     let statics_masked = setup.statics.len() <= 62;
     let facts = bin_facts(setup.profile, setup.regions, &static_arcs);
+    // Per bin, the cells that surely return its static hit (bit i: cell
+    // i), when every cell's return is decided for every azimuth of the bin
+    // ([`static_hit_bounds`], [`sure_static_return`]): a pulse there that
+    // cannot reach a car needs no ray (its counts are the same).
+    let sure: Vec<Option<u64>> =
+        if setup.brute_force || !statics_masked || cells.len() > 64 {
+            vec![None; facts.len()]
+        } else {
+            static_hit_bounds(setup.profile, setup.statics, &facts)
+                .iter()
+                .enumerate()
+                .map(|(bin, hit)| match *hit {
+                    HitBound::Unknown => None,
+                    HitBound::Miss => Some(0),
+                    HitBound::Hit { range_m, cos_lo } => states
+                        .iter()
+                        .zip(cells)
+                        .enumerate()
+                        .try_fold(0u64, |bits, (i, (st, cell))| {
+                            let power = st.power_ratio[bin];
+                            sure_static_return(cell, argus, power, range_m, cos_lo)
+                                .map(|r| bits | u64::from(r) << i)
+                        }),
+                })
+                .collect()
+        };
     let mut roi_pulses = 0u64;
     let mut current_frame = u64::MAX;
     let mut car_arcs = [static_arcs[0]; 2];
@@ -997,6 +1226,16 @@ pub fn run_group_with(
         if !setup.brute_force && mask >> 62 == 0 && !in_roi && !dens && !in_rof {
             continue;
         }
+        if mask >> 62 == 0 {
+            if let Some(returns) = sure[bin] {
+                for (i, (st, cell)) in states.iter_mut().zip(cells).enumerate() {
+                    if returns >> i & 1 == 1 {
+                        st.keep(cell.rof_keep, in_rof, in_roi, dens);
+                    }
+                }
+                continue;
+            }
+        }
         let (s, c) = *pulse.dir.get_or_insert_with(|| az.to_radians().sin_cos());
         let Some((range, cos_i, refl, car)) = cast_masked(c, s, t, mask) else {
             continue;
@@ -1025,18 +1264,9 @@ pub fn run_group_with(
                     && *noise.get_or_insert_with(|| {
                         unit(draw.noise_seed ^ k.wrapping_mul(0xD1B5_4A32_D192_ED03))
                     }) < p_d);
-            if !returned {
+            if !returned || !st.keep(cell.rof_keep, in_rof, in_roi, dens) {
                 continue;
             }
-            if cell.rof_keep < 1.0 && in_rof {
-                st.keep_acc += cell.rof_keep;
-                if st.keep_acc < 1.0 {
-                    continue;
-                }
-                st.keep_acc -= 1.0;
-            }
-            st.roi_points += u64::from(in_roi);
-            st.argus_roi_points += u64::from(dens);
             if let Some(j) = car {
                 if st.detected_at[j].is_none() && t <= t_conflict[j] {
                     let frames_hit = &mut st.hit_frames[j];
@@ -1134,6 +1364,134 @@ mod tests {
             for a in near.into_iter().chain(edges).chain([360.0, -1.0, f64::NAN]) {
                 assert_eq!(arc_contains(&arc, a), arc.contains(a), "{arc:?} {a}");
             }
+        }
+    }
+
+    /// The pulse loop's cast of a static-only pulse, plainly: every box of
+    /// `mask` in order, the nearest kept.
+    fn cast_statics(statics: &[Aabb], mask: u64, az: f64) -> Option<(f64, f64)> {
+        let (s, c) = az.to_radians().sin_cos();
+        let mut best: Option<(f64, f64)> = None;
+        for (i, b) in statics.iter().enumerate() {
+            if mask >> i & 1 == 1 {
+                if let Some(h) = b.ray_hit(c, s) {
+                    if best.is_none_or(|x| h.range_m < x.0) {
+                        best = Some((h.range_m, h.cos_incidence));
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Scenes around the paper's: corners, edges and the bend moved,
+    /// including a corner block in front of the sensor and boxes through
+    /// the axes.
+    fn scenes() -> Vec<Scenario> {
+        let mut out = vec![Scenario::default()];
+        for (corner, near, bend, stem) in [
+            (0.0, 3.0, 82.0, 7.0),
+            (0.5, 1.0, 30.0, 3.0),
+            (-3.0, 8.0, 150.0, 12.0),
+            (-0.5, 0.5, 10.0, 1.0),
+        ] {
+            out.push(Scenario {
+                corner_front_x_m: corner,
+                near_edge_x_m: near,
+                bend_distance_m: bend,
+                stem_width_m: stem,
+                ..Scenario::default()
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn static_hit_bounds_hold_for_every_azimuth_of_their_bin() {
+        // The paper's profiles at several gazes and bin counts, in several
+        // scenes: azimuths across each bin (its padded edges and their
+        // neighbours included) cast plainly land inside the bin's bound.
+        let preset = presets::paper();
+        let (mut hits, mut misses, mut cast) = (0, 0, 0);
+        for sc in scenes() {
+            let statics = sc.static_boxes();
+            let static_arcs: Vec<Arc> = statics
+                .iter()
+                .map(|b| cull_arc(std::slice::from_ref(b)))
+                .collect();
+            for gaze in [0.0, 90.0, 181.0, 300.3] {
+                for (mode, bins) in [(Mode::Joint, 360), (Mode::Resolution, 97), (Mode::Range, 7)] {
+                    let c = closed_form(&preset, mode, Some(gaze), bins).unwrap();
+                    let regions = preset.focus.regions(gaze);
+                    let facts = bin_facts(c.profile(), &regions, &static_arcs);
+                    let bounds = static_hit_bounds(c.profile(), &statics, &facts);
+                    for ((b, f), bound) in c.profile().bins.iter().zip(&facts).zip(&bounds) {
+                        if *bound == HitBound::Unknown {
+                            continue;
+                        }
+                        let (lo, hi) = padded_bin(b.start_deg, b.width_deg).unwrap();
+                        let samples = (0..=64)
+                            .map(|i| lo + (hi - lo) * f64::from(i) / 64.0)
+                            .chain([lo, lo.next_up(), hi.next_down(), hi]);
+                        for az in samples {
+                            let got = cast_statics(&statics, f.statics, az);
+                            cast += 1;
+                            match (*bound, got) {
+                                (HitBound::Miss, None) => misses += 1,
+                                (HitBound::Hit { range_m, cos_lo }, Some((r, cos))) => {
+                                    assert!(
+                                        range_m.0 <= r && r <= range_m.1,
+                                        "{az} {r} {range_m:?}"
+                                    );
+                                    assert!(cos >= cos_lo, "{az} {cos} {cos_lo}");
+                                    hits += 1;
+                                }
+                                (bound, got) => panic!("{az}: {bound:?} but {got:?}"),
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(hits > 50_000 && misses > 1_000, "{hits} {misses} of {cast}");
+    }
+
+    #[test]
+    fn decided_bins_are_bit_identical_to_brute_force_in_every_scene() {
+        // The whole planar grid (both models, every variant and fog) in
+        // each scene, the decided bins against the brute-force casts.
+        for scenario in scenes() {
+            let config = |brute_force| crate::sim::SimConfig {
+                trials: 2,
+                seed: 7,
+                brute_force,
+                scenario: scenario.clone(),
+                ..crate::sim::SimConfig::default()
+            };
+            let fast = crate::sim::run(&config(false), &|| {}).unwrap();
+            let slow = crate::sim::run(&config(true), &|| {}).unwrap();
+            assert_eq!(fast.trials, slow.trials, "{scenario:?}");
+        }
+    }
+
+    #[test]
+    fn slab_bounds_hold_across_zero() {
+        // Direction components through zero: a slab around the origin has
+        // entry ≤ 0 and an exit beyond the nearer end; one beside it may be
+        // parallel (undecided).
+        let d = (-0.01, 0.02);
+        let ((e0, e1), (x0, x1)) = slab_bounds(-2.0, 3.0, d).unwrap();
+        assert_eq!((e0, e1, x1), (f64::NEG_INFINITY, 0.0, f64::INFINITY));
+        assert_eq!(x0, 150.0);
+        assert!(slab_bounds(1.0, 3.0, d).is_none());
+        for i in 0..300 {
+            let v = -0.01 + 0.0001 * f64::from(i);
+            let hit = Aabb::new(-2.0, 3.0, 1.0, 50.0).ray_hit(v, 1.0);
+            if v.abs() > 0.0 {
+                let (a, b) = (-2.0 / v, 3.0 / v);
+                assert!(a.min(b) <= 0.0 && a.max(b) >= x0, "{v}");
+            }
+            assert!(hit.is_some(), "{v}");
         }
     }
 
