@@ -1163,7 +1163,6 @@ pub fn run_group_with(
     };
 
     for k in 0..n_pulses {
-        let t = k as f64 / pulse_rate;
         let pulse = &mut pulses[k as usize];
         let frame = pulse.frame;
         if frame != current_frame {
@@ -1236,6 +1235,8 @@ pub fn run_group_with(
                 continue;
             }
         }
+        // The pulse's time (needed from here on only).
+        let t = k as f64 / pulse_rate;
         let (s, c) = *pulse.dir.get_or_insert_with(|| az.to_radians().sin_cos());
         let Some((range, cos_i, refl, car)) = cast_masked(c, s, t, mask) else {
             continue;
