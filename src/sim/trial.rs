@@ -10,7 +10,11 @@
 //! the object's angular extent (static: once; cars: swept over the frame,
 //! padded by [`CULL_PAD_DEG`]). Rays outside an object's extent cannot hit it,
 //! so results are bit-identical to testing everything (`brute_force = true`;
-//! checked by tests).
+//! checked by tests). In a group ([`run_group`]) a bin whose static hit is
+//! bounded for every azimuth it produces, with every cell's return decided
+//! over those bounds, counts its pulses that cannot reach a car without a
+//! cast (`static_hit_bounds`; the same results, checked against brute
+//! force).
 
 use crate::model::acuity::Regions;
 use crate::model::angle::{diff_deg, wrap_deg, Arc, CircularSet};
