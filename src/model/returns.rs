@@ -741,6 +741,61 @@ mod tests {
     }
 
     #[test]
+    fn decisions_over_a_range_hold_at_every_range_in_it() {
+        // Ranges [lo, hi] across the tables (and beyond the argus 100 m):
+        // a decision over the range is the pointwise decision at ranges
+        // inside it (edges included), for cosines at or above the bound.
+        let table = ArgusBuckets::new();
+        let step = |k: u32| f64::from(k) * 0.37 + 0.05;
+        let (mut argus_decided, mut saturated) = (0, 0);
+        for fog in FOG_LEVELS_PCT {
+            let argus = model(ModelKind::Argus, fog);
+            let physical = model(ModelKind::Physical, fog);
+            let sat = Saturation::new(&physical, [0.3, 0.6], 400.0).unwrap();
+            for power in [0.25, 0.9, 1.0, 2.0] {
+                for k in 0..300u32 {
+                    for width in [0.0, 0.1, 1.0, 4.0] {
+                        let range = (step(k), step(k) + width);
+                        let buckets = (
+                            (range.0 * (1.0 / RANGE_BUCKET_M)) as usize,
+                            (range.1 * (1.0 / RANGE_BUCKET_M)) as usize,
+                        );
+                        let inside = (0..=16).map(|i| range.0 + width * f64::from(i) / 16.0);
+                        let inside: Vec<f64> = inside.chain([range.1]).collect();
+                        if let Some(p) = table.decided_over(&argus, range, buckets, power) {
+                            argus_decided += 1;
+                            for &r in &inside {
+                                let b = (r * (1.0 / RANGE_BUCKET_M)) as usize;
+                                assert_eq!(table.decided(&argus, r, b, power), Some(p), "{r}");
+                            }
+                        }
+                        for cos_lo in [0.2, 0.7, 1.0] {
+                            if sat.saturated_over(0, buckets, power, cos_lo) {
+                                saturated += 1;
+                                for &r in &inside {
+                                    let b = (r * (1.0 / RANGE_BUCKET_M)) as usize;
+                                    for cos in [cos_lo, 0.5 * (cos_lo + 1.0), 1.0] {
+                                        assert!(sat.saturated(0, b, power, cos), "{r} {cos}");
+                                        assert_eq!(
+                                            physical.detection_probability(power, 0.3, cos, r),
+                                            1.0
+                                        );
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            assert_eq!(table.decided_over(&physical, (1.0, 2.0), (4, 8), 1.0), None);
+        }
+        assert!(
+            argus_decided > 5_000 && saturated > 1_000,
+            "{argus_decided} {saturated}"
+        );
+    }
+
+    #[test]
     fn argus_buckets_decide_as_the_model_does() {
         // Every fog level, powers of the closed forms and between, ranges
         // across every bucket (their edges included) and beyond 100 m.
