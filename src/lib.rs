@@ -40,6 +40,7 @@ pub mod model;
 pub mod names;
 #[cfg(feature = "solver")]
 pub mod optimizer;
+pub mod pipeline;
 pub mod planner;
 pub mod pointcloud;
 pub mod profile;

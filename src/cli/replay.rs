@@ -115,6 +115,16 @@ fn replay_error(e: ReplayError) -> CliError {
     if let ReplayError::Config { field, reason } = &e {
         return CliError::input(format!("--{}: {reason}", field.replace('_', "-")));
     }
+    if let ReplayError::MountTilt {
+        topic,
+        reason,
+        met_at,
+    } = &e
+    {
+        return CliError::input(format!(
+            "{topic}: {reason} (give the yaw with --sensor-yaw-deg to use it anyway){met_at}"
+        ));
+    }
     if e.is_input_error() {
         CliError::input(e.to_string())
     } else {
