@@ -124,8 +124,8 @@ fn opt_error(py: Python<'_>, e: gaze_lidar::optimizer::OptError) -> PyErr {
     }
 }
 
-fn pipeline_error(py: Python<'_>, e: impl Into<PipelineError>) -> PyErr {
-    match e.into() {
+fn pipeline_error(py: Python<'_>, e: PipelineError) -> PyErr {
+    match e {
         PipelineError::Plan(p) => plan_error(py, p),
         PipelineError::Optimizer(o) => opt_error(py, o),
         other if other.is_input_error() => value_error(other.to_string()),
@@ -1630,7 +1630,7 @@ fn read_gaze<'py>(
         let bytes =
             std::fs::read(&path).map_err(|e| value_error(format!("path: {origin}: {e}")))?;
         let track = detached(py, || gaze_io::parse(&bytes, fmt, &origin))?
-            .map_err(|e| pipeline_error(py, e))?;
+            .map_err(|e| pipeline_error(py, e.into()))?;
         let d = PyDict::new(py);
         d.set_item("t_s", PyArray1::from_vec(py, track.t_s))?;
         d.set_item("gaze_deg", PyArray1::from_vec(py, track.gaze_deg))?;

@@ -7,7 +7,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use gaze_lidar::pipeline::PipelineOptions;
-use gaze_lidar::replay::{replay_file, Compression, GazeKind, ReplayError, ReplayOptions};
+use gaze_lidar::replay::{
+    replay_file, Compression, GazeKind, ReplayError, ReplayOptions, MAX_BINS,
+};
 
 use super::{
     detached, frame_planner, guard, mode_of, model_of, pipeline_error, seed_of, value_error,
@@ -32,10 +34,6 @@ fn replay_error(py: Python<'_>, e: ReplayError) -> PyErr {
         e => value_error(e.to_string()),
     }
 }
-
-/// Most bins of a replayed profile (the CLI's limit: each frame's profile
-/// is written to the output).
-const MAX_REPLAY_BINS: usize = 1440;
 
 /// `lo < v < hi`, `v` finite and not subnormal (the one numeric boundary).
 fn in_range(field: &str, v: f64, lo: f64, hi: f64) -> PyResult<f64> {
@@ -110,7 +108,7 @@ pub fn replay<'py>(
             preset,
             mode,
             bins,
-            MAX_REPLAY_BINS,
+            MAX_BINS,
             " for replay (each frame's profile is written to the output, ~240 bytes per bin)",
             config_toml,
         )?;

@@ -104,11 +104,8 @@ pub struct Args {
     compression: CompressionArg,
 }
 
-/// Most bins of a replayed profile: each frame's profile@1 document is
-/// written to the output (about 240 bytes of JSON per bin: 1440 bins are
-/// some 340 KB per frame, 3.4 MB/s at 10 Hz, already more than the
-/// adapted clouds of a 32-channel sensor); the optimizer's limit too.
-pub const MAX_REPLAY_BINS: i64 = 1440;
+/// [`gaze_lidar::replay::MAX_BINS`], as `--bins` is read.
+pub const MAX_REPLAY_BINS: i64 = gaze_lidar::replay::MAX_BINS as i64;
 
 fn replay_error(e: ReplayError) -> CliError {
     // An option is named by its flag.

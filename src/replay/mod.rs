@@ -959,8 +959,14 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
     }
 }
 
-/// Largest `--reorder-window-ms`, ns.
+/// Largest reorder window, ns.
 pub const MAX_REORDER_WINDOW_NS: u64 = 60_000_000_000;
+
+/// Most bins of a replayed profile: each frame's profile@1 document is
+/// written to the output (about 240 bytes of JSON per bin: 1440 bins are
+/// some 340 KB per frame, 3.4 MB/s at 10 Hz, already more than the
+/// adapted clouds of a 32-channel sensor); the optimizer's limit too.
+pub const MAX_BINS: usize = 1440;
 
 fn config(field: &'static str, reason: impl Into<String>) -> ReplayError {
     ReplayError::Config {
