@@ -4,8 +4,8 @@
 #![no_main]
 
 use gaze_lidar::gaze::{FailSafeConfig, FilterConfig, Format, Parser, State};
-use gaze_lidar::pipeline::{ClosedFormPlanner, GazeStream};
 use gaze_lidar::model::presets;
+use gaze_lidar::pipeline::{ClosedFormPlanner, GazeStream};
 use gaze_lidar::planner::Mode;
 use libfuzzer_sys::fuzz_target;
 
