@@ -11,10 +11,9 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use gaze_lidar::checker::check;
-use gaze_lidar::gaze::{
-    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeSample, GazeStream,
-};
+use gaze_lidar::gaze::{FailSafeConfig, FilterConfig, GazeSample};
 use gaze_lidar::model::presets;
+use gaze_lidar::pipeline::{ClosedFormPlanner, FramePlanner, GazeStream};
 use gaze_lidar::planner::Mode;
 use planned::planned_profiles;
 
@@ -96,7 +95,7 @@ fn bench(c: &mut Criterion) {
             .unwrap()
             .problem()
             .unwrap();
-        let mut planner = gaze_lidar::gaze::OptimizerPlanner::new(problem).unwrap();
+        let mut planner = gaze_lidar::pipeline::OptimizerPlanner::new(problem).unwrap();
         // Warm the cache over the phases the trace uses.
         for x in samples().iter().step_by(10) {
             planner.plan(Some(x.gaze_deg)).unwrap();

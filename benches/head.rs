@@ -25,8 +25,9 @@ use gaze_lidar::checker::check;
 use gaze_lidar::eye_safety::bound::Seg;
 use gaze_lidar::eye_safety::head::power_scale_to_certify;
 use gaze_lidar::eye_safety::{evaluate_segments, EyeSafetyParams};
-use gaze_lidar::gaze::{ClosedFormPlanner, FailSafeConfig, FilterConfig, GazeSample, GazeStream};
+use gaze_lidar::gaze::{FailSafeConfig, FilterConfig, GazeSample};
 use gaze_lidar::model::presets::{self, preset};
+use gaze_lidar::pipeline::{ClosedFormPlanner, GazeStream};
 use gaze_lidar::planner::Mode;
 
 /// Timed runs per percentile figure (`GAZE_LIDAR_HEAD_BENCH_SAMPLES`
@@ -116,7 +117,7 @@ fn gaze_trace(n: usize) -> Vec<GazeSample> {
 
 /// Thread CPU time of every `push` that produced a frame (one sample in
 /// ten plans and certifies a profile), over `n` samples: `[p50, p99]`, s.
-fn frame_cpu<P: gaze_lidar::gaze::FramePlanner>(planner: P, n: usize) -> [f64; 2] {
+fn frame_cpu<P: gaze_lidar::pipeline::FramePlanner>(planner: P, n: usize) -> [f64; 2] {
     let mut s = GazeStream::new(planner, FilterConfig::default(), FailSafeConfig::default());
     let mut cpu = Vec::new();
     for x in gaze_trace(n) {
@@ -162,9 +163,9 @@ fn single_channel_targets(n: usize) {
             .unwrap()
             .problem()
             .unwrap();
-        let mut planner = gaze_lidar::gaze::OptimizerPlanner::new(problem).unwrap();
+        let mut planner = gaze_lidar::pipeline::OptimizerPlanner::new(problem).unwrap();
         for x in gaze_trace(samples).iter().step_by(10) {
-            use gaze_lidar::gaze::FramePlanner;
+            use gaze_lidar::pipeline::FramePlanner;
             planner.plan(Some(x.gaze_deg)).unwrap();
         }
         let [p50, p99] = frame_cpu(planner, samples);

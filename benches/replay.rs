@@ -17,8 +17,8 @@ use std::io::Cursor;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use gaze_lidar::gaze::ClosedFormPlanner;
 use gaze_lidar::model::presets;
+use gaze_lidar::pipeline::ClosedFormPlanner;
 use gaze_lidar::planner::Mode;
 use gaze_lidar::replay::{replay, Compression, PipelineConfig, ReplayOptions, ZSTD_LEVEL};
 

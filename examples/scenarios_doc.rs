@@ -8,7 +8,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use gaze_lidar::gaze::{Format, PipelineConfig};
+use gaze_lidar::gaze::Format;
+use gaze_lidar::pipeline::PipelineConfig;
 use gaze_lidar::sim::gaze_drive::{self, Behaviour, GazeDrive, GazeSource, Trace};
 use gaze_lidar::sim::{self, report, stats, GridResult, ModelKind, Scenario, SimConfig, Variant};
 

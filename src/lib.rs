@@ -14,7 +14,9 @@
 //!
 //! Data flows one way:
 //! gaze → [`model`] (regions) → [`planner`] → [`profile`] → [`checker`]
-//! (certify, with [`eye_safety`]) → outputs.
+//! (certify, with [`eye_safety`]) → outputs. In real time, [`gaze`] (pure
+//! input: formats, filter, fail-safe) feeds [`pipeline`], which asks a
+//! planner for each frame's certified profile.
 //!
 //! ```
 //! use gaze_lidar::model::presets;
@@ -40,6 +42,7 @@ pub mod model;
 pub mod names;
 #[cfg(feature = "solver")]
 pub mod optimizer;
+pub mod pipeline;
 pub mod planner;
 pub mod pointcloud;
 pub mod profile;

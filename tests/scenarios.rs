@@ -4,7 +4,8 @@
 mod common;
 
 use common::{assert_bad_input, run, stderr};
-use gaze_lidar::gaze::{Format, PipelineConfig};
+use gaze_lidar::gaze::Format;
+use gaze_lidar::pipeline::PipelineConfig;
 use gaze_lidar::sim::gaze_drive::{self, Behaviour, GazeDrive, GazeSource, Trace};
 use gaze_lidar::sim::{self, GridResult, ModelKind, Scenario, SimConfig, Variant};
 

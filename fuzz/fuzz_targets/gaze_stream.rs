@@ -3,8 +3,9 @@
 //! certified and is the baseline whenever it is fail-safe.
 #![no_main]
 
-use gaze_lidar::gaze::{ClosedFormPlanner, FailSafeConfig, FilterConfig, Format, GazeStream, Parser, State};
+use gaze_lidar::gaze::{FailSafeConfig, FilterConfig, Format, Parser, State};
 use gaze_lidar::model::presets;
+use gaze_lidar::pipeline::{ClosedFormPlanner, GazeStream};
 use gaze_lidar::planner::Mode;
 use libfuzzer_sys::fuzz_target;
 

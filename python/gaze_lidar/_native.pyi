@@ -294,7 +294,10 @@ class GazeStream:
     timeout_ms when it is decided, and after a loss only once
     recover_samples consecutive valid samples arrived; otherwise it runs the
     uniform baseline. A timestamp jump of more than max_gap_frames periods
-    emits one fail-safe frame and restarts the clock.
+    emits one fail-safe frame and restarts the clock. The settings take the
+    ranges of the CLI's options: timeout_ms in (0, 1e7), rounded to a
+    microsecond; recover_samples 1..=100000; saccade_deg_s in (0, 1e6);
+    max_gap_frames 0..=1000000.
 
     With config_toml, frames are planned by the optimizer's fast path
     (mode overrides the objective); otherwise by the preset's closed form.

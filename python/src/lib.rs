@@ -22,14 +22,14 @@ use gaze_lidar::checker::{
     certify_with, CertifiedProfile, CheckOptions, Verdict as CoreVerdict, Violation,
 };
 use gaze_lidar::firmware::{FirmwareConfig, FirmwareError, FirmwareTable};
-use gaze_lidar::gaze::{
-    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeError, GazeSample, Notice,
-    State, StreamConfig,
-};
+use gaze_lidar::gaze::{GazeSample, State};
 use gaze_lidar::model::angle::wrap_deg;
 use gaze_lidar::model::lidar::PowerAccounting;
 use gaze_lidar::model::presets::{self, Preset};
 use gaze_lidar::names::Named;
+use gaze_lidar::pipeline::{
+    ClosedFormPlanner, FramePlanner, Notice, PipelineError, PipelineOptions,
+};
 use gaze_lidar::planner::{closed_form, validate_gaze, Mode, PlanError};
 use gaze_lidar::pointcloud::{keep_mask, CloudFrame, CloudOptions};
 use gaze_lidar::profile::kinematics::{BinMotion, Timeline};
@@ -124,10 +124,10 @@ fn opt_error(py: Python<'_>, e: gaze_lidar::optimizer::OptError) -> PyErr {
     }
 }
 
-fn gaze_error(py: Python<'_>, e: GazeError) -> PyErr {
+fn pipeline_error(py: Python<'_>, e: PipelineError) -> PyErr {
     match e {
-        GazeError::Plan(p) => plan_error(py, p),
-        GazeError::Optimizer(o) => opt_error(py, o),
+        PipelineError::Plan(p) => plan_error(py, p),
+        PipelineError::Optimizer(o) => opt_error(py, o),
         other if other.is_input_error() => value_error(other.to_string()),
         other => Infeasible::new_err(other.to_string()),
     }
@@ -960,7 +960,48 @@ impl PyFrame {
     }
 }
 
-type Stream = gaze_lidar::gaze::GazeStream<Box<dyn FramePlanner + Send>>;
+type Stream = gaze_lidar::pipeline::GazeStream<Box<dyn FramePlanner + Send>>;
+
+/// The frame planner of a `GazeStream` or a replay, and the rated range of
+/// its sensor, m: the optimizer's fast path on `config_toml` (`mode`
+/// replacing its objective's), else the preset's closed form on `bins`
+/// equal bins (`4..=max_bins`; `bins_note` follows the range in the
+/// message), planned once at gaze 0 so that an impossible request fails
+/// here rather than at the first frame.
+#[allow(clippy::too_many_arguments)]
+fn frame_planner(
+    py: Python<'_>,
+    preset: &str,
+    mode: Mode,
+    bins: i64,
+    max_bins: usize,
+    bins_note: &str,
+    config_toml: Option<&str>,
+) -> PyResult<(Box<dyn FramePlanner + Send>, f64)> {
+    if let Some(text) = config_toml {
+        use gaze_lidar::optimizer::OptimizerConfig;
+        let mut problem = OptimizerConfig::from_toml(text, "config_toml")
+            .and_then(|c| c.problem())
+            .map_err(|e| opt_error(py, e))?;
+        problem.objective.mode = mode;
+        let rated = problem.lidar.rated_range_m;
+        let p = gaze_lidar::pipeline::OptimizerPlanner::new(problem)
+            .map_err(|e| pipeline_error(py, e))?;
+        return Ok((Box::new(p), rated));
+    }
+    let bins = usize::try_from(bins)
+        .ok()
+        .filter(|b| (gaze_lidar::model::angle::MIN_BINS..=max_bins).contains(b))
+        .ok_or_else(|| {
+            value_error(format!(
+                "bins: {bins} must lie in [4, {max_bins}]{bins_note}"
+            ))
+        })?;
+    let preset = preset_of(preset)?;
+    closed_form(&preset, mode, Some(0.0), bins).map_err(|e| plan_error(py, e))?;
+    let rated = preset.lidar.rated_range_m;
+    Ok((Box::new(ClosedFormPlanner { preset, mode, bins }), rated))
+}
 
 /// Gaze samples in, one certified profile per LiDAR frame out.
 ///
@@ -971,7 +1012,10 @@ type Stream = gaze_lidar::gaze::GazeStream<Box<dyn FramePlanner + Send>>;
 /// recover_samples consecutive valid samples arrived (so the first
 /// adaptive frame comes after 4 valid samples by default); otherwise it
 /// runs the uniform baseline. A timestamp jump of more than max_gap_frames
-/// periods emits one fail-safe frame and restarts the clock.
+/// periods emits one fail-safe frame and restarts the clock. The settings
+/// take the ranges of the CLI's options: timeout_ms in (0, 1e7), rounded to
+/// a microsecond; recover_samples 1..=100000; saccade_deg_s in (0, 1e6);
+/// max_gap_frames 0..=1000000.
 ///
 /// With config_toml, frames are planned by the optimizer's fast path (mode
 /// overrides the objective); otherwise by the preset's closed form.
@@ -1002,68 +1046,30 @@ impl PyGazeStream {
         config_toml: Option<&str>,
     ) -> PyResult<Self> {
         let preset_name = preset.to_owned();
-        if !(timeout_ms.is_finite() && timeout_ms > 0.0 && timeout_ms < 1e7) {
-            return Err(value_error(format!(
-                "timeout_ms: {timeout_ms} must be finite, > 0 and < 1e7"
-            )));
-        }
-        if !(saccade_deg_s.is_finite() && saccade_deg_s > 0.0) {
-            return Err(value_error(format!(
-                "saccade_deg_s: {saccade_deg_s} must be finite and > 0"
-            )));
-        }
-        let max_gap_frames = u64::try_from(max_gap_frames)
-            .ok()
-            .filter(|&m| m <= 1_000_000)
-            .ok_or_else(|| {
-                value_error(format!(
-                    "max_gap_frames: {max_gap_frames} must lie in 0..=1000000"
-                ))
-            })?;
-        let recover_samples = u32::try_from(recover_samples).map_err(|_| {
-            value_error(format!(
-                "recover_samples: {recover_samples} must lie in 0..=4294967295"
-            ))
-        })?;
-        let mode = mode_of(mode)?;
-        let planner: Box<dyn FramePlanner + Send> = match config_toml {
-            Some(text) => {
-                use gaze_lidar::optimizer::OptimizerConfig;
-                let mut problem = OptimizerConfig::from_toml(text, "config_toml")
-                    .and_then(|c| c.problem())
-                    .map_err(|e| opt_error(py, e))?;
-                problem.objective.mode = mode;
-                Box::new(
-                    gaze_lidar::gaze::OptimizerPlanner::new(problem)
-                        .map_err(|e| gaze_error(py, e))?,
-                )
-            }
-            None => {
-                let bins = usize::try_from(bins)
-                    .ok()
-                    .filter(|b| {
-                        (gaze_lidar::model::angle::MIN_BINS..=gaze_lidar::model::angle::MAX_BINS)
-                            .contains(b)
-                    })
-                    .ok_or_else(|| value_error(format!("bins: {bins} must lie in [4, 36000]")))?;
-                let preset = preset_of(preset)?;
-                // Plan once now: an impossible request fails here, not at the first frame.
-                closed_form(&preset, mode, Some(0.0), bins).map_err(|e| plan_error(py, e))?;
-                Box::new(ClosedFormPlanner { preset, mode, bins })
-            }
-        };
-        let filter = FilterConfig {
+        let pipeline = PipelineOptions {
+            timeout_ms,
             saccade_deg_s,
-            ..FilterConfig::default()
-        };
-        let failsafe = FailSafeConfig {
-            timeout_us: (timeout_ms * 1000.0) as u64,
             recover_samples,
-        };
-        let config = StreamConfig { max_gap_frames };
+            max_gap_frames,
+        }
+        .config()
+        .map_err(|e| pipeline_error(py, e))?;
+        let mode = mode_of(mode)?;
+        let (planner, _) = frame_planner(
+            py,
+            preset,
+            mode,
+            bins,
+            gaze_lidar::model::angle::MAX_BINS,
+            "",
+            config_toml,
+        )?;
         Ok(Self {
-            inner: Mutex::new(gaze_lidar::gaze::GazeStream::with_config(
-                planner, filter, failsafe, config,
+            inner: Mutex::new(gaze_lidar::pipeline::GazeStream::with_config(
+                planner,
+                pipeline.filter,
+                pipeline.failsafe,
+                pipeline.stream,
             )),
             basis: config_toml.is_none().then(|| preset_name.clone()),
             preset: preset_name,
@@ -1091,7 +1097,7 @@ impl PyGazeStream {
 
 fn frames(
     py: Python<'_>,
-    frames: Vec<gaze_lidar::gaze::Frame>,
+    frames: Vec<gaze_lidar::pipeline::Frame>,
     basis: Option<&str>,
 ) -> PyResult<Vec<PyFrame>> {
     frames
@@ -1161,7 +1167,7 @@ impl PyGazeStream {
             };
             let out = self
                 .locked(py, |s| s.push(&sample))?
-                .map_err(|e| gaze_error(py, e))?;
+                .map_err(|e| pipeline_error(py, e))?;
             frames(py, out, self.basis.as_deref())
         })
     }
@@ -1246,7 +1252,7 @@ impl PyGazeStream {
                     }
                     Ok(out)
                 })?
-                .map_err(|e| gaze_error(py, e))?;
+                .map_err(|e| pipeline_error(py, e))?;
             frames(py, out, self.basis.as_deref())
         })
     }
@@ -1259,7 +1265,7 @@ impl PyGazeStream {
             finite("now_s", now_s)?;
             let out = self
                 .locked(py, |s| s.tick(now_s))?
-                .map_err(|e| gaze_error(py, e))?;
+                .map_err(|e| pipeline_error(py, e))?;
             frames(py, out, self.basis.as_deref())
         })
     }
@@ -1624,7 +1630,7 @@ fn read_gaze<'py>(
         let bytes =
             std::fs::read(&path).map_err(|e| value_error(format!("path: {origin}: {e}")))?;
         let track = detached(py, || gaze_io::parse(&bytes, fmt, &origin))?
-            .map_err(|e| gaze_error(py, e))?;
+            .map_err(|e| pipeline_error(py, e.into()))?;
         let d = PyDict::new(py);
         d.set_item("t_s", PyArray1::from_vec(py, track.t_s))?;
         d.set_item("gaze_deg", PyArray1::from_vec(py, track.gaze_deg))?;

@@ -6,14 +6,13 @@ use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use gaze_lidar::gaze::{
-    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, PipelineConfig, StreamConfig,
+use gaze_lidar::pipeline::PipelineOptions;
+use gaze_lidar::replay::{
+    replay_file, Compression, GazeKind, ReplayError, ReplayOptions, MAX_BINS,
 };
-use gaze_lidar::replay::{replay_file, Compression, GazeKind, ReplayError, ReplayOptions};
 
 use super::{
-    closed_form, detached, gaze_error, guard, mode_of, model_of, opt_error, plan_error, preset_of,
-    seed_of, value_error,
+    detached, frame_planner, guard, mode_of, model_of, pipeline_error, seed_of, value_error,
 };
 
 fn replay_error(py: Python<'_>, e: ReplayError) -> PyErr {
@@ -23,15 +22,18 @@ fn replay_error(py: Python<'_>, e: ReplayError) -> PyErr {
             field: "out",
             reason,
         } => value_error(format!("out_path: {reason}")),
-        ReplayError::Gaze(g) => gaze_error(py, g),
+        ReplayError::MountTilt {
+            topic,
+            reason,
+            met_at,
+        } => value_error(format!(
+            "{topic}: {reason} (give the yaw as sensor_yaw_deg to use it anyway){met_at}"
+        )),
+        ReplayError::Pipeline(g) => pipeline_error(py, g),
         ReplayError::Write(_) => PyOSError::new_err(e.to_string()),
         e => value_error(e.to_string()),
     }
 }
-
-/// Most bins of a replayed profile (the CLI's limit: each frame's profile
-/// is written to the output).
-const MAX_REPLAY_BINS: usize = 1440;
 
 /// `lo < v < hi`, `v` finite and not subnormal (the one numeric boundary).
 fn in_range(field: &str, v: f64, lo: f64, hi: f64) -> PyResult<f64> {
@@ -101,63 +103,23 @@ pub fn replay<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let mode = mode_of(mode)?;
-        let (planner, preset_range_m): (Box<dyn FramePlanner + Send>, f64) = match config_toml {
-            Some(text) => {
-                use gaze_lidar::optimizer::OptimizerConfig;
-                let mut problem = OptimizerConfig::from_toml(text, "config_toml")
-                    .and_then(|c| c.problem())
-                    .map_err(|e| opt_error(py, e))?;
-                problem.objective.mode = mode;
-                let rated = problem.lidar.rated_range_m;
-                let p = gaze_lidar::gaze::OptimizerPlanner::new(problem)
-                    .map_err(|e| gaze_error(py, e))?;
-                (Box::new(p), rated)
-            }
-            None => {
-                let bins = usize::try_from(bins)
-                    .ok()
-                    .filter(|b| {
-                        (gaze_lidar::model::angle::MIN_BINS..=MAX_REPLAY_BINS).contains(b)
-                    })
-                    .ok_or_else(|| {
-                        value_error(format!(
-                            "bins: {bins} must lie in [4, {MAX_REPLAY_BINS}] for replay (each frame's profile is written to the output, ~240 bytes per bin)"
-                        ))
-                    })?;
-                let preset = preset_of(preset)?;
-                closed_form(&preset, mode, Some(0.0), bins).map_err(|e| plan_error(py, e))?;
-                let rated = preset.lidar.rated_range_m;
-                (Box::new(ClosedFormPlanner { preset, mode, bins }), rated)
-            }
-        };
-        let timeout_ms = in_range("timeout_ms", timeout_ms, 0.0, 1e7)?;
-        let recover_samples = u32::try_from(recover_samples)
-            .ok()
-            .filter(|r| (1..=100_000).contains(r))
-            .ok_or_else(|| {
-                value_error(format!(
-                    "recover_samples: {recover_samples} must lie in 1..=100000"
-                ))
-            })?;
-        let max_gap_frames = u64::try_from(max_gap_frames)
-            .ok()
-            .filter(|&m| m <= 1_000_000)
-            .ok_or_else(|| {
-                value_error(format!(
-                    "max_gap_frames: {max_gap_frames} must lie in 0..=1000000"
-                ))
-            })?;
-        let pipeline = PipelineConfig {
-            filter: FilterConfig {
-                saccade_deg_s: in_range("saccade_deg_s", saccade_deg_s, 0.0, 1e6)?,
-                ..FilterConfig::default()
-            },
-            failsafe: FailSafeConfig {
-                timeout_us: (timeout_ms * 1000.0).round().max(1.0) as u64,
-                recover_samples,
-            },
-            stream: StreamConfig { max_gap_frames },
-        };
+        let (planner, preset_range_m) = frame_planner(
+            py,
+            preset,
+            mode,
+            bins,
+            MAX_BINS,
+            " for replay (each frame's profile is written to the output, ~240 bytes per bin)",
+            config_toml,
+        )?;
+        let pipeline = PipelineOptions {
+            timeout_ms,
+            saccade_deg_s,
+            recover_samples,
+            max_gap_frames,
+        }
+        .config()
+        .map_err(|e| pipeline_error(py, e))?;
         if !(gaze_lidar::model::valid::finite(reorder_window_ms).is_ok()
             && (0.0..=60_000.0).contains(&reorder_window_ms))
         {

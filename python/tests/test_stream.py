@@ -94,6 +94,18 @@ def test_bad_arguments() -> None:
         s.tick(float("inf"))
 
 
+def test_settings_take_the_cli_ranges() -> None:
+    # One range check for the CLI's options and these keywords
+    # (pipeline::PipelineOptions), so the same words as `gaze-lidar stream`.
+    with pytest.raises(ValueError, match=r"^recover_samples: 0 must lie in 1\.\.=100000$"):
+        gl.GazeStream(recover_samples=0)
+    with pytest.raises(ValueError, match=r"^saccade_deg_s: 1000000 must be finite"):
+        gl.GazeStream(saccade_deg_s=1e6)
+    with pytest.raises(ValueError, match=r"^timeout_ms: 5e-324 must be finite \(not subnormal\)"):
+        gl.GazeStream(timeout_ms=5e-324)
+    gl.GazeStream(timeout_ms=1e-3, recover_samples=100_000, max_gap_frames=1_000_000)
+
+
 def test_optimizer_stream(repo: pathlib.Path) -> None:
     cfg = (repo / "examples/configs/paper.toml").read_text()
     s = gl.GazeStream(mode="joint", config_toml=cfg)

@@ -4,15 +4,14 @@
 
 use std::path::{Path, PathBuf};
 
-use gaze_lidar::gaze::{
-    ClosedFormPlanner, FailSafeConfig, FilterConfig, FramePlanner, GazeError, PipelineConfig,
-    StreamConfig,
-};
 use gaze_lidar::model::angle::{MAX_BINS, MIN_BINS};
 use gaze_lidar::model::presets;
+use gaze_lidar::pipeline::{
+    ClosedFormPlanner, FramePlanner, PipelineConfig, PipelineError, PipelineOptions,
+};
 use gaze_lidar::planner::Mode;
 
-use super::args::{finite_between, int_in};
+use super::args::int_in;
 use super::CliError;
 
 /// Which planner decides each frame's profile.
@@ -59,20 +58,14 @@ pub struct FilterArgs {
 impl FilterArgs {
     /// Every option through its range check.
     pub fn settings(&self) -> Result<PipelineConfig, CliError> {
-        let timeout_ms = finite_between("--timeout-ms", self.timeout_ms, 0.0, 1e7)?;
-        Ok(PipelineConfig {
-            filter: FilterConfig {
-                saccade_deg_s: finite_between("--saccade-deg-s", self.saccade_deg_s, 0.0, 1e6)?,
-                ..FilterConfig::default()
-            },
-            failsafe: FailSafeConfig {
-                timeout_us: (timeout_ms * 1000.0).round().max(1.0) as u64,
-                recover_samples: int_in("--recover-samples", self.recover_samples, 1, 100_000)?,
-            },
-            stream: StreamConfig {
-                max_gap_frames: int_in("--max-gap-frames", self.max_gap_frames, 0, 1_000_000)?,
-            },
-        })
+        PipelineOptions {
+            timeout_ms: self.timeout_ms,
+            saccade_deg_s: self.saccade_deg_s,
+            recover_samples: self.recover_samples,
+            max_gap_frames: self.max_gap_frames,
+        }
+        .config()
+        .map_err(gaze_error)
     }
 }
 
@@ -120,7 +113,7 @@ impl PlanArgs {
         };
         let problem = super::config::optimizer_problem(path, &overrides)?;
         let rated = problem.lidar.rated_range_m;
-        let p = gaze_lidar::gaze::OptimizerPlanner::new(problem).map_err(gaze_error)?;
+        let p = gaze_lidar::pipeline::OptimizerPlanner::new(problem).map_err(gaze_error)?;
         Ok((Box::new(p), rated))
     }
 
@@ -134,8 +127,13 @@ impl PlanArgs {
     }
 }
 
-/// A gaze pipeline error: bad input (exit 2) or infeasible (exit 1).
-pub fn gaze_error(e: GazeError) -> CliError {
+/// A gaze pipeline error: bad input (exit 2) or infeasible (exit 1); a
+/// setting is named by its flag.
+pub fn gaze_error(e: impl Into<PipelineError>) -> CliError {
+    let e = e.into();
+    if let PipelineError::Config { field, reason } = &e {
+        return CliError::input(format!("--{}: {reason}", field.replace('_', "-")));
+    }
     if e.is_input_error() {
         CliError::input(e.to_string())
     } else {

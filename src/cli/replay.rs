@@ -104,16 +104,23 @@ pub struct Args {
     compression: CompressionArg,
 }
 
-/// Most bins of a replayed profile: each frame's profile@1 document is
-/// written to the output (about 240 bytes of JSON per bin: 1440 bins are
-/// some 340 KB per frame, 3.4 MB/s at 10 Hz, already more than the
-/// adapted clouds of a 32-channel sensor); the optimizer's limit too.
-pub const MAX_REPLAY_BINS: i64 = 1440;
+/// [`gaze_lidar::replay::MAX_BINS`], as `--bins` is read.
+pub const MAX_REPLAY_BINS: i64 = gaze_lidar::replay::MAX_BINS as i64;
 
 fn replay_error(e: ReplayError) -> CliError {
     // An option is named by its flag.
     if let ReplayError::Config { field, reason } = &e {
         return CliError::input(format!("--{}: {reason}", field.replace('_', "-")));
+    }
+    if let ReplayError::MountTilt {
+        topic,
+        reason,
+        met_at,
+    } = &e
+    {
+        return CliError::input(format!(
+            "{topic}: {reason} (give the yaw with --sensor-yaw-deg to use it anyway){met_at}"
+        ));
     }
     if e.is_input_error() {
         CliError::input(e.to_string())

@@ -517,18 +517,24 @@ fn gaze_drive(
     a: &Args,
     scenario: &Scenario,
 ) -> Result<Option<sim::gaze_drive::GazeDrive>, CliError> {
+    use gaze_lidar::gaze::GazeError;
     use sim::gaze_drive::{Behaviour, GazeDrive, GazeSource, Trace};
     let source = match (&a.gaze, &a.gaze_behaviour) {
         (Some(path), _) => {
             // Recordings are larger than configurations: 256 MiB.
             let text = read_text(path, 256 << 20)?;
             GazeSource::Trace(
-                Trace::parse(&text, a.gaze_format, &path.display().to_string())
-                    .map_err(super::gaze_args::gaze_error)?,
+                Trace::parse(&text, a.gaze_format, &path.display().to_string()).map_err(
+                    |e| match e {
+                        GazeError::Recording { .. } => CliError::input(format!("--gaze: {e}")),
+                        e => super::gaze_args::gaze_error(e),
+                    },
+                )?,
             )
         }
         (None, Some(spec)) => GazeSource::Behaviour(
-            Behaviour::parse(spec, scenario.gaze_deg).map_err(CliError::input)?,
+            Behaviour::parse(spec, scenario.gaze_deg)
+                .map_err(|e| CliError::input(format!("--gaze-behaviour: {e}")))?,
         ),
         (None, None) => return Ok(None),
     };

@@ -12,13 +12,15 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
-use gaze_lidar::gaze::{
-    Format, Frame, FramePlanner, GazeError, GazeStream, Input, LineError, Notice, Parser,
-    PipelineConfig,
+use gaze_lidar::gaze::{Format, GazeError, GazeSample, LineError, Parser};
+use gaze_lidar::pipeline::{
+    Frame, FramePlanner, GazeStream, Input, Notice, PipelineConfig, PipelineError, StreamStats,
+    LIVE_DRAIN_MAX,
 };
 use gaze_lidar::text::Num;
 
 use super::gaze_args::{gaze_error, FilterArgs, PlanArgs};
+use super::io::warn;
 use super::CliError;
 
 #[derive(Debug, clap::Args)]
@@ -41,17 +43,12 @@ pub struct Args {
     realtime: bool,
 }
 
-/// One line on stderr; a failing stderr is not worth dying for.
-fn warn(message: &str) {
-    let _ = writeln!(std::io::stderr().lock(), "gaze-lidar: {message}");
-}
-
 fn report(notices: Vec<Notice>, max_gap_frames: u64, live: bool) {
     for n in notices {
         match n {
             // Live, the frame clock is the wall clock: it never restarts
             // and no extra frame is emitted; only the gaze history goes.
-            Notice::Resync { from_s, to_s, .. } if live => warn(&format!(
+            Notice::Resync { from_s, to_s, .. } if live => warn(format!(
                 "warning: gaze clock ran backwards from {} s to {} s: gaze history discarded (fail-safe until the gaze recovers)",
                 Num(from_s),
                 Num(to_s)
@@ -66,31 +63,32 @@ fn report(notices: Vec<Notice>, max_gap_frames: u64, live: bool) {
                 } else {
                     format!("made {frames} frames due (more than --max-gap-frames {max_gap_frames} + 1)")
                 };
-                warn(&format!(
+                warn(format!(
                     "warning: gaze clock jumped from {} s to {} s and {why}: one fail-safe frame, frame clock restarted at {} s, gaze history discarded",
                     Num(from_s),
                     Num(to_s),
                     Num(to_s)
                 ));
             }
-            Notice::PlanFallback { gaze_deg, error } => warn(&format!(
+            Notice::PlanFallback { gaze_deg, error } => warn(format!(
                 "warning: no certified adaptive profile for gaze {}°, baseline instead: {error}",
                 Num(gaze_deg)
             )),
-            Notice::Late { frames } => warn(&format!(
+            Notice::Late { frames } => warn(format!(
                 "warning: output ran late, {frames} frame(s) skipped"
             )),
         }
     }
 }
 
-fn write_frame(out: &mut dyn Write, f: &Frame, flush: bool) -> Result<(), GazeError> {
+fn write_frame(out: &mut dyn Write, f: &Frame, flush: bool) -> Result<(), PipelineError> {
     let mut line = serde_json::to_string(f)
-        .map_err(|e| GazeError::Output(std::io::Error::other(e.to_string())))?;
+        .map_err(|e| PipelineError::Output(std::io::Error::other(e.to_string())))?;
     line.push('\n');
-    out.write_all(line.as_bytes()).map_err(GazeError::Output)?;
+    out.write_all(line.as_bytes())
+        .map_err(PipelineError::Output)?;
     if flush {
-        out.flush().map_err(GazeError::Output)?;
+        out.flush().map_err(PipelineError::Output)?;
     }
     Ok(())
 }
@@ -134,7 +132,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     match result {
         Ok(stats) => {
             let skipped = skipped.load(Ordering::Relaxed);
-            warn(&format!(
+            warn(format!(
                 "{} samples ({} invalid, {} outliers) → {} frames, {} in fail-safe{}{}",
                 stats.samples,
                 stats.invalid,
@@ -155,8 +153,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             Ok(0)
         }
         // Downstream closed the pipe (`| head`): stop quietly.
-        Err(GazeError::Output(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(0),
-        Err(GazeError::Output(e)) => Err(CliError::output(format!("stdout: {e}"))),
+        Err(PipelineError::Output(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(0),
+        Err(PipelineError::Output(e)) => Err(CliError::output(format!("stdout: {e}"))),
         Err(e) => Err(gaze_error(e)),
     }
 }
@@ -231,7 +229,7 @@ impl Source {
     /// not a sample (too long, not UTF-8, a byte-order mark, malformed) is
     /// an error in a recorded file and a skipped line, reported with its
     /// number, on stdin.
-    fn next(&mut self) -> Result<Option<gaze_lidar::gaze::GazeSample>, GazeError> {
+    fn next(&mut self) -> Result<Option<GazeSample>, GazeError> {
         loop {
             self.line_no += 1;
             let raw = self.read_raw().map_err(|source| GazeError::Read {
@@ -258,13 +256,13 @@ impl Source {
                 }
                 Err(e) => {
                     self.skipped.fetch_add(1, Ordering::Relaxed);
-                    warn(&format!("{}:{}: skipped: {e}", self.origin, self.line_no));
+                    warn(format!("{}:{}: skipped: {e}", self.origin, self.line_no));
                 }
             }
         }
     }
 
-    fn parse_line(&mut self) -> Result<Option<gaze_lidar::gaze::GazeSample>, LineError> {
+    fn parse_line(&mut self) -> Result<Option<GazeSample>, LineError> {
         if self.line_no == 1 && self.buf.starts_with(super::io::UTF8_BOM) {
             return Err(LineError::Bytes(
                 "starts with a UTF-8 byte-order mark (bytes EF BB BF): send the data without a BOM"
@@ -282,13 +280,13 @@ impl Source {
     }
 }
 
-type Stats = gaze_lidar::gaze::StreamStats;
+type Stats = StreamStats;
 
 fn replay(
     s: &PipelineConfig,
     mut stream: GazeStream<Box<dyn FramePlanner>>,
     mut source: Source,
-) -> Result<Stats, GazeError> {
+) -> Result<Stats, PipelineError> {
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let mut emit = |f: Frame| write_frame(&mut out, &f, false);
     while let Some(sample) = source.next()? {
@@ -296,7 +294,7 @@ fn replay(
         report(stream.take_notices(), s.stream.max_gap_frames, false);
         r?;
     }
-    out.flush().map_err(GazeError::Output)?;
+    out.flush().map_err(PipelineError::Output)?;
     Ok(stream.stats())
 }
 
@@ -305,10 +303,10 @@ fn live(
     s: &PipelineConfig,
     mut stream: GazeStream<Box<dyn FramePlanner>>,
     mut source: Source,
-) -> Result<Stats, GazeError> {
+) -> Result<Stats, PipelineError> {
     // Bounded: a reader far ahead of the frames (a file piped in) waits
     // instead of holding the whole input in memory.
-    let (tx, rx) = mpsc::sync_channel(gaze_lidar::gaze::stream::LIVE_DRAIN_MAX - 1);
+    let (tx, rx) = mpsc::sync_channel(LIVE_DRAIN_MAX - 1);
     let pace = a.input.is_some();
     // A recorded file is fed at the pace of its timestamps; a gap longer
     // than a replay jump (max_gap_frames + 1 periods) is not waited for.

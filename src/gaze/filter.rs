@@ -2,7 +2,7 @@
 //! and smoothing.
 //!
 //! - **Invalid**: the tracker's own flag, a non-finite gaze, or |gaze| beyond
-//!   [`MAX_ABS_GAZE_DEG`](crate::planner::MAX_ABS_GAZE_DEG) (3600°, the bound
+//!   [`MAX_ABS_GAZE_DEG`](crate::model::acuity::MAX_ABS_GAZE_DEG) (3600°, the bound
 //!   `profile --gaze-deg` enforces: anything larger is a unit bug, not an
 //!   azimuth). The estimate is forgotten.
 //! - **Outliers**: a sample implying an angular velocity above

@@ -35,12 +35,12 @@ pub struct GazeSample {
 
 impl GazeSample {
     /// Whether the sample carries a usable gaze: the tracker's flag, a
-    /// finite azimuth and |gaze| ≤ [`MAX_ABS_GAZE_DEG`](crate::planner::MAX_ABS_GAZE_DEG).
+    /// finite azimuth and |gaze| ≤ [`MAX_ABS_GAZE_DEG`](crate::model::acuity::MAX_ABS_GAZE_DEG).
     #[must_use]
     pub fn usable(&self) -> bool {
         self.valid
             && self.gaze_deg.is_finite()
-            && self.gaze_deg.abs() <= crate::planner::MAX_ABS_GAZE_DEG
+            && self.gaze_deg.abs() <= crate::model::acuity::MAX_ABS_GAZE_DEG
     }
 }
 

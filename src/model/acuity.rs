@@ -10,6 +10,9 @@ use thiserror::Error;
 
 use super::angle::{wrap_signed_deg, Arc, CircularSet, FULL_TURN_DEG};
 
+/// Largest |gaze| accepted, degrees (anything beyond is surely a unit bug).
+pub const MAX_ABS_GAZE_DEG: f64 = 3600.0;
+
 /// Levi's E2 for letter acuity (Song, Levi & Pelli 2014), degrees.
 pub const LEVI_E2_DEG: f64 = 2.72;
 

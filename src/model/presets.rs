@@ -125,6 +125,72 @@ fn channels(table: impl Iterator<Item = (u32, f64, f64, f64)>) -> Vec<Channel> {
         .collect()
 }
 
+/// A head whose beams leave `origin_radius_mm` from the axis at the
+/// reference height, as 10 mm exit beams (the OS1 datasheet's figure; the
+/// assumption for the Velodyne heads), seen through the aperture at 100 mm
+/// (Condition 3).
+fn head(cycle_s: f64, origin_radius_mm: f64, divergence_mrad: f64, channels: Vec<Channel>) -> Head {
+    Head {
+        cycle_s,
+        origin_radius_mm,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 10.0,
+        divergence_mrad,
+        aperture_distance_mm: 100.0,
+        channels,
+    }
+}
+
+/// What a 10 Hz sensor with its real head is beyond its laser: one channel
+/// per head channel firing once per head cycle, 10 % reference
+/// reflectivity, power by time (the physical energy budget), power within
+/// 0.2–1.3 × the mean, spin 5–20 Hz with a 100 rad/s² motor (≈ 1e-3 kg·m²
+/// inertia, 0.1 N·m spare torque: no step inside a turn), no slew limit;
+/// the Levi E2 acuity model at a 60° RoF and the paper's levels.
+struct HeadSensor {
+    name: &'static str,
+    average_power_w: f64,
+    rated_range_m: f64,
+    wavelength_nm: f64,
+    pulse_duration_s: f64,
+    beam_diameter_mm: f64,
+    head: Head,
+}
+
+impl HeadSensor {
+    fn preset(self) -> Preset {
+        let average_power_w = self.average_power_w;
+        Preset {
+            lidar: LidarSpec {
+                name: self.name.into(),
+                frame_rate_hz: 10.0,
+                pulse_rate_hz: 1.0 / self.head.cycle_s,
+                channels: u32::try_from(self.head.channels.len()).unwrap_or(u32::MAX),
+                average_power_w,
+                rated_range_m: self.rated_range_m,
+                reference_reflectivity: 0.1,
+                power_accounting: PowerAccounting::Time,
+                limits: Limits {
+                    power_w_min: 0.2 * average_power_w,
+                    power_w_max: 1.3 * average_power_w,
+                    spin_rad_s_min: TAU * 5.0,
+                    spin_rad_s_max: TAU * 20.0,
+                    spin_accel_rad_s2_max: Some(100.0),
+                    power_slew_w_per_deg_max: None,
+                    eye_safety: Some(EyeSafetyParams {
+                        wavelength_nm: self.wavelength_nm,
+                        pulse_duration_s: self.pulse_duration_s,
+                        beam_diameter_mm: self.beam_diameter_mm,
+                        head: Some(self.head),
+                    }),
+                },
+            },
+            focus: FocusModel::levi_e2_with_width(60.0),
+            levels: AdaptiveLevels::paper(),
+        }
+    }
+}
+
 /// VLS-128 / Alpha Prime laser elevations by laser id, deg: ros-drivers/velodyne
 /// `velodyne_pointcloud/params/VLS128.yaml` (`vert_correction`, in rad
 /// there; same in valgur/velodyne_decoder `src/calib_db.cpp`, "AlphaPrime",
@@ -205,53 +271,26 @@ const VLS128_CYCLE_S: f64 = 53.3e-6;
 ///   the paper's controllers and the Levi E2 acuity model at a 60° RoF.
 #[must_use]
 pub fn vls128() -> Preset {
-    let average_power_w = 18e-6;
-    let head = Head {
-        cycle_s: VLS128_CYCLE_S,
-        origin_radius_mm: 58.63,
-        origin_height_mm: 0.0,
-        exit_diameter_mm: 10.0,
-        divergence_mrad: 3.0,
-        aperture_distance_mm: 100.0,
-        channels: channels((0..128u32).map(|id| {
-            let group = id / 8;
-            let slots = if group < 8 { group } else { group + 1 };
-            (
-                id,
-                VLS128_ELEVATION_DEG[id as usize],
-                VLS128_AZIMUTH_DEG[(id % 8) as usize],
-                VLS128_GROUP_S * f64::from(slots),
-            )
-        })),
-    };
-    Preset {
-        lidar: LidarSpec {
-            name: "vls128: VLS-128-like, 903 nm, 10 Hz, 128 channels".into(),
-            frame_rate_hz: 10.0,
-            pulse_rate_hz: 1.0 / VLS128_CYCLE_S,
-            channels: 128,
-            average_power_w,
-            rated_range_m: 245.0,
-            reference_reflectivity: 0.1,
-            power_accounting: PowerAccounting::Time,
-            limits: Limits {
-                power_w_min: 0.2 * average_power_w,
-                power_w_max: 1.3 * average_power_w,
-                spin_rad_s_min: TAU * 5.0,
-                spin_rad_s_max: TAU * 20.0,
-                spin_accel_rad_s2_max: Some(100.0),
-                power_slew_w_per_deg_max: None,
-                eye_safety: Some(EyeSafetyParams {
-                    wavelength_nm: 903.0,
-                    pulse_duration_s: 3e-9,
-                    beam_diameter_mm: 10.2,
-                    head: Some(head),
-                }),
-            },
-        },
-        focus: FocusModel::levi_e2_with_width(60.0),
-        levels: AdaptiveLevels::paper(),
+    let channels = channels((0..128u32).map(|id| {
+        let group = id / 8;
+        let slots = if group < 8 { group } else { group + 1 };
+        (
+            id,
+            VLS128_ELEVATION_DEG[id as usize],
+            VLS128_AZIMUTH_DEG[(id % 8) as usize],
+            VLS128_GROUP_S * f64::from(slots),
+        )
+    }));
+    HeadSensor {
+        name: "vls128: VLS-128-like, 903 nm, 10 Hz, 128 channels",
+        average_power_w: 18e-6,
+        rated_range_m: 245.0,
+        wavelength_nm: 903.0,
+        pulse_duration_s: 3e-9,
+        beam_diameter_mm: 10.2,
+        head: head(VLS128_CYCLE_S, 58.63, 3.0, channels),
     }
+    .preset()
 }
 
 /// VLP-16 laser elevations by laser id, deg (ros-drivers/velodyne
@@ -292,51 +331,24 @@ const VLP16_CYCLE_S: f64 = 55.296e-6;
 /// - Motor, accounting, focus and levels as `vls128`.
 #[must_use]
 pub fn vlp16() -> Preset {
-    let average_power_w = 240e-6;
-    let head = Head {
-        cycle_s: VLP16_CYCLE_S,
-        origin_radius_mm: 41.91,
-        origin_height_mm: 0.0,
-        exit_diameter_mm: 10.0,
-        divergence_mrad: 3.0,
-        aperture_distance_mm: 100.0,
-        channels: channels((0..16u32).map(|id| {
-            (
-                id,
-                VLP16_ELEVATION_DEG[id as usize],
-                0.0,
-                VLP16_FIRING_S * f64::from(id),
-            )
-        })),
-    };
-    Preset {
-        lidar: LidarSpec {
-            name: "vlp16: VLP-16-like, 903 nm, 10 Hz, 16 channels".into(),
-            frame_rate_hz: 10.0,
-            pulse_rate_hz: 1.0 / VLP16_CYCLE_S,
-            channels: 16,
-            average_power_w,
-            rated_range_m: 100.0,
-            reference_reflectivity: 0.1,
-            power_accounting: PowerAccounting::Time,
-            limits: Limits {
-                power_w_min: 0.2 * average_power_w,
-                power_w_max: 1.3 * average_power_w,
-                spin_rad_s_min: TAU * 5.0,
-                spin_rad_s_max: TAU * 20.0,
-                spin_accel_rad_s2_max: Some(100.0),
-                power_slew_w_per_deg_max: None,
-                eye_safety: Some(EyeSafetyParams {
-                    wavelength_nm: 903.0,
-                    pulse_duration_s: 4e-9,
-                    beam_diameter_mm: 10.2,
-                    head: Some(head),
-                }),
-            },
-        },
-        focus: FocusModel::levi_e2_with_width(60.0),
-        levels: AdaptiveLevels::paper(),
+    let channels = channels((0..16u32).map(|id| {
+        (
+            id,
+            VLP16_ELEVATION_DEG[id as usize],
+            0.0,
+            VLP16_FIRING_S * f64::from(id),
+        )
+    }));
+    HeadSensor {
+        name: "vlp16: VLP-16-like, 903 nm, 10 Hz, 16 channels",
+        average_power_w: 240e-6,
+        rated_range_m: 100.0,
+        wavelength_nm: 903.0,
+        pulse_duration_s: 4e-9,
+        beam_diameter_mm: 10.2,
+        head: head(VLP16_CYCLE_S, 41.91, 3.0, channels),
     }
+    .preset()
 }
 
 /// Ouster OS1-128 beam elevations by row, deg: ouster-sdk
@@ -401,51 +413,26 @@ const OS1_128_CYCLE_S: f64 = 1.0 / 10_240.0;
 /// - Motor, accounting, focus and levels as `vls128`.
 #[must_use]
 pub fn os1_128() -> Preset {
-    let average_power_w = 13e-6;
-    let head = Head {
-        cycle_s: OS1_128_CYCLE_S,
-        origin_radius_mm: 15.806,
-        origin_height_mm: 0.0,
-        exit_diameter_mm: 10.0,
-        divergence_mrad: 0.18_f64.to_radians() * 1000.0 / (core::f64::consts::LN_2 / 2.0).sqrt(),
-        aperture_distance_mm: 100.0,
-        channels: channels((0..128u32).map(|id| {
-            (
-                id,
-                OS1_128_ELEVATION_DEG[id as usize],
-                OS1_128_AZIMUTH_DEG[id as usize],
-                0.0,
-            )
-        })),
-    };
-    Preset {
-        lidar: LidarSpec {
-            name: "os1-128: OS1-128-like, 865 nm, 1024x10, 128 channels".into(),
-            frame_rate_hz: 10.0,
-            pulse_rate_hz: 1.0 / OS1_128_CYCLE_S,
-            channels: 128,
-            average_power_w,
-            rated_range_m: 45.0,
-            reference_reflectivity: 0.1,
-            power_accounting: PowerAccounting::Time,
-            limits: Limits {
-                power_w_min: 0.2 * average_power_w,
-                power_w_max: 1.3 * average_power_w,
-                spin_rad_s_min: TAU * 5.0,
-                spin_rad_s_max: TAU * 20.0,
-                spin_accel_rad_s2_max: Some(100.0),
-                power_slew_w_per_deg_max: None,
-                eye_safety: Some(EyeSafetyParams {
-                    wavelength_nm: 865.0,
-                    pulse_duration_s: 5e-9,
-                    beam_diameter_mm: 10.3,
-                    head: Some(head),
-                }),
-            },
-        },
-        focus: FocusModel::levi_e2_with_width(60.0),
-        levels: AdaptiveLevels::paper(),
+    let channels = channels((0..128u32).map(|id| {
+        (
+            id,
+            OS1_128_ELEVATION_DEG[id as usize],
+            OS1_128_AZIMUTH_DEG[id as usize],
+            0.0,
+        )
+    }));
+    // The FWHM divergence widened to 1/e².
+    let divergence_mrad = 0.18_f64.to_radians() * 1000.0 / (core::f64::consts::LN_2 / 2.0).sqrt();
+    HeadSensor {
+        name: "os1-128: OS1-128-like, 865 nm, 1024x10, 128 channels",
+        average_power_w: 13e-6,
+        rated_range_m: 45.0,
+        wavelength_nm: 865.0,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: 10.3,
+        head: head(OS1_128_CYCLE_S, 15.806, divergence_mrad, channels),
     }
+    .preset()
 }
 
 #[cfg(test)]

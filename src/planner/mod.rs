@@ -19,7 +19,7 @@ pub use crate::model::mode::Mode;
 /// Why a planner could not produce a certified profile.
 #[derive(Debug, Error)]
 pub enum PlanError {
-    /// The request itself is malformed (bad argument): exit code 2.
+    /// The request itself is malformed (bad argument).
     #[error("{field}: {reason}")]
     InvalidInput {
         /// The argument or config key.
@@ -27,10 +27,10 @@ pub enum PlanError {
         /// What is wrong.
         reason: String,
     },
-    /// The request is well-formed but cannot be met (exit code 1).
+    /// The request is well-formed but cannot be met.
     #[error("infeasible: {0}")]
     Infeasible(String),
-    /// The planned profile failed the checker (exit code 1): never handed out.
+    /// The planned profile failed the checker: never handed out.
     #[error("the planned profile violates its limits: {}", crate::checker::summarize_list(&.0.violations))]
     Rejected(#[from] Rejected),
 }
@@ -54,15 +54,14 @@ impl From<AcuityError> for PlanError {
 }
 
 impl PlanError {
-    /// Whether the fault is in the input (exit 2) rather than infeasibility (exit 1).
+    /// Whether the fault is in the input rather than infeasibility.
     #[must_use]
     pub fn is_input_error(&self) -> bool {
         matches!(self, Self::InvalidInput { .. })
     }
 }
 
-/// Largest |gaze| accepted, degrees (anything beyond is surely a unit bug).
-pub const MAX_ABS_GAZE_DEG: f64 = 3600.0;
+pub use crate::model::acuity::MAX_ABS_GAZE_DEG;
 
 /// Validates a gaze angle argument.
 pub fn validate_gaze(gaze_deg: f64) -> Result<(), PlanError> {

@@ -55,9 +55,8 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use thiserror::Error;
 
 use crate::checker::CertifiedProfile;
-use crate::gaze::{
-    Frame, FramePlanner, GazeError, GazeSample, GazeStream, Notice, State, StreamStats,
-};
+use crate::gaze::{GazeSample, State};
+use crate::pipeline::{Frame, FramePlanner, GazeStream, Notice, PipelineError, StreamStats};
 use crate::pointcloud::{keep_mask, CloudError, CloudFrame, CloudOptions};
 
 /// Why a replay stopped.
@@ -91,6 +90,19 @@ pub enum ReplayError {
         /// What is wrong.
         reason: String,
     },
+    /// The static transforms tilt the cloud frame's z axis from the
+    /// vehicle's beyond the yaw-only mounting's tolerance (roll and pitch).
+    /// Giving the sensor's yaw explicitly ([`ReplayOptions::sensor_yaw_deg`])
+    /// replaces the transform.
+    #[error("{topic}: {reason}{met_at}")]
+    MountTilt {
+        /// The transform topic.
+        topic: String,
+        /// Which frames and how far they tilt.
+        reason: String,
+        /// Empty, or ` (met at …)`: the message that needed the transform.
+        met_at: String,
+    },
     /// An option is out of range.
     #[error("{field}: {reason}")]
     Config {
@@ -101,7 +113,7 @@ pub enum ReplayError {
     },
     /// The gaze pipeline failed (planner).
     #[error("{0}")]
-    Gaze(#[from] GazeError),
+    Pipeline(#[from] PipelineError),
     /// Applying a profile to a cloud failed.
     #[error("{0}")]
     Cloud(#[from] CloudError),
@@ -119,18 +131,18 @@ pub enum ReplayError {
 }
 
 impl ReplayError {
-    /// Bad input (exit 2) rather than an infeasible request or an output
-    /// failure (exit 1).
+    /// Bad input rather than an infeasible request or an output failure.
     #[must_use]
     pub fn is_input_error(&self) -> bool {
         match self {
             Self::Mcap { .. }
             | Self::Message { .. }
             | Self::Topic { .. }
+            | Self::MountTilt { .. }
             | Self::Config { .. }
             | Self::Read { .. }
             | Self::Cloud(_) => true,
-            Self::Gaze(e) => e.is_input_error(),
+            Self::Pipeline(e) => e.is_input_error(),
             Self::Write(_) => false,
         }
     }
@@ -244,7 +256,7 @@ impl ReplayOptions {
     }
 }
 
-pub use crate::gaze::PipelineConfig;
+pub use crate::pipeline::PipelineConfig;
 
 /// What a replay did.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -768,12 +780,13 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
         };
         let m = tf::mounting(q);
         if m.tilt_deg > self.opts.max_mount_tilt_deg {
-            return Err(ReplayError::Topic {
+            return Err(ReplayError::MountTilt {
                 topic: topic(),
                 reason: format!(
-                    "the transform from the cloud frame {frame:?} to the vehicle frame {vehicle:?} tilts its z axis {:.3}° from the vertical (roll and pitch), beyond the {}° tolerance of the yaw-only mounting (give the yaw with --sensor-yaw-deg to use it anyway)",
+                    "the transform from the cloud frame {frame:?} to the vehicle frame {vehicle:?} tilts its z axis {:.3}° from the vertical (roll and pitch), beyond the {}° tolerance of the yaw-only mounting",
                     m.tilt_deg, opts.max_mount_tilt_deg
                 ),
+                met_at: String::new(),
             });
         }
         Ok(m.yaw_deg)
@@ -946,8 +959,14 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
     }
 }
 
-/// Largest `--reorder-window-ms`, ns.
+/// Largest reorder window, ns.
 pub const MAX_REORDER_WINDOW_NS: u64 = 60_000_000_000;
+
+/// Most bins of a replayed profile: each frame's profile@1 document is
+/// written to the output (about 240 bytes of JSON per bin: 1440 bins are
+/// some 340 KB per frame, 3.4 MB/s at 10 Hz, already more than the
+/// adapted clouds of a 32-channel sensor); the optimizer's limit too.
+pub const MAX_BINS: usize = 1440;
 
 fn config(field: &'static str, reason: impl Into<String>) -> ReplayError {
     ReplayError::Config {
@@ -1131,13 +1150,19 @@ fn check_schema(ch: &mcap::Channel<'_>, want: &str) -> Result<(), ReplayError> {
 /// A transform error (a tilt, a cycle) named by the byte offset of the
 /// message that needed the transform, like other message errors.
 fn found_at(e: ReplayError, topic: &str, p: &Pending) -> ReplayError {
+    let met_at = format!(
+        " (met at {topic}: message {} (sequence {}, log_time {} ns))",
+        p.at, p.msg.sequence, p.log_time
+    );
     match e {
         ReplayError::Topic { topic: t, reason } => ReplayError::Topic {
             topic: t,
-            reason: format!(
-                "{reason} (met at {topic}: message {} (sequence {}, log_time {} ns))",
-                p.at, p.msg.sequence, p.log_time
-            ),
+            reason: format!("{reason}{met_at}"),
+        },
+        ReplayError::MountTilt { topic, reason, .. } => ReplayError::MountTilt {
+            topic,
+            reason,
+            met_at,
         },
         e => e,
     }

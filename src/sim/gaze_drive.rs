@@ -31,12 +31,12 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::checker::CertifiedProfile;
-use crate::gaze::{
-    ClosedFormPlanner, Format, Frame, FramePlanner, GazeError, GazeSample, GazeStream, Parser,
-    PipelineConfig, State,
-};
+use crate::gaze::{Format, GazeError, GazeSample, Parser, State};
 use crate::model::acuity::Regions;
 use crate::model::presets::Preset;
+use crate::pipeline::{
+    ClosedFormPlanner, Frame, FramePlanner, GazeStream, PipelineConfig, PipelineError,
+};
 use crate::planner::Mode;
 use crate::profile::kinematics::Timeline;
 
@@ -130,23 +130,18 @@ impl Behaviour {
                 every_s: 4.0,
                 blink_s: 0.15,
             },
-            other => {
-                return Err(format!(
-                    "--gaze-behaviour: '{other}' is not one of {}",
-                    BEHAVIOURS.join(", ")
-                ))
-            }
+            other => return Err(format!("'{other}' is not one of {}", BEHAVIOURS.join(", "))),
         };
         for kv in params.split(',').filter(|s| !s.trim().is_empty()) {
             let (k, v) = kv
                 .split_once('=')
-                .ok_or_else(|| format!("--gaze-behaviour: '{kv}' is not key=value"))?;
+                .ok_or_else(|| format!("'{kv}' is not key=value"))?;
             let (k, v) = (k.trim(), v.trim());
             let x: f64 = v
                 .parse()
                 .ok()
                 .filter(|x: &f64| x.is_finite())
-                .ok_or_else(|| format!("--gaze-behaviour: {k} = '{v}' is not a finite number"))?;
+                .ok_or_else(|| format!("{k} = '{v}' is not a finite number"))?;
             let slot = match (&mut b, k) {
                 (Self::Fixate { gaze_deg }, "gaze_deg")
                 | (Self::Mirror { gaze_deg, .. }, "gaze_deg")
@@ -159,7 +154,7 @@ impl Behaviour {
                 (Self::Mirror { every_s, .. } | Self::Blink { every_s, .. }, "every_s") => every_s,
                 (Self::Mirror { glance_s, .. }, "glance_s") => glance_s,
                 (Self::Blink { blink_s, .. }, "blink_s") => blink_s,
-                _ => return Err(format!("--gaze-behaviour: {name} has no parameter '{k}'")),
+                _ => return Err(format!("{name} has no parameter '{k}'")),
             };
             *slot = x;
         }
@@ -168,7 +163,7 @@ impl Behaviour {
     }
 
     fn validate(&self) -> Result<(), String> {
-        let bad = |k: &str, v: f64, why: &str| Err(format!("--gaze-behaviour: {k} = {v}: {why}"));
+        let bad = |k: &str, v: f64, why: &str| Err(format!("{k} = {v}: {why}"));
         let angle = |k: &str, v: f64| {
             if v.abs() > 360.0 {
                 bad(k, v, "must lie within ±360°")
@@ -333,9 +328,9 @@ impl Trace {
                 samples.push(s);
             }
         }
-        let config = |reason: String| GazeError::Config {
-            field: "--gaze",
-            reason: format!("{origin}: {reason}"),
+        let config = |reason: String| GazeError::Recording {
+            origin: origin.to_owned(),
+            reason,
         };
         let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
             return Err(config("no samples".into()));
@@ -431,7 +426,7 @@ struct SharedPlanner<'a> {
 }
 
 impl FramePlanner for SharedPlanner<'_> {
-    fn plan(&mut self, gaze_deg: Option<f64>) -> Result<CertifiedProfile, GazeError> {
+    fn plan(&mut self, gaze_deg: Option<f64>) -> Result<CertifiedProfile, PipelineError> {
         let key = gaze_deg.map(f64::to_bits);
         if let Some(p) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
             return Ok(p);
@@ -454,7 +449,7 @@ fn stream_frames(
     pipeline: &PipelineConfig,
     samples: &[GazeSample],
     t_end_s: f64,
-) -> Result<Vec<Frame>, GazeError> {
+) -> Result<Vec<Frame>, PipelineError> {
     let mut stream =
         GazeStream::with_config(planner, pipeline.filter, pipeline.failsafe, pipeline.stream);
     let mut frames = Vec::new();

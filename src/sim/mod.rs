@@ -589,11 +589,8 @@ impl OptTable {
         let gazes: Vec<f64> = (0..config.trials)
             .map(|t| draw(config.seed, t, &config.scenario).gaze_deg)
             .collect();
-        let sensor = Preset {
-            lidar: problem.lidar.clone(),
-            focus: problem.focus.clone(),
-            levels: config.sensor.levels.clone(),
-        };
+        let sensor =
+            crate::optimizer::figures::closed_form_basis(&problem, config.sensor.levels.clone());
         crate::optimizer::fast::PhaseTable::build(&problem, &gazes)
             .map(|table| Some(Self { table, sensor }))
             .map_err(SimError::from)

@@ -31,28 +31,12 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use super::failsafe::{Due, FailSafe, FailSafeConfig, FrameClock, SampleKind, State};
-use super::filter::{Class, FilterConfig, GazeFilter};
-use super::formats::GazeSample;
-use super::GazeError;
+use super::{FramePlanner, PipelineError};
 use crate::checker::CertifiedProfile;
-
-/// Something that turns a gaze (or none: fail-safe) into a certified profile.
-pub trait FramePlanner {
-    /// The profile for `gaze_deg`; `None` asks for the uniform baseline.
-    fn plan(&mut self, gaze_deg: Option<f64>) -> Result<CertifiedProfile, GazeError>;
-    /// Nominal frame rate, Hz.
-    fn frame_rate_hz(&self) -> f64;
-}
-
-impl<P: FramePlanner + ?Sized> FramePlanner for Box<P> {
-    fn plan(&mut self, gaze_deg: Option<f64>) -> Result<CertifiedProfile, GazeError> {
-        (**self).plan(gaze_deg)
-    }
-    fn frame_rate_hz(&self) -> f64 {
-        (**self).frame_rate_hz()
-    }
-}
+use crate::gaze::failsafe::{Due, FailSafe, FailSafeConfig, FrameClock, SampleKind, State};
+use crate::gaze::filter::{Class, FilterConfig, GazeFilter};
+use crate::gaze::formats::GazeSample;
+use crate::text::Num;
 
 /// One emitted frame.
 #[derive(Debug, Clone, Serialize)]
@@ -82,9 +66,9 @@ pub struct StreamConfig {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PipelineConfig {
     /// Gaze filter.
-    pub filter: crate::gaze::FilterConfig,
+    pub filter: FilterConfig,
     /// Fail-safe machine.
-    pub failsafe: crate::gaze::FailSafeConfig,
+    pub failsafe: FailSafeConfig,
     /// Stream settings.
     pub stream: StreamConfig,
 }
@@ -94,6 +78,92 @@ impl Default for StreamConfig {
         Self {
             max_gap_frames: 200,
         }
+    }
+}
+
+/// The pipeline's settings as a user gives them (`stream`'s and `replay`'s
+/// options, Python's keywords), before their range checks; the defaults
+/// are those of [`PipelineConfig::default`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PipelineOptions {
+    /// A fixation older than this when a frame is decided is stale
+    /// (fail-safe), ms, in `(0, 1e7)`.
+    pub timeout_ms: f64,
+    /// I-VT saccade threshold, °/s, in `(0, 1e6)`.
+    pub saccade_deg_s: f64,
+    /// Consecutive valid samples needed to leave fail-safe, `1..=100000`.
+    pub recover_samples: i64,
+    /// [`StreamConfig::max_gap_frames`], `0..=1000000`.
+    pub max_gap_frames: i64,
+}
+
+impl Default for PipelineOptions {
+    fn default() -> Self {
+        let c = PipelineConfig::default();
+        Self {
+            timeout_ms: c.failsafe.timeout_us as f64 / 1000.0,
+            saccade_deg_s: c.filter.saccade_deg_s,
+            recover_samples: i64::from(c.failsafe.recover_samples),
+            max_gap_frames: c.stream.max_gap_frames as i64,
+        }
+    }
+}
+
+/// `value` in `(lo, hi)` at the one numeric boundary
+/// ([`crate::model::valid::finite`]: finite, zero or normal).
+fn between(field: &'static str, value: f64, lo: f64, hi: f64) -> Result<f64, PipelineError> {
+    if crate::model::valid::finite(value).is_ok() && value > lo && value < hi {
+        Ok(value)
+    } else {
+        Err(PipelineError::Config {
+            field,
+            reason: format!(
+                "{} must be finite (not subnormal), > {} and < {}",
+                Num(value),
+                Num(lo),
+                Num(hi)
+            ),
+        })
+    }
+}
+
+/// `value` in `lo..=hi`, as `T`.
+fn int_in<T: TryFrom<i64>>(
+    field: &'static str,
+    value: i64,
+    lo: i64,
+    hi: i64,
+) -> Result<T, PipelineError> {
+    (lo..=hi)
+        .contains(&value)
+        .then(|| T::try_from(value).ok())
+        .flatten()
+        .ok_or_else(|| PipelineError::Config {
+            field,
+            reason: format!("{value} must lie in {lo}..={hi}"),
+        })
+}
+
+impl PipelineOptions {
+    /// Every setting through its range check (the first failing one named
+    /// by its field, in the order of the fields); the timeout rounds to
+    /// the nearest microsecond, at least one.
+    pub fn config(&self) -> Result<PipelineConfig, PipelineError> {
+        let timeout_ms = between("timeout_ms", self.timeout_ms, 0.0, 1e7)?;
+        let saccade_deg_s = between("saccade_deg_s", self.saccade_deg_s, 0.0, 1e6)?;
+        let recover_samples = int_in("recover_samples", self.recover_samples, 1, 100_000)?;
+        let max_gap_frames = int_in("max_gap_frames", self.max_gap_frames, 0, 1_000_000)?;
+        Ok(PipelineConfig {
+            filter: FilterConfig {
+                saccade_deg_s,
+                ..FilterConfig::default()
+            },
+            failsafe: FailSafeConfig {
+                timeout_us: (timeout_ms * 1000.0).round().max(1.0) as u64,
+                recover_samples,
+            },
+            stream: StreamConfig { max_gap_frames },
+        })
     }
 }
 
@@ -165,7 +235,7 @@ pub enum Input {
     /// A parsed sample and the instant it was read.
     Sample(GazeSample, Instant),
     /// The reader failed (e.g. a malformed line in a recorded file): stop.
-    Error(GazeError),
+    Error(crate::gaze::GazeError),
 }
 
 /// The pipeline.
@@ -271,7 +341,7 @@ impl<P: FramePlanner> GazeStream<P> {
 
     /// Decides and plans the frame starting at `t_s`, deciding staleness at
     /// `decide_us` on the frame clock.
-    fn frame(&mut self, t_s: f64, decide_us: u64) -> Result<Frame, GazeError> {
+    fn frame(&mut self, t_s: f64, decide_us: u64) -> Result<Frame, PipelineError> {
         let state = self.failsafe.at_frame(decide_us);
         let gaze = match state {
             State::Adaptive => self.filter.estimate(),
@@ -321,8 +391,8 @@ impl<P: FramePlanner> GazeStream<P> {
     fn advance(
         &mut self,
         t_s: f64,
-        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
-    ) -> Result<Option<u64>, GazeError> {
+        emit: &mut dyn FnMut(Frame) -> Result<(), PipelineError>,
+    ) -> Result<Option<u64>, PipelineError> {
         let period_s = self.clock.period_us() as f64 * 1e-6;
         let origin = *self.origin_s.get_or_insert(t_s);
         let mut rel = t_s - origin;
@@ -358,8 +428,8 @@ impl<P: FramePlanner> GazeStream<P> {
     pub fn push_each(
         &mut self,
         sample: &GazeSample,
-        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
-    ) -> Result<(), GazeError> {
+        emit: &mut dyn FnMut(Frame) -> Result<(), PipelineError>,
+    ) -> Result<(), PipelineError> {
         if !sample.t_s.is_finite() {
             self.stats.samples += 1;
             self.stats.outliers += 1;
@@ -387,10 +457,10 @@ impl<P: FramePlanner> GazeStream<P> {
     pub fn tick_each(
         &mut self,
         now_s: f64,
-        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
-    ) -> Result<(), GazeError> {
+        emit: &mut dyn FnMut(Frame) -> Result<(), PipelineError>,
+    ) -> Result<(), PipelineError> {
         if !now_s.is_finite() {
-            return Err(GazeError::Config {
+            return Err(PipelineError::Config {
                 field: "now_s",
                 reason: format!("{now_s} is not a finite time in seconds"),
             });
@@ -403,7 +473,7 @@ impl<P: FramePlanner> GazeStream<P> {
 
     /// Replay: [`tick_each`](Self::tick_each) collecting the frames (at most
     /// `max_gap_frames + 1`).
-    pub fn tick(&mut self, now_s: f64) -> Result<Vec<Frame>, GazeError> {
+    pub fn tick(&mut self, now_s: f64) -> Result<Vec<Frame>, PipelineError> {
         let mut frames = Vec::new();
         self.tick_each(now_s, &mut |f| {
             frames.push(f);
@@ -414,7 +484,7 @@ impl<P: FramePlanner> GazeStream<P> {
 
     /// Replay: [`push_each`](Self::push_each) collecting the frames (at most
     /// `max_gap_frames + 1`).
-    pub fn push(&mut self, sample: &GazeSample) -> Result<Vec<Frame>, GazeError> {
+    pub fn push(&mut self, sample: &GazeSample) -> Result<Vec<Frame>, PipelineError> {
         let mut frames = Vec::new();
         self.push_each(sample, &mut |f| {
             frames.push(f);
@@ -466,9 +536,9 @@ impl<P: FramePlanner> GazeStream<P> {
         &mut self,
         rx: &Receiver<Input>,
         start: Instant,
-        emit: &mut dyn FnMut(Frame) -> Result<(), GazeError>,
+        emit: &mut dyn FnMut(Frame) -> Result<(), PipelineError>,
         notify: &mut dyn FnMut(Notice),
-    ) -> Result<(), GazeError> {
+    ) -> Result<(), PipelineError> {
         let period_us = self.clock.period_us();
         let since_start = |at: Instant| at.saturating_duration_since(start);
         let mut k: u64 = 0;
@@ -504,7 +574,7 @@ impl<P: FramePlanner> GazeStream<P> {
                 };
                 match msg {
                     None => break,
-                    Some(Input::Error(e)) => return Err(e),
+                    Some(Input::Error(e)) => return Err(e.into()),
                     Some(Input::Sample(s, arrival)) => {
                         self.absorb_live(&s, since_start(arrival).as_secs_f64());
                     }
@@ -536,8 +606,8 @@ impl<P: FramePlanner> GazeStream<P> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gaze::ClosedFormPlanner;
     use crate::model::presets;
+    use crate::pipeline::ClosedFormPlanner;
     use crate::planner::Mode;
 
     fn stream() -> GazeStream<ClosedFormPlanner> {
@@ -703,6 +773,88 @@ mod tests {
         st.absorb_live(&s(5.0, 90.0), 0.02);
         assert_eq!(st.stats().resyncs, 1);
         assert_eq!(st.failsafe.last_fixation_us(), Some(20_000));
+    }
+
+    #[test]
+    fn options_check_every_setting_by_name() {
+        // The defaults are the configuration's defaults.
+        let c = PipelineOptions::default().config().unwrap();
+        let d = PipelineConfig::default();
+        assert_eq!(c.failsafe, d.failsafe);
+        assert_eq!(c.stream, d.stream);
+        assert_eq!(c.filter, d.filter);
+        // The timeout rounds to the nearest microsecond, at least one.
+        let timeout_us = |timeout_ms| {
+            PipelineOptions {
+                timeout_ms,
+                ..PipelineOptions::default()
+            }
+            .config()
+            .unwrap()
+            .failsafe
+            .timeout_us
+        };
+        assert_eq!(timeout_us(0.0015), 2);
+        assert_eq!(timeout_us(1e-6), 1);
+        assert_eq!(timeout_us(250.0), 250_000);
+        let bad = |o: PipelineOptions| match o.config() {
+            Err(PipelineError::Config { field, reason }) => (field, reason),
+            other => panic!("{other:?}"),
+        };
+        let o = PipelineOptions::default();
+        for (field, options, reason) in [
+            (
+                "timeout_ms",
+                PipelineOptions {
+                    timeout_ms: 0.0,
+                    ..o
+                },
+                "0 must be finite (not subnormal), > 0 and < 1e7",
+            ),
+            (
+                "timeout_ms",
+                PipelineOptions {
+                    timeout_ms: f64::NAN,
+                    ..o
+                },
+                "must be finite",
+            ),
+            (
+                "saccade_deg_s",
+                PipelineOptions {
+                    saccade_deg_s: 5e-324,
+                    ..o
+                },
+                "not subnormal",
+            ),
+            (
+                "recover_samples",
+                PipelineOptions {
+                    recover_samples: 0,
+                    ..o
+                },
+                "0 must lie in 1..=100000",
+            ),
+            (
+                "max_gap_frames",
+                PipelineOptions {
+                    max_gap_frames: -1,
+                    ..o
+                },
+                "-1 must lie in 0..=1000000",
+            ),
+        ] {
+            let (f, r) = bad(options);
+            assert_eq!(f, field);
+            assert!(r.contains(reason), "{field}: {r}");
+        }
+        // The first bad setting, in the order of the fields, is named.
+        let (f, _) = bad(PipelineOptions {
+            timeout_ms: -1.0,
+            max_gap_frames: -1,
+            ..o
+        });
+        assert_eq!(f, "timeout_ms");
     }
 
     #[test]
