@@ -479,11 +479,12 @@ fn power_checkpoint(
 /// costs tens of milliseconds on a real head, so only those above a
 /// threshold `t`, less a relative [`NEAR_SLACK`] (far above the rounding
 /// of the core's threshold test, so every cut at or above `t` comes): first
-/// `t = cut_rhs / f_lo`; if its strongest cut is at or above `t`, it is the
-/// strongest of all, which fixes `f`, and then `t = cut_rhs / f`. The
+/// `t = cut_rhs / f_lo`, then a quarter of it, and so on down to
+/// [`NEAR_FLOOR`], until the strongest cut found is at or above `t`: it is
+/// the strongest of all, which fixes `f`, and then `t = cut_rhs / f`. The
 /// answer holds every cut the tightening keeps, in the same order (a
 /// sub-list of the same sort), so the tightening is the one every cut would
-/// give. If no cut reaches the first `t`: every cut.
+/// give. If no cut reaches the floor: every cut.
 fn near_cuts(
     e: &Eye,
     s: &[Seg],
@@ -505,8 +506,8 @@ fn near_cuts(
             .fold(0.0, f64::max);
         (near, top)
     };
-    let t_a = cut_rhs() / f_lo;
-    if t_a.is_finite() && t_a > 0.0 {
+    let mut t_a = cut_rhs() / f_lo;
+    while t_a.is_finite() && t_a >= NEAR_FLOOR {
         let (near, top) = of_class(t_a);
         if top >= t_a {
             let t_b = cut_rhs() / (f_lo.max(ratio / top) * (1.0 + 1e-9));
@@ -516,9 +517,14 @@ fn near_cuts(
                 of_class(t_b)
             };
         }
+        t_a *= 0.25;
     }
     of_class(0.0)
 }
+
+/// The lowest first threshold [`near_cuts`] tries (each try a quarter of
+/// the last) before it asks for every cut.
+const NEAR_FLOOR: f64 = 1e-3;
 
 /// The relative margin by which [`near_cuts`] asks for more cuts than it
 /// needs.
