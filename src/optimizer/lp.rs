@@ -452,22 +452,15 @@ fn power_checkpoint(
     // rule's class of cuts by the bound's excess over the strongest of
     // them, so the next answer meets them where the bound would.
     let k = usize::from(report.binding_rule != Rule::SinglePulse);
-    let near: Vec<Cut> = e
-        .cuts(&s, &[witness], 0.0)
-        .into_iter()
-        .filter(|c| cut_class(c) == k)
-        .collect();
-    let top = near
-        .iter()
-        .map(|c| c.ratio(p, e.pulse_rate_hz))
-        .fold(0.0, f64::max);
+    let f_lo = factor[k] * ratio / (1.0 - S.eye_safety_headroom);
+    let (near, top) = near_cuts(e, &s, p, (witness, ratio), k, f_lo);
     if top <= 0.0 {
         return Ok(Checkpoint::Fail(OptError::Solver(format!(
             "eye-safety cuts: the bound gives {ratio:.6} at {witness:.3}° ({:?}) and no cut of that rule has any exposure there",
             report.binding_rule
         ))));
     }
-    let f = (factor[k] * ratio / (1.0 - S.eye_safety_headroom)).max(ratio / top) * (1.0 + 1e-9);
+    let f = f_lo.max(ratio / top) * (1.0 + 1e-9);
     let cuts = near
         .into_iter()
         .filter(|c| c.ratio(p, e.pulse_rate_hz) * f >= cut_rhs() && !pool.contains(c))
@@ -478,6 +471,64 @@ fn power_checkpoint(
         cuts,
     })
 }
+
+/// The cuts of class `k` at the aperture `witness` and every bin edge, and
+/// the largest ratio among them, for [`power_checkpoint`]'s tightening by
+/// `f = max(f_lo, ratio / top)·(1 + 1e-9)`, which keeps only the cuts with
+/// `ratio · f ≥ cut_rhs`. Asking the core for every cut (threshold 0)
+/// costs tens of milliseconds on a real head, so only those above a
+/// threshold `t`, less a relative [`NEAR_SLACK`] (far above the rounding
+/// of the core's threshold test, so every cut at or above `t` comes): first
+/// `t = cut_rhs / f_lo`, then a quarter of it, and so on down to
+/// [`NEAR_FLOOR`], until the strongest cut found is at or above `t`: it is
+/// the strongest of all, which fixes `f`, and then `t = cut_rhs / f`. The
+/// answer holds every cut the tightening keeps, in the same order (a
+/// sub-list of the same sort), so the tightening is the one every cut would
+/// give. If no cut reaches the floor: every cut.
+fn near_cuts(
+    e: &Eye,
+    s: &[Seg],
+    p: &[f64],
+    at: (f64, f64),
+    k: usize,
+    f_lo: f64,
+) -> (Vec<Cut>, f64) {
+    let (witness, ratio) = at;
+    let of_class = |t: f64| -> (Vec<Cut>, f64) {
+        let near: Vec<Cut> = e
+            .cuts(s, &[witness], t * (1.0 - NEAR_SLACK))
+            .into_iter()
+            .filter(|c| cut_class(c) == k)
+            .collect();
+        let top = near
+            .iter()
+            .map(|c| c.ratio(p, e.pulse_rate_hz))
+            .fold(0.0, f64::max);
+        (near, top)
+    };
+    let mut t_a = cut_rhs() / f_lo;
+    while t_a.is_finite() && t_a >= NEAR_FLOOR {
+        let (near, top) = of_class(t_a);
+        if top >= t_a {
+            let t_b = cut_rhs() / (f_lo.max(ratio / top) * (1.0 + 1e-9));
+            return if t_b >= t_a {
+                (near, top)
+            } else {
+                of_class(t_b)
+            };
+        }
+        t_a *= 0.25;
+    }
+    of_class(0.0)
+}
+
+/// The lowest first threshold [`near_cuts`] tries (each try a quarter of
+/// the last) before it asks for every cut.
+const NEAR_FLOOR: f64 = 1e-3;
+
+/// The relative margin by which [`near_cuts`] asks for more cuts than it
+/// needs.
+const NEAR_SLACK: f64 = 1e-6;
 
 /// The power step's program for the cuts in `pool` (their limits divided by
 /// `factor`), and how each bin's power reads from its columns.

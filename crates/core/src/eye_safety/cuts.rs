@@ -208,9 +208,11 @@ pub fn cuts_with(
     found.extend(single.into_iter().flatten());
     let f_p = laser.pulse_rate_hz;
     let p: Vec<f64> = segs.iter().map(|s| s.power_w).collect();
-    found.sort_by(|a, b| {
-        b.ratio(&p, f_p)
-            .total_cmp(&a.ratio(&p, f_p))
+    // Each cut's ratio once (a cut sums over all its pulses), not once per
+    // comparison: the same keys, so the same order.
+    let mut keyed: Vec<(f64, Cut)> = found.into_iter().map(|c| (c.ratio(&p, f_p), c)).collect();
+    keyed.sort_by(|(ra, a), (rb, b)| {
+        rb.total_cmp(ra)
             .then_with(|| a.limit_j.total_cmp(&b.limit_j))
             .then_with(|| {
                 a.pulses
@@ -218,8 +220,8 @@ pub fn cuts_with(
                     .unwrap_or(std::cmp::Ordering::Equal)
             })
     });
-    found.dedup_by(|a, b| a.pulses == b.pulses && a.limit_j == b.limit_j);
-    found
+    keyed.dedup_by(|(_, a), (_, b)| a.pulses == b.pulses && a.limit_j == b.limit_j);
+    keyed.into_iter().map(|(_, c)| c).collect()
 }
 
 /// One aperture's pass: its azimuth, when it starts (unwrapped), how long
