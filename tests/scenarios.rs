@@ -407,10 +407,174 @@ fn the_committed_report_and_scenarios_doc_show_the_same_tables() {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    for name in ["pedestrian", "second_car"] {
+    for name in ["pedestrian", "second_car", "false_alarms"] {
         let a = table_after(&report, &format!("### {name}\n"));
         let b = table_after(&doc, &format!("## {name}\n"));
         assert_eq!(a.lines().count(), 14, "{name}: {a}");
         assert_eq!(a, b, "{name}");
     }
+    // The gaze tables: every named behaviour and a recorded trace of each
+    // format, in the report's gaze section and in docs/scenarios.md.
+    for source in [
+        "--gaze-behaviour fixate",
+        "--gaze-behaviour scan",
+        "--gaze-behaviour mirror",
+        "--gaze-behaviour blink",
+        "--gaze tests/data/gaze/right.csv --gaze-format csv",
+        "--gaze tests/data/gaze/varjo_base.csv --gaze-format varjo",
+        "--gaze tests/data/gaze/neon_gaze.csv --gaze-format neon",
+    ] {
+        let heading = format!("### `{source}`\n");
+        let a = table_after(&report, &heading);
+        let b = table_after(&doc, &heading);
+        assert_eq!(a.lines().count(), 14, "{source}: {a}");
+        assert_eq!(a, b, "{source}");
+    }
+}
+
+#[test]
+fn the_report_tabulates_its_gaze_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("r.md");
+    let trace = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gaze/right.csv");
+    let report_gaze = format!("csv={trace}");
+    let o = run(
+        &[
+            "simulate",
+            "--trials",
+            "3",
+            "--seed",
+            "4",
+            "--model",
+            "physical",
+            "--fog",
+            "0",
+            "--fog",
+            "50",
+            "--report",
+            report.to_str().unwrap(),
+            "--report-gaze-behaviour",
+            "scan",
+            "--report-gaze",
+            &report_gaze,
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let md = std::fs::read_to_string(&report).unwrap();
+    // Each section holds the table the library computes for the same gaze
+    // (every variant at the run's fog levels, 3 trials, seed 4).
+    let c = SimConfig {
+        models: vec![ModelKind::Physical],
+        fog_pcts: vec![0, 50],
+        trials: 3,
+        seed: 4,
+        ..SimConfig::default()
+    };
+    let text = std::fs::read_to_string(trace).unwrap();
+    for (args, source) in [
+        ("--gaze-behaviour scan".to_owned(), behaviour("scan")),
+        (
+            format!("--gaze {trace} --gaze-format csv"),
+            GazeSource::Trace(Trace::parse(&text, Format::Csv, trace).unwrap()),
+        ),
+    ] {
+        let r = driven(&c, source);
+        assert_eq!(r.rows.len(), 8);
+        let table = sim::report::gaze_table(&args, &r, 4);
+        assert!(
+            table.lines().next().unwrap().contains("| fog % |"),
+            "{table}"
+        );
+        let section = md
+            .split(&format!("### `{args}`\n"))
+            .nth(1)
+            .unwrap_or_else(|| panic!("{args}: {md}"));
+        assert!(section.contains(&table), "{section}");
+        assert!(section.contains(&format!("{args} --fog 0 --fog 50 --trials 3 --seed 4")));
+    }
+    // Without --report it is refused, a bad source is named, and nothing
+    // is written.
+    assert_bad_input(
+        &run(&["simulate", "--report-gaze-behaviour", "scan"], None),
+        "--report-gaze",
+    );
+    let fresh = dir.path().join("fresh.md");
+    for (flag, value, names) in [
+        ("--report-gaze-behaviour", "wink", "'wink' is not one of"),
+        ("--report-gaze", "right.csv", "FORMAT=PATH"),
+        ("--report-gaze", "tobii2=x.csv", "tobii2"),
+        ("--report-gaze", "jsonl=/no/such.jsonl", "/no/such.jsonl"),
+    ] {
+        assert_bad_input(
+            &run(
+                &[
+                    "simulate",
+                    "--trials",
+                    "2",
+                    "--report",
+                    fresh.to_str().unwrap(),
+                    flag,
+                    value,
+                ],
+                None,
+            ),
+            names,
+        );
+        assert!(!fresh.exists());
+    }
+}
+
+#[test]
+fn the_carla_pipeline_refuses_the_gaze_stream_with_the_reason() {
+    // The carla geometry plans one profile and one region of focus per
+    // trial: a gaze stream cannot change them frame by frame there, so
+    // `--gaze`/`--gaze-behaviour` are refused with that reason, for every
+    // sampling and for the paper's detector.
+    let trace = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gaze/right.csv");
+    for extra in [
+        &["--geometry", "carla"][..],
+        &["--geometry", "carla", "--sampling", "carla-async"][..],
+        &[
+            "--geometry",
+            "carla",
+            "--detector",
+            "argus",
+            "--arrival",
+            "argus-centre",
+            "--model",
+            "physical",
+        ][..],
+    ] {
+        for gaze in [
+            &["--gaze-behaviour", "scan"][..],
+            &["--gaze", trace, "--gaze-format", "csv"][..],
+        ] {
+            let mut args = vec!["simulate", "--trials", "1", "--fog", "0"];
+            args.extend_from_slice(extra);
+            args.extend_from_slice(gaze);
+            assert_bad_input(
+                &run(&args, None),
+                "one profile and one region of focus per trial",
+            );
+        }
+    }
+    // The argus return model: its resolution variant is a fixed decimation.
+    assert_bad_input(
+        &run(
+            &[
+                "simulate",
+                "--gaze-behaviour",
+                "fixate",
+                "--geometry",
+                "carla",
+                "--detector",
+                "argus",
+                "--model",
+                "argus",
+            ],
+            None,
+        ),
+        "--gaze/--gaze-behaviour: only",
+    );
 }
