@@ -578,3 +578,82 @@ fn the_carla_pipeline_refuses_the_gaze_stream_with_the_reason() {
         "--gaze/--gaze-behaviour: only",
     );
 }
+
+#[test]
+fn a_sweep_drives_every_value_from_the_gaze() {
+    // `--sweep` with `--gaze-behaviour`: one table per key whose rows are
+    // the gaze-driven grid of each value run alone, and one figure per key.
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(
+        &[
+            "simulate",
+            "--trials",
+            "3",
+            "--seed",
+            "5",
+            "--fog",
+            "0",
+            "--variant",
+            "baseline",
+            "--variant",
+            "range",
+            "--gaze-behaviour",
+            "scan",
+            "--sweep",
+            "speed_kmh=40,60",
+            "--format",
+            "json",
+            "--plots",
+            dir.path().to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let values = v["sweeps"][0]["values"].as_array().unwrap();
+    assert_eq!(values.len(), 2);
+    for (value, speed) in values.iter().zip([40.0, 60.0]) {
+        let s = Scenario {
+            speed_kmh: speed,
+            ..Scenario::default()
+        };
+        let c = SimConfig {
+            models: vec![ModelKind::Physical],
+            variants: vec![Variant::Baseline, Variant::Range],
+            fog_pcts: vec![0],
+            trials: 3,
+            seed: 5,
+            scenario: s,
+            ..SimConfig::default()
+        };
+        let alone = driven(&c, behaviour("scan"));
+        let rows = value["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), 2);
+        for (row, expected) in rows.iter().zip(&alone.rows) {
+            assert_eq!(row["tta_median_s"].as_f64(), expected.tta_median_s);
+            assert_eq!(
+                row["fail_safe_frame_share"].as_f64(),
+                Some(expected.fail_safe_frame_share)
+            );
+        }
+    }
+    // Slower cars arrive later from the same distance: the TTA grows.
+    let tta = |i: usize| values[i]["rows"][0]["tta_median_s"].as_f64().unwrap();
+    assert!(tta(0) > tta(1) + 1.0, "{} {}", tta(0), tta(1));
+    let svg = std::fs::read_to_string(dir.path().join("sweep_speed_kmh.svg")).unwrap();
+    assert!(svg.contains("speed_kmh"));
+    // A key the gaze-driven grid does not read is refused.
+    assert_bad_input(
+        &run(
+            &[
+                "simulate",
+                "--gaze-behaviour",
+                "scan",
+                "--sweep",
+                "tick=0.05,0.1",
+            ],
+            None,
+        ),
+        "--geometry carla",
+    );
+}

@@ -101,7 +101,8 @@ pub struct Args {
     /// `grid_phase` (`carla.grid_phase_steps`, the scan grid's azimuth phase
     /// in steps) and `fog_threshold` (`argus_fog_threshold_scale`); the
     /// whole grid is run once per value and printed as tables (`--format
-    /// json`: `{"sweeps": [...]}`).
+    /// json`: `{"sweeps": [...]}`); with `--gaze`/`--gaze-behaviour` every
+    /// value's grid is driven by the gaze.
     /// With `--plots DIR`: one figure per key (`sweep_KEY.svg`/`.png`).
     /// With `--report`: the sweeps run the paper's pipeline (needs
     /// `--paper-pipeline-trials`) and make the report's sensitivity section.
@@ -246,11 +247,6 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         return Err(super::config::no_solver("--optimizer-config"));
     }
     let gaze = gaze_drive(a, &scenario)?;
-    if gaze.is_some() && !a.sweep.is_empty() {
-        return Err(CliError::input(
-            "--sweep runs the paper's grid: --gaze/--gaze-behaviour are not available with it",
-        ));
-    }
     let config = SimConfig {
         models: if a.model.is_empty() {
             if gaze.is_some() {
@@ -281,7 +277,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         ..SimConfig::default()
     };
     if !a.sweep.is_empty() && a.report.is_none() {
-        return run_sweeps(a, &config);
+        return run_sweeps(a, &config, gaze.as_ref());
     }
     // With --report, the sweeps make the sensitivity section (on the
     // paper's pipeline): parsed and validated before anything runs.
@@ -597,9 +593,9 @@ fn gaze_drive(
         ),
         (None, None) => return Ok(None),
     };
-    if a.report.is_some() || a.plots.is_some() {
+    if a.report.is_some() || (a.plots.is_some() && a.sweep.is_empty()) {
         return Err(CliError::input(
-            "--gaze/--gaze-behaviour: --report and --plots describe the paper's grid; use --format, --export-json/--export-csv or --trials-csv",
+            "--gaze/--gaze-behaviour: --report and --plots describe the paper's grid (--plots draws a --sweep's figures); use --format, --export-json/--export-csv or --trials-csv",
         ));
     }
     Ok(Some(GazeDrive {
@@ -762,7 +758,12 @@ fn render_sweep_plot(
 /// `--sweep` without `--report`: the grid once per value of each key
 /// (the values of a key run together, [`sim::run_many`]); tables (or JSON)
 /// on stdout, with `--plots DIR` one figure per key.
-fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
+/// With a gaze drive, every value's grid is driven by it.
+fn run_sweeps(
+    a: &Args,
+    config: &SimConfig,
+    gaze: Option<&sim::gaze_drive::GazeDrive>,
+) -> Result<u8, CliError> {
     if a.trials_csv.is_some() || a.export_json.is_some() || a.export_csv.is_some() {
         return Err(CliError::input(
             "--sweep prints its tables on stdout: --trials-csv, --export-json and --export-csv are not available with it",
@@ -797,7 +798,14 @@ fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
     let mut text = String::new();
     let mut json = Vec::new();
     for (sw, per_value) in sweeps.iter().zip(&configs) {
-        let results = sim::run_many(per_value, &|| {}).map_err(sim_error)?;
+        let results = match gaze {
+            Some(g) => per_value
+                .iter()
+                .map(|c| sim::gaze_drive::run(c, g, &|| {}))
+                .collect::<Result<Vec<_>, _>>(),
+            None => sim::run_many(per_value, &|| {}),
+        }
+        .map_err(sim_error)?;
         if let Some(dir) = &a.plots {
             for (name, bytes) in render_sweep_plot(sw, &results, config)? {
                 outputs.set(&dir.join(name), bytes);
