@@ -11,55 +11,13 @@ use std::path::Path;
 use gaze_lidar::gaze::Format;
 use gaze_lidar::pipeline::PipelineConfig;
 use gaze_lidar::sim::gaze_drive::{self, Behaviour, GazeDrive, GazeSource, Trace};
-use gaze_lidar::sim::{self, report, stats, GridResult, ModelKind, Scenario, SimConfig, Variant};
+use gaze_lidar::sim::{self, report, stats, ModelKind, Scenario, SimConfig, Variant};
 
 const SEED: u64 = 1;
 
 fn fail(message: &str) -> ! {
     eprintln!("scenarios_doc: {message}");
     std::process::exit(2);
-}
-
-fn num(x: Option<f64>) -> String {
-    x.map_or_else(|| "–".to_owned(), |x| format!("{x:.2}"))
-}
-
-fn flat(v: &[Option<f64>]) -> Vec<f64> {
-    v.iter().flatten().copied().collect()
-}
-
-fn gaze_table(out: &mut String, name: &str, r: &GridResult) {
-    out.push_str(
-        "| variant | detected | TTA median [95 % CI], s | modes | vs baseline (Δ median, Wilcoxon p, r) | hybrid TTA, s | fail-safe frames | detected in a fail-safe frame |\n",
-    );
-    out.push_str("| --- | --- | --- | --- | --- | --- | --- | --- |\n");
-    for row in &r.rows {
-        let right = report::tta_of(r, row.variant, row.fog_pct, 1);
-        let base = report::tta_of(r, "baseline", row.fog_pct, 1);
-        let in_fail_safe = r
-            .trials
-            .iter()
-            .filter(|t| t.variant == row.variant && t.fog_pct == row.fog_pct)
-            .filter(|t| t.outcome.detected_in_fail_safe[1] == Some(true))
-            .count();
-        let _ = writeln!(
-            out,
-            "| {} | {}/{} | {} | {} | {} | {} | {:.1} % | {} |",
-            row.variant,
-            row.detected,
-            row.trials,
-            report::median_interval(&flat(&right), SEED, &format!("{name}/{}", row.variant)),
-            report::modes_text(&flat(&right)),
-            if row.variant == "baseline" {
-                "–".to_owned()
-            } else {
-                report::paired_text(&right, &base)
-            },
-            num(row.hybrid_tta_median_s),
-            100.0 * row.fail_safe_frame_share,
-            in_fail_safe,
-        );
-    }
 }
 
 fn main() {
@@ -118,22 +76,11 @@ fn main() {
         out.push_str(&report::scenario_table(&name, &r, SEED));
         out.push('\n');
     }
-    out.push_str(
-        "## Gaze behaviour from the stream\n\n\
-         The sensor's profile is planned frame by frame from the gaze, through\n\
-         `stream`'s filter and fail-safe (defaults: 100 ms timeout, 4 samples to\n\
-         recover, 30 °/s saccade threshold); each frame runs the profile decided at\n\
-         the latest frame start at or before its own start. The gaze starts 1 s\n\
-         before the trial; the named behaviours are sampled at 200 Hz with saccades\n\
-         at 400 °/s (assumed) and a per-trial phase from the seed; a recorded trace\n\
-         repeats end to end from a per-trial starting point. The driver sees nothing\n\
-         during a blink. Paper scene, clear air; *fail-safe frames*: the share of\n\
-         frames that ran the uniform baseline because the gaze was lost or stale.\n\n",
-    );
+    out.push_str("## Gaze behaviour from the stream\n\n");
+    out.push_str(&report::gaze_preamble("Paper scene, every fog level"));
     let config = SimConfig {
         models: vec![ModelKind::Physical],
         variants: Variant::PAPER.to_vec(),
-        fog_pcts: vec![0],
         trials,
         seed: SEED,
         ..SimConfig::default()
@@ -171,9 +118,9 @@ fn main() {
         let r = gaze_drive::run(&config, &drive, &|| {}).unwrap_or_else(|e| fail(&e.to_string()));
         let _ = writeln!(
             out,
-            "### `{args}`\n\n`gaze-lidar simulate {args} --fog 0 --trials {trials} --seed {SEED}`\n"
+            "### `{args}`\n\n`gaze-lidar simulate {args} --trials {trials} --seed {SEED}`\n"
         );
-        gaze_table(&mut out, &args, &r);
+        out.push_str(&report::gaze_table(&args, &r, SEED));
         out.push('\n');
     }
     print!("{out}");

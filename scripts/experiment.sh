@@ -10,8 +10,10 @@
 #     pipeline swept over mount height, grid phase, tick, spawn distance and
 #     fog threshold, five values each (SWEEP_TRIALS per cell, default 30: fewer
 #     than the main run, to keep the script's run time to a few minutes), with
-#     one figure per key in $OUT/plots/; and the pedestrian and two-car
-#     scenario files' tables (physical model, TRIALS per cell).
+#     one figure per key in $OUT/plots/; the pedestrian, two-car and
+#     false-alarm scenario files' tables (physical model, TRIALS per cell);
+#     and the sensor driven through the gaze stream by each named behaviour
+#     and three recorded traces (physical model, TRIALS per cell).
 # Outputs go to $OUT (default: out/); the report to docs/reproduction.md.
 # CHECK=1: fail unless the regenerated report equals the committed one byte
 # for byte (git diff --exit-code).
@@ -38,7 +40,13 @@ $B simulate --trials "$TRIALS" --seed 1 --plots "$OUT/plots" --trials-csv "$OUT/
   --sweep spawn_distance=100,105,110,115,120 \
   --sweep fog_threshold=0.5,0.75,1,1.5,2 \
   --report-scenario examples/scenarios/pedestrian.toml \
-  --report-scenario examples/scenarios/second_car.toml
+  --report-scenario examples/scenarios/second_car.toml \
+  --report-scenario examples/scenarios/false_alarms.toml \
+  --report-gaze-behaviour fixate --report-gaze-behaviour scan \
+  --report-gaze-behaviour mirror --report-gaze-behaviour blink \
+  --report-gaze csv=tests/data/gaze/right.csv \
+  --report-gaze varjo=tests/data/gaze/varjo_base.csv \
+  --report-gaze neon=tests/data/gaze/neon_gaze.csv
 echo "results: $OUT/results.json, $OUT/results.csv, $OUT/trials.csv; plots: $OUT/plots/; report: docs/reproduction.md" >&2
 if [ "${CHECK:-0}" = 1 ]; then
   git diff --exit-code -- docs/reproduction.md

@@ -408,10 +408,253 @@ fn the_committed_report_and_scenarios_doc_show_the_same_tables() {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    for name in ["pedestrian", "second_car"] {
+    for name in ["pedestrian", "second_car", "false_alarms"] {
         let a = table_after(&report, &format!("### {name}\n"));
         let b = table_after(&doc, &format!("## {name}\n"));
         assert_eq!(a.lines().count(), 14, "{name}: {a}");
         assert_eq!(a, b, "{name}");
     }
+    // The gaze tables: every named behaviour and a recorded trace of each
+    // format, in the report's gaze section and in docs/scenarios.md.
+    for source in [
+        "--gaze-behaviour fixate",
+        "--gaze-behaviour scan",
+        "--gaze-behaviour mirror",
+        "--gaze-behaviour blink",
+        "--gaze tests/data/gaze/right.csv --gaze-format csv",
+        "--gaze tests/data/gaze/varjo_base.csv --gaze-format varjo",
+        "--gaze tests/data/gaze/neon_gaze.csv --gaze-format neon",
+    ] {
+        let heading = format!("### `{source}`\n");
+        let a = table_after(&report, &heading);
+        let b = table_after(&doc, &heading);
+        assert_eq!(a.lines().count(), 14, "{source}: {a}");
+        assert_eq!(a, b, "{source}");
+    }
+}
+
+#[test]
+fn the_report_tabulates_its_gaze_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("r.md");
+    let trace = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gaze/right.csv");
+    let report_gaze = format!("csv={trace}");
+    let o = run(
+        &[
+            "simulate",
+            "--trials",
+            "3",
+            "--seed",
+            "4",
+            "--model",
+            "physical",
+            "--fog",
+            "0",
+            "--fog",
+            "50",
+            "--report",
+            report.to_str().unwrap(),
+            "--report-gaze-behaviour",
+            "scan",
+            "--report-gaze",
+            &report_gaze,
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let md = std::fs::read_to_string(&report).unwrap();
+    // Each section holds the table the library computes for the same gaze
+    // (every variant at the run's fog levels, 3 trials, seed 4).
+    let c = SimConfig {
+        models: vec![ModelKind::Physical],
+        fog_pcts: vec![0, 50],
+        trials: 3,
+        seed: 4,
+        ..SimConfig::default()
+    };
+    let text = std::fs::read_to_string(trace).unwrap();
+    for (args, source) in [
+        ("--gaze-behaviour scan".to_owned(), behaviour("scan")),
+        (
+            format!("--gaze {trace} --gaze-format csv"),
+            GazeSource::Trace(Trace::parse(&text, Format::Csv, trace).unwrap()),
+        ),
+    ] {
+        let r = driven(&c, source);
+        assert_eq!(r.rows.len(), 8);
+        let table = sim::report::gaze_table(&args, &r, 4);
+        assert!(
+            table.lines().next().unwrap().contains("| fog % |"),
+            "{table}"
+        );
+        let section = md
+            .split(&format!("### `{args}`\n"))
+            .nth(1)
+            .unwrap_or_else(|| panic!("{args}: {md}"));
+        assert!(section.contains(&table), "{section}");
+        assert!(section.contains(&format!("{args} --fog 0 --fog 50 --trials 3 --seed 4")));
+    }
+    // Without --report it is refused, a bad source is named, and nothing
+    // is written.
+    assert_bad_input(
+        &run(&["simulate", "--report-gaze-behaviour", "scan"], None),
+        "--report-gaze",
+    );
+    let fresh = dir.path().join("fresh.md");
+    for (flag, value, names) in [
+        ("--report-gaze-behaviour", "wink", "'wink' is not one of"),
+        ("--report-gaze", "right.csv", "FORMAT=PATH"),
+        ("--report-gaze", "tobii2=x.csv", "tobii2"),
+        ("--report-gaze", "jsonl=/no/such.jsonl", "/no/such.jsonl"),
+    ] {
+        assert_bad_input(
+            &run(
+                &[
+                    "simulate",
+                    "--trials",
+                    "2",
+                    "--report",
+                    fresh.to_str().unwrap(),
+                    flag,
+                    value,
+                ],
+                None,
+            ),
+            names,
+        );
+        assert!(!fresh.exists());
+    }
+}
+
+#[test]
+fn the_carla_pipeline_refuses_the_gaze_stream_with_the_reason() {
+    // The carla geometry plans one profile and one region of focus per
+    // trial: a gaze stream cannot change them frame by frame there, so
+    // `--gaze`/`--gaze-behaviour` are refused with that reason, for every
+    // sampling and for the paper's detector.
+    let trace = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gaze/right.csv");
+    for extra in [
+        &["--geometry", "carla"][..],
+        &["--geometry", "carla", "--sampling", "carla-async"][..],
+        &[
+            "--geometry",
+            "carla",
+            "--detector",
+            "argus",
+            "--arrival",
+            "argus-centre",
+            "--model",
+            "physical",
+        ][..],
+    ] {
+        for gaze in [
+            &["--gaze-behaviour", "scan"][..],
+            &["--gaze", trace, "--gaze-format", "csv"][..],
+        ] {
+            let mut args = vec!["simulate", "--trials", "1", "--fog", "0"];
+            args.extend_from_slice(extra);
+            args.extend_from_slice(gaze);
+            assert_bad_input(
+                &run(&args, None),
+                "one profile and one region of focus per trial",
+            );
+        }
+    }
+    // The argus return model: its resolution variant is a fixed decimation.
+    assert_bad_input(
+        &run(
+            &[
+                "simulate",
+                "--gaze-behaviour",
+                "fixate",
+                "--geometry",
+                "carla",
+                "--detector",
+                "argus",
+                "--model",
+                "argus",
+            ],
+            None,
+        ),
+        "--gaze/--gaze-behaviour: only",
+    );
+}
+
+#[test]
+fn a_sweep_drives_every_value_from_the_gaze() {
+    // `--sweep` with `--gaze-behaviour`: one table per key whose rows are
+    // the gaze-driven grid of each value run alone, and one figure per key.
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(
+        &[
+            "simulate",
+            "--trials",
+            "3",
+            "--seed",
+            "5",
+            "--fog",
+            "0",
+            "--variant",
+            "baseline",
+            "--variant",
+            "range",
+            "--gaze-behaviour",
+            "scan",
+            "--sweep",
+            "speed_kmh=40,60",
+            "--format",
+            "json",
+            "--plots",
+            dir.path().to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let values = v["sweeps"][0]["values"].as_array().unwrap();
+    assert_eq!(values.len(), 2);
+    for (value, speed) in values.iter().zip([40.0, 60.0]) {
+        let s = Scenario {
+            speed_kmh: speed,
+            ..Scenario::default()
+        };
+        let c = SimConfig {
+            models: vec![ModelKind::Physical],
+            variants: vec![Variant::Baseline, Variant::Range],
+            fog_pcts: vec![0],
+            trials: 3,
+            seed: 5,
+            scenario: s,
+            ..SimConfig::default()
+        };
+        let alone = driven(&c, behaviour("scan"));
+        let rows = value["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), 2);
+        for (row, expected) in rows.iter().zip(&alone.rows) {
+            assert_eq!(row["tta_median_s"].as_f64(), expected.tta_median_s);
+            assert_eq!(
+                row["fail_safe_frame_share"].as_f64(),
+                Some(expected.fail_safe_frame_share)
+            );
+        }
+    }
+    // Slower cars arrive later from the same distance: the TTA grows.
+    let tta = |i: usize| values[i]["rows"][0]["tta_median_s"].as_f64().unwrap();
+    assert!(tta(0) > tta(1) + 1.0, "{} {}", tta(0), tta(1));
+    let svg = std::fs::read_to_string(dir.path().join("sweep_speed_kmh.svg")).unwrap();
+    assert!(svg.contains("speed_kmh"));
+    // A key the gaze-driven grid does not read is refused.
+    assert_bad_input(
+        &run(
+            &[
+                "simulate",
+                "--gaze-behaviour",
+                "scan",
+                "--sweep",
+                "tick=0.05,0.1",
+            ],
+            None,
+        ),
+        "--geometry carla",
+    );
 }

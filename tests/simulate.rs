@@ -163,7 +163,7 @@ fn sweeps_plot_one_figure_per_key_and_bad_sweeps_name_the_key() {
             "--sweep",
             "fog_threshold=0.5,1",
             "--sweep",
-            "grid_phase=0,0.5",
+            "speed_kmh=40,60",
             "--plots",
             dir.path().to_str().unwrap(),
         ],
@@ -171,17 +171,36 @@ fn sweeps_plot_one_figure_per_key_and_bad_sweeps_name_the_key() {
     );
     assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
     assert!(stdout(&o).contains("sweep of argus_fog_threshold_scale"));
+    assert!(stdout(&o).contains("sweep of speed_kmh"));
     for f in [
         "sweep_fog_threshold.svg",
         "sweep_fog_threshold.png",
-        "sweep_grid_phase.svg",
-        "sweep_grid_phase.png",
+        "sweep_speed_kmh.svg",
+        "sweep_speed_kmh.png",
     ] {
         let meta = std::fs::metadata(dir.path().join(f)).unwrap();
         assert!(meta.len() > 1000, "{f}");
     }
     let svg = std::fs::read_to_string(dir.path().join("sweep_fog_threshold.svg")).unwrap();
     assert!(svg.contains("fog_threshold") && svg.contains("fog 50 %"));
+    // A key the run does not read is refused, not tabulated as a flat line.
+    assert_bad_input(
+        &run(&["simulate", "--sweep", "grid_phase=0,0.5"], None),
+        "--geometry carla",
+    );
+    assert_bad_input(
+        &run(
+            &[
+                "simulate",
+                "--model",
+                "physical",
+                "--sweep",
+                "fog_threshold=0.5,1",
+            ],
+            None,
+        ),
+        "--model argus",
+    );
     for (sweep, names) in [
         ("grid_phase=1", "carla.grid_phase_steps"),
         ("fog_threshold=0.5,-1", "argus_fog_threshold_scale"),

@@ -101,7 +101,8 @@ pub struct Args {
     /// `grid_phase` (`carla.grid_phase_steps`, the scan grid's azimuth phase
     /// in steps) and `fog_threshold` (`argus_fog_threshold_scale`); the
     /// whole grid is run once per value and printed as tables (`--format
-    /// json`: `{"sweeps": [...]}`).
+    /// json`: `{"sweeps": [...]}`); with `--gaze`/`--gaze-behaviour` every
+    /// value's grid is driven by the gaze.
     /// With `--plots DIR`: one figure per key (`sweep_KEY.svg`/`.png`).
     /// With `--report`: the sweeps run the paper's pipeline (needs
     /// `--paper-pipeline-trials`) and make the report's sensitivity section.
@@ -117,6 +118,17 @@ pub struct Args {
     /// scenarios" section, with intervals, modes and paired tests.
     #[arg(long)]
     report_scenario: Vec<PathBuf>,
+    /// With `--report`: also drive the sensor from this named gaze
+    /// behaviour (repeatable; as `--gaze-behaviour`) and tabulate it in the
+    /// report's gaze section (the paper's scene, the `physical` model, the
+    /// four variants at the run's fog levels, `--trials` and `--seed`).
+    #[arg(long)]
+    report_gaze_behaviour: Vec<String>,
+    /// With `--report`: also drive the sensor from this recorded gaze trace,
+    /// given as `FORMAT=PATH` (repeatable; FORMAT as `--gaze-format`), and
+    /// tabulate it in the report's gaze section.
+    #[arg(long)]
+    report_gaze: Vec<String>,
     /// Disable ray culling (reference path; results are identical).
     #[arg(long, hide = true)]
     brute_force: bool,
@@ -160,6 +172,22 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         .input_opt("--optimizer-config", a.optimizer_config.as_deref());
     for path in &a.report_scenario {
         outputs.input_opt("--report-scenario", Some(path));
+    }
+    let report_gaze_paths: Vec<(String, PathBuf)> = a
+        .report_gaze
+        .iter()
+        .map(|spec| {
+            spec.split_once('=')
+                .map(|(f, p)| (f.trim().to_owned(), PathBuf::from(p)))
+                .ok_or_else(|| {
+                    CliError::input(format!(
+                        "--report-gaze: '{spec}' is not FORMAT=PATH (e.g. csv=gaze.csv)"
+                    ))
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    for (_, path) in &report_gaze_paths {
+        outputs.input_opt("--report-gaze", Some(path));
     }
     let scenario = match &a.scenario {
         Some(path) => {
@@ -219,11 +247,6 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         return Err(super::config::no_solver("--optimizer-config"));
     }
     let gaze = gaze_drive(a, &scenario)?;
-    if gaze.is_some() && !a.sweep.is_empty() {
-        return Err(CliError::input(
-            "--sweep runs the paper's grid: --gaze/--gaze-behaviour are not available with it",
-        ));
-    }
     let config = SimConfig {
         models: if a.model.is_empty() {
             if gaze.is_some() {
@@ -254,7 +277,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         ..SimConfig::default()
     };
     if !a.sweep.is_empty() && a.report.is_none() {
-        return run_sweeps(a, &config);
+        return run_sweeps(a, &config, gaze.as_ref());
     }
     // With --report, the sweeps make the sensitivity section (on the
     // paper's pipeline): parsed and validated before anything runs.
@@ -302,6 +325,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             sc_config,
         ));
     }
+    if (!a.report_gaze.is_empty() || !a.report_gaze_behaviour.is_empty()) && a.report.is_none() {
+        return Err(CliError::input(
+            "--report-gaze/--report-gaze-behaviour add gaze runs to the report: add --report FILE (or run one with --gaze/--gaze-behaviour)",
+        ));
+    }
+    // The report's gaze sources: read and checked before anything runs.
+    let report_gaze = report_gaze_sources(a, &report_gaze_paths)?;
     // Every output path is checked before the run — against the others
     // (the plots' file names included) and against the inputs: a bad one
     // fails now, and nothing is replaced.
@@ -472,6 +502,36 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 },
             )
             .collect();
+        let gaze_config = SimConfig {
+            models: vec![ModelKind::Physical],
+            variants: Variant::PAPER.to_vec(),
+            fog_pcts: config.fog_pcts.clone(),
+            trials,
+            seed,
+            ..SimConfig::default()
+        };
+        let gaze_results = report_gaze
+            .iter()
+            .map(|(args, drive)| {
+                sim::gaze_drive::run(&gaze_config, drive, &|| {}).map_err(|e| {
+                    let message = format!("{args}: {}", sim_message(&e));
+                    if e.is_input_error() {
+                        CliError::input(message)
+                    } else {
+                        CliError::infeasible(message)
+                    }
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let gaze_runs: Vec<sim::report::GazeRun<'_>> = report_gaze
+            .iter()
+            .zip(&gaze_results)
+            .map(|((args, _), result)| sim::report::GazeRun {
+                args,
+                result,
+                config: &gaze_config,
+            })
+            .collect();
         let md = sim::report::render_with_pipelines(
             &result,
             &config,
@@ -481,6 +541,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 lifted,
                 sensitivity: &sensitivity,
                 scenarios: &scenario_runs,
+                gaze: &gaze_runs,
             },
         );
         outputs.set(path, md);
@@ -538,15 +599,54 @@ fn gaze_drive(
         ),
         (None, None) => return Ok(None),
     };
-    if a.report.is_some() || a.plots.is_some() {
+    if a.report.is_some() || (a.plots.is_some() && a.sweep.is_empty()) {
         return Err(CliError::input(
-            "--gaze/--gaze-behaviour: --report and --plots describe the paper's grid; use --format, --export-json/--export-csv or --trials-csv",
+            "--gaze/--gaze-behaviour: --report and --plots describe the paper's grid (--plots draws a --sweep's figures); use --format, --export-json/--export-csv or --trials-csv",
         ));
     }
     Ok(Some(GazeDrive {
         source,
         pipeline: a.filter.settings()?,
     }))
+}
+
+/// The report's gaze sources (`--report-gaze-behaviour`, then
+/// `--report-gaze`), each with the options that give it to `simulate`.
+fn report_gaze_sources(
+    a: &Args,
+    paths: &[(String, PathBuf)],
+) -> Result<Vec<(String, sim::gaze_drive::GazeDrive)>, CliError> {
+    use sim::gaze_drive::{Behaviour, GazeDrive, GazeSource, Trace};
+    let pipeline = a.filter.settings()?;
+    let default_gaze_deg = Scenario::default().gaze_deg;
+    let mut out = Vec::new();
+    for spec in &a.report_gaze_behaviour {
+        let b = Behaviour::parse(spec, default_gaze_deg)
+            .map_err(|e| CliError::input(format!("--report-gaze-behaviour: {e}")))?;
+        out.push((
+            format!("--gaze-behaviour {spec}"),
+            GazeDrive {
+                source: GazeSource::Behaviour(b),
+                pipeline,
+            },
+        ));
+    }
+    for (format, path) in paths {
+        let fmt: gaze_lidar::gaze::Format = format
+            .parse()
+            .map_err(|e| CliError::input(format!("--report-gaze {format}=…: {e}")))?;
+        let text = read_text(path, 256 << 20)?;
+        let trace = Trace::parse(&text, fmt, &path.display().to_string())
+            .map_err(super::gaze_args::gaze_error)?;
+        out.push((
+            format!("--gaze {} --gaze-format {format}", path.display()),
+            GazeDrive {
+                source: GazeSource::Trace(trace),
+                pipeline,
+            },
+        ));
+    }
+    Ok(out)
 }
 
 /// Renders the plots (in a private temporary folder) and returns their
@@ -592,7 +692,7 @@ fn sim_message(e: &sim::SimError) -> String {
             C::DetectorNeedsCarla => "--detector argus needs --geometry carla (ARGUS's road mask is built from ground returns)".to_owned(),
             C::FalseAlarmsNeedPlanar => "scenario.false_alarms_per_frame needs --geometry planar (the carla geometry has no frame-based detector)".to_owned(),
             C::SamplingNeedsCarla(s) => format!("--sampling {s} needs --geometry carla (the planar geometry has only the drift pulse clock)"),
-            C::GazeNeedsPlanar => format!("{GAZE} the planar geometry is driven by the gaze stream"),
+            C::GazeNeedsPlanar => format!("{GAZE} the planar geometry is driven by the gaze stream (the carla geometry plans one profile and one region of focus per trial, not per frame)"),
             C::GazeNeedsPhysical => format!("{GAZE} --model physical is driven (the argus model's resolution variant is a fixed decimation, not a per-frame profile)"),
             C::GazeNeedsClosedForm => format!("{GAZE} the closed-form variants (baseline, range, resolution, joint) are driven"),
         },
@@ -664,7 +764,12 @@ fn render_sweep_plot(
 /// `--sweep` without `--report`: the grid once per value of each key
 /// (the values of a key run together, [`sim::run_many`]); tables (or JSON)
 /// on stdout, with `--plots DIR` one figure per key.
-fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
+/// With a gaze drive, every value's grid is driven by it.
+fn run_sweeps(
+    a: &Args,
+    config: &SimConfig,
+    gaze: Option<&sim::gaze_drive::GazeDrive>,
+) -> Result<u8, CliError> {
     if a.trials_csv.is_some() || a.export_json.is_some() || a.export_csv.is_some() {
         return Err(CliError::input(
             "--sweep prints its tables on stdout: --trials-csv, --export-json and --export-csv are not available with it",
@@ -676,6 +781,11 @@ fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
         ));
     }
     let sweeps = parse_sweeps(&a.sweep)?;
+    for sw in &sweeps {
+        if let Some(why) = sim::sweep::inert(&sw.key, config) {
+            return Err(CliError::input(format!("--sweep {}: {why}", sw.key)));
+        }
+    }
     // Every value is validated before anything runs.
     let configs = sweeps
         .iter()
@@ -694,7 +804,14 @@ fn run_sweeps(a: &Args, config: &SimConfig) -> Result<u8, CliError> {
     let mut text = String::new();
     let mut json = Vec::new();
     for (sw, per_value) in sweeps.iter().zip(&configs) {
-        let results = sim::run_many(per_value, &|| {}).map_err(sim_error)?;
+        let results = match gaze {
+            Some(g) => per_value
+                .iter()
+                .map(|c| sim::gaze_drive::run(c, g, &|| {}))
+                .collect::<Result<Vec<_>, _>>(),
+            None => sim::run_many(per_value, &|| {}),
+        }
+        .map_err(sim_error)?;
         if let Some(dir) = &a.plots {
             for (name, bytes) in render_sweep_plot(sw, &results, config)? {
                 outputs.set(&dir.join(name), bytes);

@@ -58,20 +58,8 @@ fn tta_cell(x: Option<&Row>) -> String {
                 x.detected,
                 x.trials
             );
-            if st.tta_mode_count > 1 {
-                let modes: Vec<String> = st
-                    .tta_modes
-                    .split(';')
-                    .filter_map(|m| {
-                        let (t, sh) = m.split_once(':')?;
-                        Some(format!(
-                            "{:.2}: {:.0} %",
-                            t.parse::<f64>().ok()?,
-                            sh.parse::<f64>().ok()? * 100.0
-                        ))
-                    })
-                    .collect();
-                let _ = write!(out, "; modes {}", modes.join(", "));
+            if let Some(modes) = row_modes(st) {
+                let _ = write!(out, "; modes {modes}");
             }
             if let (Some(d), Some(pw), Some(ps), Some(rb)) = (
                 st.vs_baseline_median_diff_s,
@@ -98,6 +86,93 @@ fn pfmt(p: f64) -> String {
     } else {
         format!("{p:.3}")
     }
+}
+
+/// The modes of a row's TTA as `median: share` pairs (`3.67: 25 %, …`),
+/// or `None` when the sample has one peak.
+fn row_modes(st: &super::stats::CellStats) -> Option<String> {
+    if st.tta_mode_count <= 1 {
+        return None;
+    }
+    let modes: Vec<String> = st
+        .tta_modes
+        .split(';')
+        .filter_map(|m| {
+            let (t, sh) = m.split_once(':')?;
+            Some(format!(
+                "{:.2}: {:.0} %",
+                t.parse::<f64>().ok()?,
+                sh.parse::<f64>().ok()? * 100.0
+            ))
+        })
+        .collect();
+    Some(modes.join(", "))
+}
+
+/// A per-trial sample's summary for a table cell: median [bootstrap 95 %
+/// interval] (the interval seeded by `seed` and `label`), its modes when it
+/// has several, and, given the baseline's sample on the same trials, the
+/// paired comparison (median difference in `unit` with `digits` decimals,
+/// rank-biserial r, Wilcoxon and sign p). `None` entries (not detected) are
+/// left out; a pair needs both.
+fn sample_cell(
+    values: &[Option<f64>],
+    baseline: Option<&[Option<f64>]>,
+    seed: u64,
+    label: &str,
+    (unit, digits): (&str, usize),
+    note: &str,
+) -> String {
+    let flat: Vec<f64> = values.iter().flatten().copied().collect();
+    let Some(m) = super::stats::bootstrap_median(
+        &flat,
+        super::stats::BOOTSTRAP_RESAMPLES,
+        super::stats::derive_seed(seed, label),
+    ) else {
+        return "—".to_owned();
+    };
+    let mut out = format!(
+        "{:.digits$} [{:.digits$}–{:.digits$}]{note}",
+        m.median, m.lo, m.hi
+    );
+    let modes = super::stats::modes(&flat, super::stats::MODE_GAP_S);
+    if unit == "s" && modes.len() > 1 {
+        let list: Vec<String> = modes
+            .iter()
+            .map(|x| format!("{:.2}: {:.0} %", x.median, 100.0 * x.share))
+            .collect();
+        let _ = write!(out, "; modes {}", list.join(", "));
+    }
+    if let Some(base) = baseline {
+        let (a, b): (Vec<f64>, Vec<f64>) = values
+            .iter()
+            .zip(base)
+            .filter_map(|(a, b)| Some(((*a)?, (*b)?)))
+            .unzip();
+        if let Some(p) = super::stats::paired(&a, &b) {
+            let _ = write!(
+                out,
+                "; Δ {:+.digits$}{}{unit}, r {:+.2}, p {} (W) / {} (sign)",
+                p.median_difference,
+                if unit.is_empty() { "" } else { " " },
+                p.rank_biserial,
+                pfmt(p.wilcoxon.p_value),
+                pfmt(p.sign.p_value)
+            );
+        }
+    }
+    out
+}
+
+/// A per-trial quantity of one cell, in trial order (for [`sample_cell`]).
+fn per_trial(
+    r: &GridResult,
+    m: ModelKind,
+    variant: &str,
+    fog: u32,
+    f: impl Fn(&super::TrialRecord) -> Option<f64>,
+) -> Vec<Option<f64>> {
+    r.cell(m, variant, fog).map(f).collect()
 }
 
 /// The paper's pipeline cell: median (q1–q3) and detections.
@@ -129,6 +204,8 @@ pub struct PipelineExtras<'a> {
     pub sensitivity: &'a [SweepRun<'a>],
     /// Scenario files run for the "Other scenarios" section, in order.
     pub scenarios: &'a [ScenarioRun<'a>],
+    /// Gaze sources driving the sensor (the gaze section), in order.
+    pub gaze: &'a [GazeRun<'a>],
 }
 
 /// One scenario file's grid for the report's "Other scenarios" section
@@ -261,6 +338,100 @@ pub fn scenario_table(name: &str, r: &GridResult, seed: u64) -> String {
     out
 }
 
+/// The table of a gaze-driven grid (Markdown), one row per variant (and
+/// fog level, with a fog column when the grid has several): detections, the
+/// right mover's median TTA with its 95 % bootstrap interval (seeded by
+/// `seed` and `name/variant`, `name/variant/fog` with a fog column), its
+/// modes, the paired test against the baseline, the hybrid TTA, the share
+/// of fail-safe frames and the trials detected in a fail-safe frame.
+/// `docs/scenarios.md` and the report print the same table.
+#[must_use]
+pub fn gaze_table(name: &str, r: &GridResult, seed: u64) -> String {
+    let flat = |v: &[Option<f64>]| -> Vec<f64> { v.iter().flatten().copied().collect() };
+    let fogs = r
+        .rows
+        .iter()
+        .any(|x| r.rows.first().is_some_and(|f| f.fog_pct != x.fog_pct));
+    let mut out = String::new();
+    out.push_str(if fogs {
+        "| variant | fog % | detected | TTA median [95 % CI], s | modes | vs baseline (Δ median, Wilcoxon p, r) | hybrid TTA, s | fail-safe frames | detected in a fail-safe frame |\n\
+         | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
+    } else {
+        "| variant | detected | TTA median [95 % CI], s | modes | vs baseline (Δ median, Wilcoxon p, r) | hybrid TTA, s | fail-safe frames | detected in a fail-safe frame |\n\
+         | --- | --- | --- | --- | --- | --- | --- | --- |\n"
+    });
+    for row in &r.rows {
+        let right = tta_of(r, row.variant, row.fog_pct, 1);
+        let base = tta_of(r, "baseline", row.fog_pct, 1);
+        let in_fail_safe = r
+            .trials
+            .iter()
+            .filter(|t| t.variant == row.variant && t.fog_pct == row.fog_pct)
+            .filter(|t| t.outcome.detected_in_fail_safe[1] == Some(true))
+            .count();
+        let (fog, label) = if fogs {
+            (
+                format!(" {} |", row.fog_pct),
+                format!("{name}/{}/{}", row.variant, row.fog_pct),
+            )
+        } else {
+            (String::new(), format!("{name}/{}", row.variant))
+        };
+        let _ = writeln!(
+            out,
+            "| {} |{fog} {}/{} | {} | {} | {} | {} | {:.1} % | {} |",
+            row.variant,
+            row.detected,
+            row.trials,
+            median_interval(&flat(&right), seed, &label),
+            modes_text(&flat(&right)),
+            if row.variant == "baseline" {
+                "–".to_owned()
+            } else {
+                paired_text(&right, &base)
+            },
+            row.hybrid_tta_median_s
+                .map_or_else(|| "–".to_owned(), |x| format!("{x:.2}")),
+            100.0 * row.fail_safe_frame_share,
+            in_fail_safe,
+        );
+    }
+    out
+}
+
+/// One gaze source's grid for the report's gaze section (tabulated by
+/// [`gaze_table`]).
+#[derive(Debug, Clone, Copy)]
+pub struct GazeRun<'a> {
+    /// The source as `simulate`'s options give it (`--gaze-behaviour scan`,
+    /// `--gaze FILE --gaze-format F`).
+    pub args: &'a str,
+    /// The grid.
+    pub result: &'a GridResult,
+    /// Its configuration (trials, seed, fog levels).
+    pub config: &'a SimConfig,
+}
+
+/// The text before the gaze tables (report and `docs/scenarios.md`): how
+/// the stream drives the sensor, given the scene's description.
+#[must_use]
+pub fn gaze_preamble(scene: &str) -> String {
+    format!(
+        "The sensor's profile is planned frame by frame from the gaze, through\n\
+         `stream`'s filter and fail-safe (defaults: 100 ms timeout, 4 samples to\n\
+         recover, 30 °/s saccade threshold); each frame runs the profile decided at\n\
+         the latest frame start at or before its own start. The gaze starts {} s\n\
+         before the trial; the named behaviours are sampled at {} Hz with saccades\n\
+         at {} °/s (assumed) and a per-trial phase from the seed; a recorded trace\n\
+         repeats end to end from a per-trial starting point. The driver sees nothing\n\
+         during a blink. {scene}; *fail-safe frames*: the share of\n\
+         frames that ran the uniform baseline because the gaze was lost or stale.\n\n",
+        crate::text::Num(super::gaze_drive::WARMUP_S),
+        crate::text::Num(super::gaze_drive::SAMPLE_RATE_HZ),
+        crate::text::Num(super::gaze_drive::SACCADE_DEG_S),
+    )
+}
+
 /// One sensitivity sweep of the paper's pipeline: a result per value.
 #[derive(Debug, Clone, Copy)]
 pub struct SweepRun<'a> {
@@ -383,7 +554,9 @@ pub fn render_with_pipelines(
         s,
         "Definition: points returned from pulses inside the RoI, per degree of RoI, accumulated over the trial \
          (from the start until the later car arrives, ≈ {:.1} s) and scaled to the 64 channels of the paper's sensor \
-         (× 64, as if every channel returned like the simulated one); median over trials [its bootstrap 95 % interval]. \
+         (× 64, as if every channel returned like the simulated one); median over trials [its bootstrap 95 % interval]; \
+         for a variant, the paired comparison with the baseline of the same model and fog on the same trials: median \
+         difference Δ (points per degree, positive: more points), rank-biserial r, Wilcoxon signed-rank p and sign-test p. \
          The paper reports 16,000–26,000 points per degree, joint highest, then resolution, then range and baseline, \
          little change with fog.\n",
         r.trials.first().map_or(0.0, |t| t.outcome.duration_s)
@@ -395,14 +568,29 @@ pub fn render_with_pipelines(
             let d = |m| {
                 row(r, m, v.name(), fog).map_or_else(
                     || "—".to_owned(),
-                    |x| match (
-                        x.stats.density_ci_lo_pts_per_deg,
-                        x.stats.density_ci_hi_pts_per_deg,
-                    ) {
-                        (Some(lo), Some(hi)) => {
-                            format!("{:.0} [{lo:.0}–{hi:.0}]", x.density_median_pts_per_deg)
+                    |x| {
+                        let st = &x.stats;
+                        let mut out =
+                            match (st.density_ci_lo_pts_per_deg, st.density_ci_hi_pts_per_deg) {
+                                (Some(lo), Some(hi)) => {
+                                    format!("{:.0} [{lo:.0}–{hi:.0}]", x.density_median_pts_per_deg)
+                                }
+                                _ => format!("{:.0}", x.density_median_pts_per_deg),
+                            };
+                        if let (Some(d), Some(rb), Some(pw), Some(ps)) = (
+                            st.density_vs_baseline_median_diff_pts_per_deg,
+                            st.density_vs_baseline_rank_biserial,
+                            st.density_vs_baseline_wilcoxon_p,
+                            st.density_vs_baseline_sign_p,
+                        ) {
+                            let _ = write!(
+                                out,
+                                "; Δ {d:+.0}, r {rb:+.2}, p {} (W) / {} (sign)",
+                                pfmt(pw),
+                                pfmt(ps)
+                            );
                         }
-                        _ => format!("{:.0}", x.density_median_pts_per_deg),
+                        out
                     },
                 )
             };
@@ -429,35 +617,32 @@ pub fn render_with_pipelines(
         for &fog in &config.fog_pcts {
             for v in &config.variants {
                 if let Some(x) = row(r, m, v.name(), fog) {
-                    let st = &x.stats;
-                    // The left car's hybrid TTA: its interval here (the
-                    // rows carry the other two).
-                    let left_hybrid: Vec<f64> = r
-                        .cell(m, v.name(), fog)
-                        .filter_map(|t| t.outcome.hybrid_tta_s[0])
-                        .collect();
-                    let label = format!("{}/{}/{fog}/left_hybrid", m.name(), v.name());
-                    let left_hybrid_ci = super::stats::bootstrap_median(
-                        &left_hybrid,
-                        super::stats::BOOTSTRAP_RESAMPLES,
-                        super::stats::derive_seed(config.seed, &label),
-                    );
+                    let base = (v.name() != "baseline").then_some("baseline");
+                    let cell =
+                        |what: &str, note: &str, f: &dyn Fn(&super::TrialRecord) -> Option<f64>| {
+                            let values = per_trial(r, m, v.name(), fog, f);
+                            let baseline = base.map(|b| per_trial(r, m, b, fog, f));
+                            sample_cell(
+                                &values,
+                                baseline.as_deref(),
+                                config.seed,
+                                &format!("{}/{}/{fog}/{what}", m.name(), v.name()),
+                                ("s", 2),
+                                note,
+                            )
+                        };
                     let _ = writeln!(
                         s,
-                        "| {} | {fog} % | {} | {} [{}–{}] ({}/{} det.) | {} [{}–{}] | {} [{}–{}] |",
+                        "| {} | {fog} % | {} | {} | {} | {} |",
                         m.name(),
                         v.name(),
-                        f2(x.left_tta_median_s),
-                        f2(st.left_tta_ci_lo_s),
-                        f2(st.left_tta_ci_hi_s),
-                        x.left_detected,
-                        x.trials,
-                        f2(x.hybrid_tta_median_s),
-                        f2(st.hybrid_tta_ci_lo_s),
-                        f2(st.hybrid_tta_ci_hi_s),
-                        f2(x.left_hybrid_tta_median_s),
-                        f2(left_hybrid_ci.map(|c| c.lo)),
-                        f2(left_hybrid_ci.map(|c| c.hi)),
+                        cell(
+                            "left_tta",
+                            &format!(" ({}/{} det.)", x.left_detected, x.trials),
+                            &|t| t.outcome.tta_s[0]
+                        ),
+                        cell("hybrid", "", &|t| t.outcome.hybrid_tta_s[1]),
+                        cell("left_hybrid", "", &|t| t.outcome.hybrid_tta_s[0]),
                     );
                 }
             }
@@ -465,7 +650,10 @@ pub fn render_with_pipelines(
     }
     let _ = writeln!(
         s,
-        "\nEach cell: median [95 % percentile bootstrap interval of the median], s. \
+        "\nEach cell: median [95 % percentile bootstrap interval of the median], s; the modes when the TTAs fall into \
+         several groups (as above); for a variant, the paired comparison with the baseline of the same model and fog \
+         on the same trials (both detected): median difference Δ (positive: earlier), rank-biserial r, Wilcoxon \
+         signed-rank p and sign-test p. \
          The hybrid TTA is the earlier of the driver seeing the car (inside the region of focus, in line of sight, \
          within the fog's optical range) and the LiDAR detecting it. Range control lowers the power inside the \
          driver's focus (P_low = 0.5 P̄), so the LiDAR sees the left car later; the driver, who looks there, covers it.\n"
@@ -658,11 +846,13 @@ pub fn render_with_pipelines(
             s.push_str(&scenario_table(run.name, run.result, run.config.seed));
             s.push('\n');
         }
-        let _ = writeln!(
-            s,
-            "The same tables, a detector with false alarms and the sensor driven by recorded gaze traces and \
-             named gaze behaviours: `docs/scenarios.md` (regenerated by `bash scripts/scenarios.sh`)."
-        );
+        if extras.gaze.is_empty() {
+            let _ = writeln!(
+                s,
+                "The same tables, every scenario file in `examples/scenarios/` and the sensor driven by recorded \
+                 gaze traces and named gaze behaviours: `docs/scenarios.md` (regenerated by `bash scripts/scenarios.sh`)."
+            );
+        }
     } else {
         let _ = writeln!(
             s,
@@ -672,6 +862,9 @@ pub fn render_with_pipelines(
              recorded gaze traces and named gaze behaviours: `docs/scenarios.md` (regenerated by \
              `bash scripts/scenarios.sh`; scenario files in `examples/scenarios/`)."
         );
+    }
+    if !extras.gaze.is_empty() {
+        gaze_section(&mut s, extras.gaze);
     }
     let _ = writeln!(s, "\n## Figures\n");
     let _ = write!(s, "Written by `--plots DIR`: `tta_argus.svg`, `tta_physical.svg` (as the paper's figure 3), `density_argus.svg`, `density_physical.svg` (figure 4), `profiles_polar.svg`");
@@ -683,6 +876,52 @@ pub fn render_with_pipelines(
     }
     let _ = writeln!(s, ".");
     s
+}
+
+/// The gaze section: per gaze source (named behaviour or recorded trace)
+/// its table, the sensor driven frame by frame through the stream.
+fn gaze_section(s: &mut String, runs: &[GazeRun<'_>]) {
+    if !s.ends_with("\n\n") {
+        s.push('\n');
+    }
+    let _ = writeln!(s, "## Gaze behaviour from the stream\n");
+    let fogs: Vec<String> = runs
+        .first()
+        .map(|r| r.config.fog_pcts.iter().map(|f| format!("{f} %")).collect())
+        .unwrap_or_default();
+    s.push_str(&gaze_preamble(&format!(
+        "Paper scene, planar geometry, `physical` return model, fog {}",
+        fogs.join(", ")
+    )));
+    let _ = writeln!(
+        s,
+        "TTA: the right car's, with the median's 95 % percentile bootstrap interval ({} resamples), the modes and \
+         the paired test against the baseline driven by the same gaze on the same draws, as in *Other scenarios*.\n",
+        super::stats::BOOTSTRAP_RESAMPLES
+    );
+    for run in runs {
+        let fog_args: String = if run.config.fog_pcts == super::FOG_LEVELS_PCT {
+            String::new()
+        } else {
+            run.config
+                .fog_pcts
+                .iter()
+                .map(|f| format!(" --fog {f}"))
+                .collect()
+        };
+        let _ = writeln!(
+            s,
+            "### `{}`\n\n`gaze-lidar simulate {}{fog_args} --trials {} --seed {}`\n",
+            run.args, run.args, run.config.trials, run.config.seed
+        );
+        s.push_str(&gaze_table(run.args, run.result, run.config.seed));
+        s.push('\n');
+    }
+    let _ = writeln!(
+        s,
+        "The same scenario and gaze tables, with every scenario file in `examples/scenarios/` and one more \
+         blink behaviour: `docs/scenarios.md` (regenerated by `bash scripts/scenarios.sh`)."
+    );
 }
 
 /// The paper's-pipeline section: its clear-air result explained, the fog
@@ -725,17 +964,30 @@ fn pipeline_section(s: &mut String, p: &GridResult, pc: &SimConfig, extras: &Pip
     );
     let _ = writeln!(
         s,
-        "| fog | variant | TTA median (q1–q3) | ARGUS density (points per trial, median) |"
+        "| fog | variant | TTA median (q1–q3) | ARGUS density (points per trial, median [95 % interval]; paired Δ against the baseline) |"
     );
     let _ = writeln!(s, "|---:|---|---:|---:|");
     for &fog in &pc.fog_pcts {
         for v in &pc.variants {
-            let d = p
-                .row(ModelKind::Argus, v.name(), fog)
-                .map_or(0.0, |x| x.argus_density_points);
+            // Every channel is cast in the carla geometry: the count is
+            // the trial's own (no channel scaling).
+            let dens = |variant: &str| {
+                per_trial(p, ModelKind::Argus, variant, fog, |t| {
+                    Some(t.outcome.argus_roi_points as f64)
+                })
+            };
+            let baseline = (v.name() != "baseline").then(|| dens("baseline"));
+            let d = sample_cell(
+                &dens(v.name()),
+                baseline.as_deref(),
+                pc.seed,
+                &format!("argus/{}/{fog}/argus_density", v.name()),
+                ("", 0),
+                "",
+            );
             let _ = writeln!(
                 s,
-                "| {fog} % | {} | {} | {d:.0} |",
+                "| {fog} % | {} | {} | {d} |",
                 v.name(),
                 pipeline_cell(Some(p), v.name(), fog)
             );
@@ -1091,9 +1343,12 @@ fn sensitivity_section(s: &mut String, p: &GridResult, pc: &SimConfig, runs: &[S
          above: {trials} trials per cell and value (fewer than the {} above, to keep the experiment's run time \
          sane; the same seed, so the trials are paired across values too; `--sweep KEY=V1,… --sweep-trials {trials}`). \
          Each cell: median TTA [95 % bootstrap interval], s; `*` marks a variant that detects the car earlier than \
-         the baseline of the same value and fog (paired Wilcoxon p < 0.05, r > 0), `−` one that detects it later. \
+         the baseline of the same value and fog (paired Wilcoxon p < 0.05, r > 0), `−` one that detects it later; \
+         when the TTAs fall into several groups (cut at gaps over {} s: the far ground ring or the next one), each \
+         group's median and share of the detections. \
          The conclusions tested are the report's: {}.\n",
         pc.trials,
+        super::stats::MODE_GAP_S,
         CONCLUSIONS
             .iter()
             .enumerate()
@@ -1151,8 +1406,10 @@ fn sensitivity_section(s: &mut String, p: &GridResult, pc: &SimConfig, runs: &[S
                             } else {
                                 ""
                             };
+                            let modes = row_modes(&x.stats)
+                                .map_or_else(String::new, |m| format!("; modes {m}"));
                             format!(
-                                "{} [{}–{}]{mark}",
+                                "{} [{}–{}]{mark}{modes}",
                                 f2(x.tta_median_s),
                                 f2(x.stats.tta_ci_lo_s),
                                 f2(x.stats.tta_ci_hi_s)

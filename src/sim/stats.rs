@@ -486,6 +486,15 @@ pub struct CellStats {
     pub vs_baseline_wilcoxon_method: Option<WilcoxonMethod>,
     /// Two-sided exact sign-test p-value.
     pub vs_baseline_sign_p: Option<f64>,
+    /// Accumulated RoI density against the baseline on the same trials
+    /// (every trial pairs): median of (this − baseline), points/degree.
+    pub density_vs_baseline_median_diff_pts_per_deg: Option<f64>,
+    /// Matched-pairs rank-biserial correlation of the density differences.
+    pub density_vs_baseline_rank_biserial: Option<f64>,
+    /// Two-sided Wilcoxon signed-rank p-value of the density differences.
+    pub density_vs_baseline_wilcoxon_p: Option<f64>,
+    /// Two-sided exact sign-test p-value of the density differences.
+    pub density_vs_baseline_sign_p: Option<f64>,
 }
 
 /// `median:share;…` of [`modes`].
@@ -578,6 +587,22 @@ pub fn annotate(
                     out.vs_baseline_wilcoxon_p = Some(p.wilcoxon.p_value);
                     out.vs_baseline_wilcoxon_method = Some(p.wilcoxon.method);
                     out.vs_baseline_sign_p = Some(p.sign.p_value);
+                }
+                // Density: every trial pairs with the baseline's same trial.
+                let (mut v, mut w) = (Vec::new(), Vec::new());
+                if let (Some(dv), Some(dw)) = (density.get(i), density.get(b)) {
+                    for ((x, y), (a, c)) in chunk.iter().zip(base_chunk).zip(dv.iter().zip(dw)) {
+                        if x.trial == y.trial {
+                            v.push(*a);
+                            w.push(*c);
+                        }
+                    }
+                }
+                if let Some(p) = paired(&v, &w) {
+                    out.density_vs_baseline_median_diff_pts_per_deg = Some(p.median_difference);
+                    out.density_vs_baseline_rank_biserial = Some(p.rank_biserial);
+                    out.density_vs_baseline_wilcoxon_p = Some(p.wilcoxon.p_value);
+                    out.density_vs_baseline_sign_p = Some(p.sign.p_value);
                 }
             }
             out

@@ -134,6 +134,30 @@ pub fn apply(scenario: &Scenario, key: &str, value: f64) -> Result<Scenario, Swe
     })
 }
 
+/// Why sweeping `key` cannot change a run of `config`, if it cannot: a
+/// `[carla]` key (but the ego's yaw) outside the carla geometry, or the argus model's fog
+/// threshold without the argus model. A sweep that changes nothing is
+/// refused rather than tabulated as a flat line.
+#[must_use]
+pub fn inert(key: &str, config: &super::SimConfig) -> Option<String> {
+    // The planar geometry reads one `[carla]` key: the ego's yaw (ARGUS's
+    // density half-plane).
+    if key.starts_with("carla.")
+        && key != "carla.ego_yaw_deg"
+        && config.geometry != super::Geometry::Carla
+    {
+        return Some(format!(
+            "{key} is a parameter of the carla geometry: add --geometry carla (the planar geometry does not read it)"
+        ));
+    }
+    if key == "argus_fog_threshold_scale" && !config.models.contains(&super::ModelKind::Argus) {
+        return Some(format!(
+            "{key} scales the argus return model's thresholds: add --model argus"
+        ));
+    }
+    None
+}
+
 /// The text table of a sweep: one line per value × cell with the median
 /// TTA, its interval, the modes and the paired test against the baseline.
 #[must_use]
@@ -235,6 +259,32 @@ mod tests {
             parse("speed_kmh=-5"),
             Err(SweepError::Value { .. })
         ));
+    }
+
+    #[test]
+    fn keys_a_run_does_not_read_are_inert() {
+        use crate::sim::{Geometry, ModelKind, SimConfig};
+        let mut c = SimConfig {
+            geometry: Geometry::Planar,
+            models: vec![ModelKind::Physical],
+            ..SimConfig::default()
+        };
+        for key in [
+            "carla.tick_s",
+            "carla.grid_phase_steps",
+            "carla.mount_height_m",
+        ] {
+            let why = inert(key, &c).expect("inert");
+            assert!(why.contains("--geometry carla"), "{why}");
+        }
+        assert_eq!(inert("carla.ego_yaw_deg", &c), None);
+        assert_eq!(inert("speed_kmh", &c), None);
+        let why = inert("argus_fog_threshold_scale", &c).expect("inert");
+        assert!(why.contains("--model argus"), "{why}");
+        c.models.push(ModelKind::Argus);
+        assert_eq!(inert("argus_fog_threshold_scale", &c), None);
+        c.geometry = Geometry::Carla;
+        assert_eq!(inert("carla.tick_s", &c), None);
     }
 
     #[test]
