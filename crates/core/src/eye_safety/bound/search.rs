@@ -227,10 +227,11 @@ fn first_max_sorted(
     (best.0 > 0.0).then_some(best)
 }
 
-/// A cell and its bound, ordered by the bound (`total_cmp`), then by the
-/// smaller index: the max-heap of [`first_max_sorted`] pops the largest
-/// bound first and, among equal bounds, the first cell.
-struct ByBound(f64, usize);
+/// An index and its bound, ordered by the bound (`total_cmp`), then by the
+/// smaller index: a max-heap of them pops the largest bound first and,
+/// among equal bounds, the first index (the order of a sort by decreasing
+/// bound, ties by index; [`first_max_sorted`], the walks).
+pub(super) struct ByBound(pub(super) f64, pub(super) usize);
 
 impl PartialEq for ByBound {
     fn eq(&self, other: &Self) -> bool {

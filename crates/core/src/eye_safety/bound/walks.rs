@@ -5,11 +5,12 @@
 use super::count::{time_rounding_s, AEL_LB_SLACK, PRUNE_SLACK, REACH_SLACK};
 use super::envelope::Envelope;
 use super::laser::{AelEnds, Laser};
-use super::search::Best;
+use super::search::{Best, ByBound};
 use super::seg::Seg;
 use super::sliding::SlidingMax;
 use super::Search;
 use crate::profile::kinematics::Timeline;
+use std::collections::BinaryHeap;
 
 /// Envelope pieces a window walk visits before it continues with the slope
 /// of the hottest piece within its reach (sound, looser); bounds the work on
@@ -79,13 +80,16 @@ impl Walks<'_> {
                 }
             }
             Search::Pruned => {
-                let mut order: Vec<usize> = (0..walks.len()).collect();
-                order.sort_unstable_by(|&a, &b| {
-                    walks[b].p_span.total_cmp(&walks[a].p_span).then(a.cmp(&b))
-                });
+                // Decreasing `p_span`, ties by index: popped from a heap as
+                // far as the search goes, in the order a full sort gives.
+                let mut order: BinaryHeap<ByBound> = walks
+                    .iter()
+                    .enumerate()
+                    .map(|(k, w)| ByBound(w.p_span, k))
+                    .collect();
                 let mut g = (f64::NAN, 0.0);
                 let mut ends = AelEnds::default();
-                for k in order {
+                while let Some(ByBound(_, k)) = order.pop() {
                     let w = walks[k];
                     if g.0 != w.p_span {
                         let (r, _) = laser.linear_capped_max_memo(
