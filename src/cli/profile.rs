@@ -176,6 +176,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         bins: bins.unwrap_or(360),
         optimized: false,
     };
+    // A `detection_bound.json` this run does not write is another
+    // problem's: removed once this run's files are in place.
+    let mut stale = None;
     let certified = if a.optimize || a.config.is_some() {
         let overrides = Overrides {
             preset: a.preset.as_deref(),
@@ -193,6 +196,8 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                 let path = dir.join("detection_bound.json");
                 outputs.file_opt("--certificate", Some(&path));
                 extra.push((path, json?.into_bytes()));
+            } else {
+                stale = Some(dir.join("detection_bound.json"));
             }
         }
         c
@@ -235,6 +240,17 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         None => outputs.stdout(bytes),
     }
     outputs.commit()?;
+    if let Some(path) = stale {
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(CliError::output(format!(
+                    "{}: a previous run's file that this run's certificate does not include: {e}",
+                    path.display()
+                )));
+            }
+            _ => {}
+        }
+    }
     Ok(0)
 }
 
@@ -462,8 +478,21 @@ fn text_summary(c: &CertifiedProfile, basis: &Basis) -> String {
             o.objective,
             o.upper_bound,
             labelled_gap(o.gap, o.upper_bound),
-            if o.exact { " (proven optimal)" } else { "" }
+            if o.exact && o.eye_safety_tightening.is_none() {
+                " (proven optimal)"
+            } else {
+                ""
+            }
         );
+        if let Some(f) = o.eye_safety_tightening {
+            // The power step's figures are for a program whose eye-safety
+            // limits were divided by up to `f`: profiles within the true
+            // limits may score more (the global bound covers them).
+            let _ = write!(
+                out,
+                " for the program with eye-safety limits divided by up to {f:.4} (a profile within the true limits may score more; the global bound covers it)"
+            );
+        }
         if let Some(g) = &o.global {
             let _ = write!(
                 out,

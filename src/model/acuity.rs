@@ -16,6 +16,12 @@ pub const MAX_ABS_GAZE_DEG: f64 = 3600.0;
 /// Levi's E2 for letter acuity (Song, Levi & Pelli 2014), degrees.
 pub const LEVI_E2_DEG: f64 = 2.72;
 
+/// Smallest `e2_deg` / `sigma_deg` accepted, degrees: far below a bin
+/// (at least 0.25°), and large enough that `σ²` and every weight computed
+/// from the model stay normal doubles (a `σ²` that underflows makes
+/// `V(0) = exp(−0/0)` NaN).
+pub const MIN_ACUITY_WIDTH_DEG: f64 = 1e-9;
+
 /// Errors in an acuity model or focus threshold.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum AcuityError {
@@ -82,13 +88,13 @@ impl AcuityModel {
     /// Checks every parameter.
     pub fn validate(&self) -> Result<(), AcuityError> {
         let positive = |field, value: f64| {
-            if value.is_finite() && value > 0.0 && value <= FULL_TURN_DEG {
+            if value.is_finite() && (MIN_ACUITY_WIDTH_DEG..=FULL_TURN_DEG).contains(&value) {
                 Ok(())
             } else {
                 Err(AcuityError::BadParameter {
                     field,
                     value,
-                    reason: "must be finite, > 0 and <= 360",
+                    reason: "must be finite and in [1e-9, 360]",
                 })
             }
         };

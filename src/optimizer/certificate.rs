@@ -281,10 +281,21 @@ pub fn check(lp: &LinearProgram, x: &[f64], y: &[f64]) -> Exact {
     use super::exact::Sum;
     let n = lp.cost.len();
     let finite = x.len() == n && x.iter().all(|v| v.is_finite()) && y.iter().all(|v| v.is_finite());
-    if !finite {
+    // The program's own numbers: a NaN or infinite cost or coefficient, or
+    // a NaN bound, has no exact value (an infinite bound is "none").
+    let program_finite = lp.cost.iter().all(|c| c.is_finite())
+        && lp.col_lo.iter().chain(&lp.col_hi).all(|b| !b.is_nan())
+        && lp
+            .rows
+            .iter()
+            .all(|r| !r.lo.is_nan() && !r.hi.is_nan() && r.coefs.iter().all(|t| t.1.is_finite()));
+    if !finite || !program_finite {
         return Exact {
             primal_feasible: false,
-            violation: Some("a value is not finite, or x has the wrong length".into()),
+            violation: Some(
+                "a value is not finite, or x has the wrong length, or the program has a non-finite cost, bound or coefficient"
+                    .into(),
+            ),
             objective: BigRational::zero(),
             upper_bound: None,
         };

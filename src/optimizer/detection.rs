@@ -149,10 +149,13 @@ impl Detection {
     /// The conditions `(weight, model)`, weights summing to 1.
     fn conditions(&self, problem: &Problem) -> Vec<(f64, ReturnModel)> {
         let spec = &problem.lidar;
+        // Relative weights, divided by the largest first so that their sum
+        // cannot overflow (`[1e308, 1e308]` is `[1, 1]`).
         let fog_w: Vec<f64> = if self.fog_weight.is_empty() {
             vec![1.0; self.fog_pct.len()]
         } else {
-            self.fog_weight.clone()
+            let top = self.fog_weight.iter().fold(0.0_f64, |m, &w| m.max(w));
+            self.fog_weight.iter().map(|&w| w / top).collect()
         };
         let total: f64 = fog_w.iter().sum::<f64>() * self.models.len() as f64;
         let mut out = Vec::new();

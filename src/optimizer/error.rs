@@ -98,6 +98,16 @@ pub enum Infeasible {
         /// Where it binds, degrees.
         at_deg: f64,
     },
+    /// Resolution mode with spin set-points: the set-point answer is over
+    /// the limit, and a move shortened for eye safety would leave the
+    /// set-points.
+    #[error("eye safety: the spin set-points' answer (levels.spin_rad_s; resolution mode does not move the power) is {:.4} % of the Class 1 limit at {at_deg:.3}°, and a shorter move would leave the set-points", 100.0 * .ratio)]
+    EyeAtSetPoints {
+        /// The bound's ratio to the limit.
+        ratio: f64,
+        /// Where it binds, degrees.
+        at_deg: f64,
+    },
     /// The eye-safety bound refused the bins (its own error).
     #[error("eye safety: {0}")]
     EyeSafety(String),

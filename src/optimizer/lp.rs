@@ -652,6 +652,22 @@ fn budget_weights(problem: &Problem, g: &Grid, t: &[f64]) -> (Vec<f64>, f64) {
     }
 }
 
+/// The `slew` rows' side relative to the limit: continuous powers keep
+/// the continuous margin inside it (they are clamped and lowered to meet
+/// it); hardware levels are exact, so their rows sit at the limit plus
+/// `level_budget_slack` (inside the checker's relative 10⁻⁹), as the
+/// budget row does: a pair of levels one slew step apart (`0.0011 −
+/// 0.0009` is `2.0000000000000006e-4` in doubles) stays compatible, as
+/// `check` accepts it. With the margin, such a pair was incompatible and
+/// a whole level was lost from every bin.
+fn slew_side(problem: &Problem) -> f64 {
+    if problem.levels.power_w.is_empty() {
+        1.0 - S.margin
+    } else {
+        1.0 + S.level_budget_slack
+    }
+}
+
 /// Per bin `i`, the largest `|x_next − x_i|` the `slew` rows allow, with a
 /// relative 10⁻⁹ of head-room; `None` without a slew limit.
 fn slew_reach(problem: &Problem, g: &Grid) -> Option<Vec<f64>> {
@@ -662,7 +678,7 @@ fn slew_reach(problem: &Problem, g: &Grid) -> Option<Vec<f64>> {
             .map(|i| {
                 let j = next_index(i, g.n);
                 s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean
-                    * (1.0 - S.margin)
+                    * slew_side(problem)
                     * (1.0 + 1e-9)
             })
             .collect(),
@@ -703,9 +719,10 @@ fn power_program(
     let budget_row = lp.rows();
     budget(&mut lp, problem, g, t, &x);
     if let Some(s) = problem.lidar.limits.power_slew_w_per_deg_max {
-        slew(&mut lp, g, &x, s, problem.lidar.average_power_w);
+        let (p_mean, side) = (problem.lidar.average_power_w, slew_side(problem));
+        slew(&mut lp, g, &x, s, (p_mean, side));
         if !problem.levels.power_w.is_empty() {
-            slew_levels(&mut lp, g, &x, s, problem.lidar.average_power_w);
+            slew_levels(&mut lp, g, &x, s, (p_mean, side));
         }
     }
     let rows_before_cuts = lp.rows();
@@ -912,18 +929,28 @@ fn budget(lp: &mut Program, problem: &Problem, g: &Grid, t: &[f64], x: &[LinearF
         }
     };
     // A floor that spends the whole budget (power_w_min = P̄) keeps its own
-    // spend: the margin must not make the all-floor answer infeasible.
+    // spend: the margin must not make the all-floor answer infeasible. The
+    // spend is a float sum of up to 1440 products, a few ulps from the exact
+    // one the certificate computes: raised by a relative 1e-12 (far above
+    // 1440·ε, far inside the checker's 1e-9) so that the floor point meets
+    // the row exactly.
     let floor: Vec<f64> = (0..lp.len()).map(|j| lp.bounds(j).0).collect();
     let floor_spend = lp.eval(&spend, &floor);
-    lp.at_most("budget", spend, budget.max(floor_spend));
+    let side = if floor_spend > budget {
+        floor_spend * (1.0 + 1e-12)
+    } else {
+        budget
+    };
+    lp.at_most("budget", spend, side);
 }
 
-/// `slew`: `|x_{i+1} − x_i| ≤ s·(Δ_i + Δ_{i+1})/2·(1 − margin)` around the
-/// circle (`s` in W per degree, `x` in units of `p_mean`).
-fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
+/// `slew`: `|x_{i+1} − x_i| ≤ s·(Δ_i + Δ_{i+1})/2·side` around the circle
+/// (`s` in W per degree, `side` from [`slew_side`]; `x` in units of
+/// `p_mean`).
+fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, (p_mean, side): (f64, f64)) {
     for i in 0..g.n {
         let j = next_index(i, g.n);
-        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
+        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * side;
         let mut d = x[j].clone();
         d.add_mul(-1.0, &x[i]);
         lp.between("slew", d, -lim, lim);
@@ -939,7 +966,7 @@ fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
 /// LP relaxation, which the aggregate `slew` rows let mix far-apart levels
 /// into a ramp no level choice can follow, is tighter, and so is the
 /// certificate's bound (the relaxation's duals).
-fn slew_levels(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64) {
+fn slew_levels(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, (p_mean, side): (f64, f64)) {
     // Per bin its (x level, binary), ordered by level then column.
     let levels: Vec<Vec<(f64, Variable)>> = x
         .iter()
@@ -954,7 +981,7 @@ fn slew_levels(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, p_mean: f64
         .collect();
     for i in 0..g.n {
         let j = next_index(i, g.n);
-        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * (1.0 - S.margin);
+        let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * side;
         let reach = lim * (1.0 + 1e-9);
         for (a, b) in [(i, j), (j, i)] {
             for &(xa, za) in &levels[a] {
@@ -1194,7 +1221,15 @@ impl PowerLp {
             }
             let shrink = 1.0 - f64::EPSILON * f64::from(1u32 << k.min(30));
             for qi in &mut q {
-                *qi = floor + (*qi - floor).max(0.0) * shrink;
+                let toward_floor = floor + (*qi - floor).max(0.0) * shrink;
+                // A floor within a few ulps of the power (a floor at the
+                // budget): shrinking the excess over it moves nothing, so
+                // the power itself shrinks, never below the floor.
+                *qi = if toward_floor < *qi {
+                    toward_floor
+                } else {
+                    (*qi * shrink).max(floor)
+                };
             }
         }
         Err(CertificateError::PowerStep)
@@ -1837,6 +1872,12 @@ fn shorten_for_eye_safety(
         Ok(e.verdict(&segs(g, sp, p))?.0 <= 1.0 - S.eye_safety_headroom)
     };
     let mut shortened = false;
+    if !ctx.problem.levels.spin_rad_s.is_empty() && !safe(&spins)? {
+        // A shortened move leaves the set-points (the hardware cannot run
+        // it): the request is infeasible as posed.
+        let (ratio, at_deg) = e.verdict(&segs(g, &spins, p))?;
+        return Err(Infeasible::EyeAtSetPoints { ratio, at_deg }.into());
+    }
     let mut alpha = 1.0;
     while !safe(&spins)? && alpha > 0.0 {
         shortened = true;

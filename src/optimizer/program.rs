@@ -205,6 +205,52 @@ impl Program {
         }
     }
 
+    /// The power of two HiGHS's objective is multiplied by: 1 unless every
+    /// cost is below [`S`]`.objective_scale_below` in magnitude, then the
+    /// one that brings the largest into `[1, 2)`. HiGHS's dual feasibility
+    /// tolerance is absolute (1e-7): costs of that size (small objective
+    /// weights: weights are relative) would read as zero, and the answer
+    /// would depend on the weights' scale. A power of two scales exactly.
+    fn objective_scale(&self) -> f64 {
+        let top = self
+            .columns
+            .iter()
+            .fold(0.0_f64, |m, c| m.max(c.cost.abs()));
+        if !(top.is_normal() && top < S.objective_scale_below) {
+            return 1.0;
+        }
+        let e = top.log2().floor();
+        2.0_f64.powi(-(e as i32))
+    }
+
+    /// Every cost, bound and coefficient a number HiGHS and the exact
+    /// checker can take (costs and coefficients finite, bounds not NaN):
+    /// a NaN from a degenerate model is an internal error, never an
+    /// "optimal" answer.
+    fn check_finite(&self, what: &str) -> Result<(), OptError> {
+        let bad_column = self
+            .columns
+            .iter()
+            .position(|c| !c.cost.is_finite() || c.lo.is_nan() || c.hi.is_nan());
+        if let Some(j) = bad_column {
+            let c = self.columns[j];
+            return Err(OptError::Solver(format!(
+                "{what} step: column {j} has cost {} and bounds [{}, {}]: not a finite program",
+                c.cost, c.lo, c.hi
+            )));
+        }
+        for (k, (c, _)) in self.constraints.iter().enumerate() {
+            let e = c.expression();
+            let k0 = IntoAffineExpression::constant(e);
+            if k0.is_nan() || e.linear_coefficients().any(|(_, a)| !a.is_finite()) {
+                return Err(OptError::Solver(format!(
+                    "{what} step: row {k} has a non-finite coefficient: not a finite program"
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// The program as a HiGHS model through good_lp (integrality dropped
     /// when `relax`); HiGHS refusing it (a coefficient or a bound it cannot
     /// take, e.g. from limits of no physical size) is a solver error, never
@@ -226,7 +272,7 @@ impl Program {
                 def
             });
             debug_assert_eq!(added, v);
-            objective.add_mul(c.cost, v);
+            objective.add_mul(c.cost * self.objective_scale(), v);
         }
         let mut pb = vars.maximise(objective).using(highs);
         for (c, _) in &self.constraints {
@@ -335,13 +381,18 @@ impl Program {
 
     /// [`Self::solve`] with options (a hot start, a feasibility tolerance).
     pub fn solve_with(&self, what: &str, opts: &SolveOptions<'_>) -> Result<Solved, OptError> {
+        self.check_finite(what)?;
+        // HiGHS solved `max (s·c)ᵀx`: its objective, bound and row duals
+        // are `s` times this program's (`s` a power of two: exact).
+        let s = self.objective_scale();
+        let unscale = |v: Vec<f64>| -> Vec<f64> { v.into_iter().map(|y| y / s).collect() };
         if !self.is_mip() {
             let main = self.run_limited(false, what, opts)?;
             let sol = main.get_solution();
             return Ok(Solved {
                 x: sol.columns().to_vec(),
-                y: sol.dual_rows().to_vec(),
-                solver_objective: main.objective_value(),
+                y: unscale(sol.dual_rows().to_vec()),
+                solver_objective: main.objective_value() / s,
                 solver_dual_bound: None,
             });
         }
@@ -354,7 +405,7 @@ impl Program {
         // solver runs.
         let relaxed = self.run_limited(true, what, opts)?;
         let rsol = relaxed.get_solution();
-        let y = rsol.dual_rows().to_vec();
+        let y = unscale(rsol.dual_rows().to_vec());
         let integral = rsol
             .columns()
             .iter()
@@ -367,10 +418,10 @@ impl Program {
                 .zip(&self.columns)
                 .map(|(&v, c)| if c.integer { v.round() } else { v })
                 .collect();
-            let obj = relaxed.objective_value();
+            let obj = relaxed.objective_value() / s;
             (x, obj, Some(obj))
         } else {
-            let bound = relaxed.objective_value();
+            let bound = relaxed.objective_value() / s;
             // A primal heuristic's point, kept only if it meets every bound,
             // row and integrality exactly.
             let start = opts
@@ -400,8 +451,10 @@ impl Program {
                     let main = self.run_limited(false, what, &with_start)?;
                     let found = (
                         main.get_solution().columns().to_vec(),
-                        main.objective_value(),
-                        main.double_info_value(c"mip_dual_bound").ok(),
+                        main.objective_value() / s,
+                        main.double_info_value(c"mip_dual_bound")
+                            .ok()
+                            .map(|b| b / s),
                     );
                     match start {
                         Some((x0, obj)) if obj > found.1 => (x0, obj, found.2),

@@ -124,6 +124,12 @@ pub struct OptimizerSettings {
     /// its minimum): its default, 1e-6, lets a level choice overspend the
     /// budget by far more than the checker's relative 1e-9.
     pub mip_feasibility_tol: f64,
+    /// A program whose every cost is below this in magnitude (default
+    /// 2⁻¹⁰) goes to HiGHS with its objective multiplied by the power of
+    /// two that brings the largest cost into `[1, 2)` (HiGHS's dual
+    /// tolerance is an absolute 1e-7: small weights, which are relative,
+    /// would otherwise stop it early); its answers are divided back.
+    pub objective_scale_below: f64,
     /// Distance from an integer within which a relaxation's value counts as
     /// integral (default 1e-9; HiGHS's own `mip_feasibility_tolerance` is
     /// 1e-6).
@@ -181,6 +187,7 @@ impl OptimizerSettings {
         mip_heuristic_gap: 1e-3,
         mip_max_nodes_without_incumbent: 5000,
         mip_feasibility_tol: 1e-10,
+        objective_scale_below: 1.0 / 1024.0,
         relaxation_integrality_tol: 1e-9,
         global_tangents: 12,
         global_widen: 1e-9,
