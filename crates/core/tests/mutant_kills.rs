@@ -1,8 +1,7 @@
-//! Tests that pin two parts of the bound no other core test reached
+//! Tests that pin parts of the bound and the head no other core test reached
 //! (`specs/mutants.md`, "`eye_safety/bound/*.rs` (the split bound)" and
-//! "`eye_safety/head/*.rs`"): a window walk over more than `WALK_MAX_PIECES`
-//! envelope pieces inside one pass, and the multi-pass pass-count rule on a
-//! pass longer than half a frame. Each names the mutant it kills.
+//! "`eye_safety/head/*.rs`"). Each names the mutant it kills and works its
+//! expected value out by hand.
 
 use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
 use gaze_lidar_core::eye_safety::bound::{Seg, WALK_MAX_PIECES};
@@ -462,5 +461,67 @@ fn time_base_ratio_is_energy_over_the_ael() {
         "time base {} below {truth_lb} ({:?})",
         r.rule_ratios[3],
         r.rule_ratios
+    );
+}
+
+/// Kills `bound/whole_pass.rs` `Cells::full_pass`: `t_err / (hi - lo)` →
+/// `t_err / (hi / lo)` (the spread that widens a whole-pass energy
+/// interpolated at a Table 3 row edge for the error of the pass durations
+/// at the cell's cuts shrinks from `t_err/(hi − lo)` of the cell's energy
+/// change to about `t_err` of it).
+///
+/// The stated margin (`specs/eye_safety.md`, "Whole-pass windows"; the
+/// margin table of `bound/count.rs`): the durations at the cuts may be off
+/// by `t_err = 2·PRUNE_SLACK·T_f` (`PRUNE_SLACK` = 1e-12), so the azimuth
+/// where `τ` meets a row edge `t_e` is uncertain and the figure there must
+/// cover `E(t_e) + |dE/dτ|·t_err` over the AEL at `t_e`: the energy of
+/// every pass whose duration is within `t_err` of the edge.
+///
+/// By hand: 1450 nm, beam 1 mm (`2h` = 0.045571 rad), 10 kHz, power `p` on
+/// `[340°, 350°)` at `ω₁ = 2h/0.3` and on `[350°, 360°)` at `ω₂ = 2h/0.4`,
+/// dark on `[0°, 340°)` at `ω_d` such that `T_f` = 10⁵ s (`t_err` =
+/// 2·10⁻⁷ s). A pass straddling 350° lasts `τ` from 0.3 s to 0.4 s, affine
+/// in the azimuth, and holds `E = p·(τ + Δ)` (lit throughout): `dE/dτ = p`.
+/// It meets the 0.35 s edge at 350°, where the AEL is the smaller row,
+/// `4.4e-3·0.35^0.25` = 3.38431e-3 J (the `10⁻²·t` row beyond is 3.5e-3 J
+/// and falls in `E/τ`; the row before rises in `E/τ^0.25`): the pass-train
+/// figure binds there at `p·(0.35 + Δ + t_err)/3.38431e-3`. The mutant's
+/// spread covers `p·t_err·(hi − lo)·lo/hi` ≤ 0.1·`p·t_err`: its figure is
+/// about 5·10⁻⁷ (relative) lower, ten times what the ratio margin and the
+/// energy rounding pad add.
+#[test]
+fn whole_pass_figure_at_a_row_edge_covers_the_cut_error() {
+    use gaze_lidar_core::eye_safety::bound;
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let prm = params(1450.0, 1.0);
+    let (f_p, p) = (1e4, 1e-3);
+    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let (w1, w2) = (two_h / 0.3, two_h / 0.4);
+    let ten = 10f64.to_radians();
+    let frame_s = 1e5;
+    let w_d = 340f64.to_radians() / (frame_s - ten / w1 - ten / w2);
+    let segs = vec![
+        seg(0.0, 340.0, 0.0, w_d),
+        seg(340.0, 10.0, p, w1),
+        seg(350.0, 10.0, p, w2),
+    ];
+    let l = laser(&prm, f_p).unwrap();
+    let half_deg = 0.5 * pass_angle_deg(&prm, &l);
+    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-12);
+    let t_err = 2.0 * 1e-12 * frame_s;
+    let ael_edge = 4.4e-3 * 0.35f64.powf(0.25);
+    assert!((ael_edge / 3.38431e-3 - 1.0).abs() < 1e-5, "{ael_edge}");
+    let covered = p * (0.35 + 1.0 / f_p + t_err) / ael_edge;
+    let b = bound::evaluate(&segs, half_deg, &l);
+    assert!(
+        (b.rule_windows_s[0] - 0.35).abs() < 1e-12,
+        "{:?}",
+        b.rule_windows_s
+    );
+    assert!(
+        b.ratios[1] >= covered,
+        "pass train {} below {covered} ({:?})",
+        b.ratios[1],
+        b.ratios
     );
 }
