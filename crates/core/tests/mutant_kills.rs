@@ -525,3 +525,83 @@ fn whole_pass_figure_at_a_row_edge_covers_the_cut_error() {
         b.ratios
     );
 }
+
+/// Kills `bound/whole_pass.rs` `Cells::full_pass`: `tu + dt * w` →
+/// `tu + dt + w` and `tu + dt / w` (the duration of the whole pass where
+/// its energy reaches the cap `E⁺` lands at or beyond the cell's longer
+/// end, so the cap's kink, where `min(E, E⁺)/AEL(τ)` is largest, is
+/// evaluated at a longer window and a larger AEL).
+///
+/// By the definition (`specs/eye_safety.md`, "Whole-pass windows"): the
+/// figure is at least `min(E(φ), E⁺)/AEL_inf(τ(φ))` at every azimuth `φ`,
+/// with `E⁺` the bound's largest pulse energy of a pass (read back, and
+/// checked against the 20 pulses below). 1450 nm, beam 1 mm (`2h` =
+/// 0.045571 rad), 99.5 Hz (`Δ` = 10.05 ms): `2p` on `[0°, 10°)` at
+/// `ω_A = 2h/0.01`, `p` on `[10°, 350°)` at `ω_B = 2h/0.2`, dark on
+/// `[350°, 360°)` at `ω_A` (so that only the passes leaving the hot sector,
+/// whose cells run from the short to the long pass, reach `E⁺`; the passes
+/// entering it hold under `0.05·p`). A pass with a share `x` of its arc in
+/// the hot sector lasts `τ = 0.01x + 0.2(1 − x)`
+/// and its envelope holds `E = 2p(0.01x + Δ) + p·0.2(1 − x)` (the max
+/// filter keeps `2p` for `Δ` after the sector): `E` grows with `τ`, and so
+/// does `E/τ^0.25` (the `4.4e-3·t^0.25` row) until `E` reaches `E⁺`. For
+/// `x` just above 0 a clock phase puts one pulse in the hot sector and 19
+/// after it within `19Δ` = 0.190955 s: `E⁺ ≥ (2 + 19)·p·Δ`, below
+/// `E(0)` = 0.22010·`p`. With `E⁺` = 21·`p·Δ`, `E` reaches it at `x_c` =
+/// 0.0503, `τ_c` = 0.190452 s: the figure is at least `E⁺/(4.4e-3·τ_c^0.25)`.
+/// Those 20 pulses alone are a true exposure of `21·p·Δ` in a window of
+/// `19Δ`: the true worst ratio is at least `21·p·Δ/(4.4e-3·(19Δ)^0.25)`
+/// (1 − 6.6·10⁻⁴ of the kink's figure). The mutants evaluate the cap at
+/// `τ ≥ 0.2` s and report the longest pass's `E⁺/AEL(0.2 s)`, 1.2 % below
+/// the kink and below that true exposure (0.07173 against 0.07256 at
+/// `p` = 1 mW; applied by hand, both fail here).
+#[test]
+fn whole_pass_figure_takes_the_cap_s_kink() {
+    use gaze_lidar_core::eye_safety::bound;
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let prm = params(1450.0, 1.0);
+    let (f_p, p) = (99.5, 1e-3);
+    let delta = 1.0 / f_p;
+    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let (tau_a, tau_b) = (0.01, 0.2);
+    let segs = vec![
+        seg(0.0, 10.0, 2.0 * p, two_h / tau_a),
+        seg(10.0, 340.0, p, two_h / tau_b),
+        seg(350.0, 10.0, 0.0, two_h / tau_a),
+    ];
+    let l = laser(&prm, f_p).unwrap();
+    let half_deg = 0.5 * pass_angle_deg(&prm, &l);
+    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-12);
+    let b = bound::evaluate(&segs, half_deg, &l);
+    let e_cap = b.max_pass_energy_j;
+    let twenty = 21.0 * p * delta;
+    assert!((19.0 * delta - 0.190_955).abs() < 1e-6);
+    let e_env = |x: f64| 2.0 * p * (tau_a * x + delta) + p * tau_b * (1.0 - x);
+    assert!((e_env(0.0) / p - 0.220_10).abs() < 1e-5);
+    assert!(
+        e_cap >= twenty && e_cap < e_env(0.0),
+        "E⁺ {e_cap}, 20 pulses {twenty}, E(0) {}",
+        e_env(0.0)
+    );
+    // `E(x_c) = E⁺`, `E` affine in `x`.
+    let x_c = (e_env(0.0) - e_cap) / (e_env(0.0) - e_env(1.0));
+    let tau_c = tau_a * x_c + tau_b * (1.0 - x_c);
+    if e_cap == twenty {
+        assert!((x_c - 0.0503).abs() < 1e-4, "{x_c}");
+        assert!((tau_c - 0.190_452).abs() < 1e-6, "{tau_c}");
+    }
+    let truth_lb = twenty / (4.4e-3 * (19.0 * delta).powf(0.25));
+    assert!(
+        b.ratios[1] >= truth_lb,
+        "pass train {} below 20 pulses in 19Δ: {truth_lb}",
+        b.ratios[1]
+    );
+    let kink = e_cap / (4.4e-3 * tau_c.powf(0.25));
+    assert!(
+        b.ratios[1] >= kink,
+        "pass train {} below {kink} at {tau_c} s ({:?}, {:?})",
+        b.ratios[1],
+        b.ratios,
+        b.rule_windows_s
+    );
+}
