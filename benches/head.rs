@@ -13,6 +13,11 @@
 //! `benches/check.rs`. To compare two versions of the code, build this
 //! bench at each and run the two binaries in turn on the same machine (see
 //! `specs/eye_safety.md`, "Performance").
+//!
+//! `GAZE_LIDAR_HEAD_BENCH_ONLY=PRESET/WHICH` (`WHICH` = `head` or `one`, e.g.
+//! `vls128/head`) times that one evaluation alone and skips the rest: for an
+//! instruction count under a profiler (`valgrind --tool=callgrind
+//! --toggle-collect='head::percentiles*'`).
 
 #[path = "common/big_profile.rs"]
 mod big_profile;
@@ -204,8 +209,34 @@ fn single_channel_targets(n: usize) {
     }
 }
 
+/// `GAZE_LIDAR_HEAD_BENCH_ONLY`, split: the preset and which evaluation.
+fn only() -> Option<(String, String)> {
+    let v = std::env::var("GAZE_LIDAR_HEAD_BENCH_ONLY").ok()?;
+    let (name, which) = v.split_once('/').expect("PRESET/WHICH");
+    assert!(which == "head" || which == "one", "WHICH is head or one");
+    Some((name.to_owned(), which.to_owned()))
+}
+
 fn bench(c: &mut Criterion) {
     let (n, criterion) = samples();
+    if let Some((name, which)) = only() {
+        let p = preset(&name).unwrap();
+        let f_p = p.lidar.pulse_rate_hz;
+        let mut params = p.lidar.limits.eye_safety.clone().unwrap();
+        if which == "one" {
+            params.head = None;
+        }
+        let (segs, _) = certified(&params, f_p);
+        let [p50, p99, _, _] = percentiles(n, || {
+            black_box(evaluate_segments(black_box(&segs), &params, f_p).unwrap());
+        });
+        println!(
+            "{name}/{which} ({n} runs): CPU p50 {:.1} µs p99 {:.1} µs",
+            p50 * 1e6,
+            p99 * 1e6
+        );
+        return;
+    }
     single_channel_targets(n);
     let mut g = c.benchmark_group("head");
     for name in ["vls128", "os1-128", "vlp16"] {

@@ -382,8 +382,13 @@ impl<'a, B: BinMotion> Timeline<'a, B> {
         self.time_at_located(self.locate_unwrapped_from(theta_deg, hint))
     }
 
+    /// The unwrapped time at an azimuth located by
+    /// [`Self::locate_unwrapped`] (or [`Self::locate_unwrapped_from`]):
+    /// `time_at_located(locate_unwrapped(θ))` is
+    /// [`Self::time_at_unwrapped_s`]`(θ)`, for a caller that needs both.
     #[inline]
-    fn time_at_located(&self, (k, i, x_deg): (f64, usize, f64)) -> f64 {
+    #[must_use]
+    pub fn time_at_located(&self, (k, i, x_deg): (f64, usize, f64)) -> f64 {
         let b = &self.bins[i];
         k * self.period_s()
             + self.cum_time_s[i]

@@ -215,6 +215,7 @@ impl<'a> Cells<'a> {
         // point too), so a value between two arguments of one count has it.
         let mut window = SlidingMax::new();
         let (mut h4, mut h5, mut h6, mut h7) = (0usize, 0usize, 0usize, 0usize);
+        let (mut h8, mut h9) = (0usize, 0usize);
         let mut per_pass_of = StepMemo::default();
         let mut passes_of = StepMemo::default();
         let mut rows = Vec::with_capacity(m);
@@ -260,8 +261,12 @@ impl<'a> Cells<'a> {
                 // breakpoints of one edge can sample the neighbouring pieces
                 // and miss the inside's (found by `cell_figures_bound_a_dense_scan`:
                 // a bound 1.9 % under the scanned energy).
-                let pr_mid = env.power_at(tl.time_at_unwrapped_s(mid + h) + delta);
-                let pl_mid = env.power_at(tl.time_at_unwrapped_s(mid - h));
+                // (`time_at_located` of the bins located above is
+                // `time_at_unwrapped_s(mid ± h)`, and `locate_from` finds
+                // the piece `power_at` finds: the same values.)
+                let (t_r, t_l) = (tl.time_at_located(right) + delta, tl.time_at_located(left));
+                let pr_mid = env.p_w[env.locate_from(t_r, &mut h8).2];
+                let pl_mid = env.p_w[env.locate_from(t_l, &mut h9).2];
                 let ((pl_u, pr_u), (pl_v, pr_v)) = (edge_p[c], edge_p[c + 1]);
                 let (pr_min, pr_max) = (pr_u.min(pr_v).min(pr_mid), pr_u.max(pr_v).max(pr_mid));
                 let (pl_min, pl_max) = (pl_u.min(pl_v).min(pl_mid), pl_u.max(pl_v).max(pl_mid));

@@ -15,6 +15,7 @@
 //! | [`COUNT_MARGIN`] | 1e-9 | relative and absolute, on `x` | every floor count `⌊x(1 + m) + m⌋` | a count on an integer (`T2·f = 200`) is the larger one; input noise of 1e-12 cannot lower it |
 //! | [`RATIO_MARGIN`] | 1e-9 | relative, on every ratio | `bound::evaluate`, last step | the float rounding of the bound's sums and of merged widths ([`coalesce`](super::seg)) |
 //! | [`PRUNE_SLACK`] | 1e-12 | relative, of a turn's time or envelope energy | curved cells' bounds, whole-pass interpolations (`2·`), the pruning thresholds (`1 + s`) | the few ulps by which two evaluations of one difference of cumulative totals may differ |
+//! | [`AEL_LB_SLACK`] | 1e-9 | relative, down, on an AEL infimum | a window walk's lower bound of the AEL of its longer windows (a piece is skipped only if its energy over that bound is below the best) | the few ulps by which two evaluations of the infimum at increasing lengths may fail to increase |
 //! | [`REACH_SLACK`] | 1e-9 | relative, of a turn's time | each walk's reach | the float inversions of the head's motion (time at an azimuth and back) |
 //! | [`TOUCH_SNAP_DEG`] | 1e-9 | deg | the arc a cell's pulses come from (Rule 1, pulse caps) | the rounding of the cuts (an ulp of 360° is 5.7e-14°) |
 //! | [`TIME_ROUNDING`] | 64·ε (ε = 2⁻⁵² = 2u) | of the frame period `T_f`, absolute, on every duration | every pulse count of a pass or of a bin's share of it (`Cells`, pulse caps), as `⌊(τ + time_rounding_s)·f⌋ + 1`; the multi-pass rules' `τ`; every within-pass window (walks, whole passes) takes the AEL of a window `time_rounding_s` shorter | the rounding of a time *from 0°*: see "Times from 0°" below |
@@ -111,6 +112,12 @@ pub const RATIO_MARGIN: f64 = 1e-9;
 /// above the exact evaluation's rounding (a few units in the last place of
 /// those totals).
 pub(super) const PRUNE_SLACK: f64 = 1e-12;
+
+/// Relative slack by which a window walk lowers the AEL infimum it kept
+/// before it uses it as a lower bound for longer windows: the infimum over
+/// `[t, one_pass_s]` is nondecreasing in `t`, and two float evaluations of
+/// it (Table 3's powers, a few ulps each) can only break that by a few ulps.
+pub(super) const AEL_LB_SLACK: f64 = 1e-9;
 
 /// Relative slack (of a turn's time) by which a walk's reach is widened, so
 /// the float inversions of the head's motion stay above the exact reach.

@@ -33,6 +33,12 @@ pub(super) struct AelEnds {
 }
 
 impl AelEnds {
+    /// The kept AEL infimum of the longer window length (the `t1` of the
+    /// last [`Laser::linear_capped_max_memo`] call), if any.
+    pub(super) fn at_longest(&self) -> Option<f64> {
+        self.ends[1].map(|(_, ael_j)| ael_j)
+    }
+
     /// `laser.ael_inf_j(t_s, one_pass_s)`, looked up if kept.
     fn get(&self, laser: &Laser, t_s: f64, one_pass_s: f64) -> f64 {
         if self.one_pass_bits == one_pass_s.to_bits() {

@@ -29,7 +29,10 @@ impl Cells<'_> {
         let segs = tl.bins();
         let n = segs.len() as i64;
         let (lo_deg, hi_deg) = (u - self.h - TOUCH_SNAP_DEG, v + self.h + TOUCH_SNAP_DEG);
-        let mut hint = 0;
+        // From the last bin: a binary search for the first end (a forward
+        // search from bin 0 would step through every bin before it), then
+        // forward to the second; the same bins either way.
+        let mut hint = usize::MAX;
         let lo = unwrapped_bin(tl, lo_deg, &mut hint);
         let hi = unwrapped_bin(tl, hi_deg, &mut hint).max(lo);
         if hi - lo + 1 > PULSE_CAP_MAX_BINS {

@@ -7,6 +7,8 @@
 use super::cells::{CellRow, Cells};
 use super::Search;
 use crate::model::angle::wrap_deg;
+use core::cmp::Ordering;
+use std::collections::BinaryHeap;
 
 /// The maxima over cells: Rule 1 (ratio, azimuth), pass energy
 /// (J, azimuth), envelope integral over a pass (J), pass duration (s).
@@ -203,9 +205,14 @@ fn first_max_sorted(
     let top = (0..len).max_by(|&a, &b| ub(a).total_cmp(&ub(b)).then(b.cmp(&a)))?;
     let mut best = (exact(top), top);
     let beats = |x: f64, c: usize, best: (f64, usize)| x > best.0 || (x == best.0 && c < best.1);
-    let mut order: Vec<usize> = (0..len).filter(|&c| beats(ub(c), c, best)).collect();
-    order.sort_unstable_by(|&a, &b| ub(b).total_cmp(&ub(a)).then(a.cmp(&b)));
-    for c in order {
+    // The candidates in decreasing order of their bound (ties by index: a
+    // strict total order, so a heap pops them in exactly the order a full
+    // sort gives), popped only as far as the search goes.
+    let mut order: BinaryHeap<ByBound> = (0..len)
+        .filter(|&c| beats(ub(c), c, best))
+        .map(|c| ByBound(ub(c), c))
+        .collect();
+    while let Some(ByBound(_, c)) = order.pop() {
         if !beats(ub(c), c, best) {
             break;
         }
@@ -218,6 +225,31 @@ fn first_max_sorted(
         }
     }
     (best.0 > 0.0).then_some(best)
+}
+
+/// A cell and its bound, ordered by the bound (`total_cmp`), then by the
+/// smaller index: the max-heap of [`first_max_sorted`] pops the largest
+/// bound first and, among equal bounds, the first cell.
+struct ByBound(f64, usize);
+
+impl PartialEq for ByBound {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for ByBound {}
+
+impl PartialOrd for ByBound {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for ByBound {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.0.total_cmp(&other.0).then(other.1.cmp(&self.1))
+    }
 }
 
 /// The best (ratio, window duration) seen: larger ratio, ties to the

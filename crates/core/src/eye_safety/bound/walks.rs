@@ -2,7 +2,7 @@
 //! (`specs/eye_safety.md`, "Walks"), each followed piece by piece up to its
 //! reach, in decreasing order of their bound when pruned.
 
-use super::count::{time_rounding_s, PRUNE_SLACK, REACH_SLACK};
+use super::count::{time_rounding_s, AEL_LB_SLACK, PRUNE_SLACK, REACH_SLACK};
 use super::envelope::Envelope;
 use super::laser::{AelEnds, Laser};
 use super::search::Best;
@@ -192,6 +192,9 @@ impl Walks<'_> {
         let (mut e, mut l, mut idx) = (0.0f64, 0.0f64, w.start);
         // Consecutive pieces share a window length: its AEL is kept.
         let mut ends = AelEnds::default();
+        // A lower bound of `AEL_inf` of every window length from the last
+        // evaluated piece's end on (0: none yet), see below.
+        let mut ael_lb = 0.0f64;
         for _ in 0..WALK_MAX_PIECES {
             let (next_idx, piece_p) = if w.dir > 0 {
                 (idx + 1, env.p_of(idx))
@@ -202,15 +205,32 @@ impl Walks<'_> {
             if seg_end > delta {
                 let l0 = l.max(delta);
                 let e0 = e + piece_p * (l0 - l);
-                best.take(laser.linear_capped_max_memo(
-                    l0 - delta - pad,
-                    seg_end - delta - pad,
-                    e0,
-                    piece_p,
-                    e_pass,
-                    self.one_pass_s,
-                    &mut ends,
-                ));
+                let (t0, t1) = (l0 - delta - pad, seg_end - delta - pad);
+                // Skipped when it cannot raise `best`: the piece's energy is
+                // at most its value at `t1` (the same expression
+                // `linear_capped_max_memo` evaluates, nondecreasing in `t`),
+                // and every AEL it would divide by is at least `ael_lb`
+                // (the infimum over `[t, one_pass_s]` grows with `t` up to
+                // `one_pass_s`, and window lengths grow along the walk; past
+                // `one_pass_s` it is Table 3 at `t` alone, which steps down,
+                // so such pieces are never skipped). Strictly below: the
+                // piece's ratios are all below `best`, which keeps it.
+                let e1 = (e0 + piece_p * (t1 - t0)).min(e_pass);
+                let skip = ael_lb > 0.0 && t1 <= self.one_pass_s && e1 / ael_lb < best.0;
+                if !skip {
+                    best.take(laser.linear_capped_max_memo(
+                        t0,
+                        t1,
+                        e0,
+                        piece_p,
+                        e_pass,
+                        self.one_pass_s,
+                        &mut ends,
+                    ));
+                    if let Some(a) = ends.at_longest() {
+                        ael_lb = a / (1.0 + AEL_LB_SLACK);
+                    }
+                }
             }
             e += piece_p * (seg_end - l);
             l = seg_end;

@@ -297,19 +297,10 @@ pub fn head_figures(
     let t_g = group_window_s(laser);
     let o = head_overlaps(head, laser.band.aperture_mm(), t_g);
     let r = head.aperture_distance_mm;
-    let circ = core::f64::consts::TAU * r;
     let smear = r * spin_max_rad_s * t_g * (1.0 + overlap::SUM_MARGIN);
-    let (g, spans) = overlap::group(&o.fps, &o.scales, &o.slots, head.cycle_s, t_g, smear, circ);
+    let (g, spans) = o.group_plan.max(smear);
     let turn_per_pulse = r * spin_max_rad_s * head.cycle_s * (1.0 + overlap::SUM_MARGIN);
-    let (inst, _) = overlap::group(
-        &o.fps,
-        &o.scales,
-        &o.zeros,
-        head.cycle_s,
-        0.0,
-        turn_per_pulse,
-        circ,
-    );
+    let (inst, _) = o.instant_plan.max(turn_per_pulse);
     let (v, sim, disc) = (o.vertical, o.simultaneous, o.stalled);
     let (g0, spans0) = o.stalled_group;
     Ok(HeadFigures {
@@ -347,11 +338,11 @@ pub fn head_figures(
 /// enumeration that does not depend on the spin.
 #[derive(Debug)]
 pub struct HeadOverlaps {
-    fps: Vec<Footprint>,
-    scales: Vec<f64>,
-    slots: Vec<f64>,
-    /// One slot for every channel (pulses of any time at one instant).
-    zeros: Vec<f64>,
+    /// `W_g`'s enumeration (the pulses within the grouping window) but the
+    /// smear, which grows with the spin.
+    group_plan: overlap::GroupPlan,
+    /// `W_inst`'s (every channel at one slot, window 0) but the smear.
+    instant_plan: overlap::GroupPlan,
     /// `W_v`, `K_v` and the worst height.
     vertical: overlap::Meet,
     slots_vertical: u32,
@@ -383,8 +374,10 @@ impl HeadOverlaps {
         let t_g = group_window_s;
         let vertical = overlap::vertical(&fps, &scales);
         let (simultaneous, _) = overlap::group(&fps, &scales, &slots, head.cycle_s, 0.0, 0.0, circ);
-        let (stalled, _) = overlap::group(&fps, &scales, &zeros, head.cycle_s, 0.0, 0.0, circ);
-        let stalled_group = overlap::group(&fps, &scales, &slots, head.cycle_s, t_g, 0.0, circ);
+        let group_plan = overlap::GroupPlan::new(&fps, &scales, &slots, head.cycle_s, t_g, circ);
+        let instant_plan = overlap::GroupPlan::new(&fps, &scales, &zeros, head.cycle_s, 0.0, circ);
+        let (stalled, _) = instant_plan.max(0.0);
+        let stalled_group = group_plan.max(0.0);
         let fold = |f: fn(&Footprint) -> f64| fps.iter().map(f).fold(0.0, f64::max);
         let pass_angle_deg = fold(|f| f.pass_angle_deg);
         Self {
@@ -398,10 +391,8 @@ impl HeadOverlaps {
             footprint_max_mm: fold(|f| f.width_mm),
             pass_angle_deg,
             power_scale_max: scales.iter().copied().fold(0.0, f64::max),
-            fps,
-            scales,
-            slots,
-            zeros,
+            group_plan,
+            instant_plan,
             vertical,
             simultaneous,
             stalled,

@@ -146,15 +146,44 @@ pub fn pulses_in(slot_s: f64, t0_s: f64, window_s: f64, cycle_s: f64) -> u32 {
     (more as u32).saturating_add(1)
 }
 
+/// Boxes: `(x_lo, x_hi, z_lo, z_hi, weight)`.
+type Box5 = (f64, f64, f64, f64, f64);
+
+/// The boxes' distinct left ends, sorted, and every box's height ends,
+/// sorted (stably: pushed in box order, lower end first), as
+/// [`boxes_max_sorted`] takes them.
+fn sorted_ends(boxes: &[Box5]) -> (Vec<f64>, Vec<(f64, bool, usize)>) {
+    let mut xs: Vec<f64> = boxes.iter().map(|b| b.0).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    let mut all_ends: Vec<(f64, bool, usize)> = Vec::with_capacity(2 * boxes.len());
+    for (i, b) in boxes.iter().enumerate() {
+        all_ends.push((b.2, false, i));
+        all_ends.push((b.3, true, i));
+    }
+    all_ends.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    (xs, all_ends)
+}
+
+/// The most weight of boxes sharing a point ([`boxes_max_sorted`] with
+/// the boxes' own [`sorted_ends`]).
+#[cfg(test)]
+fn boxes_max(boxes: &[Box5]) -> Meet {
+    let (xs, all_ends) = sorted_ends(boxes);
+    boxes_max_sorted(boxes, &xs, &all_ends)
+}
+
 /// Boxes: `(x_lo, x_hi, z_lo, z_hi, weight)`; the most weight sharing a
 /// point, exactly (candidate points: every box's left end × lower end; at
 /// each left end a sweep over the active boxes' height ends, lower ends
 /// first at a tie, so touching boxes meet; a left end whose active boxes
 /// all reach the next left end is skipped, its set being a subset of the
-/// next one's). The sweep's running sum adds
-/// and subtracts: its rounding error is at most `2·m·ε·Σ w` for `m` ends,
-/// added to the result when there is more than one box.
-fn boxes_max(boxes: &[(f64, f64, f64, f64, f64)]) -> Meet {
+/// next one's). `xs` and `all_ends` are the boxes' [`sorted_ends`]: they
+/// depend on the left and height ends only, not on the right ends. The
+/// sweep's running sum adds and subtracts: its rounding error is at most
+/// `2·m·ε·Σ w` for `m` ends, added to the result when there is more than
+/// one box.
+fn boxes_max_sorted(boxes: &[Box5], xs: &[f64], all_ends: &[(f64, bool, usize)]) -> Meet {
     let mut best = Meet {
         weight: 0.0,
         count: 0,
@@ -162,20 +191,10 @@ fn boxes_max(boxes: &[(f64, f64, f64, f64, f64)]) -> Meet {
         height_mm: 0.0,
         arc_mm: 0.0,
     };
-    let mut xs: Vec<f64> = boxes.iter().map(|b| b.0).collect();
-    xs.sort_by(f64::total_cmp);
-    xs.dedup();
-    // Every box's height ends, sorted once (stably: pushed in box order,
-    // lower end first): the ends of the boxes active at one left end, in
-    // this order, are exactly the stable sort of those boxes' ends alone,
-    // so the sweep below adds and subtracts in the same order (the same
-    // bits) as sorting each active set on its own.
-    let mut all_ends: Vec<(f64, bool, usize)> = Vec::with_capacity(2 * boxes.len());
-    for (i, b) in boxes.iter().enumerate() {
-        all_ends.push((b.2, false, i));
-        all_ends.push((b.3, true, i));
-    }
-    all_ends.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    // Every box's height ends sorted once: the ends of the boxes active at
+    // one left end, in this order, are exactly the stable sort of those
+    // boxes' ends alone, so the sweep below adds and subtracts in the same
+    // order (the same bits) as sorting each active set on its own.
     let mut is_active = vec![false; boxes.len()];
     let mut err = 0.0f64;
     for (k, &x) in xs.iter().enumerate() {
@@ -198,7 +217,7 @@ fn boxes_max(boxes: &[(f64, f64, f64, f64, f64)]) -> Meet {
         }
         err = err.max(2.0 * n_ends as f64 * f64::EPSILON * total);
         let (mut w, mut n) = (0.0f64, 0u32);
-        for &(z, close, i) in &all_ends {
+        for &(z, close, i) in all_ends {
             if !is_active[i] {
                 continue;
             }
@@ -244,67 +263,129 @@ pub fn group(
     smear_mm: f64,
     circumference_mm: f64,
 ) -> (Meet, bool) {
-    let mut starts: Vec<f64> = slots_s.to_vec();
-    starts.sort_by(f64::total_cmp);
-    starts.dedup();
-    let wraps = smear_mm >= 0.5 * circumference_mm;
-    let mut best = Meet {
-        weight: 0.0,
-        count: 0,
-        count_at_worst: 0,
-        height_mm: 0.0,
-        arc_mm: 0.0,
-    };
-    let mut multi_time = false;
-    let mut boxes = Vec::with_capacity(fps.len());
-    let mut slot_of = Vec::with_capacity(fps.len());
-    for &t0 in &starts {
-        boxes.clear();
-        slot_of.clear();
-        for (i, f) in fps.iter().enumerate() {
-            let k = pulses_in(slots_s[i], t0, window_s, cycle_s);
-            if k == 0 {
+    GroupPlan::new(fps, weights, slots_s, cycle_s, window_s, circumference_mm).max(smear_mm)
+}
+
+/// [`group`] for one head, window and aperture circle with everything that
+/// does not depend on the smear done once: per window start (a distinct
+/// slot) the channels firing in the window, their boxes but the smeared
+/// right end, and the boxes' sorted left and height ends (neither depends
+/// on the smear; boxes that wrap the circle have one left end, −∞).
+/// [`Self::max`] at a smear is [`group`] at it, the same bits.
+#[derive(Debug, Clone)]
+pub struct GroupPlan {
+    circumference_mm: f64,
+    starts: Vec<StartPlan>,
+}
+
+/// One window start of a [`GroupPlan`].
+#[derive(Debug, Clone)]
+struct StartPlan {
+    /// `(x_lo, x + half_arc, z_lo, z_hi, weight)` per channel firing in the
+    /// window: the right end before the smear and the touch widening.
+    boxes: Vec<Box5>,
+    /// `(slot, pulses in the window)` per box.
+    slot_of: Vec<(f64, u32)>,
+    /// The boxes' [`sorted_ends`] (not wrapped).
+    xs: Vec<f64>,
+    all_ends: Vec<(f64, bool, usize)>,
+}
+
+impl GroupPlan {
+    /// The plan of [`group`] for these arguments (all but the smear).
+    #[must_use]
+    pub fn new(
+        fps: &[Footprint],
+        weights: &[f64],
+        slots_s: &[f64],
+        cycle_s: f64,
+        window_s: f64,
+        circumference_mm: f64,
+    ) -> Self {
+        let mut t0s: Vec<f64> = slots_s.to_vec();
+        t0s.sort_by(f64::total_cmp);
+        t0s.dedup();
+        let mut starts = Vec::with_capacity(t0s.len());
+        for &t0 in &t0s {
+            let mut boxes = Vec::with_capacity(fps.len());
+            let mut slot_of = Vec::with_capacity(fps.len());
+            for (i, f) in fps.iter().enumerate() {
+                let k = pulses_in(slots_s[i], t0, window_s, cycle_s);
+                if k == 0 {
+                    continue;
+                }
+                let x = f.psi_rad * (circumference_mm / core::f64::consts::TAU);
+                boxes.push((
+                    x - f.half_arc_mm - TOUCH_MM,
+                    x + f.half_arc_mm,
+                    f.z_mm - f.half_height_mm - TOUCH_MM,
+                    f.z_mm + f.half_height_mm + TOUCH_MM,
+                    weights[i] * f64::from(k),
+                ));
+                slot_of.push((slots_s[i], k));
+            }
+            if boxes.is_empty() {
                 continue;
             }
-            let x = f.psi_rad * (circumference_mm / core::f64::consts::TAU);
-            let (x_lo, x_hi) = if wraps {
-                (f64::NEG_INFINITY, f64::INFINITY)
-            } else {
-                (
-                    x - f.half_arc_mm - TOUCH_MM,
-                    x + f.half_arc_mm + smear_mm + TOUCH_MM,
-                )
-            };
-            boxes.push((
-                x_lo,
-                x_hi,
-                f.z_mm - f.half_height_mm - TOUCH_MM,
-                f.z_mm + f.half_height_mm + TOUCH_MM,
-                weights[i] * f64::from(k),
-            ));
-            slot_of.push((slots_s[i], k));
+            let (xs, all_ends) = sorted_ends(&boxes);
+            starts.push(StartPlan {
+                boxes,
+                slot_of,
+                xs,
+                all_ends,
+            });
         }
-        if boxes.is_empty() {
-            continue;
-        }
-        let m = boxes_max(&boxes);
-        if !multi_time {
-            multi_time = multi_time_overlap(&boxes, &slot_of);
-        }
-        best.count = best.count.max(m.count);
-        if m.weight > best.weight {
-            best = Meet {
-                count: best.count,
-                ..m
-            };
+        Self {
+            circumference_mm,
+            starts,
         }
     }
-    (best, multi_time)
+
+    /// [`group`] with the boxes widened along the arc by `smear_mm`.
+    #[must_use]
+    pub fn max(&self, smear_mm: f64) -> (Meet, bool) {
+        let wraps = smear_mm >= 0.5 * self.circumference_mm;
+        let mut best = Meet {
+            weight: 0.0,
+            count: 0,
+            count_at_worst: 0,
+            height_mm: 0.0,
+            arc_mm: 0.0,
+        };
+        let mut multi_time = false;
+        let mut boxes = Vec::new();
+        for sp in &self.starts {
+            boxes.clear();
+            boxes.extend(sp.boxes.iter().map(|&(x_lo, x_hi, z_lo, z_hi, w)| {
+                if wraps {
+                    (f64::NEG_INFINITY, f64::INFINITY, z_lo, z_hi, w)
+                } else {
+                    (x_lo, x_hi + smear_mm + TOUCH_MM, z_lo, z_hi, w)
+                }
+            }));
+            let m = if wraps {
+                boxes_max_sorted(&boxes, &[f64::NEG_INFINITY], &sp.all_ends)
+            } else {
+                boxes_max_sorted(&boxes, &sp.xs, &sp.all_ends)
+            };
+            if !multi_time {
+                multi_time = multi_time_overlap(&boxes, &sp.slot_of);
+            }
+            best.count = best.count.max(m.count);
+            if m.weight > best.weight {
+                best = Meet {
+                    count: best.count,
+                    ..m
+                };
+            }
+        }
+        (best, multi_time)
+    }
 }
 
 /// Whether two boxes of pulses fired at different times share a point, or a
 /// box holds two pulses (a channel firing twice in the window).
-fn multi_time_overlap(boxes: &[(f64, f64, f64, f64, f64)], slot_of: &[(f64, u32)]) -> bool {
+fn multi_time_overlap(boxes: &[Box5], slot_of: &[(f64, u32)]) -> bool {
     if slot_of.iter().any(|&(_, k)| k > 1) {
         return true;
     }
