@@ -605,3 +605,39 @@ fn whole_pass_figure_takes_the_cap_s_kink() {
         b.rule_windows_s
     );
 }
+
+/// Kills `head/overlap.rs` `vertical`: the interval's upper end
+/// `z + h + TOUCH_MM` → `z + h − TOUCH_MM` (two channels whose height
+/// intervals miss by less than `2·TOUCH_MM` no longer meet one aperture
+/// height, so `W_v`, the weight every energy rule of the head multiplies,
+/// can fall to one channel's).
+///
+/// The stated widening (`overlap::TOUCH_MM`, 1e-9 mm): every interval end
+/// moves out by it, so positions that touch in exact arithmetic but miss by
+/// a rounding error still meet; two intervals `2·TOUCH_MM` or less apart
+/// meet. By hand: `[−5, 5]` and `[5 + 1.5e-9, 15 + 1.5e-9]` (half-height
+/// 5 mm): 1.5e-9 mm apart, so both channels count (weight `2·(1 + 1e-12)`);
+/// 3e-9 mm apart, only one does.
+#[test]
+fn vertical_overlap_meets_within_the_touch_widening() {
+    use gaze_lidar_core::eye_safety::head::geometry::Footprint;
+    use gaze_lidar_core::eye_safety::head::overlap::{vertical, SUM_MARGIN, TOUCH_MM};
+    assert_eq!(TOUCH_MM, 1e-9);
+    let fp = |z_mm: f64| Footprint {
+        index: 0,
+        psi_rad: 0.0,
+        z_mm,
+        slant_mm: 100.0,
+        width_mm: 3.0,
+        cos_beta: 1.0,
+        half_arc_mm: 5.0,
+        half_height_mm: 5.0,
+        pass_angle_deg: 0.1f64.to_degrees(),
+    };
+    let m = vertical(&[fp(0.0), fp(10.0 + 1.5e-9)], &[1.0, 1.0]);
+    assert_eq!(m.count, 2, "{m:?}");
+    assert_eq!(m.weight, 2.0 * (1.0 + SUM_MARGIN), "{m:?}");
+    let m = vertical(&[fp(0.0), fp(10.0 + 3e-9)], &[1.0, 1.0]);
+    assert_eq!(m.count, 1, "{m:?}");
+    assert_eq!(m.weight, 1.0, "{m:?}");
+}
