@@ -606,22 +606,25 @@ fn whole_pass_figure_takes_the_cap_s_kink() {
     );
 }
 
-/// Kills `head/overlap.rs` `vertical`: the interval's upper end
-/// `z + h + TOUCH_MM` → `z + h − TOUCH_MM` (two channels whose height
+/// Kills `head/overlap.rs` `vertical` and `vertical_slots`: the interval's
+/// upper end `z + h + TOUCH_MM` → `z + h − TOUCH_MM` (two channels whose height
 /// intervals miss by less than `2·TOUCH_MM` no longer meet one aperture
 /// height, so `W_v`, the weight every energy rule of the head multiplies,
-/// can fall to one channel's).
+/// can fall to one channel's, and `S_v`, which bounds the head's pulse
+/// count for C5, to one slot: a smaller count is a larger C5).
 ///
 /// The stated widening (`overlap::TOUCH_MM`, 1e-9 mm): every interval end
 /// moves out by it, so positions that touch in exact arithmetic but miss by
 /// a rounding error still meet; two intervals `2·TOUCH_MM` or less apart
 /// meet. By hand: `[−5, 5]` and `[5 + 1.5e-9, 15 + 1.5e-9]` (half-height
 /// 5 mm): 1.5e-9 mm apart, so both channels count (weight `2·(1 + 1e-12)`);
-/// 3e-9 mm apart, only one does.
+/// 3e-9 mm apart, only one does. The same for two distinct slots.
 #[test]
 fn vertical_overlap_meets_within_the_touch_widening() {
     use gaze_lidar_core::eye_safety::head::geometry::Footprint;
-    use gaze_lidar_core::eye_safety::head::overlap::{vertical, SUM_MARGIN, TOUCH_MM};
+    use gaze_lidar_core::eye_safety::head::overlap::{
+        vertical, vertical_slots, SUM_MARGIN, TOUCH_MM,
+    };
     assert_eq!(TOUCH_MM, 1e-9);
     let fp = |z_mm: f64| Footprint {
         index: 0,
@@ -640,4 +643,11 @@ fn vertical_overlap_meets_within_the_touch_widening() {
     let m = vertical(&[fp(0.0), fp(10.0 + 3e-9)], &[1.0, 1.0]);
     assert_eq!(m.count, 1, "{m:?}");
     assert_eq!(m.weight, 1.0, "{m:?}");
+    // `S_v`, the distinct firing slots meeting one height (the head's pulse
+    // count for C5), with the same widening.
+    assert_eq!(
+        vertical_slots(&[fp(0.0), fp(10.0 + 1.5e-9)], &[0.0, 1e-5]),
+        2
+    );
+    assert_eq!(vertical_slots(&[fp(0.0), fp(10.0 + 3e-9)], &[0.0, 1e-5]), 1);
 }
