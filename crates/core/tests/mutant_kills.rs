@@ -1,8 +1,7 @@
-//! Tests that pin two parts of the bound no other core test reached
+//! Tests that pin parts of the bound and the head no other core test reached
 //! (`specs/mutants.md`, "`eye_safety/bound/*.rs` (the split bound)" and
-//! "`eye_safety/head/*.rs`"): a window walk over more than `WALK_MAX_PIECES`
-//! envelope pieces inside one pass, and the multi-pass pass-count rule on a
-//! pass longer than half a frame. Each names the mutant it kills.
+//! "`eye_safety/head/*.rs`"). Each names the mutant it kills and works its
+//! expected value out by hand.
 
 use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
 use gaze_lidar_core::eye_safety::bound::{Seg, WALK_MAX_PIECES};
@@ -463,4 +462,192 @@ fn time_base_ratio_is_energy_over_the_ael() {
         r.rule_ratios[3],
         r.rule_ratios
     );
+}
+
+/// Kills `bound/whole_pass.rs` `Cells::full_pass`: `t_err / (hi - lo)` →
+/// `t_err / (hi / lo)` (the spread that widens a whole-pass energy
+/// interpolated at a Table 3 row edge for the error of the pass durations
+/// at the cell's cuts shrinks from `t_err/(hi − lo)` of the cell's energy
+/// change to about `t_err` of it).
+///
+/// The stated margin (`specs/eye_safety.md`, "Whole-pass windows"; the
+/// margin table of `bound/count.rs`): the durations at the cuts may be off
+/// by `t_err = 2·PRUNE_SLACK·T_f` (`PRUNE_SLACK` = 1e-12), so the azimuth
+/// where `τ` meets a row edge `t_e` is uncertain and the figure there must
+/// cover `E(t_e) + |dE/dτ|·t_err` over the AEL at `t_e`: the energy of
+/// every pass whose duration is within `t_err` of the edge.
+///
+/// By hand: 1450 nm, beam 1 mm (`2h` = 0.045571 rad), 10 kHz, power `p` on
+/// `[340°, 350°)` at `ω₁ = 2h/0.3` and on `[350°, 360°)` at `ω₂ = 2h/0.4`,
+/// dark on `[0°, 340°)` at `ω_d` such that `T_f` = 10⁵ s (`t_err` =
+/// 2·10⁻⁷ s). A pass straddling 350° lasts `τ` from 0.3 s to 0.4 s, affine
+/// in the azimuth, and holds `E = p·(τ + Δ)` (lit throughout): `dE/dτ = p`.
+/// It meets the 0.35 s edge at 350°, where the AEL is the smaller row,
+/// `4.4e-3·0.35^0.25` = 3.38431e-3 J (the `10⁻²·t` row beyond is 3.5e-3 J
+/// and falls in `E/τ`; the row before rises in `E/τ^0.25`): the pass-train
+/// figure binds there at `p·(0.35 + Δ + t_err)/3.38431e-3`. The mutant's
+/// spread covers `p·t_err·(hi − lo)·lo/hi` ≤ 0.1·`p·t_err`: its figure is
+/// about 5·10⁻⁷ (relative) lower, ten times what the ratio margin and the
+/// energy rounding pad add.
+#[test]
+fn whole_pass_figure_at_a_row_edge_covers_the_cut_error() {
+    use gaze_lidar_core::eye_safety::bound;
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let prm = params(1450.0, 1.0);
+    let (f_p, p) = (1e4, 1e-3);
+    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let (w1, w2) = (two_h / 0.3, two_h / 0.4);
+    let ten = 10f64.to_radians();
+    let frame_s = 1e5;
+    let w_d = 340f64.to_radians() / (frame_s - ten / w1 - ten / w2);
+    let segs = vec![
+        seg(0.0, 340.0, 0.0, w_d),
+        seg(340.0, 10.0, p, w1),
+        seg(350.0, 10.0, p, w2),
+    ];
+    let l = laser(&prm, f_p).unwrap();
+    let half_deg = 0.5 * pass_angle_deg(&prm, &l);
+    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-12);
+    let t_err = 2.0 * 1e-12 * frame_s;
+    let ael_edge = 4.4e-3 * 0.35f64.powf(0.25);
+    assert!((ael_edge / 3.38431e-3 - 1.0).abs() < 1e-5, "{ael_edge}");
+    let covered = p * (0.35 + 1.0 / f_p + t_err) / ael_edge;
+    let b = bound::evaluate(&segs, half_deg, &l);
+    assert!(
+        (b.rule_windows_s[0] - 0.35).abs() < 1e-12,
+        "{:?}",
+        b.rule_windows_s
+    );
+    assert!(
+        b.ratios[1] >= covered,
+        "pass train {} below {covered} ({:?})",
+        b.ratios[1],
+        b.ratios
+    );
+}
+
+/// Kills `bound/whole_pass.rs` `Cells::full_pass`: `tu + dt * w` →
+/// `tu + dt + w` and `tu + dt / w` (the duration of the whole pass where
+/// its energy reaches the cap `E⁺` lands at or beyond the cell's longer
+/// end, so the cap's kink, where `min(E, E⁺)/AEL(τ)` is largest, is
+/// evaluated at a longer window and a larger AEL).
+///
+/// By the definition (`specs/eye_safety.md`, "Whole-pass windows"): the
+/// figure is at least `min(E(φ), E⁺)/AEL_inf(τ(φ))` at every azimuth `φ`,
+/// with `E⁺` the bound's largest pulse energy of a pass (read back, and
+/// checked against the 20 pulses below). 1450 nm, beam 1 mm (`2h` =
+/// 0.045571 rad), 99.5 Hz (`Δ` = 10.05 ms): `2p` on `[0°, 10°)` at
+/// `ω_A = 2h/0.01`, `p` on `[10°, 350°)` at `ω_B = 2h/0.2`, dark on
+/// `[350°, 360°)` at `ω_A` (so that only the passes leaving the hot sector,
+/// whose cells run from the short to the long pass, reach `E⁺`; the passes
+/// entering it hold under `0.05·p`). A pass with a share `x` of its arc in
+/// the hot sector lasts `τ = 0.01x + 0.2(1 − x)`
+/// and its envelope holds `E = 2p(0.01x + Δ) + p·0.2(1 − x)` (the max
+/// filter keeps `2p` for `Δ` after the sector): `E` grows with `τ`, and so
+/// does `E/τ^0.25` (the `4.4e-3·t^0.25` row) until `E` reaches `E⁺`. For
+/// `x` just above 0 a clock phase puts one pulse in the hot sector and 19
+/// after it within `19Δ` = 0.190955 s: `E⁺ ≥ (2 + 19)·p·Δ`, below
+/// `E(0)` = 0.22010·`p`. With `E⁺` = 21·`p·Δ`, `E` reaches it at `x_c` =
+/// 0.0503, `τ_c` = 0.190452 s: the figure is at least `E⁺/(4.4e-3·τ_c^0.25)`.
+/// Those 20 pulses alone are a true exposure of `21·p·Δ` in a window of
+/// `19Δ`: the true worst ratio is at least `21·p·Δ/(4.4e-3·(19Δ)^0.25)`
+/// (1 − 6.6·10⁻⁴ of the kink's figure). The mutants evaluate the cap at
+/// `τ ≥ 0.2` s and report the longest pass's `E⁺/AEL(0.2 s)`, 1.2 % below
+/// the kink and below that true exposure (0.07173 against 0.07256 at
+/// `p` = 1 mW; applied by hand, both fail here).
+#[test]
+fn whole_pass_figure_takes_the_cap_s_kink() {
+    use gaze_lidar_core::eye_safety::bound;
+    use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
+    let prm = params(1450.0, 1.0);
+    let (f_p, p) = (99.5, 1e-3);
+    let delta = 1.0 / f_p;
+    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let (tau_a, tau_b) = (0.01, 0.2);
+    let segs = vec![
+        seg(0.0, 10.0, 2.0 * p, two_h / tau_a),
+        seg(10.0, 340.0, p, two_h / tau_b),
+        seg(350.0, 10.0, 0.0, two_h / tau_a),
+    ];
+    let l = laser(&prm, f_p).unwrap();
+    let half_deg = 0.5 * pass_angle_deg(&prm, &l);
+    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-12);
+    let b = bound::evaluate(&segs, half_deg, &l);
+    let e_cap = b.max_pass_energy_j;
+    let twenty = 21.0 * p * delta;
+    assert!((19.0 * delta - 0.190_955).abs() < 1e-6);
+    let e_env = |x: f64| 2.0 * p * (tau_a * x + delta) + p * tau_b * (1.0 - x);
+    assert!((e_env(0.0) / p - 0.220_10).abs() < 1e-5);
+    assert!(
+        e_cap >= twenty && e_cap < e_env(0.0),
+        "E⁺ {e_cap}, 20 pulses {twenty}, E(0) {}",
+        e_env(0.0)
+    );
+    // `E(x_c) = E⁺`, `E` affine in `x`.
+    let x_c = (e_env(0.0) - e_cap) / (e_env(0.0) - e_env(1.0));
+    let tau_c = tau_a * x_c + tau_b * (1.0 - x_c);
+    if e_cap == twenty {
+        assert!((x_c - 0.0503).abs() < 1e-4, "{x_c}");
+        assert!((tau_c - 0.190_452).abs() < 1e-6, "{tau_c}");
+    }
+    let truth_lb = twenty / (4.4e-3 * (19.0 * delta).powf(0.25));
+    assert!(
+        b.ratios[1] >= truth_lb,
+        "pass train {} below 20 pulses in 19Δ: {truth_lb}",
+        b.ratios[1]
+    );
+    let kink = e_cap / (4.4e-3 * tau_c.powf(0.25));
+    assert!(
+        b.ratios[1] >= kink,
+        "pass train {} below {kink} at {tau_c} s ({:?}, {:?})",
+        b.ratios[1],
+        b.ratios,
+        b.rule_windows_s
+    );
+}
+
+/// Kills `head/overlap.rs` `vertical` and `vertical_slots`: the interval's
+/// upper end `z + h + TOUCH_MM` → `z + h − TOUCH_MM` (two channels whose height
+/// intervals miss by less than `2·TOUCH_MM` no longer meet one aperture
+/// height, so `W_v`, the weight every energy rule of the head multiplies,
+/// can fall to one channel's, and `S_v`, which bounds the head's pulse
+/// count for C5, to one slot: a smaller count is a larger C5).
+///
+/// The stated widening (`overlap::TOUCH_MM`, 1e-9 mm): every interval end
+/// moves out by it, so positions that touch in exact arithmetic but miss by
+/// a rounding error still meet; two intervals `2·TOUCH_MM` or less apart
+/// meet. By hand: `[−5, 5]` and `[5 + 1.5e-9, 15 + 1.5e-9]` (half-height
+/// 5 mm): 1.5e-9 mm apart, so both channels count (weight `2·(1 + 1e-12)`);
+/// 3e-9 mm apart, only one does. The same for two distinct slots.
+#[test]
+fn vertical_overlap_meets_within_the_touch_widening() {
+    use gaze_lidar_core::eye_safety::head::geometry::Footprint;
+    use gaze_lidar_core::eye_safety::head::overlap::{
+        vertical, vertical_slots, SUM_MARGIN, TOUCH_MM,
+    };
+    assert_eq!(TOUCH_MM, 1e-9);
+    let fp = |z_mm: f64| Footprint {
+        index: 0,
+        psi_rad: 0.0,
+        z_mm,
+        slant_mm: 100.0,
+        width_mm: 3.0,
+        cos_beta: 1.0,
+        half_arc_mm: 5.0,
+        half_height_mm: 5.0,
+        pass_angle_deg: 0.1f64.to_degrees(),
+    };
+    let m = vertical(&[fp(0.0), fp(10.0 + 1.5e-9)], &[1.0, 1.0]);
+    assert_eq!(m.count, 2, "{m:?}");
+    assert_eq!(m.weight, 2.0 * (1.0 + SUM_MARGIN), "{m:?}");
+    let m = vertical(&[fp(0.0), fp(10.0 + 3e-9)], &[1.0, 1.0]);
+    assert_eq!(m.count, 1, "{m:?}");
+    assert_eq!(m.weight, 1.0, "{m:?}");
+    // `S_v`, the distinct firing slots meeting one height (the head's pulse
+    // count for C5), with the same widening.
+    assert_eq!(
+        vertical_slots(&[fp(0.0), fp(10.0 + 1.5e-9)], &[0.0, 1e-5]),
+        2
+    );
+    assert_eq!(vertical_slots(&[fp(0.0), fp(10.0 + 3e-9)], &[0.0, 1e-5]), 1);
 }
