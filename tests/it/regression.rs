@@ -2,7 +2,7 @@
 //! failure (bad bytes and huge lines on stdin, stale gaze, pacing, option
 //! ranges, contradictory files, outputs that would replace inputs, plots,
 //! exit codes, message wording, byte-order marks, beam widths); the ARGUS
-//! road mask's memory is tested with the simulator (`tests/pipeline.rs`).
+//! road mask's memory is tested with the simulator (`tests/it/simulate/pipeline.rs`).
 //! Each test failed before its fix; the comment on each says how.
 
 use crate::common;

@@ -3,7 +3,7 @@
 //! `check` benchmark's rough profile, and `gaze-lidar check` on the
 //! constructed profiles. The references, the differential test and the
 //! library-level regression cases live in the core crate
-//! (`crates/core/tests/eye_safety_reference.rs`), where `cargo mutants -p
+//! (`crates/core/tests/it/eye_safety/reference.rs`), where `cargo mutants -p
 //! gaze-lidar-core` runs them.
 
 use crate::big_profile;

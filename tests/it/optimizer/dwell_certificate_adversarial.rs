@@ -10,7 +10,7 @@ use crate::common;
 use std::path::Path;
 
 /// HiGHS reads `path` (free MPS) with its own reader and solves it afresh
-/// at tight tolerances (as `tests/certificate.rs` does); the objective.
+/// at tight tolerances (as `tests/it/optimizer/certificate.rs` does); the objective.
 fn highs_objective_of_file(path: &Path) -> f64 {
     let run = common::highs_solve_file(
         path,

@@ -23,7 +23,7 @@ fn shipped(name: &str) -> Problem {
 /// and its exact optimality under the bound; with the head, the bound's
 /// energy rules are a minimum over candidate channel weights (not linear
 /// in the powers), so the cuts scale by the smallest weight and the power
-/// step is no longer exactly optimal: `tests/head_presets.rs` certifies the
+/// step is no longer exactly optimal: `tests/it/eye_safety/head_presets.rs` certifies the
 /// head's optimized profiles instead.
 fn vls128_eye_one_channel() -> Problem {
     let mut p = shipped("vls128_eye");

@@ -322,7 +322,7 @@ fn head_file_defaults_are_the_description_s() {
 /// in `bound/count.rs`), and every duration by `64ε·T_f`: the pass figures
 /// the multi-pass rules use must exceed the largest pass energy and the
 /// longest pass by at least those. On the near-stopped frame of
-/// `tests/time_rounding.rs` (905 nm, 152 kHz, 16.2 mW over 20° at
+/// `tests/it/eye_safety/time_rounding.rs` (905 nm, 152 kHz, 16.2 mW over 20° at
 /// 600 rad/s, 340° dark at 2.6e-6 rad/s) by hand: `T_f` =
 /// `0.349066/600 + 5.934119/2.6e-6` = 2.282353·10⁶ s, so the pads are at
 /// least `2 · 16.2e-3 W · 64ε · T_f` = 1.0509·10⁻⁹ J (1 % of one pulse's

@@ -1,7 +1,7 @@
 //! Adversarial review of the optimizer's cuts (`eye_safety::cuts`): every
 //! cut must stay at or under the bound's worst ratio (`bound::evaluate`)
 //! for the powers it was found at, over a wider input space than
-//! `tests/cuts.rs` draws from: pass angles up to and beyond 360°, bins
+//! `tests/it/eye_safety/cuts.rs` draws from: pass angles up to and beyond 360°, bins
 //! narrower than a pass and down to 1e-6 of a turn, spins from 0.01 to
 //! 2,000 rad/s, pulse rates up to 2 MHz (several pulses within `T_i`),
 //! pulses at and beyond `T_i`, equal neighbours (which the bound merges).
@@ -283,7 +283,7 @@ fn bound_over_best_cut_on_uniform_profiles() {
 /// at 10 Hz the bound is 0.199673 and the best cut 0.168130 (ratio
 /// 1.187610 = 1 + 1e-5·18,761). The optimizer's loop then stops with "no
 /// concrete exposure there is over its limit" on every such laser where
-/// eye safety binds (`tests/eye_cuts_adversarial.rs`). The same factor
+/// eye safety binds (`tests/it/optimizer/eye_cuts_adversarial.rs`). The same factor
 /// `1 + T·f_p`, `T` the bound's worst window, is 1.005 for 3 ns pulses at
 /// 1 kHz (`T` = 5 µs, the row edge where the AEL steps down): any laser
 /// whose within-pass figure binds is out of the loop's reach (head-room

@@ -1,4 +1,4 @@
-//! The head oracle (`tests/head_oracle_defs/`): a brute-force reference for
+//! The head oracle (`tests/it/head_oracle_defs.rs`): a brute-force reference for
 //! the eye safety of a whole multi-beam head, and its self-tests (each able
 //! to fail). `HEAD_ORACLE_CASES` scales the random runs; `HEAD_ORACLE_SHAPES`
 //! caps the fixed-shape runs (real heads, separated pairs) for quick nets

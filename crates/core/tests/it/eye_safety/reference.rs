@@ -1,8 +1,8 @@
 #![allow(clippy::needless_range_loop)]
 //! Differential soundness test of the eye-safety checker against two
-//! independent brute-force references: `reference/` (explicit pulse runs,
+//! independent brute-force references: `reference.rs` (explicit pulse runs,
 //! windows between run boundaries, the AEL at the span of the pulses a
-//! window holds, its own copy of Table 3) and `reference_defs/` (written
+//! window holds, its own copy of Table 3) and `reference_defs.rs` (written
 //! from the standard's definitions: explicit pulses, windows `[t, t + T)`
 //! for every length `T` of a dense grid through every row edge ± ε, the AEL
 //! and Table 10's aperture at the window's own length). The two share no
