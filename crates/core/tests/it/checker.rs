@@ -16,14 +16,7 @@ const N: usize = 36;
 const FRAME_HZ: f64 = 10.0;
 const POWER_W: f64 = 1e-4;
 
-fn params() -> EyeSafetyParams {
-    EyeSafetyParams {
-        wavelength_nm: 905.0,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm: 8.0,
-        head: None,
-    }
-}
+use crate::common::params;
 
 fn limits() -> Limits {
     Limits {

@@ -67,3 +67,20 @@ pub fn profile(bins: &[(f64, f64, f64, bool)]) -> Vec<gaze_lidar_core::eye_safet
         })
         .collect()
 }
+
+/// Eye-safety parameters of one 5 ns beam at `lambda_nm`, `beam_mm` wide (no head).
+#[allow(dead_code)]
+pub fn params_at(lambda_nm: f64, beam_mm: f64) -> EyeSafetyParams {
+    EyeSafetyParams {
+        wavelength_nm: lambda_nm,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: beam_mm,
+        head: None,
+    }
+}
+
+/// The fixtures' usual beam: 905 nm, 5 ns pulses, 8 mm.
+#[allow(dead_code)]
+pub fn params() -> EyeSafetyParams {
+    params_at(905.0, 8.0)
+}

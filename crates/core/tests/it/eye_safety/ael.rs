@@ -327,13 +327,13 @@ fn ael_infimum_is_the_minimum_of_a_dense_scan() {
     }
 }
 
-/// The issue's two windows, by hand: 9986 pulses span 9.985 s at 1550 nm,
+/// Two windows just longer than their pulses' span, by hand: 9986 pulses span 9.985 s at 1550 nm,
 /// but the window `[t, t + 10.000001 s)` holds them too, and the AEL there is
 /// `1e-2·T` = 0.1 J, not `1.8e-2·9.985^0.75`; at 1450 nm, 199 pulses span
 /// 0.99 ms, and a window of 1.0000001 ms holds them against
 /// `4.4e-3·(1e-3)^0.25` = 7.824e-4 J, not 8e-4 J.
 #[test]
-fn ael_infimum_by_hand_on_the_issue_windows() {
+fn ael_infimum_by_hand_on_windows_just_longer_than_their_pulses() {
     let span = 9985.0 / 1000.0;
     assert!((ael_j(1550.0, span).unwrap() - 1.8e-2 * 9.985f64.powf(0.75)).abs() < 1e-15);
     assert!(ael_j(1550.0, span).unwrap() > 0.1011);

@@ -7,17 +7,10 @@
 
 use gaze_lidar_core::eye_safety::ael::{self, ael_j, Band, APERTURE_IR_MM};
 use gaze_lidar_core::eye_safety::bound::Seg;
-use gaze_lidar_core::eye_safety::{ael_report, evaluate_segments, EyeSafetyParams};
+use gaze_lidar_core::eye_safety::{ael_report, evaluate_segments};
 use std::f64::consts::TAU;
 
-fn params(lambda_nm: f64, beam_mm: f64) -> EyeSafetyParams {
-    EyeSafetyParams {
-        wavelength_nm: lambda_nm,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm: beam_mm,
-        head: None,
-    }
-}
+use crate::common::params_at as params;
 
 /// The assumption behind taking the 1400–1500 nm rows at 1500.0 and
 /// 1800.0 nm: they are at most the 1500–1800 nm rows at every duration of

@@ -9,14 +9,7 @@ use gaze_lidar_core::model::lidar::{Limits, PowerAccounting};
 use gaze_lidar_core::profile::{Bin, Profile, PROFILE_FORMAT};
 use std::f64::consts::TAU;
 
-fn params() -> EyeSafetyParams {
-    EyeSafetyParams {
-        wavelength_nm: 905.0,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm: 8.0,
-        head: None,
-    }
-}
+use crate::common::params;
 
 /// `n` equal bins at 10 Hz; bin `i` at `power(i)`.
 fn segs(n: usize, power: impl Fn(usize) -> f64) -> Vec<Seg> {

@@ -60,7 +60,7 @@ fn profiles() -> Vec<(String, Profile)> {
 /// report is today's, bit for bit (the head's figures only added), so every
 /// rejected one stays rejected at the same figure.
 #[test]
-fn one_channel_head_is_todays_bound_on_every_regression_profile() {
+fn one_channel_head_is_the_single_channel_bound_on_every_committed_profile() {
     let all = profiles();
     assert!(all.len() >= 12, "{} profiles", all.len());
     let mut rejected = 0;
@@ -246,7 +246,7 @@ proptest! {
     /// 1-channel head of the single-channel shape is today's report, bit for
     /// bit.
     #[test]
-    fn one_channel_head_is_todays_bound_on_random_profiles(
+    fn one_channel_head_is_the_single_channel_bound_on_random_profiles(
         bins in proptest::collection::vec((0.05f64..1.0, 0.0f64..0.05, 2.0f64..80.0, any::<bool>()), 1..16),
         lambda in prop_oneof![Just(905.0), Just(1450.0), Just(1550.0)],
         f_p in 1e3f64..3e5,

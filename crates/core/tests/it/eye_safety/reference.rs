@@ -791,7 +791,7 @@ fn constructed_cases_true_ratio_and_reference() {
 /// on pulse-capped pass energies). The true ratio of that window is computed
 /// here by hand from the bins; the checker must not be below it.
 #[test]
-fn free_clock_nine_passes_regression() {
+fn free_clock_nine_pass_window_is_at_least_its_ratio_by_hand() {
     let p = load("regression_free_clock_nine_passes_1450.json");
     let es = p.limits.eye_safety.clone().unwrap();
     let fp = p.pulse_rate_hz;
@@ -1019,13 +1019,13 @@ fn windows_longer_than_their_pulses_across_an_ael_step_down_are_rejected() {
     }
 }
 
-/// The definitions reference on the issue's profiles: it finds the 10 s
+/// The definitions reference on the AEL step-down profiles: it finds the 10 s
 /// window of the 1550 nm one over the limit under the standard's own
 /// Table 10 aperture (3.5 mm at 10 s), as computed by hand, and never
 /// exceeds the hand-computed supremum (the model's wider aperture); the
 /// first reference (AEL at the span) cannot see either.
 #[test]
-fn definitions_reference_finds_the_issue_windows() {
+fn definitions_reference_finds_the_ael_step_down_windows() {
     for c in ael_step_cases() {
         let p = load(c.name);
         let defs = DefReference::new(&def_scan(&p));

@@ -9,7 +9,7 @@
 
 use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
 use gaze_lidar_core::eye_safety::bound::Seg;
-use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams, Rule};
+use gaze_lidar_core::eye_safety::{evaluate_segments, Rule};
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::ToPrimitive;
@@ -20,14 +20,7 @@ fn q(x: f64) -> BigRational {
     BigRational::from_float(x).unwrap()
 }
 
-fn params(lambda_nm: f64, beam_mm: f64) -> EyeSafetyParams {
-    EyeSafetyParams {
-        wavelength_nm: lambda_nm,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm: beam_mm,
-        head: None,
-    }
-}
+use crate::common::params_at as params;
 
 fn seg(start_deg: f64, width_deg: f64, power_w: f64, spin_rad_s: f64) -> Seg {
     Seg {
@@ -88,7 +81,7 @@ fn true_ratio(lambda_nm: f64, k: u64, e_j: f64, f_p: f64) -> f64 {
     k as f64 * e_j / ael
 }
 
-/// The two profiles of the finding. 905 nm, 152 kHz, 16.2 mW at 600 rad/s
+/// Two near-stopped profiles. 905 nm, 152 kHz, 16.2 mW at 600 rad/s
 /// over 20°, the rest at 2.6e-6 rad/s (`T_f` = 2.28·10⁶ s), 0.5 mm beam:
 /// the pass is `0.075 rad / 600 rad/s` = 1.25·10⁻⁴ s = exactly 19 pulse
 /// spacings, so 20 pulses fit (closed interval) for some phase:
@@ -99,7 +92,7 @@ fn true_ratio(lambda_nm: f64, k: u64, e_j: f64, f_p: f64) -> f64 {
 /// truth.) 1550 nm, 20 kHz, 158 W, the pass exactly one spacing long: two
 /// pulses, `2 · 7.9e-3 J / 8e-3 J` = 1.975.
 #[test]
-fn near_stopped_frames_of_the_finding_are_rejected_at_their_true_ratio() {
+fn near_stopped_frames_are_rejected_at_their_true_ratio() {
     // 905 nm.
     let (f_p, p, fast) = (152e3, 16.2e-3, 600.0);
     let k = exact_pulses(7.0, 0.5, fast, f_p);

@@ -7,7 +7,7 @@ use crate::common;
 
 use gaze_lidar_core::checker::{certify, certify_with, CheckOptions};
 use gaze_lidar_core::eye_safety::bound::Seg;
-use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams};
+use gaze_lidar_core::eye_safety::evaluate_segments;
 use gaze_lidar_core::firmware::eye::{evaluate, IntEyeLimits};
 use gaze_lidar_core::firmware::{
     as_run_segments, check_table, table_exposure, FirmwareConfig, FirmwareError, FirmwareTable,
@@ -22,14 +22,7 @@ const POWER_W: f64 = 1e-4;
 /// 2π·10 rad/s: one turn in 0.1 s.
 const SPIN: f64 = TAU * FRAME_HZ;
 
-fn params() -> EyeSafetyParams {
-    EyeSafetyParams {
-        wavelength_nm: 905.0,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm: 8.0,
-        head: None,
-    }
-}
+use crate::common::params;
 
 /// Spin limits exactly at the profile's spin, so every dwell bound is
 /// exactly the ideal dwell (`θ·f/ω`), within the checker's tolerance.
