@@ -2038,9 +2038,12 @@ fn run_measured(args: &[&std::ffi::OsStr]) -> (i32, String, u64) {
         .map(|a| a.as_bytes())
         .collect::<Vec<_>>()
         .join(&0x1fu8);
+    // The helper's full test name: this module's path without the crate's.
+    let module = module_path!().split_once("::").map_or("", |(_, m)| m);
+    let helper = format!("{module}::rss_probe_helper");
     let o = Command::new(std::env::current_exe().unwrap())
         .args([
-            "rss_probe_helper",
+            helper.as_str(),
             "--exact",
             "--nocapture",
             "--test-threads",
