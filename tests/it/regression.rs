@@ -1,3 +1,5 @@
+//! Regressions of the command line: each test guards a fixed bug and cites it.
+//!
 //! The binary under hostile input and conditions: one test per kind of
 //! failure (bad bytes and huge lines on stdin, stale gaze, pacing, option
 //! ranges, contradictory files, outputs that would replace inputs, plots,
@@ -1009,7 +1011,9 @@ fn a_beam_wider_than_a_turn_is_refused() {
 
 /// `stream --realtime` fed a line of non-UTF-8 bytes and a 10 MiB line
 /// between valid samples keeps emitting frames every period, reports both
-/// lines with their numbers, and exits 0 when stdin closes.
+/// lines with their numbers, and exits 0 when stdin closes. Guards the
+/// live path of the two stdin regressions above (invalid UTF-8, a line over
+/// 64 KiB).
 #[test]
 fn realtime_stream_survives_bad_bytes_and_a_10_mib_line() {
     let (mut child, rx, reader) = live_child(&["--bins", "36"]);
