@@ -2,7 +2,7 @@
 # Rewrites tests/data/optimizer_golden/ with BIN (default: the release
 # binary of CARGO_TARGET_DIR or target/): the four shipped configs at gazes
 # 0, 90 and 200, profile + certificate folder. Only for a change meant to
-# move the optimizer's answers (tests/optimizer_golden.rs compares them).
+# move the optimizer's answers (tests/it/optimizer/golden.rs compares them).
 set -eu
 cd "$(dirname "$0")/.."
 BIN=${BIN:-${CARGO_TARGET_DIR:-target}/release/gaze-lidar}

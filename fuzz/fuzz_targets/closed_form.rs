@@ -4,7 +4,7 @@
 //! checker that has just certified it).
 #![no_main]
 
-#[path = "../../tests/independent/mod.rs"]
+#[path = "../../tests/it/independent.rs"]
 mod independent;
 
 use gaze_lidar::model::acuity::{AcuityModel, AcuitySample};

@@ -4,7 +4,7 @@
 //! `check_table`, which `from_certified` has already run).
 #![no_main]
 
-#[path = "../../tests/independent/mod.rs"]
+#[path = "../../tests/it/independent.rs"]
 mod independent;
 
 use gaze_lidar::checker::certify;

@@ -8,7 +8,7 @@
 //! the block its mode does not move at its start value — is feasible for
 //! it, and its objective is at least the model's. (The checker alone knows
 //! none of the grid, the levels or the mode: a profile off them is another
-//! problem's, `tests/global_adversarial.rs`; [`model_objective`] refuses
+//! problem's, `tests/it/optimizer/global_adversarial.rs`; [`model_objective`] refuses
 //! another grid.)
 //!
 //! Model objective (the one the steps approximate from below with chords):

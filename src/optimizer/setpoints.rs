@@ -171,7 +171,7 @@ mod tests {
         }
     }
 
-    /// The set-points of `tests/dwell_certificate_adversarial.rs` (24
+    /// The set-points of `tests/it/optimizer/dwell_certificate_adversarial.rs` (24
     /// bins): the best composition is 4.1e-4 off.
     #[test]
     fn a_known_miss() {

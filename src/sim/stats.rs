@@ -4,7 +4,7 @@
 //!
 //! Conventions (each matches `scipy.stats`, checked against fixtures the
 //! script `tests/fixtures/stats/make_fixtures.py` generated with scipy;
-//! see `tests/sim_stats.rs`):
+//! see `tests/it/simulate/stats.rs`):
 //!
 //! - **Median**: the middle order statistic, or the mean of the two middle
 //!   ones (`numpy.median`).

@@ -30,7 +30,7 @@
 //! So a cut never removes a certifiable profile, whatever powers it was
 //! found at: a program with cuts in place of the bound is a relaxation of
 //! "the bound certifies", and its optimum an upper bound of the best
-//! certifiable objective. `tests/cuts.rs` checks every cut against the
+//! certifiable objective. `tests/it/eye_safety/cuts.rs` checks every cut against the
 //! bound on random profiles of every band.
 //!
 //! Nothing here decides that a profile is safe: a cut is a lower bound of
@@ -537,7 +537,7 @@ pub fn rule_one_cap_w(laser: &Laser, half_deg: f64, spin_max_rad_s: f64, frame_s
 /// written) is not of the form `W · r`; where it is the smallest, a cut
 /// scaled by `W` may exceed the head's figure, which can only make the
 /// optimizer conservative (every answer is still decided by the checker),
-/// never unsafe. `tests/eye_cuts.rs::cuts_never_exceed_the_bound_on_optimized_profiles`
+/// never unsafe. `tests/it/optimizer/eye_cuts.rs::cuts_never_exceed_the_bound_on_optimized_profiles`
 /// holds on the shipped configs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeadScale {

@@ -1,0 +1,5 @@
+//! The integer firmware side (`firmware::*`): the quantizer that builds tables, the codec and the integer checker.
+
+mod build;
+mod check;
+mod codec;

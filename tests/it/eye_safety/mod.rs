@@ -1,0 +1,5 @@
+//! Eye safety through the root crate: AEL figures, exposures, the head presets and the references on the planner's profiles.
+
+mod figures;
+mod head_presets;
+mod reference;

@@ -1,0 +1,286 @@
+//! The optimizer at the edges of its input: degenerate objectives, limits
+//! met exactly. Each test names the wrong answer it rules out.
+#![cfg(feature = "solver")]
+
+use crate::common;
+
+use common::run;
+use gaze_lidar::optimizer::certificate::{check, LinearProgram, Row};
+use gaze_lidar::optimizer::{optimize, OptError, OptimizerConfig};
+
+/// The bins' powers of the optimizer's answer for a config text.
+fn powers(toml: &str, gaze_deg: f64) -> Vec<f64> {
+    let problem = OptimizerConfig::from_toml(toml, "t.toml")
+        .unwrap()
+        .problem()
+        .unwrap();
+    optimize(&problem, gaze_deg)
+        .unwrap()
+        .profile()
+        .bins
+        .iter()
+        .map(|b| b.power_w)
+        .collect()
+}
+
+/// A Gaussian acuity whose `σ²` underflows gave `V(0) = NaN`: an all-zero
+/// profile "proven optimal" in range mode, a hang in joint mode. Refused
+/// by name as bad input (exit 2), in every mode, without solving.
+#[test]
+fn an_acuity_too_narrow_for_doubles_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    for mode in ["range", "joint", "resolution"] {
+        for (model, key) in [("gaussian", "sigma_deg"), ("levi_e2", "e2_deg")] {
+            for v in ["1e-300", "5e-324", "1e-10"] {
+                let cfg = dir.path().join("t.toml");
+                std::fs::write(
+                    &cfg,
+                    format!(
+                        "bins = 36\n[objective]\nmode = \"{mode}\"\n[focus]\nthreshold = 0.5\nacuity = {{ model = \"{model}\", {key} = {v} }}\n"
+                    ),
+                )
+                .unwrap();
+                let out = dir.path().join("o.json");
+                let o = run(
+                    &[
+                        "profile",
+                        "--config",
+                        cfg.to_str().unwrap(),
+                        "--gaze-deg",
+                        "90",
+                        "--out",
+                        out.to_str().unwrap(),
+                    ],
+                    None,
+                );
+                common::expect(&o, 2, &[key], &format!("{mode} {model} {v}"));
+                assert!(!out.exists(), "{mode} {model} {v}: an output was written");
+            }
+        }
+    }
+}
+
+/// The exact checker refuses a program with a NaN or infinite cost or
+/// coefficient: NaN costs were once certified with a made-up exact value.
+#[test]
+fn the_exact_checker_refuses_a_non_finite_program() {
+    let base = LinearProgram {
+        cost: vec![1.0, 2.0],
+        col_lo: vec![0.0, 0.0],
+        col_hi: vec![1.0, 1.0],
+        integer: vec![false, false],
+        rows: vec![Row {
+            coefs: vec![(0, 1.0), (1, 1.0)],
+            lo: f64::NEG_INFINITY,
+            hi: 1.0,
+        }],
+    };
+    let (x, y) = (vec![0.0, 1.0], vec![2.0]);
+    assert!(check(&base, &x, &y).primal_feasible);
+    let mut nan_cost = base.clone();
+    nan_cost.cost[0] = f64::NAN;
+    let mut inf_cost = base.clone();
+    inf_cost.cost[1] = f64::INFINITY;
+    let mut nan_coef = base.clone();
+    nan_coef.rows[0].coefs[0].1 = f64::NAN;
+    let mut nan_rhs = base.clone();
+    nan_rhs.rows[0].hi = f64::NAN;
+    let mut nan_bound = base.clone();
+    nan_bound.col_hi[0] = f64::NAN;
+    for (what, lp) in [
+        ("NaN cost", nan_cost),
+        ("infinite cost", inf_cost),
+        ("NaN coefficient", nan_coef),
+        ("NaN right-hand side", nan_rhs),
+        ("NaN column bound", nan_bound),
+    ] {
+        let e = check(&lp, &x, &y);
+        assert!(!e.primal_feasible, "{what}: certified");
+        assert!(e.violation.is_some(), "{what}");
+    }
+}
+
+/// Weights are relative: the range step's answer is the same for
+/// `range_weight` 1, 1e-6 and 1e-9 (small costs once read as zero under
+/// HiGHS's absolute dual tolerance: 63 % and then 0 % of the budget used).
+#[test]
+fn the_answer_does_not_depend_on_the_weights_scale() {
+    let cfg = |w: &str| format!("bins = 36\n[objective]\nmode = \"range\"\nrange_weight = {w}\n");
+    let reference = powers(&cfg("1.0"), 90.0);
+    let spent: f64 = reference.iter().sum();
+    assert!(spent > 0.0);
+    for w in ["1e-6", "1e-9"] {
+        let p = powers(&cfg(w), 90.0);
+        for (k, (a, b)) in p.iter().zip(&reference).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-9 * b.abs().max(1e-6),
+                "range_weight {w}, bin {k}: {a} W, against {b} W at weight 1"
+            );
+        }
+    }
+}
+
+/// Fog weights are relative: `[1e308, 1e308]` (each accepted, their sum
+/// overflows) is `[1, 1]`, not an all-zero objective "proven optimal".
+#[test]
+fn fog_weights_whose_sum_overflows_are_still_relative() {
+    let cfg = |w: &str| {
+        format!(
+            "bins = 36\n[objective]\nmode = \"range\"\nkind = \"detection\"\n[objective.detection]\nfog_pct = [0, 25]\nfog_weight = [{w}, {w}]\n"
+        )
+    };
+    let a = powers(&cfg("1.0"), 90.0);
+    let b = powers(&cfg("1e308"), 90.0);
+    assert!(a.iter().sum::<f64>() > 0.0);
+    assert_eq!(a, b);
+}
+
+/// Hardware levels one slew step apart (`0.0011 − 0.0009` is
+/// `2.0000000000000006e-4` W in doubles, within the checker's tolerance of
+/// a 2e-4 W step) stay compatible neighbours: the program's slew rows once
+/// sat 1e-6 inside the limit, the top level was lost from every bin, and
+/// a uniform lower level was "proven optimal" while a profile using the
+/// top level in the region of interest is certified.
+#[test]
+fn levels_exactly_one_slew_step_apart_stay_neighbours() {
+    for levels in [
+        "[0.0009, 0.0011]",
+        "[0.0003, 0.0005, 0.0007, 0.0009, 0.0011]",
+    ] {
+        let p = powers(
+            &format!(
+                "bins = 36\n[limits]\npower_slew_w_per_deg_max = 2e-5\n[levels]\npower_w = {levels}\n[objective]\nmode = \"range\"\n"
+            ),
+            90.0,
+        );
+        assert!(
+            p.contains(&0.0011),
+            "levels {levels}: the top level is never used: {p:?}"
+        );
+    }
+}
+
+/// A power floor that is (or is within a few ulps of) the budget: the
+/// all-floor point once overspent the program's own budget row by a few
+/// ulps of its float sum, so the answer came without its exact
+/// certificate (no `optimality` block; `--certificate` refused it).
+#[test]
+fn a_floor_at_the_budget_keeps_its_certificate() {
+    for (accounting, floor, mode) in [
+        ("angle", "0.001", "joint"),
+        ("angle", "0.001", "range"),
+        ("time", "0.000999999999", "joint"),
+        ("time", "0.00099999999", "joint"),
+    ] {
+        let toml = format!(
+            "bins = 36\n[lidar]\npower_accounting = \"{accounting}\"\n[limits]\npower_w_min = {floor}\n[objective]\nmode = \"{mode}\"\n"
+        );
+        let problem = OptimizerConfig::from_toml(&toml, "t.toml")
+            .unwrap()
+            .problem()
+            .unwrap();
+        let c = optimize(&problem, 90.0).unwrap();
+        assert!(
+            c.profile().optimality.is_some(),
+            "{accounting} {floor} {mode}: no exact certificate"
+        );
+    }
+}
+
+/// Resolution mode with spin set-points the eye-safety rules forbid (the
+/// only set-point choice that meets the frame is over the limit): the
+/// move was once shortened to spins that are no set-points and handed out
+/// with exit 0. Infeasible, by name.
+#[test]
+fn set_points_eye_safety_forbids_are_infeasible_not_left() {
+    let toml = "bins = 36\n[levels]\nspin_rad_s = [50.0, 180.20301935392519]\n[objective]\nmode = \"resolution\"\n";
+    let problem = OptimizerConfig::from_toml(toml, "t.toml")
+        .unwrap()
+        .problem()
+        .unwrap();
+    match optimize(&problem, 90.0) {
+        Ok(c) => {
+            let spins: Vec<f64> = c
+                .profile()
+                .bins
+                .iter()
+                .map(|b| b.spin_start_rad_s)
+                .collect();
+            panic!("an answer with spins {spins:?}");
+        }
+        Err(OptError::Infeasible(i)) => {
+            let msg = i.to_string();
+            assert!(msg.contains("levels.spin_rad_s"), "{msg}");
+        }
+        Err(e) => panic!("not an infeasible verdict: {e}"),
+    }
+}
+
+/// A certificate folder reused by a run without a detection objective
+/// holds that run's certificate only: an earlier run's
+/// `detection_bound.json` (another problem's claim) is removed.
+#[test]
+fn a_reused_certificate_folder_keeps_no_stale_detection_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let cert = dir.path().join("cert");
+    let solve = |toml: &str| {
+        let cfg = dir.path().join("t.toml");
+        std::fs::write(&cfg, toml).unwrap();
+        let out = dir.path().join("o.json");
+        let o = run(
+            &[
+                "profile",
+                "--config",
+                cfg.to_str().unwrap(),
+                "--gaze-deg",
+                "90",
+                "--certificate",
+                cert.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            None,
+        );
+        assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
+    };
+    solve("bins = 36\n[objective]\nmode = \"range\"\nkind = \"detection\"\n[objective.detection]\nfog_pct = [0, 25]\n");
+    assert!(cert.join("detection_bound.json").exists());
+    solve("bins = 36\n[objective]\nmode = \"range\"\n");
+    assert!(cert.join("certificate.json").exists());
+    assert!(
+        !cert.join("detection_bound.json").exists(),
+        "a stale detection_bound.json stays beside the new certificate"
+    );
+}
+
+/// When the power step tightened its eye-safety cuts (its figures are for
+/// a program with lowered limits), the text summary says so and does not
+/// call the answer "proven optimal" (the shipped `vls128_eye` once read
+/// "gap 2e-13" while a certified profile scored 0.5 % more).
+#[test]
+fn the_text_summary_states_an_eye_safety_tightening() {
+    let cfg = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/configs/vls128_eye.toml"
+    );
+    let args = ["profile", "--config", cfg, "--gaze-deg", "90"];
+    let json = run(&args, None);
+    assert_eq!(json.status.code(), Some(0), "{}", common::stderr(&json));
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let tightening = v["optimality"]["eye_safety_tightening"].as_f64();
+    let text = run(&[&args[..], &["--format", "text"]].concat(), None);
+    assert_eq!(text.status.code(), Some(0), "{}", common::stderr(&text));
+    let line = common::stdout(&text)
+        .lines()
+        .find(|l| l.starts_with("optimality"))
+        .unwrap()
+        .to_owned();
+    match tightening {
+        Some(f) => {
+            assert!(f > 1.0);
+            assert!(line.contains("eye-safety limits divided by"), "{line}");
+            assert!(!line.contains("proven optimal"), "{line}");
+        }
+        None => assert!(!line.contains("divided by"), "{line}"),
+    }
+}

@@ -1,0 +1,17 @@
+//! The optimizer (HiGHS): solves, certificates, the global bound, cuts, set-points, the random family and golden outputs.
+
+mod certificate;
+mod detection_certificate;
+mod detection_global;
+mod dwell_certificate;
+mod dwell_certificate_adversarial;
+mod edge_cases;
+mod eye_cuts;
+mod eye_cuts_adversarial;
+mod family;
+mod global_adversarial;
+mod golden;
+mod head;
+mod setpoints;
+mod solve;
+mod units;
