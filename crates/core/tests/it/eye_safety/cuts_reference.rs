@@ -154,6 +154,23 @@ fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= REL * a.abs().max(b.abs())
 }
 
+/// Absolute tolerance on a window's ends, in units of `f64::EPSILON` times
+/// the frame. A window end is a difference of times within the frame (the
+/// last pulse of a whole-frame pass to the next pass's first is
+/// `T_f − (K − 1)·Δ`, the pass's slack): where it is many decades below the
+/// frame, the code's and the reference's frames, equal up to their last
+/// bits, differ in it by far more than `REL` of its size (a slack of
+/// 1.8 µs in a 64 ms frame: 2 ulps of the frame are 8e-12 of it). A few
+/// ulps of the frame stay far below the windows' own margin
+/// (`COUNT_INSIDE` = 1e-9 of a window of 1 µs is 1e-15 s, this 5e-16 s at
+/// a frame of 0.07 s), so a window without its margin is still caught.
+const WINDOW_FRAME_ULPS: f64 = 32.0;
+
+/// Window ends equal up to `REL` of their size or rounding of the frame.
+fn close_window(a: f64, b: f64, frame_s: f64) -> bool {
+    (a - b).abs() <= REL * a.abs().max(b.abs()) + WINDOW_FRAME_ULPS * f64::EPSILON * frame_s
+}
+
 /// What the reference derives for one profile.
 struct Reference {
     /// Runs within a pass and group cuts, keyed by their pulses.
@@ -320,6 +337,7 @@ fn compare(segs: &[Seg], half_deg: f64, laser: &Laser, extra: &[f64]) -> Result<
         return Ok(false);
     }
     let f_p = laser.pulse_rate_hz;
+    let frame_s = Profile::new(segs).frame_s();
     let p: Vec<f64> = segs.iter().map(|s| s.power_w).collect();
     let got = cuts(segs, half_deg, laser, extra, 0.0);
     let mut by_key: BTreeMap<Vec<(usize, u64)>, Vec<&Cut>> = BTreeMap::new();
@@ -370,8 +388,8 @@ fn compare(segs: &[Seg], half_deg: f64, laser: &Laser, extra: &[f64]) -> Result<
             .any(|es| {
                 es.iter().any(|e| {
                     close(c.limit_j, e.limit_j)
-                        && close(c.window_s.0, e.window_s.0)
-                        && close(c.window_s.1, e.window_s.1)
+                        && close_window(c.window_s.0, e.window_s.0, frame_s)
+                        && close_window(c.window_s.1, e.window_s.1, frame_s)
                 })
             });
         if !found {
