@@ -1411,7 +1411,9 @@ mod drive;
 fn a_signal_removes_the_temporary_output() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("drive.mcap");
-    drive::write_bag(std::fs::File::create(&input).unwrap(), 3).unwrap();
+    // Six seconds of drive (≈ 300 MB of clouds): the replay runs far longer
+    // than the wait for its first output bytes below, even on a free machine.
+    drive::write_bag(std::fs::File::create(&input).unwrap(), 6).unwrap();
     let out = dir.path().join("out.mcap");
     std::fs::write(&out, b"old").unwrap();
     let temps = || -> Vec<String> {
@@ -1446,14 +1448,21 @@ fn a_signal_removes_the_temporary_output() {
             .stderr(std::process::Stdio::piped())
             .spawn()
             .unwrap();
-        // Wait for the temporary file, then for some output in it.
+        // Wait for the temporary file and for some output in it.
         let start = std::time::Instant::now();
-        while temps().is_empty() {
-            assert!(start.elapsed().as_secs() < 60, "no temporary file");
+        let written = || {
+            temps()
+                .iter()
+                .any(|n| std::fs::metadata(dir.path().join(n)).is_ok_and(|m| m.len() > 0))
+        };
+        while !written() {
+            assert!(
+                start.elapsed().as_secs() < 60,
+                "no output in a temporary file"
+            );
             assert!(child.try_wait().unwrap().is_none(), "finished too early");
-            std::thread::sleep(std::time::Duration::from_millis(5));
+            std::thread::sleep(std::time::Duration::from_millis(2));
         }
-        std::thread::sleep(std::time::Duration::from_millis(150));
         assert!(
             child.try_wait().unwrap().is_none(),
             "finished before the signal"
