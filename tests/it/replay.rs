@@ -1409,6 +1409,7 @@ mod drive;
 /// it was.
 #[test]
 fn a_signal_removes_the_temporary_output() {
+    use std::os::unix::process::CommandExt;
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("drive.mcap");
     // Six seconds of drive (≈ 300 MB of clouds): the replay runs far longer
@@ -1434,8 +1435,8 @@ fn a_signal_removes_the_temporary_output() {
         ("XFSZ", 153),
         ("VTALRM", 154),
     ] {
-        let mut child = bin()
-            .arg("replay")
+        let mut cmd = bin();
+        cmd.arg("replay")
             .arg(&input)
             .args([
                 "--gaze-topic",
@@ -1445,9 +1446,35 @@ fn a_signal_removes_the_temporary_output() {
             ])
             .args(["--preset", "vls128", "--out"])
             .arg(&out)
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
+            .stderr(std::process::Stdio::piped());
+        // A runner that started these tests with a signal ignored (a
+        // non-interactive shell's background job ignores INT and QUIT) passes
+        // that on, and the replay keeps a signal ignored at start: the child
+        // starts with every tested signal at its default action, so the test
+        // is of the replay's handler whoever runs it.
+        let tested: Vec<i32> = [
+            libc::SIGINT,
+            libc::SIGTERM,
+            libc::SIGHUP,
+            libc::SIGQUIT,
+            libc::SIGUSR1,
+            libc::SIGUSR2,
+            libc::SIGALRM,
+            libc::SIGXFSZ,
+            libc::SIGVTALRM,
+        ]
+        .to_vec();
+        // SAFETY: the closure runs in the forked child before exec and only
+        // calls `signal`, which is async-signal-safe.
+        unsafe {
+            cmd.pre_exec(move || {
+                for &s in &tested {
+                    libc::signal(s, libc::SIG_DFL);
+                }
+                Ok(())
+            });
+        }
+        let mut child = cmd.spawn().unwrap();
         // Wait for the temporary file and for some output in it.
         let start = std::time::Instant::now();
         let written = || {
