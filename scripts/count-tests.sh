@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Counts, over the integration tests (tests/ and crates/core/tests/, every .rs
-# file below them, data dirs included if they hold .rs):
+# file below them, data dirs included if they hold .rs) and the fixtures and
+# references they share (crates/core/src/testing/):
 #   tests      = `#[test]` attributes (proptest fns inside `proptest!` carry one)
 #   assertions = calls of assert!, assert_eq!, assert_ne!, prop_assert!,
 #                prop_assert_eq!, prop_assert_ne!, assert_relative_eq!,
@@ -11,7 +12,7 @@
 # Comments (// ...) are excluded from every count.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-files=$(find tests crates/core/tests -name '*.rs' | sort)
+files=$(find tests crates/core/tests crates/core/src/testing -name '*.rs' | sort)
 strip() { sed -E 's#//.*$##' $files; }
 echo "files:      $(echo "$files" | wc -l)"
 echo "tests:      $(strip | grep -oE '#\[test\]' | wc -l)"

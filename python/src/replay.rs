@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 
 use gaze_lidar::pipeline::PipelineOptions;
 use gaze_lidar::replay::{
-    replay_file, Compression, GazeKind, ReplayError, ReplayOptions, MAX_BINS,
+    reorder_window_ns, replay_file, Compression, GazeKind, ReplayError, ReplayOptions, MAX_BINS,
 };
 
 use super::{
@@ -120,13 +120,7 @@ pub fn replay<'py>(
         }
         .config()
         .map_err(|e| pipeline_error(py, e))?;
-        if !(gaze_lidar::model::valid::finite(reorder_window_ms).is_ok()
-            && (0.0..=60_000.0).contains(&reorder_window_ms))
-        {
-            return Err(value_error(format!(
-                "reorder_window_ms: {reorder_window_ms} must lie in 0..=60000"
-            )));
-        }
+        let window_ns = reorder_window_ns(reorder_window_ms).map_err(|e| replay_error(py, e))?;
         let rated_range_m = match rated_range_m {
             Some(r) => in_range("rated_range_m", r, 0.0, 1e7)?,
             None => preset_range_m,
@@ -148,7 +142,7 @@ pub fn replay<'py>(
         opts.cloud.fog_mor_m = fog_mor_m;
         opts.cloud.seed = seed_of(seed)?;
         opts.cloud.cloud_spin_rad_s = cloud_spin_rad_s;
-        opts.reorder_window_ns = (reorder_window_ms * 1e6).round() as u64;
+        opts.reorder_window_ns = window_ns;
         opts.compression = match compression {
             "none" => Compression::None,
             "lz4" => Compression::Lz4,

@@ -9,11 +9,12 @@
 use std::path::PathBuf;
 
 use gaze_lidar::replay::{
-    replay_file_staged, replay_file_to, Compression, GazeKind, ReplayError, ReplayOptions, Staging,
+    reorder_window_ns, replay_file_staged, replay_file_to, Compression, GazeKind, ReplayError,
+    ReplayOptions, Staging,
 };
 use gaze_lidar::sim::returns::ModelKind;
 
-use super::args::{finite, finite_between};
+use super::args::finite_between;
 use super::gaze_args::{FilterArgs, PlanArgs};
 use super::CliError;
 
@@ -185,12 +186,7 @@ fn ignored_signals() -> u64 {
 
 pub fn run(a: &Args) -> Result<u8, CliError> {
     let pipeline = a.filter.settings()?;
-    let window_ms = finite("--reorder-window-ms", a.reorder_window_ms)?;
-    if !(0.0..=60_000.0).contains(&window_ms) {
-        return Err(CliError::input(format!(
-            "--reorder-window-ms: {window_ms} must lie in 0..=60000"
-        )));
-    }
+    let window_ns = reorder_window_ns(a.reorder_window_ms).map_err(replay_error)?;
     if let Some(b) = a.plan.bins.filter(|&b| b > MAX_REPLAY_BINS) {
         return Err(CliError::input(format!(
             "--bins: {b} is more than replay's {MAX_REPLAY_BINS} (each frame's profile is written to the output, ~240 bytes per bin)"
@@ -224,7 +220,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     opts.cloud.fog_mor_m = a.fog_mor_m;
     opts.cloud.seed = a.seed;
     opts.cloud.cloud_spin_rad_s = a.cloud_spin_rad_s;
-    opts.reorder_window_ns = (window_ms * 1e6).round() as u64;
+    opts.reorder_window_ns = window_ns;
     opts.compression = match a.compression {
         CompressionArg::None => Compression::None,
         CompressionArg::Lz4 => Compression::Lz4,
@@ -257,7 +253,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     if stats.late_gaze > 0 || stats.late_clouds > 0 {
         super::io::warn(format!(
             "warning: messages more than --reorder-window-ms ({2} ms) behind newer ones in the file's record order: {0} gaze sample(s) dropped, {1} cloud(s) outside the remembered frames given the baseline (the data section is read in record order; sort the bag by log_time or widen the window)",
-            stats.late_gaze, stats.late_clouds, window_ms
+            stats.late_gaze, stats.late_clouds, a.reorder_window_ms
         ));
     }
     if let Some(frame) = &stats.gaze_frame_without_tf {

@@ -1,5 +1,5 @@
 //! The optimizer's typed errors: why a request cannot be met
-//! ([`Infeasible`], exit 1) and why a program's answer carries no exact
+//! ([`Infeasible`]) and why a program's answer carries no exact
 //! certificate ([`CertificateError`]). Their messages are the ones the
 //! command line prints.
 

@@ -165,7 +165,7 @@ pub struct Problem {
 /// Why no certified profile came out.
 #[derive(Debug, Error)]
 pub enum OptError {
-    /// Bad configuration or argument (exit 2).
+    /// Bad configuration or argument: an input fault.
     #[error("{field}: {reason}")]
     Invalid {
         /// Key.
@@ -173,7 +173,7 @@ pub enum OptError {
         /// Why.
         reason: String,
     },
-    /// The limits cannot all be met (exit 1); says which.
+    /// The limits cannot all be met (infeasible); says which.
     #[error("infeasible: {0}")]
     Infeasible(#[from] Infeasible),
     /// HiGHS failed.
@@ -185,7 +185,7 @@ pub enum OptError {
 }
 
 impl OptError {
-    /// Input fault (exit 2) rather than infeasibility (exit 1).
+    /// An input fault rather than infeasibility.
     #[must_use]
     pub fn is_input_error(&self) -> bool {
         matches!(self, Self::Invalid { .. })

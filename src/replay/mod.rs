@@ -962,6 +962,16 @@ impl<P: FramePlanner, W: Write + Seek> Replayer<'_, P, W> {
 /// Largest reorder window, ns.
 pub const MAX_REORDER_WINDOW_NS: u64 = 60_000_000_000;
 
+/// A reorder window given in milliseconds, as
+/// [`ReplayOptions::reorder_window_ns`] (rounded to the nearest
+/// nanosecond): `ms` passes the one numeric boundary and lies in
+/// `0..=60000` ([`MAX_REORDER_WINDOW_NS`]), else a [`ReplayError::Config`]
+/// naming `reorder_window_ms`. The CLI and Python read the option through it.
+pub fn reorder_window_ns(ms: f64) -> Result<u64, ReplayError> {
+    let ms = in_range("reorder_window_ms", ms, 0.0, 60_000.0)?;
+    Ok((ms * 1e6).round() as u64)
+}
+
 /// Most bins of a replayed profile: each frame's profile@1 document is
 /// written to the output (about 240 bytes of JSON per bin: 1440 bins are
 /// some 340 KB per frame, 3.4 MB/s at 10 Hz, already more than the

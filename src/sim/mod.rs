@@ -72,7 +72,7 @@ pub enum SimError {
     Optimizer {
         /// What is wrong (names the key or the limit).
         message: String,
-        /// A configuration fault (exit 2) rather than infeasibility (exit 1).
+        /// A configuration (input) fault rather than infeasibility.
         input: bool,
     },
 }
@@ -106,7 +106,7 @@ pub enum Conflict {
 }
 
 impl SimError {
-    /// Input fault (exit 2) rather than infeasibility (exit 1).
+    /// An input fault rather than infeasibility.
     #[must_use]
     pub fn is_input_error(&self) -> bool {
         match self {

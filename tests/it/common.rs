@@ -58,6 +58,25 @@ pub fn expect(o: &Output, code: i32, needles: &[&str], what: &str) {
     }
 }
 
+/// The smallest `simulate` run: one trial of the argus model's baseline
+/// variant without fog.
+pub const TINY_SIM: [&str; 9] = [
+    "simulate",
+    "--trials",
+    "1",
+    "--model",
+    "argus",
+    "--variant",
+    "baseline",
+    "--fog",
+    "0",
+];
+
+/// [`TINY_SIM`] followed by `extra`.
+pub fn tiny_sim<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    [&TINY_SIM[..], extra].concat()
+}
+
 /// Stdout as text.
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()

@@ -6,7 +6,7 @@
 //! code with `gaze_lidar::checker`: its own kinematics (constant angular
 //! acceleration inside a bin: dwell = 2·Δθ/(ω₀+ω₁), α = (ω₁²−ω₀²)/(2·Δθ)),
 //! its own sums and its own tolerance. Eye safety is the business of the
-//! brute-force reference (`crates/core/tests/it/reference.rs`), see [`reference_ratio`].
+//! brute-force reference (`crates/core/src/testing/reference.rs`), see [`reference_ratio`].
 
 #![allow(dead_code)]
 

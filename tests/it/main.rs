@@ -2,7 +2,9 @@
 //! module per subject. A test of X goes in X's subject module (each opens with
 //! a line saying what belongs there); a test that guards a fixed bug of the
 //! command line goes in `regression`, citing what it guards. The fixtures
-//! shared by several modules are the modules at the end.
+//! shared by several modules are the modules at the end; those shared with
+//! the core's tests (and the brute-force eye-safety references) are
+//! `gaze_lidar_core::testing`.
 
 mod checker;
 mod cli_inputs;
@@ -21,9 +23,5 @@ mod traceability;
 #[path = "../../benches/common/big_profile.rs"]
 mod big_profile;
 mod common;
-#[path = "../../crates/core/tests/it/eye_cases.rs"]
-mod eye_cases;
 mod independent;
 mod mps;
-#[path = "../../crates/core/tests/it/reference.rs"]
-mod reference;

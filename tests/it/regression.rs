@@ -526,21 +526,7 @@ fn an_output_never_replaces_an_input() {
     std::fs::hard_link(&scenario, &hard).unwrap();
     let sim = |flag: &str, out: &Path| {
         run(
-            &[
-                "simulate",
-                "--trials",
-                "1",
-                "--model",
-                "argus",
-                "--variant",
-                "baseline",
-                "--fog",
-                "0",
-                "--scenario",
-                s(&scenario),
-                flag,
-                s(out),
-            ],
+            &common::tiny_sim(&["--scenario", s(&scenario), flag, s(out)]),
             None,
         )
     };
@@ -612,29 +598,8 @@ fn an_output_never_replaces_an_input() {
     assert!(stray.is_empty(), "{stray:?}");
 }
 
-fn tiny_sim(extra: &[&str]) -> Vec<String> {
-    let mut v: Vec<String> = [
-        "simulate",
-        "--trials",
-        "1",
-        "--model",
-        "argus",
-        "--variant",
-        "baseline",
-        "--fog",
-        "0",
-    ]
-    .iter()
-    .map(|x| (*x).to_owned())
-    .collect();
-    v.extend(extra.iter().map(|x| (*x).to_owned()));
-    v
-}
-
 fn run_sim(extra: &[&str]) -> std::process::Output {
-    let args = tiny_sim(extra);
-    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-    run(&refs, None)
+    run(&common::tiny_sim(extra), None)
 }
 
 /// Regression: before the fix, with `pl/density_argus.svg` a folder, the run exited 1

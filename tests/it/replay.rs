@@ -57,6 +57,24 @@ fn cloud_msg(sec: i32, nanosec: u32, seed: u64, n: usize) -> Vec<u8> {
     w.finish()
 }
 
+/// A channel on `topic` of the ROS 2 message type `ty` (its `ros2msg`
+/// schema, CDR encoding, no metadata).
+fn channel<W: std::io::Write + std::io::Seek>(
+    w: &mut mcap::Writer<W>,
+    topic: &str,
+    ty: &str,
+) -> u16 {
+    let s = w
+        .add_schema(
+            ty,
+            schemas::ROS2MSG,
+            schemas::ros2msg(ty).unwrap().as_bytes(),
+        )
+        .unwrap();
+    w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
+        .unwrap()
+}
+
 /// Clouds at 10 Hz for 3 s, gaze at 100 Hz looking left with a gap from
 /// 1.0 s to 1.5 s, an unrelated topic at 2 Hz; one gaze sample written out
 /// of order and one duplicate timestamp.
@@ -68,20 +86,9 @@ fn bag(compression: Option<mcap::Compression>) -> Vec<u8> {
         .profile("ros2")
         .create(Cursor::new(&mut buf))
         .unwrap();
-    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
-        let s = w
-            .add_schema(
-                ty,
-                schemas::ROS2MSG,
-                schemas::ros2msg(ty).unwrap().as_bytes(),
-            )
-            .unwrap();
-        w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
-            .unwrap()
-    };
-    let g = chan(&mut w, GAZE, schemas::VECTOR3_STAMPED);
-    let c = chan(&mut w, CLOUD, schemas::POINT_CLOUD2);
-    let o = chan(&mut w, OTHER, schemas::STRING);
+    let g = channel(&mut w, GAZE, schemas::VECTOR3_STAMPED);
+    let c = channel(&mut w, CLOUD, schemas::POINT_CLOUD2);
+    let o = channel(&mut w, OTHER, schemas::STRING);
     let t0: u64 = 1_700_000_000_000_000_000;
     let mut msgs: Vec<(u64, u16, Vec<u8>)> = Vec::new();
     for k in 0..300u64 {
@@ -440,20 +447,9 @@ fn tf_bag(mounts: &[(&str, &str, [f64; 4])]) -> Vec<u8> {
         .compression(None)
         .create(Cursor::new(&mut buf))
         .unwrap();
-    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
-        let s = w
-            .add_schema(
-                ty,
-                schemas::ROS2MSG,
-                schemas::ros2msg(ty).unwrap().as_bytes(),
-            )
-            .unwrap();
-        w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
-            .unwrap()
-    };
-    let tf = chan(&mut w, "/tf_static", schemas::TF_MESSAGE);
-    let g = chan(&mut w, "/yaw", schemas::FLOAT64);
-    let c = chan(&mut w, CLOUD, schemas::POINT_CLOUD2);
+    let tf = channel(&mut w, "/tf_static", schemas::TF_MESSAGE);
+    let g = channel(&mut w, "/yaw", schemas::FLOAT64);
+    let c = channel(&mut w, CLOUD, schemas::POINT_CLOUD2);
     let t0: u64 = 5_000_000_000;
     let transforms: Vec<cdr::TransformStamped> = mounts
         .iter()
@@ -700,19 +696,8 @@ fn float64_yaw_gaze_and_a_mounting_yaw() {
         .compression(None)
         .create(Cursor::new(&mut buf))
         .unwrap();
-    let chan = |w: &mut mcap::Writer<_>, topic: &str, ty: &str| {
-        let s = w
-            .add_schema(
-                ty,
-                schemas::ROS2MSG,
-                schemas::ros2msg(ty).unwrap().as_bytes(),
-            )
-            .unwrap();
-        w.add_channel(s, topic, schemas::CDR, &BTreeMap::new())
-            .unwrap()
-    };
-    let g = chan(&mut w, "/yaw", schemas::FLOAT64);
-    let c = chan(&mut w, CLOUD, schemas::POINT_CLOUD2);
+    let g = channel(&mut w, "/yaw", schemas::FLOAT64);
+    let c = channel(&mut w, CLOUD, schemas::POINT_CLOUD2);
     let t0: u64 = 5_000_000_000;
     for k in 0..100u64 {
         let t = t0 + k * 10_000_000;

@@ -24,6 +24,9 @@
 //! the linear constraints the optimizer builds from the bound); all on by
 //! default. A vendor who only certifies takes `default-features = false,
 //! features = ["json"]`; without `std` the firmware checker builds `no_std`.
+//! A fourth feature, `testing`, off by default and enabled only by the
+//! tests' dev-dependencies, adds the shared test fixtures and brute-force
+//! references (`testing`); no certifying build contains them.
 //!
 //! ## Start here
 //!
@@ -56,6 +59,8 @@ pub mod firmware;
 pub mod model;
 #[cfg(feature = "std")]
 pub mod profile;
+#[cfg(feature = "testing")]
+pub mod testing;
 pub mod text;
 #[doc(hidden)]
 pub mod verification;

@@ -77,24 +77,9 @@ fn run_into_head(args: &[&str], head: &str) -> (i32, String) {
     (code, std::fs::read_to_string(err.path()).unwrap())
 }
 
-const TINY_SIM: [&str; 10] = [
-    "simulate",
-    "--trials",
-    "1",
-    "--model",
-    "argus",
-    "--variant",
-    "baseline",
-    "--fog",
-    "0",
-    "--seed",
-];
-
+/// [`common::tiny_sim`] at seed 3.
 fn tiny_sim<'a>(extra: &[&'a str]) -> Vec<&'a str> {
-    let mut v: Vec<&str> = TINY_SIM.to_vec();
-    v.push("3");
-    v.extend_from_slice(extra);
-    v
+    common::tiny_sim(&[&["--seed", "3"][..], extra].concat())
 }
 
 #[test]

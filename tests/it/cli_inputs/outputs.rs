@@ -371,25 +371,13 @@ fn simulate_outputs_on_a_full_disk_change_nothing() {
     std::fs::write(disk.path("rows.csv"), "old csv").unwrap();
     std::fs::create_dir(disk.path("pl")).unwrap();
     std::fs::write(disk.path("pl/tta_argus.svg"), "old svg").unwrap();
-    let tiny = [
-        "simulate",
-        "--trials",
-        "1",
-        "--model",
-        "argus",
-        "--variant",
-        "baseline",
-        "--fog",
-        "0",
-    ];
     for extra in [
         &["--export-json", "rows.json", "--export-csv", "rows.csv"][..],
         &["--trials-csv", "trials.csv", "--report", "report.md"][..],
         &["--plots", "pl", "--export-json", "rows.json"][..],
         &["--plots", "new/plots"][..],
     ] {
-        let mut args = tiny.to_vec();
-        args.extend_from_slice(extra);
+        let args = common::tiny_sim(extra);
         let o = fails_on_full_disk(&disk, &args, &format!("{extra:?}"));
         assert!(o.stdout.is_empty(), "{extra:?}: the table was printed");
     }

@@ -1,7 +1,7 @@
 //! AEL figures, per-azimuth exposure, check integration.
 
 use crate::common;
-use crate::reference;
+use gaze_lidar_core::testing::reference;
 
 use common::{assert_bad_input, run, stdout};
 use gaze_lidar::checker::{certify, check, Violation};

@@ -8,7 +8,7 @@
 
 use crate::big_profile;
 use crate::common;
-use crate::eye_cases;
+use gaze_lidar_core::testing::eye_cases;
 
 use eye_cases::{ael_step_cases, constructed};
 use gaze_lidar::eye_safety::bound::Search;

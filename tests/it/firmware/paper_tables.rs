@@ -2,7 +2,7 @@
 
 use crate::common;
 use crate::independent;
-use crate::reference;
+use gaze_lidar_core::testing::reference;
 
 use common::{run, stdout};
 use gaze_lidar::firmware::{binary, check_table, FirmwareTable};

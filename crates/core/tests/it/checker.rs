@@ -16,46 +16,26 @@ const N: usize = 36;
 const FRAME_HZ: f64 = 10.0;
 const POWER_W: f64 = 1e-4;
 
-use crate::common::params;
+use gaze_lidar_core::testing::{self, params};
 
+/// Power 0.5e-4–2e-4 W, spin 50–80 rad/s, acceleration ≤ 1e4 rad/s², slew
+/// ≤ 1e-5 W/deg, the usual beam.
 fn limits() -> Limits {
     Limits {
-        power_w_min: 0.5e-4,
-        power_w_max: 2e-4,
-        spin_rad_s_min: 50.0,
-        spin_rad_s_max: 80.0,
         spin_accel_rad_s2_max: Some(1e4),
         power_slew_w_per_deg_max: Some(1e-5),
-        eye_safety: Some(params()),
+        ..testing::limits((0.5e-4, 2e-4), (50.0, 80.0))
     }
 }
 
-/// 36 bins of 10° at `POWER_W`, constant spin 2π·10 rad/s (one turn in 0.1 s).
+/// 36 bins of 10° at `POWER_W`, constant spin 2π·10 rad/s (one turn in
+/// 0.1 s), the first six in the region of interest.
 fn uniform() -> Profile {
-    let w = TAU * FRAME_HZ;
-    Profile {
-        format: PROFILE_FORMAT.to_owned(),
-        frame_rate_hz: FRAME_HZ,
-        pulse_rate_hz: 20_000.0,
-        average_power_w: POWER_W,
-        power_accounting: PowerAccounting::Angle,
-        gaze_deg: None,
-        limits: limits(),
-        bins: (0..N)
-            .map(|i| Bin {
-                start_deg: 10.0 * i as f64,
-                width_deg: 10.0,
-                power_w: POWER_W,
-                spin_start_rad_s: w,
-                spin_end_rad_s: w,
-                region: (i < 6).then_some(Region::Rof),
-                dwell_s: None,
-            })
-            .collect(),
-        mode: None,
-        summary: None,
-        optimality: None,
+    let mut p = testing::uniform(N, FRAME_HZ, POWER_W, PowerAccounting::Angle, limits());
+    for b in &mut p.bins[..6] {
+        b.region = Some(Region::Rof);
     }
+    p
 }
 
 fn sensor() -> LidarSpec {

@@ -1,7 +1,8 @@
 //! The core's integration tests: one binary, one module per subject. A test
 //! of X goes in X's subject module (each opens with a line saying what
 //! belongs there); the fixtures and brute-force references it shares with
-//! other modules are the modules at the end.
+//! other modules are the modules at the end (fixtures and references both
+//! crates' tests share are in `gaze_lidar_core::testing`).
 
 mod checker;
 mod eye_safety;
@@ -9,9 +10,6 @@ mod firmware;
 mod mutant_kills;
 mod profile;
 
-// Shared fixtures and brute-force references.
-mod common;
-mod eye_cases;
+// Definitions references only this crate's tests use.
 mod head_oracle_defs;
-mod reference;
 mod reference_defs;

@@ -53,13 +53,8 @@ fn profile() -> Profile {
         power_accounting: PowerAccounting::Angle,
         gaze_deg: Some(12.5),
         limits: Limits {
-            power_w_min: 0.5e-4,
-            power_w_max: 2e-4,
-            spin_rad_s_min: 50.0,
-            spin_rad_s_max: 80.0,
-            spin_accel_rad_s2_max: None,
-            power_slew_w_per_deg_max: None,
             eye_safety: None,
+            ..gaze_lidar_core::testing::limits((0.5e-4, 2e-4), (50.0, 80.0))
         },
         bins: vec![bin(0.0, 360.0, 62.5, 62.5)],
         mode: Some("test".into()),

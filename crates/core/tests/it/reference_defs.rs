@@ -1,7 +1,7 @@
 //! Second brute-force reference for the Class 1 rules of a scanned, pulsed
 //! beam, written from the standard's **definitions** (IEC 60825-1:2014:
 //! Table 3, Table 10, C5 and T_i, read row by row), not from the bound nor from the first
-//! reference (`tests/it/reference.rs`): it shares no code and no modelling
+//! reference (`crates/core/src/testing/reference.rs`): it shares no code and no modelling
 //! shortcut with either.
 //!
 //! - **Explicit pulse trains.** Every pulse is a clock tick `t0 + k/f_p`

@@ -10,7 +10,7 @@ use gaze_lidar_core::eye_safety::bound::Seg;
 use gaze_lidar_core::eye_safety::{ael_report, evaluate_segments};
 use std::f64::consts::TAU;
 
-use crate::common::params_at as params;
+use gaze_lidar_core::testing::params_at as params;
 
 /// The assumption behind taking the 1400–1500 nm rows at 1500.0 and
 /// 1800.0 nm: they are at most the 1500–1800 nm rows at every duration of

@@ -8,8 +8,7 @@ use gaze_lidar_core::eye_safety::bound::{evaluate, Laser, Rule, Seg};
 use gaze_lidar_core::eye_safety::cuts::cuts;
 use proptest::prelude::*;
 
-use crate::common;
-use common::profile;
+use gaze_lidar_core::testing::segments;
 
 fn powers(segs: &[Seg]) -> Vec<f64> {
     segs.iter().map(|s| s.power_w).collect()
@@ -42,7 +41,7 @@ proptest! {
         half_deg in 0.05f64..5.0,
         extra in 0.0f64..360.0,
     ) {
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         // Pulses never overlap (the model's validation): f_p·t_pulse < 1.
         let f_p = f_p.min(0.9 / pulse_s);
         let laser = Laser { band, c4: 1.0, pulse_duration_s: pulse_s, pulse_rate_hz: f_p };
@@ -68,7 +67,7 @@ proptest! {
         half_deg in 0.05f64..5.0,
         share in 0.0f64..1.2,
     ) {
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
         let p = powers(&segs);
         let all = cuts(&segs, half_deg, &laser, &[], 0.0);
@@ -97,7 +96,7 @@ proptest! {
         half_deg in 0.05f64..5.0,
         above in 1.0f64..3.0,
     ) {
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
         let w_max = segs
             .iter()
@@ -122,7 +121,7 @@ proptest! {
         half_deg in 0.05f64..5.0,
     ) {
         let bins: Vec<(f64, f64, f64, bool)> = p.iter().map(|&q| (1.0, q, spin, false)).collect();
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
         let b = evaluate(&segs, half_deg, &laser);
         prop_assume!(b.ratios[0] > 0.0);
@@ -222,7 +221,7 @@ proptest! {
         kind in 0usize..3,
         share in prop_oneof![0.0f64..1.2, 0.999f64..1.0],
     ) {
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         let spin = segs.iter().map(|s| s.spin_start_rad_s).sum::<f64>() / segs.len() as f64;
         let f_p = (pulses * spin / (2.0 * half_deg).to_radians()).min(2e7);
         let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
@@ -259,7 +258,7 @@ proptest! {
         half_deg in 0.05f64..5.0,
         share in prop_oneof![0.0f64..1.2, Just(1.0)],
     ) {
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
         let p = powers(&segs);
         let single = gaze_lidar_core::eye_safety::cuts::cuts_with(&segs, half_deg, &laser, &[], f64::INFINITY, 0.0);

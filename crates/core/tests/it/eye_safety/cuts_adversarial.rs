@@ -11,8 +11,7 @@ use gaze_lidar_core::eye_safety::bound::{evaluate, Laser, Seg};
 use gaze_lidar_core::eye_safety::cuts::cuts;
 use proptest::prelude::*;
 
-use crate::common;
-use common::profile;
+use gaze_lidar_core::testing::segments;
 
 fn cases() -> u32 {
     std::env::var("GAZE_LIDAR_CUTS_CASES")
@@ -62,7 +61,7 @@ proptest! {
         half_deg in prop_oneof![log_uniform(1e-4, 400.0), Just(180.0), Just(360.0), Just(90.0)],
         extra in 0.0f64..360.0,
     ) {
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         let pulse_s = pulse_s.min(0.9 / f_p);
         let laser = Laser { band, c4: 1.0, pulse_duration_s: pulse_s, pulse_rate_hz: f_p };
         let (r, what) = worst_excess(&segs, half_deg, &laser, &[extra]);
@@ -82,7 +81,7 @@ proptest! {
         half_deg in log_uniform(0.005, 10.0),
         band in prop_oneof![Just(Band::RetinalNir), Just(Band::Ir1400), Just(Band::Ir1500)],
     ) {
-        let segs = profile(&bins);
+        let segs = segments(&bins);
         let laser = Laser { band, c4: 1.0, pulse_duration_s: 5e-9, pulse_rate_hz: f_p };
         let (r, what) = worst_excess(&segs, half_deg, &laser, &[]);
         prop_assert!(r <= 1.0, "cut over the bound by {r}: {what}");
@@ -110,7 +109,7 @@ proptest! {
             .enumerate()
             .map(|(i, &(w, p))| (w, p, spin * (1.0 + 0.3 * (i % 2) as f64), accel))
             .collect();
-        let segs = profile(&b);
+        let segs = segments(&b);
         let laser = Laser { band, c4: 1.0, pulse_duration_s: 1e-9, pulse_rate_hz: f_p };
         let (r, what) = worst_excess(&segs, half_deg, &laser, &[]);
         prop_assert!(r <= 1.0, "cut over the bound by {r}: {what}");
@@ -134,7 +133,7 @@ proptest! {
         let half_deg = 0.5 * (spin * k / f_p).to_degrees();
         let b: Vec<(f64, f64, f64, bool)> =
             bins.iter().map(|&(w, p, s, a)| (w, p, spin * s, a)).collect();
-        let segs = profile(&b);
+        let segs = segments(&b);
         let pulse_s = pulse_frac / f_p;
         let laser = Laser { band: Band::RetinalNir, c4: 1.0, pulse_duration_s: pulse_s, pulse_rate_hz: f_p };
         let (r, what) = worst_excess(&segs, half_deg, &laser, &[]);
@@ -325,7 +324,7 @@ fn timing_of_cuts_against_the_bound() {
                 )
             })
             .collect();
-        let segs = profile(&b);
+        let segs = segments(&b);
         let laser = Laser {
             band: Band::RetinalNir,
             c4,

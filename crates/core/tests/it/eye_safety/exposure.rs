@@ -5,11 +5,11 @@
 use gaze_lidar_core::eye_safety::bound::Seg;
 use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg, segments};
 use gaze_lidar_core::eye_safety::{evaluate_profile, evaluate_segments, EyeSafetyParams};
-use gaze_lidar_core::model::lidar::{Limits, PowerAccounting};
+use gaze_lidar_core::model::lidar::PowerAccounting;
 use gaze_lidar_core::profile::{Bin, Profile, PROFILE_FORMAT};
 use std::f64::consts::TAU;
 
-use crate::common::params;
+use gaze_lidar_core::testing::{self, params, params_at};
 
 /// `n` equal bins at 10 Hz; bin `i` at `power(i)`.
 fn segs(n: usize, power: impl Fn(usize) -> f64) -> Vec<Seg> {
@@ -49,12 +49,7 @@ fn pass_angle_is_aperture_plus_beam_over_100_mm() {
     // 905 nm: 7 mm aperture + 8 mm beam at 100 mm.
     let expected = (15.0f64 / 100.0).to_degrees();
     assert!((pass_angle_deg(&params(), &l) - expected).abs() < 1e-12);
-    let p1550 = EyeSafetyParams {
-        wavelength_nm: 1550.0,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm: 1.5,
-        head: None,
-    };
+    let p1550 = params_at(1550.0, 1.5);
     let l = laser(&p1550, 20_000.0).unwrap();
     // 1550 nm: Table 10's largest aperture, 1.5·10^0.375 = 3.5571 mm, + 1.5 mm.
     let expected = ((1.5 * 10f64.powf(0.375) + 1.5) / 100.0).to_degrees();
@@ -143,15 +138,7 @@ fn a_profile_is_read_as_its_segments_at_its_pulse_rate() {
         average_power_w: 1.0,
         power_accounting: PowerAccounting::Angle,
         gaze_deg: None,
-        limits: Limits {
-            power_w_min: 0.0,
-            power_w_max: 1.0,
-            spin_rad_s_min: 0.0,
-            spin_rad_s_max: 1e3,
-            spin_accel_rad_s2_max: None,
-            power_slew_w_per_deg_max: None,
-            eye_safety: Some(params()),
-        },
+        limits: testing::limits((0.0, 1.0), (0.0, 1e3)),
         bins: s
             .iter()
             .map(|x| Bin {
@@ -226,12 +213,7 @@ fn pass_energy_is_capped_per_bin() {
 fn eye_safety_params_are_validated_at_their_edges() {
     use gaze_lidar_core::eye_safety::ael::Band;
     use gaze_lidar_core::eye_safety::EyeSafetyError;
-    let with = |wavelength_nm: f64, beam_diameter_mm: f64| EyeSafetyParams {
-        wavelength_nm,
-        pulse_duration_s: 5e-9,
-        beam_diameter_mm,
-        head: None,
-    };
+    let with = params_at;
     // Bands by Table 3's wavelength ranges.
     assert_eq!(with(905.0, 8.0).validate(), Ok(Band::RetinalNir));
     assert_eq!(with(1450.0, 8.0).validate(), Ok(Band::Ir1400));

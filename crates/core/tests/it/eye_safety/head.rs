@@ -5,7 +5,7 @@
 //!
 //! Run: `cargo test --release -p gaze-lidar-core --test head`.
 
-use crate::eye_cases;
+use gaze_lidar_core::testing::eye_cases;
 
 use gaze_lidar_core::eye_safety::bound::Seg;
 use gaze_lidar_core::eye_safety::head::{power_scale_to_certify, Channel, Head};

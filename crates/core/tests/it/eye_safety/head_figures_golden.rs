@@ -29,7 +29,7 @@
 //! Regenerate the file (only when a figure is meant to change, saying why in
 //! the commit): `GAZE_LIDAR_GOLDEN_REGENERATE=1` with the same command.
 
-use crate::eye_cases;
+use gaze_lidar_core::testing::eye_cases;
 
 use gaze_lidar_core::eye_safety::bound::Seg;
 use gaze_lidar_core::eye_safety::head::{Channel, Head};

@@ -1,6 +1,6 @@
 #![allow(clippy::needless_range_loop)]
 //! Differential soundness test of the eye-safety checker against two
-//! independent brute-force references: `reference.rs` (explicit pulse runs,
+//! independent brute-force references: `testing::reference` (explicit pulse runs,
 //! windows between run boundaries, the AEL at the span of the pulses a
 //! window holds, its own copy of Table 3) and `reference_defs.rs` (written
 //! from the standard's definitions: explicit pulses, windows `[t, t + T)`
@@ -23,9 +23,9 @@
 //! `GAZE_LIDAR_REF_ONLY=<i>,<j>` runs only those cases of the stream and
 //! writes their profiles to `target/tmp/eye_safety_reference_case_<i>.json`.
 
-use crate::eye_cases;
-use crate::reference;
 use crate::reference_defs;
+use gaze_lidar_core::testing::eye_cases;
+use gaze_lidar_core::testing::reference;
 
 use eye_cases::{ael_step_cases, constructed, load, t_into};
 use gaze_lidar_core::eye_safety::bound::Search;
@@ -1103,4 +1103,33 @@ fn definitions_reference_tables_by_hand() {
     assert!(def_aperture_mm(DBand::Ir1500, 9.9) > 3.5);
     assert_eq!(def_aperture_mm(DBand::Ir1500, 10.0), 3.5);
     assert_eq!(def_aperture_mm(DBand::Nir, 1e-3), 7.0);
+}
+
+/// The brute-force reference and the hand-computed cases share no code with
+/// the model they check: the only items of the crate they name are the
+/// profile type they read and the test-data path.
+#[test]
+fn references_use_nothing_of_the_crate_but_the_profile_type() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/testing");
+    let allowed = ["crate::profile::Profile", "super::data_path"];
+    for file in ["reference.rs", "eye_cases.rs"] {
+        let text = std::fs::read_to_string(dir.join(file)).expect("reference source");
+        let mut named = 0;
+        for (i, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            let mut rest = code;
+            while let Some(at) = rest.find("crate::").or_else(|| rest.find("super::")) {
+                let path = &rest[at..];
+                assert!(
+                    allowed.iter().any(|a| path.starts_with(a)),
+                    "{file}:{}: names the crate's `{}`",
+                    i + 1,
+                    path.trim_end()
+                );
+                named += 1;
+                rest = &path[7..];
+            }
+        }
+        assert!(named > 0, "{file}: no path of the crate found (moved?)");
+    }
 }

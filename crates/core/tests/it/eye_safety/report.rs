@@ -112,15 +112,11 @@ fn stationary_rate_bounds() {
     assert!(ael_report(905.0, 5e-9, Some(f64::INFINITY)).is_err());
 }
 
+/// Power 0–1 W, spin 1–100 rad/s, no other limit, no eye safety.
 fn limits() -> Limits {
     Limits {
-        power_w_min: 0.0,
-        power_w_max: 1.0,
-        spin_rad_s_min: 1.0,
-        spin_rad_s_max: 100.0,
-        spin_accel_rad_s2_max: None,
-        power_slew_w_per_deg_max: None,
         eye_safety: None,
+        ..gaze_lidar_core::testing::limits((0.0, 1.0), (1.0, 100.0))
     }
 }
 

@@ -20,7 +20,7 @@ fn q(x: f64) -> BigRational {
     BigRational::from_float(x).unwrap()
 }
 
-use crate::common::params_at as params;
+use gaze_lidar_core::testing::params_at as params;
 
 fn seg(start_deg: f64, width_deg: f64, power_w: f64, spin_rad_s: f64) -> Seg {
     Seg {
@@ -218,13 +218,8 @@ fn near_stopped_profiles_are_rejected_naming_eye_safety() {
             power_accounting: PowerAccounting::Time,
             gaze_deg: None,
             limits: Limits {
-                power_w_min: 0.0,
-                power_w_max: 2.0 * p,
-                spin_rad_s_min: 1e-6,
-                spin_rad_s_max: 2.0 * fast,
-                spin_accel_rad_s2_max: None,
-                power_slew_w_per_deg_max: None,
                 eye_safety: Some(params(lambda, 0.5)),
+                ..gaze_lidar_core::testing::limits((0.0, 2.0 * p), (1e-6, 2.0 * fast))
             },
             bins,
             mode: None,

@@ -3,7 +3,7 @@
 //! `table_exposure` had no test inside the core crate). Expected tick counts,
 //! codes, bounds and budgets are worked out by hand in the comments.
 
-use crate::common;
+use gaze_lidar_core::testing;
 
 use gaze_lidar_core::checker::{certify, certify_with, CheckOptions};
 use gaze_lidar_core::eye_safety::bound::Seg;
@@ -14,7 +14,7 @@ use gaze_lidar_core::firmware::{
     FwViolation, QuantizeError, FIRMWARE_FORMAT, MAX_TABLE_BINS,
 };
 use gaze_lidar_core::model::lidar::{Limits, PowerAccounting};
-use gaze_lidar_core::profile::{Bin, Profile, PROFILE_FORMAT};
+use gaze_lidar_core::profile::Profile;
 use std::f64::consts::{PI, TAU};
 
 const FRAME_HZ: f64 = 10.0;
@@ -22,55 +22,18 @@ const POWER_W: f64 = 1e-4;
 /// 2π·10 rad/s: one turn in 0.1 s.
 const SPIN: f64 = TAU * FRAME_HZ;
 
-use crate::common::params;
+use gaze_lidar_core::testing::params;
 
 /// Spin limits exactly at the profile's spin, so every dwell bound is
 /// exactly the ideal dwell (`θ·f/ω`), within the checker's tolerance.
 fn limits(spin_min: f64, spin_max: f64) -> Limits {
-    Limits {
-        power_w_min: 0.5e-4,
-        power_w_max: 2e-4,
-        spin_rad_s_min: spin_min,
-        spin_rad_s_max: spin_max,
-        spin_accel_rad_s2_max: None,
-        power_slew_w_per_deg_max: None,
-        eye_safety: Some(params()),
-    }
+    testing::limits((0.5e-4, 2e-4), (spin_min, spin_max))
 }
 
 /// Bins of the given widths (degrees, summing to 360) at `POWER_W` and
 /// constant spin `SPIN`.
 fn profile(widths: &[f64], accounting: PowerAccounting, lim: Limits) -> Profile {
-    let mut start = 0.0;
-    let bins = widths
-        .iter()
-        .map(|&w| {
-            let b = Bin {
-                start_deg: start,
-                width_deg: w,
-                power_w: POWER_W,
-                spin_start_rad_s: SPIN,
-                spin_end_rad_s: SPIN,
-                region: None,
-                dwell_s: None,
-            };
-            start += w;
-            b
-        })
-        .collect();
-    Profile {
-        format: PROFILE_FORMAT.to_owned(),
-        frame_rate_hz: FRAME_HZ,
-        pulse_rate_hz: 20_000.0,
-        average_power_w: POWER_W,
-        power_accounting: accounting,
-        gaze_deg: None,
-        limits: lim,
-        bins,
-        mode: None,
-        summary: None,
-        optimality: None,
-    }
+    testing::profile_of_widths(widths, FRAME_HZ, POWER_W, accounting, lim)
 }
 
 fn uniform(accounting: PowerAccounting) -> Profile {
@@ -338,7 +301,7 @@ fn json_round_trips_with_a_newline() {
 }
 
 fn fw_table(tick_hz: u64, bins: &[(u32, u64, u32)]) -> FirmwareTable {
-    common::open_table(tick_hz, 20_000.0, Some(params()), bins)
+    testing::open_table(tick_hz, 20_000.0, Some(params()), bins)
 }
 
 fn close(a: f64, b: f64) -> bool {

@@ -6,9 +6,9 @@
 //! early exits) on seeded random tables; plus hand-computed cases, the error
 //! paths, and the checker's assembly of violations.
 
-use crate::common;
+use gaze_lidar_core::testing;
 
-use gaze_lidar_core::eye_safety::{EyeSafetyParams, Rule};
+use gaze_lidar_core::eye_safety::Rule;
 use gaze_lidar_core::firmware::eye::{
     evaluate, millihz_ceil, pass_timing, DeriveError, IntEyeError, IntEyeLimits, IntRule,
     TrainLimit,
@@ -22,17 +22,7 @@ const W: i64 = 360_000;
 
 /// A table of `(width_mdeg, dwell_ticks, code)` bins; frame = Σ dwell.
 fn table(tick_hz: u64, bins: &[(u32, u64, u32)]) -> FirmwareTable {
-    common::open_table(
-        tick_hz,
-        100.0,
-        Some(EyeSafetyParams {
-            wavelength_nm: 905.0,
-            pulse_duration_s: 5e-9,
-            beam_diameter_mm: 8.0,
-            head: None,
-        }),
-        bins,
-    )
+    testing::open_table(tick_hz, 100.0, Some(testing::params()), bins)
 }
 
 /// Limits for `t` with every figure given (the struct is non-exhaustive:

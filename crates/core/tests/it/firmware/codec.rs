@@ -3,7 +3,6 @@
 //! trips, no panics); these pin the exact values, worked out by hand, and
 //! every decode error at its edge.
 
-use gaze_lidar_core::eye_safety::EyeSafetyParams;
 use gaze_lidar_core::firmware::binary::{decode, encode, DecodeError, HEADER_LEN, RECORD_LEN};
 use gaze_lidar_core::firmware::{
     apportion, floor_code, FirmwareTable, FwBin, IntLimits, QuantizeError, TickTarget,
@@ -147,12 +146,7 @@ fn table(bins: &[(u32, u64, u32)], eye: bool) -> FirmwareTable {
         power_w_per_code: 0.25,
         power_accounting: PowerAccounting::Angle,
         pulse_rate_hz: 20_000.0,
-        eye_safety: eye.then_some(EyeSafetyParams {
-            wavelength_nm: 905.0,
-            pulse_duration_s: 5e-9,
-            beam_diameter_mm: 8.0,
-            head: None,
-        }),
+        eye_safety: eye.then(gaze_lidar_core::testing::params),
         limits: IntLimits {
             power_code_min: 0x2122_2324,
             power_code_max: 0x3132_3334,

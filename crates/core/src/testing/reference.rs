@@ -2,7 +2,7 @@
 //! scanned, pulsed beam (the profile@1 kinematics, constant angular acceleration within a
 //! bin, as README's "The profile format" states them; IEC 60825-1:2014).
 //!
-//! Written independently of `gaze_lidar_core::eye_safety`: it shares no code with
+//! Written independently of `crate::eye_safety`: it shares no code with
 //! the crate (own kinematics, own AEL table, own pulse clock). It is slow and
 //! plain on purpose.
 //!
@@ -34,8 +34,6 @@
 //! - rule 2: energy in a window of duration T ≤ AEL(T), every T from one
 //!   pulse to the 100 s time base; rule 3 is rule 2 at 100 s.
 
-#![allow(dead_code)]
-
 use std::fmt;
 
 /// Spectral band (the columns of IEC 60825-1:2014 Table 3).
@@ -50,6 +48,7 @@ pub enum Band {
 }
 
 impl Band {
+    /// The band of `lambda_nm` (panics outside the three bands).
     pub fn of(lambda_nm: f64) -> Band {
         if (700.0..=1050.0).contains(&lambda_nm) {
             Band::Nir
@@ -61,6 +60,7 @@ impl Band {
             panic!("wavelength {lambda_nm} nm outside the reference's bands")
         }
     }
+    /// The limiting aperture of the band, mm (7 in 700–1050 nm, 3.5 beyond).
     pub fn aperture_mm(self) -> f64 {
         match self {
             Band::Nir => 7.0,
@@ -125,33 +125,46 @@ pub fn c5(band: Band, n: f64) -> f64 {
     }
 }
 
+/// T2 (the pulse-count horizon of C5), s.
 pub const T2_S: f64 = 10.0;
+/// The classification time base, s.
 pub const TIME_BASE_S: f64 = 100.0;
+/// T_i in 700–1050 nm (pulses within it form one group), s.
 pub const T_I_NIR_S: f64 = 5e-6;
 
 /// One bin as the reference reads it.
 #[derive(Debug, Clone)]
 pub struct RBin {
+    /// Start azimuth, deg.
     pub start_deg: f64,
+    /// Angular width, deg.
     pub width_deg: f64,
+    /// Laser power, W.
     pub power_w: f64,
+    /// Spin at the bin's start, rad/s.
     pub w0: f64,
+    /// Spin at the bin's end, rad/s.
     pub w1: f64,
 }
 
 /// The scan as plain numbers.
 #[derive(Debug, Clone)]
 pub struct Scan {
+    /// The bins in scan order.
     pub bins: Vec<RBin>,
+    /// Pulse repetition rate, Hz.
     pub pulse_rate_hz: f64,
+    /// Wavelength, nm.
     pub lambda_nm: f64,
+    /// Pulse duration, s.
     pub pulse_s: f64,
+    /// Beam diameter at the aperture, mm.
     pub beam_mm: f64,
 }
 
 impl Scan {
     /// A profile's bins and laser as plain numbers (public fields only).
-    pub fn of_profile(p: &gaze_lidar_core::profile::Profile) -> Self {
+    pub fn of_profile(p: &crate::profile::Profile) -> Self {
         let es = p.limits.eye_safety.as_ref().expect("eye_safety params");
         Scan {
             bins: p
@@ -286,9 +299,15 @@ fn pass_geom(head: &Head, phi_deg: f64, h_deg: f64) -> PassGeom {
 #[derive(Debug, Clone, Copy)]
 pub enum Clock {
     /// Pulses at `t0 + k/f_p`, every integer k.
-    Free { t0: f64 },
+    Free {
+        /// Phase of pulse 0, s.
+        t0: f64,
+    },
     /// Pulses at `q·T_f + t0 + k/f_p`, `0 ≤ t0 + k/f_p < T_f`, `t0 ∈ [0, 1/f_p)`.
-    PerTurn { t0: f64 },
+    PerTurn {
+        /// Phase of pulse 0 within the turn, s.
+        t0: f64,
+    },
 }
 
 /// A run of consecutive pulses of equal energy.
@@ -540,12 +559,17 @@ pub enum RuleKind {
 /// The worst exposure the reference found.
 #[derive(Debug, Clone, Copy)]
 pub struct Worst {
+    /// Exposure over its limit.
     pub ratio: f64,
+    /// The rule it is measured against.
     pub rule: RuleKind,
+    /// The aperture's azimuth, deg.
     pub azimuth_deg: f64,
     /// Window duration (rule 2) or N (rule 1).
     pub detail: f64,
+    /// Energy received, J.
     pub energy_j: f64,
+    /// The pulse clock that fired it.
     pub clock: Clock,
 }
 
@@ -606,6 +630,7 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// The reference for `scan`.
     pub fn new(scan: &Scan) -> Reference {
         let band = Band::of(scan.lambda_nm);
         let c4 = if band == Band::Nir {
@@ -630,9 +655,11 @@ impl Reference {
         }
     }
 
+    /// The frame period `T_f = Σ dwell`, s.
     pub fn period_s(&self) -> f64 {
         self.head.period
     }
+    /// Half the angle over which one aperture receives the beam, deg.
     pub fn half_pass_deg(&self) -> f64 {
         self.h_deg
     }

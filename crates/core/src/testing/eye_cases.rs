@@ -3,10 +3,8 @@
 //! the core's differential test (library level) and the root crate's CLI
 //! test (`gaze-lidar check` must exit 1 naming eye safety).
 
-#![allow(dead_code)]
-
-use gaze_lidar_core::profile::Profile;
-use std::path::{Path, PathBuf};
+use crate::profile::Profile;
+use std::path::PathBuf;
 
 // ---------------------------------------------------------------------------
 // Four constructed profiles (tests/data/eye_safety/), each within every
@@ -17,13 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// `tests/data/eye_safety/` of the workspace (from the root crate or the core).
 pub fn data_dir() -> PathBuf {
-    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let root = here.join("tests/data/eye_safety");
-    if root.is_dir() {
-        root
-    } else {
-        here.join("../../tests/data/eye_safety")
-    }
+    super::data_path("eye_safety")
 }
 
 /// The committed profile `name` of [`data_dir`].
@@ -33,6 +25,7 @@ pub fn load(name: &str) -> Profile {
     Profile::from_json(&std::fs::read_to_string(&path).unwrap(), &origin).unwrap()
 }
 
+/// C4 at 905 nm, `10^(0.002·(905 − 700))`.
 pub const C4_905: f64 = 2.570395782768864; // 10^(0.002·205)
 
 /// Rule 1 at 905 nm: a 5 ns pulse of `e` J against C5(N)·7.7e-8·C4.
@@ -50,17 +43,24 @@ pub fn t_into(w0: f64, a: f64, x: f64) -> f64 {
     2.0 * x / (w0 + (w0 * w0 + 2.0 * a * x).sqrt())
 }
 
+/// A constructed profile and its true worst ratio.
 pub struct Constructed {
+    /// The file's name in [`data_dir`].
     pub name: &'static str,
-    /// True worst ratio (closed form) and the lowest value the reference may
-    /// legitimately find (a phase-dependent pulse exactly on a window edge).
+    /// True worst ratio (closed form).
     pub truth: f64,
+    /// The lowest value the reference may legitimately find (a
+    /// phase-dependent pulse exactly on a window edge).
     pub truth_low: f64,
+    /// How the truth was worked out (for failure messages).
     pub how: String,
+    /// Aperture azimuths the reference is asked to look at, deg.
     pub phis: Vec<f64>,
+    /// Whether the pulse clock is phase-locked to the turn.
     pub locked: bool,
 }
 
+/// The four constructed profiles.
 pub fn constructed() -> Vec<Constructed> {
     let mut v = Vec::new();
     let h905 = 0.5 * (7.0 + 8.0) / 100.0; // rad
@@ -173,6 +173,7 @@ pub const APERTURE_IR_MODEL_MM: f64 = 3.557_060_558_492_482_4;
 
 /// An AEL step-down profile and its true ratios.
 pub struct AelStepCase {
+    /// The file's name in [`data_dir`].
     pub name: &'static str,
     /// Sup over clock phases, under the model's aperture.
     pub truth: f64,
@@ -183,6 +184,7 @@ pub struct AelStepCase {
     /// Under the standard's own Table 10 aperture at the window's length
     /// (every phase), when it is over too.
     pub truth_standard: Option<f64>,
+    /// How the truth was worked out (for failure messages).
     pub how: String,
 }
 
