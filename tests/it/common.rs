@@ -100,6 +100,26 @@ pub fn assert_bad_input(o: &Output, needle: &str) {
     assert!(err.contains(needle), "expected '{needle}' in: {err}");
 }
 
+/// The arguments of `gaze-lidar profile --preset PRESET --mode MODE
+/// --gaze-deg GAZE`, then `extra`.
+pub fn profile_args<'a>(
+    preset: &'a str,
+    mode: &'a str,
+    gaze_deg: &'a str,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let head = [
+        "profile",
+        "--preset",
+        preset,
+        "--mode",
+        mode,
+        "--gaze-deg",
+        gaze_deg,
+    ];
+    [&head[..], extra].concat()
+}
+
 /// Runs `gaze-lidar` expecting success and parses its stdout as profile@1.
 pub fn profile_from(args: &[&str]) -> gaze_lidar::profile::Profile {
     let o = run(args, None);

@@ -10,30 +10,12 @@ use gaze_lidar::profile::Profile;
 
 fn profile_and_table(mode: &str, gaze: &str) -> (Profile, FirmwareTable) {
     let t = run(
-        &[
-            "profile",
-            "--preset",
-            "paper",
-            "--mode",
-            mode,
-            "--gaze-deg",
-            gaze,
-            "--format",
-            "firmware",
-        ],
+        &common::profile_args("paper", mode, gaze, &["--format", "firmware"]),
         None,
     );
     assert_eq!(t.status.code(), Some(0), "{}", common::stderr(&t));
     (
-        common::profile_from(&[
-            "profile",
-            "--preset",
-            "paper",
-            "--mode",
-            mode,
-            "--gaze-deg",
-            gaze,
-        ]),
+        common::profile_from(&common::profile_args("paper", mode, gaze, &[])),
         serde_json::from_str(&stdout(&t)).unwrap(),
     )
 }

@@ -8,7 +8,7 @@ use crate::firmware::{FirmwareTable, FwBin, IntLimits, FIRMWARE_FORMAT};
 use crate::model::lidar::{Limits, PowerAccounting};
 use crate::profile::{Bin, Profile, PROFILE_FORMAT};
 use std::f64::consts::TAU;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Eye-safety parameters of one 5 ns beam at `wavelength_nm`,
 /// `beam_mm` wide at the aperture, no multi-beam head.
@@ -163,7 +163,12 @@ pub fn segments(bins: &[(f64, f64, f64, bool)]) -> Vec<Seg> {
 /// The workspace's committed test data, `tests/data/` at the repository
 /// root (the same directory from either crate's tests).
 pub fn data_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data"))
+    let core = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = core
+        .ancestors()
+        .nth(2)
+        .expect("the core lives at crates/core");
+    root.join("tests/data")
 }
 
 /// The file or directory `rel` below [`data_dir`].

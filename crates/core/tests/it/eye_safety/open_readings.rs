@@ -4,16 +4,7 @@
 //! until the reading is settled against a licensed copy of the standard.
 
 use gaze_lidar_core::eye_safety::evaluate_profile;
-use gaze_lidar_core::profile::Profile;
-
-fn load(name: &str) -> Profile {
-    let path = format!(
-        "{}/../../tests/data/eye_safety/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(&path).expect("test profile");
-    Profile::from_json(&text, &path).expect("test profile parses")
-}
+use gaze_lidar_core::testing::eye_cases::load;
 
 /// 905 nm, 6 µs pulses (longer than T_i = 5 µs, shorter than 0.25 s),
 /// 7812.5 Hz, one bin of 1.62 mW at a uniform 125.66 rad/s (20 Hz), 8 mm beam.
