@@ -330,10 +330,18 @@ fn power_step(
     // by a factor.
     let mut factor = [1.0f64; 2];
     let mut round = 0;
+    let mut prev_x: Option<Vec<f64>> = None;
+    let warm = std::env::var_os("OPT_WARM").is_some();
+    let trace = std::env::var_os("OPT_TRACE").is_some();
     loop {
+        let t0 = std::time::Instant::now();
         let program = power_program(problem, g, eye, t, pool, &factor)?;
+        let t1 = std::time::Instant::now();
         let opts = SolveOptions {
             heuristic: program.ring.as_ref().map(|r| r as &dyn Heuristic),
+            initial: prev_x
+                .as_deref()
+                .filter(|x| warm && x.len() == program.lp.len()),
             ..SolveOptions::default()
         };
         let solved = program
@@ -346,10 +354,21 @@ fn power_step(
                 (other, _) => other,
             })?;
         let p = powers(problem, g, t, &program, &solved.x);
+        prev_x = Some(solved.x.clone());
+        let t2 = std::time::Instant::now();
         let checkpoint = match eye {
             None => Checkpoint::Certified,
             Some(e) => power_checkpoint(e, g, spins, &p, pool, &factor, round)?,
         };
+        if trace {
+            let what = match &checkpoint {
+                Checkpoint::Certified => "certified".to_string(),
+                Checkpoint::AddCuts(f) => format!("add {}", f.len()),
+                Checkpoint::Tighten { class, factor, cuts } => format!("tighten {class} {factor} +{}", cuts.len()),
+                Checkpoint::Fail(_) => "fail".into(),
+            };
+            eprintln!("round {round} pool {} rows {} build {:?} solve {:?} check {:?} -> {what}", pool.len(), program.lp.rows(), t1 - t0, t2 - t1, t2.elapsed());
+        }
         match checkpoint {
             Checkpoint::Certified => {
                 let top = factor[0].max(factor[1]);
@@ -461,6 +480,10 @@ fn power_checkpoint(
         ))));
     }
     let f = f_lo.max(ratio / top) * (1.0 + 1e-9);
+    if std::env::var_os("OPT_TRACE").is_some() {
+        let pool_top = pool.iter().filter(|c| cut_class(c) == k).map(|c| c.ratio(p, e.pulse_rate_hz) * factor[k]).fold(0.0, f64::max);
+        eprintln!("  ratio {ratio} at {witness} rule {:?} top {top} f_lo {f_lo} ratio/top {} pool class-k max ratio*factor {pool_top} cut_rhs {} near {}", report.binding_rule, ratio / top, cut_rhs(), near.len());
+    }
     let cuts = near
         .into_iter()
         .filter(|c| c.ratio(p, e.pulse_rate_hz) * f >= cut_rhs() && !pool.contains(c))
@@ -506,7 +529,7 @@ fn near_cuts(
             .fold(0.0, f64::max);
         (near, top)
     };
-    let mut t_a = cut_rhs() / f_lo;
+    let mut t_a = cut_rhs() / f_lo * NEAR_FIRST;
     while t_a.is_finite() && t_a >= NEAR_FLOOR {
         let (near, top) = of_class(t_a);
         if top >= t_a {
@@ -521,6 +544,12 @@ fn near_cuts(
     }
     of_class(0.0)
 }
+
+/// The first threshold [`near_cuts`] tries, relative to `cut_rhs / f_lo`:
+/// a little below it, so that where the strongest cut fixes `f` at `f_lo`
+/// (its threshold `cut_rhs / f` then a hair below `cut_rhs / f_lo`) one
+/// call of the core holds every cut the tightening keeps.
+const NEAR_FIRST: f64 = 0.99;
 
 /// The lowest first threshold [`near_cuts`] tries (each try a quarter of
 /// the last) before it asks for every cut.
