@@ -330,18 +330,10 @@ fn power_step(
     // by a factor.
     let mut factor = [1.0f64; 2];
     let mut round = 0;
-    let mut prev_x: Option<Vec<f64>> = None;
-    let warm = std::env::var_os("OPT_WARM").is_some();
-    let trace = std::env::var_os("OPT_TRACE").is_some();
     loop {
-        let t0 = std::time::Instant::now();
         let program = power_program(problem, g, eye, t, pool, &factor)?;
-        let t1 = std::time::Instant::now();
         let opts = SolveOptions {
             heuristic: program.ring.as_ref().map(|r| r as &dyn Heuristic),
-            initial: prev_x
-                .as_deref()
-                .filter(|x| warm && x.len() == program.lp.len()),
             ..SolveOptions::default()
         };
         let solved = program
@@ -354,21 +346,10 @@ fn power_step(
                 (other, _) => other,
             })?;
         let p = powers(problem, g, t, &program, &solved.x);
-        prev_x = Some(solved.x.clone());
-        let t2 = std::time::Instant::now();
         let checkpoint = match eye {
             None => Checkpoint::Certified,
             Some(e) => power_checkpoint(e, g, spins, &p, pool, &factor, round)?,
         };
-        if trace {
-            let what = match &checkpoint {
-                Checkpoint::Certified => "certified".to_string(),
-                Checkpoint::AddCuts(f) => format!("add {}", f.len()),
-                Checkpoint::Tighten { class, factor, cuts } => format!("tighten {class} {factor} +{}", cuts.len()),
-                Checkpoint::Fail(_) => "fail".into(),
-            };
-            eprintln!("round {round} pool {} rows {} build {:?} solve {:?} check {:?} -> {what}", pool.len(), program.lp.rows(), t1 - t0, t2 - t1, t2.elapsed());
-        }
         match checkpoint {
             Checkpoint::Certified => {
                 let top = factor[0].max(factor[1]);
@@ -480,10 +461,6 @@ fn power_checkpoint(
         ))));
     }
     let f = f_lo.max(ratio / top) * (1.0 + 1e-9);
-    if std::env::var_os("OPT_TRACE").is_some() {
-        let pool_top = pool.iter().filter(|c| cut_class(c) == k).map(|c| c.ratio(p, e.pulse_rate_hz) * factor[k]).fold(0.0, f64::max);
-        eprintln!("  ratio {ratio} at {witness} rule {:?} top {top} f_lo {f_lo} ratio/top {} pool class-k max ratio*factor {pool_top} cut_rhs {} near {}", report.binding_rule, ratio / top, cut_rhs(), near.len());
-    }
     let cuts = near
         .into_iter()
         .filter(|c| c.ratio(p, e.pulse_rate_hz) * f >= cut_rhs() && !pool.contains(c))
@@ -502,12 +479,17 @@ fn power_checkpoint(
 /// costs tens of milliseconds on a real head, so only those above a
 /// threshold `t`, less a relative [`NEAR_SLACK`] (far above the rounding
 /// of the core's threshold test, so every cut at or above `t` comes): first
-/// `t = cut_rhs / f_lo`, then a quarter of it, and so on down to
+/// `t = NEAR_FIRST · cut_rhs / f_lo`, then half of it, and so on down to
 /// [`NEAR_FLOOR`], until the strongest cut found is at or above `t`: it is
 /// the strongest of all, which fixes `f`, and then `t = cut_rhs / f`. The
 /// answer holds every cut the tightening keeps, in the same order (a
 /// sub-list of the same sort), so the tightening is the one every cut would
-/// give. If no cut reaches the floor: every cut.
+/// give (the caller keeps only the cuts at or above `cut_rhs / f`, so a
+/// longer list from a lower threshold keeps the same ones in the same
+/// order). If no cut reaches the floor: every cut. Each call of the core
+/// enumerates the exposures at every bin edge, and its cost grows as the
+/// threshold falls: halving (not quartering) keeps the last call's
+/// threshold within 2× of the strongest cut.
 fn near_cuts(
     e: &Eye,
     s: &[Seg],
@@ -540,7 +522,7 @@ fn near_cuts(
                 of_class(t_b)
             };
         }
-        t_a *= 0.25;
+        t_a *= 0.5;
     }
     of_class(0.0)
 }
@@ -551,8 +533,8 @@ fn near_cuts(
 /// call of the core holds every cut the tightening keeps.
 const NEAR_FIRST: f64 = 0.99;
 
-/// The lowest first threshold [`near_cuts`] tries (each try a quarter of
-/// the last) before it asks for every cut.
+/// The lowest first threshold [`near_cuts`] tries (each try half the
+/// last) before it asks for every cut.
 const NEAR_FLOOR: f64 = 1e-3;
 
 /// The relative margin by which [`near_cuts`] asks for more cuts than it
