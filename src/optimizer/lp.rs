@@ -479,12 +479,17 @@ fn power_checkpoint(
 /// costs tens of milliseconds on a real head, so only those above a
 /// threshold `t`, less a relative [`NEAR_SLACK`] (far above the rounding
 /// of the core's threshold test, so every cut at or above `t` comes): first
-/// `t = cut_rhs / f_lo`, then a quarter of it, and so on down to
+/// `t = NEAR_FIRST · cut_rhs / f_lo`, then half of it, and so on down to
 /// [`NEAR_FLOOR`], until the strongest cut found is at or above `t`: it is
 /// the strongest of all, which fixes `f`, and then `t = cut_rhs / f`. The
 /// answer holds every cut the tightening keeps, in the same order (a
 /// sub-list of the same sort), so the tightening is the one every cut would
-/// give. If no cut reaches the floor: every cut.
+/// give (the caller keeps only the cuts at or above `cut_rhs / f`, so a
+/// longer list from a lower threshold keeps the same ones in the same
+/// order). If no cut reaches the floor: every cut. Each call of the core
+/// enumerates the exposures at every bin edge, and its cost grows as the
+/// threshold falls: halving (not quartering) keeps the last call's
+/// threshold within 2× of the strongest cut.
 fn near_cuts(
     e: &Eye,
     s: &[Seg],
@@ -506,7 +511,7 @@ fn near_cuts(
             .fold(0.0, f64::max);
         (near, top)
     };
-    let mut t_a = cut_rhs() / f_lo;
+    let mut t_a = cut_rhs() / f_lo * NEAR_FIRST;
     while t_a.is_finite() && t_a >= NEAR_FLOOR {
         let (near, top) = of_class(t_a);
         if top >= t_a {
@@ -517,13 +522,19 @@ fn near_cuts(
                 of_class(t_b)
             };
         }
-        t_a *= 0.25;
+        t_a *= 0.5;
     }
     of_class(0.0)
 }
 
-/// The lowest first threshold [`near_cuts`] tries (each try a quarter of
-/// the last) before it asks for every cut.
+/// The first threshold [`near_cuts`] tries, relative to `cut_rhs / f_lo`:
+/// a little below it, so that where the strongest cut fixes `f` at `f_lo`
+/// (its threshold `cut_rhs / f` then a hair below `cut_rhs / f_lo`) one
+/// call of the core holds every cut the tightening keeps.
+const NEAR_FIRST: f64 = 0.99;
+
+/// The lowest first threshold [`near_cuts`] tries (each try half the
+/// last) before it asks for every cut.
 const NEAR_FLOOR: f64 = 1e-3;
 
 /// The relative margin by which [`near_cuts`] asks for more cuts than it

@@ -264,6 +264,7 @@ impl Program {
     ) -> Result<highs::Model, OptError> {
         let mut vars = ProblemVariables::new();
         let mut objective = Expression::with_capacity(self.columns.len());
+        let scale = self.objective_scale();
         for (c, &v) in self.columns.iter().zip(&self.vars) {
             let def = variable().min(c.lo).max(c.hi);
             let added = vars.add(if c.integer && !relax {
@@ -272,7 +273,7 @@ impl Program {
                 def
             });
             debug_assert_eq!(added, v);
-            objective.add_mul(c.cost * self.objective_scale(), v);
+            objective.add_mul(c.cost * scale, v);
         }
         let mut pb = vars.maximise(objective).using(highs);
         for (c, _) in &self.constraints {
