@@ -23,6 +23,8 @@ mod big_profile;
 mod common;
 #[path = "../../crates/core/tests/it/eye_cases.rs"]
 mod eye_cases;
+#[path = "../../crates/core/tests/it/head_oracle_defs.rs"]
+mod head_oracle_defs;
 mod independent;
 mod mps;
 #[path = "../../crates/core/tests/it/reference.rs"]
