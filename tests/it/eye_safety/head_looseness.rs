@@ -171,7 +171,7 @@ fn worst(o: &Oracle, positions: &[Pos], effort: &Effort, long: bool) -> OWorst {
         .map(|(&p, &k)| o.proxy(p, &ivs[k].1))
         .collect();
     let mut chosen: Vec<usize> = Vec::new();
-    for key in 0..3 {
+    for key in [0, 1, 2] {
         let mut order: Vec<usize> = (0..positions.len()).collect();
         order.sort_by(|&a, &b| proxies[b][key].total_cmp(&proxies[a][key]));
         chosen.extend(order.into_iter().take(effort.top_k));
