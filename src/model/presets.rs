@@ -255,8 +255,9 @@ const VLS128_CYCLE_S: f64 = 53.3e-6;
 ///   preset's limits at the mean spin) reaches 74.2 × the Class 1 limit at
 ///   1.5 mW (123 beams can cross one aperture height over a sweep, 8 of
 ///   one firing group at once), so every power is scaled by 0.012 (÷ 83):
-///   that uniform profile is at 0.89 of the limit (10 % head-room for the
-///   bound's rounding and later tightening). The rated range stays the
+///   that uniform profile was at 0.89 of the limit (10 % head-room for the
+///   bound's rounding and later tightening); the head bound's short windows
+///   (by firing slots) put it at 0.38, the power kept. The rated range stays the
 ///   vendor's (it is the range at the preset's mean power, whatever that
 ///   unpublished power is).
 /// - `beam_diameter_mm` (the one-channel figure) is the exit beam grown by
@@ -327,7 +328,8 @@ const VLP16_CYCLE_S: f64 = 55.296e-6;
 ///   Scaled for the head from 1.5 mW by 0.16 (÷ 6.25): at 1.5 mW a uniform
 ///   profile at `power_w_max` (1.3 × the mean) reaches 5.61 × the Class 1
 ///   limit as a head (9 beams can cross one aperture height over a sweep,
-///   3 within one `T_i`); at 240 µW it is at 0.90.
+///   3 within one `T_i`); at 240 µW it was at 0.90, 0.69 with the head
+///   bound's short windows (by firing slots), the power kept.
 /// - Motor, accounting, focus and levels as `vls128`.
 #[must_use]
 pub fn vlp16() -> Preset {

@@ -23,5 +23,7 @@ mod traceability;
 #[path = "../../benches/common/big_profile.rs"]
 mod big_profile;
 mod common;
+#[path = "../../crates/core/tests/it/head_oracle_defs.rs"]
+mod head_oracle_defs;
 mod independent;
 mod mps;

@@ -152,12 +152,13 @@ fn check_output_names_the_head_and_the_scale_that_certifies() {
             assert!(eye["head"]["beams_meeting_worst"].as_u64().unwrap() >= 1);
             assert!(eye["head"]["worst_height_mm"].is_number());
         }
-        // Over the limit: every power ×3 (limits widened to allow it).
+        // Over the limit: every power ×5 (limits widened to allow it; the
+        // range profile is at 0.32 of the head's limit on `vls128`).
         let mut hot: Profile = profile.clone();
-        hot.limits.power_w_max *= 3.0;
-        hot.average_power_w *= 3.0;
+        hot.limits.power_w_max *= 5.0;
+        hot.average_power_w *= 5.0;
         for b in &mut hot.bins {
-            b.power_w *= 3.0;
+            b.power_w *= 5.0;
         }
         let path = dir.join(format!("{name}-hot.json"));
         std::fs::write(&path, hot.to_json().unwrap()).unwrap();
@@ -354,8 +355,15 @@ fn firmware_tables_are_checked_as_the_head() {
         let int = report.unwrap().worst_ratio_ppm as f64 / 1e6;
         eprintln!("{name}: integer head ratio {int:.6}, float head ratio {float:.6}");
         // Two sound upper bounds of one model (the integer one on the
-        // quantized table, with exact pass counts): close, not equal.
-        assert!((int / float - 1.0).abs() < 0.15, "{name}: {int} vs {float}");
+        // quantized table, with exact pass counts): the integer check takes
+        // the head bound's first energy candidate (`W_v ×` the
+        // single-channel figures), the float bound may take a tighter one
+        // (the short windows' by firing slots, up to 2.5× lower on
+        // `vls128`): never much below the float figure, at most 3× above.
+        assert!(
+            int >= 0.85 * float && int <= 3.0 * float,
+            "{name}: {int} vs {float}"
+        );
         // The binary codec carries the head.
         let back = binary::decode(&binary::encode(&table)).unwrap();
         assert_eq!(back.eye_safety, table.eye_safety);

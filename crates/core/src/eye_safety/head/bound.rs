@@ -125,6 +125,149 @@ pub struct HeadFigures {
     /// weight of channels whose passes over one aperture position such a
     /// turn can reach.
     pub separations: Vec<Separation>,
+    /// Windows shorter than one firing cycle, by the slots they can hold
+    /// (see [`slot_windows`]); empty when at most one channel meets any
+    /// height or the enumeration is over its budget.
+    #[serde(skip)]
+    pub slot_windows: Vec<SlotWindow>,
+}
+
+/// The channels a window shorter than one firing cycle can receive, by its
+/// length: every window of length `T` in `[lo_s, hi_s)` receives pulses of
+/// total `power_scale` at most `weight`, one pulse per channel.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SlotWindow {
+    /// Shortest window length of the range, s.
+    pub lo_s: f64,
+    /// The range's end (excluded), s.
+    pub hi_s: f64,
+    /// The most `Σ power_scale` of channels meeting one height whose slots
+    /// a window of that length can hold.
+    pub weight: f64,
+}
+
+/// Most window-length ranges of [`slot_windows`].
+pub const SLOT_WINDOWS_MAX: usize = 64;
+
+/// Most `heights × window starts × channels` steps [`slot_windows`] takes
+/// (beyond it the candidate is not formed: a looser bound, never an
+/// unsound one).
+pub const SLOT_WINDOWS_BUDGET: usize = 1 << 22;
+
+/// The slot-window figures of a head (`specs/eye_safety.md`, "The head",
+/// Short windows): a window shorter than the cycle holds at most one pulse
+/// of each channel; the channels the aperture at height `z` can receive
+/// are those whose height interval holds `z` (any head angle, so no turn
+/// needs widening); slid to start at one of its pulses (channel `a`, an
+/// instant `slot_a + k·cycle`), a window of length `T` holds the channels
+/// with `(slot_c − slot_a) mod cycle ≤ T`. With `B` the sorted distinct
+/// differences (those within ε/4 of the previous one dropped, subsampled to
+/// at most [`SLOT_WINDOWS_MAX`]) and `ε` =
+/// 1e-9 cycle, every `T` in `[B_j − ε, B_{j+1} − ε)` holds only channels
+/// whose computed difference is below `B_{j+1} − ε/2` (the differences err
+/// by a few ulps of the cycle), so its weight is the most `Σ s_c` of those
+/// over every height lower end and every start; the last range ends at
+/// `cycle·(1 − 1e-9)`, below which no channel fires twice.
+#[must_use]
+pub fn slot_windows(
+    fps: &[Footprint],
+    scales: &[f64],
+    slots: &[f64],
+    cycle_s: f64,
+) -> Vec<SlotWindow> {
+    let iv: Vec<(f64, f64)> = fps
+        .iter()
+        .map(|f| {
+            (
+                f.z_mm - f.half_height_mm - overlap::TOUCH_MM,
+                f.z_mm + f.half_height_mm + overlap::TOUCH_MM,
+            )
+        })
+        .collect();
+    let n = iv.len();
+    let mut distinct: Vec<f64> = slots.to_vec();
+    distinct.sort_by(f64::total_cmp);
+    distinct.dedup();
+    if n.saturating_mul(n).saturating_mul(distinct.len()) > SLOT_WINDOWS_BUDGET {
+        return Vec::new();
+    }
+    let diff = |c: f64, a: f64| {
+        let d = c - a;
+        if d < 0.0 {
+            d + cycle_s
+        } else {
+            d
+        }
+    };
+    let mut b: Vec<f64> = Vec::new();
+    for &a in &distinct {
+        for &c in &distinct {
+            b.push(diff(c, a));
+        }
+    }
+    b.sort_by(f64::total_cmp);
+    // Differences one rounding apart are one (the first kept): the ranges
+    // hold for any increasing `B` from 0, only their tightness needs the
+    // differences.
+    let eps = 1e-9 * cycle_s;
+    b.dedup_by(|later, kept| *later - *kept <= 0.25 * eps);
+    if b.len() > SLOT_WINDOWS_MAX {
+        let m = b.len();
+        b = (0..SLOT_WINDOWS_MAX)
+            .map(|k| b[k * (m - 1) / (SLOT_WINDOWS_MAX - 1)])
+            .collect();
+    }
+    let t_cut = cycle_s * (1.0 - 1e-9);
+    // Range j: [B_j − ε, B_{j+1} − ε) (the first from 0, the last to t_cut),
+    // holding differences below `below_j` = B_{j+1} − ε/2 (+∞ for the last).
+    let mut ranges: Vec<(f64, f64, f64)> = Vec::new();
+    for j in 0..b.len() {
+        let lo = if j == 0 { 0.0 } else { b[j] - eps };
+        let (hi, below) = if j + 1 < b.len() {
+            (b[j + 1] - eps, b[j + 1] - 0.5 * eps)
+        } else {
+            (t_cut, f64::INFINITY)
+        };
+        if lo < hi.min(t_cut) {
+            ranges.push((lo, hi.min(t_cut), below));
+        }
+    }
+    let mut weight = vec![0.0f64; ranges.len()];
+    let mut at: Vec<(f64, f64)> = Vec::with_capacity(n);
+    for &(z, _) in &iv {
+        let members: Vec<usize> = (0..n).filter(|&i| iv[i].0 <= z && z <= iv[i].1).collect();
+        let mut starts: Vec<f64> = members.iter().map(|&i| slots[i]).collect();
+        starts.sort_by(f64::total_cmp);
+        starts.dedup();
+        for &a in &starts {
+            at.clear();
+            at.extend(members.iter().map(|&i| (diff(slots[i], a), scales[i])));
+            at.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let (mut k, mut sum, mut terms) = (0usize, 0.0f64, 0u32);
+            for (j, r) in ranges.iter().enumerate() {
+                while k < at.len() && at[k].0 < r.2 {
+                    sum += at[k].1;
+                    terms += 1;
+                    k += 1;
+                }
+                let w = if terms > 1 {
+                    sum * (1.0 + overlap::SUM_MARGIN)
+                } else {
+                    sum
+                };
+                weight[j] = weight[j].max(w);
+            }
+        }
+    }
+    ranges
+        .iter()
+        .zip(weight)
+        .map(|(r, weight)| SlotWindow {
+            lo_s: r.0,
+            hi_s: r.1,
+            weight,
+        })
+        .collect()
 }
 
 /// One head-turn bound of the channels a window can reach.
@@ -226,6 +369,32 @@ pub fn energy_ratios(
         cand[k] = cand[k].max(w * r_long * (1.0 + RATIO_MARGIN));
         if peak(&cand) < peak(&best) {
             best = cand;
+        }
+    }
+    // Windows shorter than a cycle by the slots they can hold (one pulse
+    // of at most `s_c·P̂/f_p` per channel, `SlotWindow::weight` of them
+    // against the smallest AEL of the range), longer ones by `W_v ×` the
+    // multi-pass bounds from the last range's end.
+    if h.count_vertical > 1 && power_max_w > 0.0 {
+        if let Some(last) = h.slot_windows.last() {
+            let e_pulse = power_max_w / laser.pulse_rate_hz;
+            let short = h
+                .slot_windows
+                .iter()
+                .map(|r| r.weight * e_pulse / laser.ael_inf_j(r.lo_s, r.hi_s))
+                .fold(0.0, f64::max)
+                * (1.0 + RATIO_MARGIN);
+            let (r_long, t_long) = laser.windows_from_ratio(frame_s, pass, power_max_w, last.hi_s);
+            let mut cand = [0.0, short, 0.0, 0.0];
+            let k = match crate::eye_safety::Rule::for_duration(t_long, frame_s) {
+                crate::eye_safety::Rule::PassTrain | crate::eye_safety::Rule::SinglePulse => 1,
+                crate::eye_safety::Rule::T2Train => 2,
+                crate::eye_safety::Rule::TimeBase => 3,
+            };
+            cand[k] = cand[k].max(w * r_long * (1.0 + RATIO_MARGIN));
+            if peak(&cand) < peak(&best) {
+                best = cand;
+            }
         }
     }
     // The head's received power is at most `W_inst·P̂` at any instant, so a
@@ -330,6 +499,7 @@ pub fn head_figures(
         pass_angle_deg: o.pass_angle_deg,
         power_scale_max: o.power_scale_max,
         separations: o.separations.clone(),
+        slot_windows: o.slot_windows.clone(),
     })
 }
 
@@ -355,6 +525,7 @@ pub struct HeadOverlaps {
     /// `W_g` with the head stopped, and whether it spans two times.
     stalled_group: (overlap::Meet, bool),
     separations: Vec<Separation>,
+    slot_windows: Vec<SlotWindow>,
     footprint_max_mm: f64,
     pass_angle_deg: f64,
     power_scale_max: f64,
@@ -385,6 +556,11 @@ impl HeadOverlaps {
             union_passes: union_passes(&fps, pass_angle_deg),
             separations: if vertical.count > 1 {
                 separations(&fps, &scales, r, head.cycle_s)
+            } else {
+                Vec::new()
+            },
+            slot_windows: if vertical.count > 1 {
+                slot_windows(&fps, &scales, &slots, head.cycle_s)
             } else {
                 Vec::new()
             },
@@ -687,6 +863,54 @@ mod tests {
         }
     }
 
+    /// By hand: a cycle of 100 µs, slots 0, 10 and 30 µs on three channels
+    /// 0.1° apart (one height meets all three), a fourth at 30° elevation
+    /// (58 mm up: meets none of them) at slot 50 µs. Differences among all
+    /// slots mod the cycle: 0, 10, 20, 30, 40, 50, 60, 70, 80, 90 µs (every
+    /// one of them, since 50 adds 50 − 30 = 20, 50 − 10 = 40, …). A window
+    /// shorter than 10 µs holds one channel; from 10 µs, 0 and 10 (or 10
+    /// and 30 from 20 µs): 2; from 30 µs, all three of the column: 3; the
+    /// fourth never joins them (its height interval holds none of theirs).
+    /// Ranges start 1e-9·cycle = 1e-13 s early and the last ends at
+    /// `cycle·(1 − 1e-9)`.
+    #[test]
+    fn slot_windows_by_hand() {
+        let mut h = column(&[0.0, 1e-5, 3e-5], &[0.0, 0.0, 0.0]);
+        h.channels.push(Channel {
+            id: 3,
+            elevation_deg: 30.0,
+            azimuth_offset_deg: 0.0,
+            slot_s: 5e-5,
+            power_scale: 1.0,
+        });
+        let fps = footprints(&h, 7.0);
+        let scales = [1.0; 4];
+        let slots: Vec<f64> = h.channels.iter().map(|c| c.slot_s).collect();
+        let w = slot_windows(&fps, &scales, &slots, h.cycle_s);
+        let eps = 1e-13;
+        let lo: Vec<f64> = w.iter().map(|r| r.lo_s).collect();
+        let want_lo: Vec<f64> = (0..10)
+            .map(|k| if k == 0 { 0.0 } else { k as f64 * 1e-5 - eps })
+            .collect();
+        assert_eq!(lo.len(), 10, "{w:?}");
+        for (a, b) in lo.iter().zip(&want_lo) {
+            assert!((a - b).abs() < 1e-18, "{w:?}");
+        }
+        let weights: Vec<f64> = w.iter().map(|r| (r.weight * 1e6).round() / 1e6).collect();
+        assert_eq!(
+            weights,
+            [1.0, 2.0, 2.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0],
+            "{w:?}"
+        );
+        assert_eq!(w.last().unwrap().hi_s, 1e-4 * (1.0 - 1e-9));
+        for p in w.windows(2) {
+            assert_eq!(p[0].hi_s, p[1].lo_s);
+        }
+        // Sums of more than one weight are rounded up, one is exact.
+        assert_eq!(w[0].weight, 1.0);
+        assert!(w[1].weight > 2.0);
+    }
+
     /// By hand: from the axis (`r0 = 0`) every ray is radial, `ψ_c = φ_c`;
     /// a 7 mm aperture and a 5 mm beam give a pass of 12/100 rad = 6.8755°.
     /// Offsets 0 and 6°: (6 + 6.8755)/6.8755 = 1.87, two passes; offsets
@@ -784,6 +1008,7 @@ mod tests {
             pass_angle_deg: 6.0,
             power_scale_max: 1.0,
             separations: Vec::new(),
+            slot_windows: Vec::new(),
         }
     }
 
