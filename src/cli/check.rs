@@ -21,7 +21,9 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
     /// Also certify against this preset's sensor: any declared limit looser
-    /// than the sensor's is rejected, naming the key.
+    /// than the sensor's, and any laser parameter (pulse rate, accounting,
+    /// eye-safety parameters and head) not exactly the sensor's, is
+    /// rejected, naming the key.
     #[arg(long, conflicts_with = "sensor")]
     preset: Option<String>,
     /// Also certify against a sensor described in TOML: exactly the fields
