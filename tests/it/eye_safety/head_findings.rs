@@ -143,3 +143,71 @@ fn a_subnormal_head_value_is_refused_for_being_subnormal() {
         "{lines:?}"
     );
 }
+
+/// `check` of a head declared at 10 000 mm says the verdict covers the
+/// 100 mm surface too, and rejects the vlp16 range profile at 11.83× its
+/// power (certified at 10 000 mm alone, 6.33× over at 100 mm by the outside
+/// tester's reference) with the 100 mm figure.
+#[test]
+fn check_of_a_far_declared_surface_names_both_surfaces() {
+    let p = preset("vlp16").unwrap();
+    let mut profile = build_profile(&p, Mode::Range, Some(90.0), 360).unwrap();
+    for b in &mut profile.bins {
+        b.power_w *= 11.83;
+    }
+    profile.average_power_w *= 11.83;
+    profile.limits.power_w_max *= 11.83;
+    let mut near = profile.clone();
+    profile
+        .limits
+        .eye_safety
+        .as_mut()
+        .and_then(|e| e.head.as_mut())
+        .expect("vlp16 has a head")
+        .aperture_distance_mm = 10_000.0;
+    let dir = tempfile::tempdir().unwrap();
+    let far_path = dir.path().join("far.json");
+    std::fs::write(&far_path, profile.to_json().unwrap()).unwrap();
+    near.limits
+        .eye_safety
+        .as_mut()
+        .unwrap()
+        .head
+        .as_mut()
+        .unwrap()
+        .aperture_distance_mm = 100.0;
+    let near_path = dir.path().join("near.json");
+    std::fs::write(&near_path, near.to_json().unwrap()).unwrap();
+    let far = crate::common::run(&["check", far_path.to_str().unwrap()], None);
+    let near = crate::common::run(&["check", near_path.to_str().unwrap()], None);
+    assert_eq!(
+        far.status.code(),
+        Some(1),
+        "{}",
+        crate::common::stdout(&far)
+    );
+    assert_eq!(near.status.code(), Some(1));
+    let far_out = crate::common::stdout(&far);
+    assert!(
+        far_out.contains(
+            "evaluated on the 100 mm Condition 3 surface and on the declared 10000 mm one"
+        ),
+        "{far_out}"
+    );
+    let near_out = crate::common::stdout(&near);
+    assert!(!near_out.contains("declared"), "{near_out}");
+    let percent = |s: &str| {
+        s.split(" % of")
+            .next()
+            .unwrap()
+            .rsplit(' ')
+            .next()
+            .unwrap()
+            .to_owned()
+    };
+    assert_eq!(
+        percent(&far_out),
+        percent(&near_out),
+        "{far_out}\n{near_out}"
+    );
+}
