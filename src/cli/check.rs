@@ -21,7 +21,9 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
     /// Also certify against this preset's sensor: any declared limit looser
-    /// than the sensor's is rejected, naming the key.
+    /// than the sensor's, and any laser parameter (pulse rate, accounting,
+    /// eye-safety parameters and head) not exactly the sensor's, is
+    /// rejected, naming the key.
     #[arg(long, conflicts_with = "sensor")]
     preset: Option<String>,
     /// Also certify against a sensor described in TOML: exactly the fields
@@ -55,14 +57,30 @@ fn verdict_json(v: &Verdict) -> Result<serde_json::Value, CliError> {
 }
 
 /// One line naming what was evaluated: the head (channels, the worst
-/// aperture position, the beams meeting it, the binding rule) or one
-/// channel.
-fn head_line(r: &ExposureReport) -> String {
+/// aperture position, the beams meeting it, the binding rule, and both
+/// surfaces when the head declares an aperture distance other than 100 mm)
+/// or one channel.
+fn head_line(r: &ExposureReport, profile: &Profile) -> String {
     match &r.head {
         Some(h) => {
             let (height_mm, beams) = worst_position(r.binding_rule, h);
+            let declared_mm = profile
+                .limits
+                .eye_safety
+                .as_ref()
+                .and_then(|e| e.head.as_ref())
+                .map_or(100.0, |h| h.aperture_distance_mm);
+            #[allow(clippy::float_cmp)]
+            let surfaces = if declared_mm == 100.0 {
+                String::new()
+            } else {
+                format!(
+                    "; evaluated on the 100 mm Condition 3 surface and on the declared {} mm one (the worse is the verdict)",
+                    gaze_lidar::text::Num(declared_mm)
+                )
+            };
             format!(
-                "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height; {} beam(s) meet it; binding rule: {}",
+                "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height; {} beam(s) meet it; binding rule: {}{surfaces}",
                 h.channels, r.worst_azimuth_deg, height_mm, beams, r.binding_rule
             )
         }
@@ -131,7 +149,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                                 "eye safety: Class 1 at every azimuth; worst {:.3}° ({}), {:.1} % of the limit (margin {:.2}×)",
                                 r.worst_azimuth_deg, r.binding_rule, 100.0 * r.worst_ratio, r.margin
                             ))?;
-                            out.line(head_line(r))?;
+                            out.line(head_line(r, &profile))?;
                         }
                         None => out.line("eye safety: NOT evaluated (--no-eye-safety; limits.eye_safety is null): this verdict is not Class 1 evidence")?,
                     }
@@ -159,7 +177,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                         match eye.filter(|_| matches!(v, Violation::EyeSafety { .. })) {
                             Some(r) => out.line(format_args!(
                                 "violation: {v}; {}; to certify: scale every bin power by at most {:.6} (the largest uniform power scale at which the {} certifies)",
-                                head_line(r),
+                                head_line(r, &profile),
                                 power_scale_to_certify(r.worst_ratio),
                                 if r.head.is_some() { "head" } else { "channel" }
                             ))?,

@@ -79,11 +79,13 @@ impl From<gaze_lidar::profile::IoError> for CliError {
 /// The exit codes, as `--help` shows them (the README says the same).
 const EXIT_CODES: &str = "Exit codes:
   0  success
-  1  an infeasible request or a rejected profile (the limit is named); also a
+  1  an infeasible request or a rejected profile (the limit is named; in a
+     checked profile or firmware table, a field out of its range too); also a
      write that fails once started (a full disk, stdout on /dev/full): the
      outputs it was replacing are left as they were
-  2  bad input: an argument, a file or a field (with line:column for files),
-     or an output path that cannot be written, is given twice, or is one of
+  2  bad input: an argument, a file or a field that cannot be read (with
+     line:column for files), a sensor file's out-of-range value, a firmware
+     table's header numbers, or an output path that cannot be written, is given twice, or is one of
      the inputs (checked before any work; nothing is written)
 Errors are one line on stderr.";
 

@@ -218,6 +218,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             power_w_per_code: a.power_w_per_code,
         };
         FirmwareTable::from_certified(&certified, &cfg).map_err(|e| match e {
+            FirmwareError::Config {
+                field: "power_w_per_code",
+                reason,
+            } if a.power_w_per_code.is_some() => {
+                CliError::input(format!("--power-w-per-code: {reason}"))
+            }
             FirmwareError::Config { .. } => CliError::input(format!("firmware: {e}")),
             other => CliError::infeasible(format!("firmware: {other}")),
         })

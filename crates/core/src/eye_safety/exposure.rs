@@ -143,6 +143,24 @@ pub fn evaluate_segments(
     evaluate_segments_with(segs, params, pulse_rate_hz, Search::Pruned)
 }
 
+/// The bound of a head on its declared surface alone
+/// (`aperture_distance_mm`), without the 100 mm surface every verdict also
+/// covers ([`evaluate_segments`]): the bound as a function of the distance,
+/// for tests of it against references at any distance. Never a verdict.
+/// Without a head, [`evaluate_segments`].
+#[doc(hidden)]
+pub fn evaluate_segments_at_declared_distance(
+    segs: &[Seg],
+    params: &EyeSafetyParams,
+    pulse_rate_hz: f64,
+) -> Result<ExposureReport, EyeSafetyError> {
+    let laser = laser(params, pulse_rate_hz)?;
+    match &params.head {
+        Some(head) => evaluate_head_at(segs, params, head, &laser, Search::Pruned),
+        None => evaluate_segments(segs, params, pulse_rate_hz),
+    }
+}
+
 fn evaluate_segments_with(
     segs: &[Seg],
     params: &EyeSafetyParams,
@@ -197,11 +215,61 @@ fn check_pass_duration(b: &bound::Bound) -> Result<(), EyeSafetyError> {
     Ok(())
 }
 
-/// The head's evaluation (`specs/eye_safety.md`, "The head"): the
-/// single-channel bound at the head's widest pass, every energy rule times
-/// `W_v`, Rule 1 from the head's groups ([`head_bound::single_pulse_ratio`])
-/// and the stalled rotor for every channel meeting one aperture.
+/// The head's verdict (`specs/eye_safety.md`, "The head", "The aperture's
+/// surface"): a certificate always covers the Condition 3 surface, 100 mm
+/// from the spin axis. A head declaring another `aperture_distance_mm` is
+/// evaluated at its declared distance **and** at 100 mm, and the report
+/// with the larger worst ratio is the verdict (a nearer surface is not
+/// provably the stricter one for every head, so neither is skipped); the
+/// stalled-rotor figure is the larger of the two. A crossing point at or
+/// beyond 100 mm from the axis leaves no 100 mm surface to evaluate: refused
+/// by name.
 fn evaluate_head(
+    segs: &[Seg],
+    params: &EyeSafetyParams,
+    head: &Head,
+    laser: &Laser,
+    search: Search,
+) -> Result<ExposureReport, EyeSafetyError> {
+    // Exact comparison: any other distance, however near, is evaluated too.
+    #[allow(clippy::float_cmp)]
+    if head.aperture_distance_mm == APERTURE_DISTANCE_MM {
+        return evaluate_head_at(segs, params, head, laser, search);
+    }
+    let declared = evaluate_head_at(segs, params, head, laser, search)?;
+    // Not `< 100` written as a negation: NaN was refused by the declared
+    // evaluation's validation above.
+    if head.origin_radius_mm >= APERTURE_DISTANCE_MM {
+        return Err(EyeSafetyError::Param {
+            field: "head.origin_radius_mm",
+            value: head.origin_radius_mm,
+            reason: "must be < 100 mm: a certificate covers the Condition 3 surface 100 mm from the spin axis",
+        });
+    }
+    let standard_head = Head {
+        aperture_distance_mm: APERTURE_DISTANCE_MM,
+        ..head.clone()
+    };
+    let standard = evaluate_head_at(segs, params, &standard_head, laser, search)?;
+    let stalled_rotor_ratio = declared
+        .stalled_rotor_ratio
+        .max(standard.stalled_rotor_ratio);
+    // Ties (and a NaN, which never compares greater) take the 100 mm report.
+    let mut worse = if declared.worst_ratio > standard.worst_ratio {
+        declared
+    } else {
+        standard
+    };
+    worse.stalled_rotor_ratio = stalled_rotor_ratio;
+    Ok(worse)
+}
+
+/// The head's evaluation on the surface `head.aperture_distance_mm` from the
+/// spin axis: the single-channel bound at the head's widest pass, every
+/// energy rule times `W_v`, Rule 1 from the head's groups
+/// ([`head_bound::single_pulse_ratio`]) and the stalled rotor for every
+/// channel meeting one aperture.
+fn evaluate_head_at(
     segs: &[Seg],
     params: &EyeSafetyParams,
     head: &Head,

@@ -166,6 +166,19 @@ impl FirmwareTable {
                 })
             })
             .collect::<Result<_, _>>()?;
+        // A step that rounds every bin's power down to code 0 gives a table
+        // that keeps the laser off (certifiable, but never what was asked).
+        let p_top = p.bins.iter().map(|b| b.power_w).fold(0.0, f64::max);
+        if p_top > 0.0 && codes.iter().all(|&c| c == 0) {
+            return Err(FirmwareError::Config {
+                field: "power_w_per_code",
+                reason: format!(
+                    "{} W per code rounds every bin's power (the largest {} W) down to code 0: the table would keep the laser off; give a step of at most the largest bin power",
+                    crate::text::Num(step),
+                    crate::text::Num(p_top)
+                ),
+            });
+        }
         let max_code = floor_code(l.power_w_max, step).unwrap_or(u32::MAX);
         // Budget in code units per tick (time) or per millidegree (angle):
         // floor(P̄/step) exactly (as the codes are rounded), plus the

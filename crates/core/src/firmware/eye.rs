@@ -697,7 +697,7 @@ impl Greedy<'_> {
 #[cfg(feature = "std")]
 mod derive {
     use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
-    use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
+    use crate::eye_safety::ael::{APERTURE_DISTANCE_MM, T2_S, TIME_BASE_S};
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
     use crate::eye_safety::head::bound::{
         head_figures, single_pulse_ratio as single_pulse_ratio_head, SingleFigures,
@@ -781,6 +781,16 @@ mod derive {
             let tick_hz_f = table.tick_hz as f64;
             let head = match &params.head {
                 None => None,
+                // A certificate covers the 100 mm surface; the float checker
+                // evaluates a declared other distance *and* 100 mm, which one
+                // set of integer limits cannot hold: refused by name.
+                #[allow(clippy::float_cmp)]
+                Some(h) if h.aperture_distance_mm != APERTURE_DISTANCE_MM => {
+                    return Err(DeriveError::Range {
+                        field: "eye_safety.head.aperture_distance_mm",
+                        reason: "must be 100 mm in a firmware table (the integer checker evaluates the Condition 3 surface, 100 mm from the spin axis, only)",
+                    });
+                }
                 Some(h) => {
                     let spin_max = table
                         .bins

@@ -128,13 +128,112 @@ pub fn laser_mismatches(
     }
     if let (Some(x), Some(y)) = (eye_safety, &sensor.limits.eye_safety) {
         if x != y {
-            v.push((
-                "eye_safety",
-                format!("laser parameters {x:?} differ from the sensor's {y:?}"),
-            ));
+            v.push(("eye_safety", first_laser_difference(x, y)));
         }
     }
     v
+}
+
+/// The first field where two unequal laser parameter sets differ, in one
+/// line: `limits.eye_safety.head.channels[3].power_scale: 0.5 differs from
+/// the sensor's 1`. Fields are compared with `!=` in declaration order, as
+/// the derived `PartialEq` compares them, so two unequal sets always name
+/// one.
+fn first_laser_difference(x: &EyeSafetyParams, y: &EyeSafetyParams) -> String {
+    use crate::text::Num;
+    let differs = |path: &str, a: String, b: String| {
+        format!(
+            "limits.eye_safety.{path}: {a} differs from the sensor's {b} (a file's laser parameters must be the sensor's exactly)"
+        )
+    };
+    let num = |path: &str, a: f64, b: f64| {
+        #[allow(clippy::float_cmp)]
+        let same = a == b;
+        (!same).then(|| differs(path, Num(a).to_string(), Num(b).to_string()))
+    };
+    let top = num("wavelength_nm", x.wavelength_nm, y.wavelength_nm)
+        .or_else(|| num("pulse_duration_s", x.pulse_duration_s, y.pulse_duration_s))
+        .or_else(|| num("beam_diameter_mm", x.beam_diameter_mm, y.beam_diameter_mm));
+    if let Some(d) = top {
+        return d;
+    }
+    let (hx, hy) = match (&x.head, &y.head) {
+        (Some(hx), Some(hy)) => (hx, hy),
+        (a, b) => {
+            let shown = |h: &Option<crate::eye_safety::head::Head>| match h {
+                Some(h) => format!("a head of {} channels", h.channels.len()),
+                None => "no head (one channel)".to_owned(),
+            };
+            return differs("head", shown(a), shown(b));
+        }
+    };
+    let head = num("head.cycle_s", hx.cycle_s, hy.cycle_s)
+        .or_else(|| {
+            num(
+                "head.origin_radius_mm",
+                hx.origin_radius_mm,
+                hy.origin_radius_mm,
+            )
+        })
+        .or_else(|| {
+            num(
+                "head.origin_height_mm",
+                hx.origin_height_mm,
+                hy.origin_height_mm,
+            )
+        })
+        .or_else(|| {
+            num(
+                "head.exit_diameter_mm",
+                hx.exit_diameter_mm,
+                hy.exit_diameter_mm,
+            )
+        })
+        .or_else(|| {
+            num(
+                "head.divergence_mrad",
+                hx.divergence_mrad,
+                hy.divergence_mrad,
+            )
+        })
+        .or_else(|| {
+            num(
+                "head.aperture_distance_mm",
+                hx.aperture_distance_mm,
+                hy.aperture_distance_mm,
+            )
+        });
+    if let Some(d) = head {
+        return d;
+    }
+    if hx.channels.len() != hy.channels.len() {
+        return differs(
+            "head.channels",
+            format!("{} channels", hx.channels.len()),
+            format!("{}", hy.channels.len()),
+        );
+    }
+    for (i, (a, b)) in hx.channels.iter().zip(&hy.channels).enumerate() {
+        let f = |name: &str| format!("head.channels[{i}].{name}");
+        if a.id != b.id {
+            return differs(&f("id"), a.id.to_string(), b.id.to_string());
+        }
+        let d = num(&f("elevation_deg"), a.elevation_deg, b.elevation_deg)
+            .or_else(|| {
+                num(
+                    &f("azimuth_offset_deg"),
+                    a.azimuth_offset_deg,
+                    b.azimuth_offset_deg,
+                )
+            })
+            .or_else(|| num(&f("slot_s"), a.slot_s, b.slot_s))
+            .or_else(|| num(&f("power_scale"), a.power_scale, b.power_scale));
+        if let Some(d) = d {
+            return d;
+        }
+    }
+    // Unreachable for unequal sets (every field compared above).
+    "limits.eye_safety: differs from the sensor's".to_owned()
 }
 
 impl LidarSpec {
@@ -259,7 +358,7 @@ impl LidarSpec {
                 } => err(&format!("limits.eye_safety.{field}"), value, reason),
                 crate::eye_safety::EyeSafetyError::Head(h) => err(
                     &format!("limits.eye_safety.head.{}", h.field),
-                    f64::NAN,
+                    h.value,
                     h.reason,
                 ),
                 crate::eye_safety::EyeSafetyError::PulseRate { expected_hz, .. } => err(

@@ -96,16 +96,25 @@ pub struct Head {
     pub channels: Vec<Channel>,
 }
 
-/// Why a head was refused: the field (a path such as `channels[3].slot_s`)
-/// and the reason.
+/// Why a head was refused: the field (a path such as `channels[3].slot_s`),
+/// the value written there and the reason.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("head.{field}: {reason}")]
+#[error("head.{field} = {}: {reason}", crate::text::Num(*.value))]
 pub struct HeadError {
     /// The field, relative to `head` (e.g. `channels[3].slot_s`).
     pub field: alloc::string::String,
+    /// The value written (a count for `channels`, the repeated id for a
+    /// duplicate).
+    pub value: f64,
     /// Why.
     pub reason: &'static str,
 }
+
+/// The reason given for a refused finite subnormal value: it meets every
+/// other rule's wording (finite, `>= 0`, inside the range), so the rule it
+/// breaks is named instead.
+const SUBNORMAL: &str =
+    "is subnormal (below 2.2e-308, not a physical size): must be zero or a normal float";
 
 impl Head {
     /// Validates the head at the one numeric boundary: 1–512 channels,
@@ -116,16 +125,26 @@ impl Head {
     pub fn validate(&self) -> Result<(), HeadError> {
         use crate::model::valid;
         use alloc::format;
-        let err = |field: &str, reason: &'static str| HeadError {
+        let err = |field: &str, value: f64, reason: &'static str| HeadError {
             field: field.into(),
-            reason,
+            value,
+            reason: if value.is_subnormal() {
+                SUBNORMAL
+            } else {
+                reason
+            },
         };
         if self.channels.is_empty() || self.channels.len() > CHANNELS_MAX {
-            return Err(err("channels", "must hold 1 to 512 channels"));
+            return Err(err(
+                "channels",
+                self.channels.len() as f64,
+                "must hold 1 to 512 channels",
+            ));
         }
         if valid::positive(self.cycle_s).is_err() || !(self.cycle_s <= 1.0) {
             return Err(err(
                 "cycle_s",
+                self.cycle_s,
                 "must be finite, > 0 (not subnormal) and <= 1 s",
             ));
         }
@@ -134,6 +153,7 @@ impl Head {
         {
             return Err(err(
                 "aperture_distance_mm",
+                self.aperture_distance_mm,
                 "must be finite, > 0 and <= 10000 mm",
             ));
         }
@@ -142,21 +162,28 @@ impl Head {
         {
             return Err(err(
                 "origin_radius_mm",
+                self.origin_radius_mm,
                 "must be finite, >= 0 and less than aperture_distance_mm",
             ));
         }
         if valid::finite(self.origin_height_mm).is_err() || !(self.origin_height_mm.abs() <= 1e4) {
             return Err(err(
                 "origin_height_mm",
+                self.origin_height_mm,
                 "must be finite and within ±10000 mm",
             ));
         }
         if valid::positive(self.exit_diameter_mm).is_err() || !(self.exit_diameter_mm < 1000.0) {
-            return Err(err("exit_diameter_mm", "must be finite, > 0 and < 1000 mm"));
+            return Err(err(
+                "exit_diameter_mm",
+                self.exit_diameter_mm,
+                "must be finite, > 0 and < 1000 mm",
+            ));
         }
         if valid::magnitude(self.divergence_mrad).is_err() || !(self.divergence_mrad <= 1000.0) {
             return Err(err(
                 "divergence_mrad",
+                self.divergence_mrad,
                 "must be finite, >= 0 and <= 1000 mrad",
             ));
         }
@@ -166,6 +193,7 @@ impl Head {
             if valid::finite(c.elevation_deg).is_err() || !(c.elevation_deg.abs() < 90.0) {
                 return Err(err(
                     &f("elevation_deg"),
+                    c.elevation_deg,
                     "must be finite and within (-90, 90) deg",
                 ));
             }
@@ -173,17 +201,23 @@ impl Head {
             {
                 return Err(err(
                     &f("azimuth_offset_deg"),
+                    c.azimuth_offset_deg,
                     "must be finite and within (-90, 90) deg",
                 ));
             }
             if valid::magnitude(c.slot_s).is_err() || !(c.slot_s < self.cycle_s) {
                 return Err(err(
                     &f("slot_s"),
+                    c.slot_s,
                     "must be finite, >= 0 and inside the cycle (< cycle_s)",
                 ));
             }
             if valid::magnitude(c.power_scale).is_err() || !(c.power_scale <= 1e3) {
-                return Err(err(&f("power_scale"), "must be finite, >= 0 and <= 1000"));
+                return Err(err(
+                    &f("power_scale"),
+                    c.power_scale,
+                    "must be finite, >= 0 and <= 1000",
+                ));
             }
             ids.push(c.id);
         }
@@ -191,6 +225,7 @@ impl Head {
         if let Some(w) = ids.windows(2).find(|w| w[0] == w[1]) {
             return Err(HeadError {
                 field: format!("channels (id {})", w[0]),
+                value: f64::from(w[0]),
                 reason: "duplicate channel id",
             });
         }

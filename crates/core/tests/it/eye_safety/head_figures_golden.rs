@@ -1,7 +1,9 @@
 //! Every figure of the eye-safety evaluation, frozen bit for bit: a seeded
-//! family of heads and profiles is evaluated (`evaluate_segments`) and each
-//! report — every ratio, the worst aperture position, the binding rule, the
-//! head's overlap figures — is compared with the recorded file
+//! family of heads and profiles is evaluated
+//! (`evaluate_segments_at_declared_distance`: a head on its declared
+//! surface, the bound at any distance) and each report — every ratio, the
+//! worst aperture position, the binding rule, the head's overlap figures —
+//! is compared with the recorded file
 //! `tests/data/head_golden/figures.txt`, every `f64` as the hex of its bits.
 //! A change that makes the evaluation faster must leave every line as it is
 //! (the long differential run of the bound against its reference stays
@@ -32,8 +34,9 @@
 use gaze_lidar_core::testing::eye_cases;
 
 use gaze_lidar_core::eye_safety::bound::Seg;
+use gaze_lidar_core::eye_safety::exposure::evaluate_segments_at_declared_distance;
 use gaze_lidar_core::eye_safety::head::{Channel, Head};
-use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams};
+use gaze_lidar_core::eye_safety::EyeSafetyParams;
 use gaze_lidar_core::profile::Profile;
 use serde_json::Value;
 use std::path::PathBuf;
@@ -371,7 +374,7 @@ fn hex_floats(v: Value) -> Value {
 /// One line per case: its name, a tab, the report (or the error) as JSON
 /// with every float as its bits.
 fn record(case: &Case) -> String {
-    let figures = match evaluate_segments(&case.segs, &case.params, case.f_p) {
+    let figures = match evaluate_segments_at_declared_distance(&case.segs, &case.params, case.f_p) {
         Ok(report) => hex_floats(serde_json::to_value(&report).unwrap()),
         Err(e) => serde_json::json!({ "error": e.to_string() }),
     };

@@ -8,7 +8,7 @@
 use crate::head_oracle_defs;
 use crate::reference_defs;
 
-use gaze_lidar_core::eye_safety::evaluate_profile;
+use gaze_lidar_core::eye_safety::exposure::{evaluate_segments_at_declared_distance, segments};
 use gaze_lidar_core::eye_safety::head::{Channel, Head};
 use gaze_lidar_core::profile::Profile;
 use head_oracle_defs::{hit, Fast, OBin, OScan, Oracle, Pos, Train};
@@ -699,10 +699,13 @@ fn profile_of(s: &OScan, h: &Head) -> Profile {
     Profile::from_json(&v.to_string(), "head oracle").expect("generated profile parses")
 }
 
-/// The checker's figure for the profile.
+/// The bound's figure for the profile on the head's declared surface (the
+/// verdict also covers 100 mm; the bound is tested at any distance).
 fn bound_ratio(p: &Profile) -> f64 {
     let params = p.limits.eye_safety.clone().unwrap();
-    evaluate_profile(p, &params).expect("evaluates").worst_ratio
+    evaluate_segments_at_declared_distance(&segments(p), &params, p.pulse_rate_hz)
+        .expect("evaluates")
+        .worst_ratio
 }
 
 /// Harness check on what exists today: a 1-channel head on the axis

@@ -13,6 +13,7 @@ mod head;
 mod head_figures_golden;
 mod head_oracle;
 mod head_reference;
+mod head_surface;
 mod open_readings;
 mod reference;
 mod report;

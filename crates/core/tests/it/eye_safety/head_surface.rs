@@ -1,0 +1,152 @@
+//! The surface a head's certificate covers (`specs/eye_safety.md`, "The
+//! head", "The aperture's surface"): the Condition 3 surface 100 mm from the
+//! spin axis always, and a declared other `aperture_distance_mm` as well, the
+//! worse report being the verdict; the integer firmware checker refuses a
+//! declared other distance by name.
+//!
+//! Run: `cargo test --release -p gaze-lidar-core --test it eye_safety::head_surface`.
+
+use crate::common;
+
+use gaze_lidar_core::eye_safety::bound::Seg;
+use gaze_lidar_core::eye_safety::exposure::evaluate_segments_at_declared_distance;
+use gaze_lidar_core::eye_safety::head::{Channel, Head};
+use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams};
+use gaze_lidar_core::firmware::eye::{DeriveError, IntEyeLimits};
+use gaze_lidar_core::firmware::{check_table, FwViolation};
+
+const F_P: f64 = 100_000.0;
+
+/// One radial channel from the axis, 10 mm exit beam, no divergence, at
+/// `aperture_distance_mm`; 905 nm, 5 ns, 100 kHz.
+fn params(aperture_distance_mm: f64, origin_radius_mm: f64) -> EyeSafetyParams {
+    EyeSafetyParams {
+        wavelength_nm: 905.0,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: 10.0,
+        head: Some(Head {
+            cycle_s: 1.0 / F_P,
+            origin_radius_mm,
+            origin_height_mm: 0.0,
+            exit_diameter_mm: 10.0,
+            divergence_mrad: 0.0,
+            aperture_distance_mm,
+            channels: vec![Channel {
+                id: 0,
+                elevation_deg: 0.0,
+                azimuth_offset_deg: 0.0,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            }],
+        }),
+    }
+}
+
+/// 360 one-degree bins at `power_w`, 1 Hz (2π rad/s).
+fn segs(power_w: f64) -> Vec<Seg> {
+    let w = std::f64::consts::TAU;
+    (0..360)
+        .map(|i| Seg {
+            start_deg: f64::from(i),
+            width_deg: 1.0,
+            power_w,
+            spin_start_rad_s: w,
+            spin_end_rad_s: w,
+        })
+        .collect()
+}
+
+/// The outside tester's case: 12.67 mW, uniform, 1 Hz. At 100 mm one pass
+/// is (7 + 10)/100 rad = 9.74°, 27.05 ms, 2706 pulses of 1.267e-7 J:
+/// 3.43e-4 J against AEL(27.05 ms) = 7e-4·0.02705^0.75·C4(905) = 1.200e-4 J,
+/// 2.857 (their independent reference, `ref.py`: 2.85696). At 10 000 mm the
+/// pass is 100× narrower and the bound alone certifies the same profile.
+/// The verdict is the 100 mm one. (Before the rule, the profile was certified
+/// at 0.999 with the file's 10 000 mm.)
+#[test]
+fn a_head_declared_far_away_is_judged_on_the_100_mm_surface_too() {
+    let p = 0.012_670_675_543_394_85;
+    let far = params(10_000.0, 0.0);
+    let near = params(100.0, 0.0);
+    let declared = evaluate_segments_at_declared_distance(&segs(p), &far, F_P).unwrap();
+    assert!(declared.worst_ratio < 1.0, "{}", declared.worst_ratio);
+    let verdict = evaluate_segments(&segs(p), &far, F_P).unwrap();
+    let at_100 = evaluate_segments(&segs(p), &near, F_P).unwrap();
+    assert_eq!(verdict, at_100);
+    assert!(verdict.worst_ratio >= 2.856_95, "{}", verdict.worst_ratio);
+    assert!(verdict.worst_ratio < 2.86, "{}", verdict.worst_ratio);
+}
+
+/// A nearer declared surface whose figure is the larger one is the verdict
+/// (a nearer surface sees a wider pass here: (7 + 10)/50 rad).
+#[test]
+fn a_nearer_declared_surface_that_is_worse_is_the_verdict() {
+    let p = 0.004;
+    let nearer = params(50.0, 0.0);
+    let declared = evaluate_segments_at_declared_distance(&segs(p), &nearer, F_P).unwrap();
+    let at_100 = evaluate_segments(&segs(p), &params(100.0, 0.0), F_P).unwrap();
+    assert!(declared.worst_ratio > at_100.worst_ratio);
+    let verdict = evaluate_segments(&segs(p), &nearer, F_P).unwrap();
+    assert_eq!(verdict, declared);
+}
+
+/// Of two reports the stalled-rotor figure is the larger one even when the
+/// other surface gives the verdict.
+#[test]
+fn the_stalled_rotor_figure_is_the_larger_of_both_surfaces() {
+    let p = 0.004;
+    for r in [30.0, 100.0, 400.0, 10_000.0] {
+        let verdict = evaluate_segments(&segs(p), &params(r, 0.0), F_P).unwrap();
+        let at_r = evaluate_segments_at_declared_distance(&segs(p), &params(r, 0.0), F_P).unwrap();
+        let at_100 = evaluate_segments(&segs(p), &params(100.0, 0.0), F_P).unwrap();
+        assert!(verdict.worst_ratio >= at_r.worst_ratio.max(at_100.worst_ratio));
+        assert!(
+            verdict.stalled_rotor_ratio >= at_r.stalled_rotor_ratio.max(at_100.stalled_rotor_ratio)
+        );
+    }
+}
+
+/// A crossing point at or beyond 100 mm leaves no 100 mm surface outside
+/// the head: refused naming `head.origin_radius_mm` (valid as a head at its
+/// declared 10 000 mm).
+#[test]
+fn a_crossing_point_beyond_100_mm_is_refused_by_name() {
+    let far = params(10_000.0, 150.0);
+    assert!(evaluate_segments_at_declared_distance(&segs(0.004), &far, F_P).is_ok());
+    let err = evaluate_segments(&segs(0.004), &far, F_P).unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("head.origin_radius_mm = 150"), "{msg}");
+    assert!(msg.contains("100 mm"), "{msg}");
+}
+
+/// The integer firmware checker holds one set of limits: a table whose
+/// head declares another distance is refused naming the field, never
+/// certified at that distance alone; at 100 mm it derives.
+#[test]
+fn firmware_refuses_a_head_declared_at_another_distance() {
+    // 360 bins of 1°, 1 s frame at 1 MHz ticks, 1 mW codes.
+    let bins: Vec<(u32, u64, u32)> = (0..360).map(|_| (1000, 2778, 1)).collect();
+    for r in [99.0, 10_000.0] {
+        let t = common::open_table(1_000_000, F_P, Some(params(r, 0.0)), &bins);
+        let err = IntEyeLimits::derive(&t).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                DeriveError::Range {
+                    field: "eye_safety.head.aperture_distance_mm",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        let v = check_table(&t);
+        assert!(
+            v.iter()
+                .any(|x| matches!(x, FwViolation::EyeSafetyParams { reason }
+                if reason.contains("aperture_distance_mm"))),
+            "{v:?}"
+        );
+    }
+    let t = common::open_table(1_000_000, F_P, Some(params(100.0, 0.0)), &bins);
+    assert!(IntEyeLimits::derive(&t).is_ok());
+}
