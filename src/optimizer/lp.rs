@@ -42,6 +42,16 @@ fn level_rhs() -> f64 {
     (1.0 - S.eye_safety_headroom) / (1.0 + RATIO_MARGIN)
 }
 
+/// What `check` accepts of a limit `v ≥ 0`: its relative `REL_TOL`, and a
+/// relative 1e-12 more for the rounding of the checker's floating-point
+/// sums. The power step's rows and boxes sit inside the limits (margins);
+/// its certificate's bound is taken on the program with these sides
+/// (`Program::relax_row`), so it bounds every profile `check` certifies,
+/// not only the tightened program's points.
+fn accepted(v: f64) -> f64 {
+    v * (1.0 + crate::checker::REL_TOL) * (1.0 + 1e-12)
+}
+
 /// Whether the dwell `next` is within `settings::slp_settled` of `t` in every bin.
 fn settled(next: &[f64], t: &[f64]) -> bool {
     next.iter()
@@ -357,6 +367,7 @@ fn power_step(
                     p,
                     PowerLp {
                         lp: program.lp.view(),
+                        outer: program.lp.outer_view(),
                         bins: program.bins,
                         one: program.one,
                         tightening: (top > 1.0).then_some(top),
@@ -850,6 +861,7 @@ fn power_bin(
     // The utility as boxed segment columns (see `utility`).
     let shape = super::detection::range_segments(problem, g.theta[i], dwell_s, lo_x, hi_x);
     let deltas = shape.add_to(lp, xi, 1.0, lo_x, c);
+    relax_bin(lp, problem, (xi, &deltas, &shape), (lo_x, hi_x), bare_w);
     let constant = c * shape.base;
     let bin = PowerBin::Continuous {
         x: lp.col(xi),
@@ -858,6 +870,40 @@ fn power_bin(
         shape,
     };
     Ok((xi.into(), bin, constant))
+}
+
+/// The user's box of a continuous bin (as `check` accepts the floor,
+/// `power_w_max` and the bin's bare single-bin eye-safety cap) recorded on
+/// the program (`Program::relax_col`): `x` between them, and the utility's
+/// first and last segments extended by the difference (a chord of a concave
+/// utility extended past its ends lies above it, so the extended program
+/// still bounds the utility there).
+fn relax_bin(
+    lp: &mut Program,
+    problem: &Problem,
+    (xi, deltas, shape): (Variable, &[Variable], &SqrtSegments),
+    (lo_x, hi_x): (f64, f64),
+    bare_w: f64,
+) {
+    let l = &problem.lidar.limits;
+    let p_mean = problem.lidar.average_power_w;
+    let lo_o = (l.power_w_min / p_mean * (1.0 - crate::checker::REL_TOL) * (1.0 - 1e-12)).min(lo_x);
+    let hi_o = (accepted(l.power_w_max.min(bare_w)) / p_mean).max(hi_x);
+    let j = lp.col(xi);
+    lp.relax_col(j, lo_o, hi_o);
+    if let (Some(first), Some(last)) = (deltas.first(), deltas.last()) {
+        let (first, last) = (lp.col(*first), lp.col(last.to_owned()));
+        let below = (lo_x - lo_o) * (1.0 + 1e-12);
+        let above = (hi_o - hi_x) * (1.0 + 1e-12);
+        let n = shape.segments.len();
+        let len = |k: usize| shape.segments[k].1;
+        if first == last {
+            lp.relax_col(first, -below, len(0) + above);
+        } else {
+            lp.relax_col(first, -below, len(0));
+            lp.relax_col(last, 0.0, len(n - 1) + above);
+        }
+    }
 }
 
 /// `levels`: one binary column per hardware level within
@@ -941,7 +987,12 @@ fn budget(lp: &mut Program, problem: &Problem, g: &Grid, t: &[f64], x: &[LinearF
     } else {
         budget
     };
-    lp.at_most("budget", spend, side);
+    let row = lp.at_most("budget", spend, side);
+    let full = match problem.lidar.power_accounting {
+        PowerAccounting::Angle => TAU,
+        PowerAccounting::Time => 1.0,
+    };
+    lp.relax_row(row, accepted(full).max(side));
 }
 
 /// `slew`: `|x_{i+1} − x_i| ≤ s·(Δ_i + Δ_{i+1})/2·side` around the circle
@@ -953,7 +1004,10 @@ fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, (p_mean, side): (f
         let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * side;
         let mut d = x[j].clone();
         d.add_mul(-1.0, &x[i]);
-        lp.between("slew", d, -lim, lim);
+        let (upper, lower) = lp.between("slew", d, -lim, lim);
+        let outer = accepted(s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean).max(lim);
+        lp.relax_row(upper, outer);
+        lp.relax_row(lower, -outer);
     }
 }
 
@@ -1038,7 +1092,14 @@ fn eye_cuts(
             }
             .into());
         }
-        lp.at_most("eye_cuts", row, cut_rhs().max(at_floor * (1.0 + 1e-12)));
+        let side = cut_rhs().max(at_floor * (1.0 + 1e-12));
+        let row = lp.at_most("eye_cuts", row, side);
+        // A certified profile meets every cut at its bare limit (a cut is
+        // one concrete exposure, at most the bound's worst case, which
+        // `check` holds to 1): the row's value is the exposure's ratio
+        // times `f`. A relative 1e-9 covers the rounding of the row's
+        // coefficients.
+        lp.relax_row(row, (f * (1.0 + 1e-9)).max(side));
     }
     Ok(())
 }
@@ -1150,6 +1211,10 @@ enum PowerBin {
 /// vector against it.
 pub(super) struct PowerLp {
     lp: LinearProgram,
+    /// `lp` with the user's limits as `check` accepts them in place of the
+    /// margins (`Program::outer_view`): the program the certificate's bound
+    /// is for and the one exported.
+    outer: LinearProgram,
     bins: Vec<PowerBin>,
     /// The largest factor an eye-safety cut was tightened by, if any.
     pub(super) tightening: Option<f64>,
@@ -1203,13 +1268,24 @@ impl PowerLp {
         let mut q = p.to_vec();
         for k in 0..S.repair_tries {
             let v = self.point(&q).ok_or(CertificateError::NotALevel)?;
-            match Certified::new(
+            // The point meets the solved program (the margins inside the
+            // limits) exactly; its bound is the user's problem's.
+            let inner = Certified::new(
                 Step::Power,
                 self.lp.clone(),
-                v,
+                v.clone(),
                 self.y.clone(),
                 self.solver_dual_bound,
-            ) {
+            );
+            match inner.and_then(|_| {
+                Certified::new(
+                    Step::Power,
+                    self.outer.clone(),
+                    v,
+                    self.y.clone(),
+                    self.solver_dual_bound,
+                )
+            }) {
                 Ok(c) => return Ok((c, q)),
                 Err(e)
                     if k + 1 == S.repair_tries

@@ -284,3 +284,43 @@ fn the_text_summary_states_an_eye_safety_tightening() {
         None => assert!(!line.contains("divided by"), "{line}"),
     }
 }
+
+/// The optimizer's answer and its `optimality` block for a config text.
+fn answer(toml: &str, gaze_deg: f64) -> gaze_lidar::profile::Profile {
+    let problem = OptimizerConfig::from_toml(toml, "t.toml")
+        .unwrap()
+        .problem()
+        .unwrap();
+    optimize(&problem, gaze_deg).unwrap().profile().clone()
+}
+
+/// The power step's upper bound bounds every profile `check` certifies for
+/// the user's limits, not only the program's points: its budget and slew
+/// rows sit 1e-6 inside the limits, and the answer to a slew limit
+/// 1/(1 − 1e-6) looser (certified under the tighter limit too: its largest
+/// step is within it) once scored 6e-9 above the bound stated for the
+/// tighter limit, whose gap read 7e-14. Both runs score on the same
+/// objective (range mode, uniform spin, same gaze and weights).
+#[test]
+fn the_power_step_bound_covers_every_certified_profile() {
+    let cfg = |slew: f64, accounting: &str| {
+        format!(
+            "bins = 360\n[lidar]\npower_accounting = \"{accounting}\"\n[limits]\npower_slew_w_per_deg_max = {slew:?}\n[focus]\nthreshold = 0.0831\nacuity = {{ model = \"levi_e2\", e2_deg = 2.72 }}\n[objective]\nmode = \"range\"\n"
+        )
+    };
+    for accounting in ["time", "angle"] {
+        let tight = answer(&cfg(2e-5, accounting), 90.0);
+        let loose = answer(&cfg(2e-5 / (1.0 - 1e-6), accounting), 90.0);
+        let mut hand = loose.clone();
+        hand.limits = tight.limits.clone();
+        hand.optimality = None;
+        gaze_lidar::checker::certify(hand)
+            .unwrap_or_else(|e| panic!("{accounting}: the looser answer is not certified: {e:?}"));
+        let bound = tight.optimality.as_ref().unwrap().upper_bound;
+        let score = loose.optimality.as_ref().unwrap().objective;
+        assert!(
+            score <= bound,
+            "{accounting}: a certified profile scores {score}, above the bound {bound}"
+        );
+    }
+}
