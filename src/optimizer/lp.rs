@@ -52,6 +52,18 @@ fn accepted(v: f64) -> f64 {
     v * (1.0 + crate::checker::REL_TOL) * (1.0 + 1e-12)
 }
 
+/// The bound's figure at or below which an answer counts as eye-safe:
+/// continuous powers keep `eye_safety_headroom` below the Class 1 limit;
+/// hardware levels are exact, so a level the checker accepts (the bound's
+/// figure at most 1) stays available, however close to the limit it is.
+fn eye_accept(problem: &Problem) -> f64 {
+    if problem.levels.power_w.is_empty() {
+        1.0 - S.eye_safety_headroom
+    } else {
+        1.0
+    }
+}
+
 /// Whether the dwell `next` is within `settings::slp_settled` of `t` in every bin.
 fn settled(next: &[f64], t: &[f64]) -> bool {
     next.iter()
@@ -358,7 +370,10 @@ fn power_step(
         let p = powers(problem, g, t, &program, &solved.x);
         let checkpoint = match eye {
             None => Checkpoint::Certified,
-            Some(e) => power_checkpoint(e, g, spins, &p, pool, &factor, round)?,
+            Some(e) => {
+                let at = (round, eye_accept(problem));
+                power_checkpoint(e, g, spins, &p, pool, &factor, at)?
+            }
         };
         match checkpoint {
             Checkpoint::Certified => {
@@ -429,12 +444,12 @@ fn power_checkpoint(
     p: &[f64],
     pool: &[Cut],
     factor: &[f64; 2],
-    round: usize,
+    (round, accept): (usize, f64),
 ) -> Result<Checkpoint, OptError> {
     let s = segs(g, spins, p);
     let report = e.report(&s)?;
     let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
-    if ratio <= 1.0 - S.eye_safety_headroom {
+    if ratio <= accept {
         return Ok(Checkpoint::Certified);
     }
     let round = round + 1;
@@ -449,6 +464,13 @@ fn power_checkpoint(
     let mut fresh = new_cuts(&[]);
     if fresh.is_empty() {
         fresh = new_cuts(&[witness]);
+    }
+    // No cut separates the answer (or the rounds ran out) and the checker
+    // accepts it (the bound's figure at most 1): a floor within the
+    // head-room of the limit holds bins there whatever the cuts say, and
+    // the head-room is a preference, not a limit.
+    if ratio <= 1.0 && (fresh.is_empty() || round > S.cut_rounds) {
+        return Ok(Checkpoint::Certified);
     }
     if round > S.cut_rounds {
         return Ok(Checkpoint::Fail(OptError::Solver(format!(
@@ -807,10 +829,12 @@ fn eye_caps(
 ) -> (Vec<f64>, Vec<f64>) {
     // A cut on one bin's power alone is that bin's column bound (the
     // utility's chords then span the reachable powers only).
+    // Levels: a level the checker accepts (the bound's figure at most 1,
+    // its rounding margin applied) stays; the checkpoint decides.
     let rhs = if problem.levels.power_w.is_empty() {
         cut_rhs()
     } else {
-        level_rhs()
+        1.0 / (1.0 + RATIO_MARGIN)
     };
     let mut caps = vec![f64::INFINITY; g.n];
     let mut bare = vec![f64::INFINITY; g.n];
@@ -1945,7 +1969,7 @@ fn shorten_for_eye_safety(
     let g = ctx.g;
     let p = &it.p;
     let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
-        Ok(e.verdict(&segs(g, sp, p))?.0 <= 1.0 - S.eye_safety_headroom)
+        Ok(e.verdict(&segs(g, sp, p))?.0 <= eye_accept(ctx.problem))
     };
     let mut shortened = false;
     if !ctx.problem.levels.spin_rad_s.is_empty() && !safe(&spins)? {
@@ -1966,7 +1990,7 @@ fn shorten_for_eye_safety(
         spins = spins_of(g, &ta, smooth, ctx.problem.lidar.frame_rate_hz);
     }
     let (ratio, at) = e.verdict(&segs(g, &spins, p))?;
-    if ratio > 1.0 - S.eye_safety_headroom {
+    if ratio > eye_accept(ctx.problem) {
         return Err(Infeasible::EyeAtUniformSpin {
             power_w: p[0],
             ratio,

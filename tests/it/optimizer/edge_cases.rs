@@ -324,3 +324,114 @@ fn the_power_step_bound_covers_every_certified_profile() {
         );
     }
 }
+
+/// A hardware level 4e-11 under the eye-safety limit (`check` accepts
+/// uniform power up to 0.0011546536827443574 W on this config) stays
+/// available: it was dropped with the head-room continuous powers keep,
+/// and uniform 0.5 mW was "proven optimal" (gap 0) while the top level
+/// everywhere is certified and scores 52 % more.
+#[test]
+fn a_level_within_the_checkers_tolerance_of_the_eye_limit_is_used() {
+    let toml = "bins = 36\n[lidar]\naverage_power_w = 0.00116\n[levels]\npower_w = [0.0005, 0.0011546536827]\n[objective]\nmode = \"range\"\n";
+    let p = powers(toml, 90.0);
+    assert!(
+        p.contains(&0.0011546536827),
+        "the top level is never used: {p:?}"
+    );
+}
+
+/// A config naming a multi-beam preset (`vls128`) that restates
+/// `[limits.eye_safety]` without a `head` key keeps the preset's head: the
+/// table once replaced it whole, and the answer was certified for one
+/// channel while the real 128-channel head was at 244.7 % of the limit.
+#[test]
+fn a_restated_eye_safety_table_keeps_the_presets_head() {
+    let toml = "bins = 36\n[lidar]\npreset = \"vls128\"\naverage_power_w = 6e-5\n[limits]\npower_w_max = 2e-4\n[limits.eye_safety]\nwavelength_nm = 903.0\npulse_duration_s = 3e-9\nbeam_diameter_mm = 10.2\n[objective]\nmode = \"range\"\n";
+    let problem = OptimizerConfig::from_toml(toml, "t.toml")
+        .unwrap()
+        .problem()
+        .unwrap();
+    let eye = problem.lidar.limits.eye_safety.as_ref().unwrap();
+    let head = eye.head.as_ref().expect("the preset's head was dropped");
+    let preset = gaze_lidar::model::presets::preset("vls128").unwrap();
+    assert_eq!(
+        Some(head),
+        preset
+            .lidar
+            .limits
+            .eye_safety
+            .as_ref()
+            .unwrap()
+            .head
+            .as_ref()
+    );
+}
+
+/// A budget far above the highest power (`average_power_w = 1e6` W against
+/// `power_w_max` 1.15 mW) put every power, in units of the budget, below
+/// the solver's tolerance: every bin 0 W, exit 0. Refused by name (exit 2).
+#[test]
+fn a_budget_out_of_scale_with_the_powers_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(
+        &cfg,
+        "bins = 36\n[lidar]\naverage_power_w = 1e6\n[objective]\nmode = \"range\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("o.json");
+    let o = run(
+        &[
+            "profile",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--gaze-deg",
+            "90",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        None,
+    );
+    common::expect(&o, 2, &["lidar.average_power_w"], "average_power_w = 1e6");
+    assert!(!out.exists());
+    // 1e3 times the budget of the default is still answered, with power.
+    let p = powers(
+        "bins = 36\n[lidar]\naverage_power_w = 1.0\n[objective]\nmode = \"range\"\n",
+        90.0,
+    );
+    assert!(p.iter().all(|&w| w > 0.0), "{p:?}");
+}
+
+/// A duplicate key in a config is named (toml's message, "duplicate
+/// key", named none), with its line and column.
+#[test]
+fn a_duplicate_key_is_named() {
+    for (toml, key, at) in [
+        ("bins = 36\nbins = 37\n", "bins", "2:1"),
+        (
+            "[objective]\nmode = \"range\"\nmode = \"joint\"\n",
+            "mode",
+            "3:1",
+        ),
+        ("[lidar]\n[lidar]\n", "lidar", "2:"),
+    ] {
+        let e = OptimizerConfig::from_toml(toml, "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("duplicate key") && e.contains(&format!("`{key}`")) && e.contains(at),
+            "{toml:?}: {e}"
+        );
+    }
+}
+
+/// A power floor within 1e-9 of the eye-safety limit (`check` accepts the
+/// uniform floor): the cut loop wanted the continuous head-room under the
+/// limit, which the floor itself breaks, and refused the request after 61
+/// rounds. The floor profile is the answer.
+#[test]
+fn a_floor_within_the_head_room_of_the_eye_limit_is_answered() {
+    let toml = "bins = 36\n[lidar]\naverage_power_w = 0.00116\n[limits]\npower_w_min = 0.001154653682\n[objective]\nmode = \"range\"\n";
+    let p = powers(toml, 90.0);
+    assert!(p.iter().all(|&w| w >= 0.001154653682), "{p:?}");
+}
