@@ -1370,15 +1370,38 @@ fn dwell_step(
     p: &[f64],
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
-    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, false)?;
-    let solved = d.lp.solve_with(
-        "dwell",
-        &SolveOptions {
-            initial: Some(&d.start),
-            primal_feasibility_tolerance: S.dwell_feasibility_tol,
-            ..SolveOptions::default()
-        },
-    )?;
+    let build = |frame_rel: f64| {
+        dwell_program(
+            problem,
+            g,
+            binding,
+            pulse_rate_hz,
+            p,
+            current,
+            (false, frame_rel),
+        )
+    };
+    let solve = |d: &DwellProgram| {
+        d.lp.solve_with(
+            "dwell",
+            &SolveOptions {
+                initial: Some(&d.start),
+                primal_feasibility_tolerance: S.dwell_feasibility_tol,
+                ..SolveOptions::default()
+            },
+        )
+    };
+    let mut d = build(0.0)?;
+    let solved = match solve(&d) {
+        // Spin set-points that meet the frame only within the checker's
+        // tolerance (a datasheet's figures are never exact to 1e-10): the
+        // frame row widened to half of it.
+        Err(OptError::Infeasible(_)) if !problem.levels.spin_rad_s.is_empty() => {
+            d = build(0.5 * crate::checker::REL_TOL)?;
+            solve(&d)?
+        }
+        other => other?,
+    };
     let view = d.lp.view();
     let x = view.clamped(&solved.x);
     let t = dwell_answer(problem, g, &d, &x);
@@ -1411,7 +1434,7 @@ fn answer_dwell_certificate(
 ) -> Result<Certified, CertificateError> {
     let f_p = problem.lidar.pulse_rate_hz;
     let solver = |e: OptError| CertificateError::AnswerProgram(e.to_string());
-    let d = dwell_program(problem, g, &[], f_p, p, answer, true).map_err(solver)?;
+    let d = dwell_program(problem, g, &[], f_p, p, answer, (true, 0.0)).map_err(solver)?;
     let solved =
         d.lp.solve_with(
             "dwell",
@@ -1449,6 +1472,7 @@ struct DwellProgram {
 /// set-points: the `levels` family, one binary per set-point and a one-hot
 /// row), then the constraint families in a fixed order — `frame`,
 /// `budget` (time accounting), `accel`, `eye_cuts` (linearised).
+/// `frame_rel`: see [`frame`].
 /// `contain`: the program is linearised at an answer `current` and must
 /// contain it (see [`answer_dwell_certificate`]): its boxes and
 /// acceleration rows are widened to the answer where it lies outside them.
@@ -1459,7 +1483,7 @@ fn dwell_program(
     pulse_rate_hz: f64,
     p: &[f64],
     current: &[f64],
-    contain: bool,
+    (contain, frame_rel): (bool, f64),
 ) -> Result<DwellProgram, OptError> {
     let l = &problem.lidar.limits;
     let setpoints = &problem.levels.spin_rad_s;
@@ -1500,7 +1524,7 @@ fn dwell_program(
         d.lp.column(1.0, 1.0, utility_constant, false);
         d.start.push(1.0);
     }
-    frame(&mut d, g.n);
+    frame(&mut d, g.n, frame_rel);
     if problem.lidar.power_accounting == PowerAccounting::Time {
         dwell_budget(&mut d, p, problem.lidar.average_power_w, g.n);
     }
@@ -1612,14 +1636,20 @@ fn spin_levels(d: &mut DwellProgram, problem: &Problem, g: &Grid, i: usize, allo
     d.sp_cols.push(cols);
 }
 
-/// `frame`: `Σ τ_i = N` (one turn per frame period).
-fn frame(d: &mut DwellProgram, n: usize) {
+/// `frame`: `Σ τ_i = N` (one turn per frame period), or within a relative
+/// `rel` of it (`rel > 0`: spin set-points that meet the frame only within
+/// the checker's tolerance, whose dwell is not rescaled).
+fn frame(d: &mut DwellProgram, n: usize, rel: f64) {
     let n = n as f64;
     let mut turn = Expression::default();
     for form in &d.tau {
         turn.add_mul(1.0, form);
     }
-    d.lp.equal("frame", turn, n);
+    if rel > 0.0 {
+        d.lp.between("frame", turn, n * (1.0 - rel), n * (1.0 + rel));
+    } else {
+        d.lp.equal("frame", turn, n);
+    }
 }
 
 /// `budget` under time accounting at the fixed powers `p`:
