@@ -158,24 +158,28 @@ fn limit(field: &str, v: &LimitValue) -> Result<Option<f64>, OptError> {
     }
 }
 
+/// A normal number `> 0` (a subnormal, such as `5e-324`, has no physical
+/// size and reached the solver as an "optimized" profile that violates
+/// its own limits).
 fn positive(field: &str, v: f64) -> Result<f64, OptError> {
-    if v.is_finite() && v > 0.0 {
+    if v.is_normal() && v > 0.0 {
         Ok(v)
     } else {
         Err(OptError::Invalid {
             field: field.into(),
-            reason: format!("{} must be finite and > 0", Num(v)),
+            reason: format!("{} must be finite, normal and > 0", Num(v)),
         })
     }
 }
 
+/// Zero or a normal number `> 0` (see [`positive`]).
 fn nonneg(field: &str, v: f64) -> Result<f64, OptError> {
-    if v.is_finite() && v >= 0.0 {
+    if v == 0.0 || (v.is_normal() && v > 0.0) {
         Ok(v)
     } else {
         Err(OptError::Invalid {
             field: field.into(),
-            reason: format!("{} must be finite and >= 0", Num(v)),
+            reason: format!("{} must be finite and zero or normal and > 0", Num(v)),
         })
     }
 }

@@ -454,3 +454,25 @@ fn set_points_meeting_the_frame_within_tolerance_are_answered() {
         );
     }
 }
+
+/// A subnormal power or rate in a config (`5e-324`) is bad input naming
+/// its key: it once reached the solver and came back as an "optimized"
+/// profile violating its own limits (exit 1).
+#[test]
+fn a_subnormal_config_number_is_refused_by_name() {
+    for (toml, key) in [
+        (
+            "[lidar]\naverage_power_w = 5e-324\n",
+            "lidar.average_power_w",
+        ),
+        ("[lidar]\nframe_rate_hz = 5e-324\n", "lidar.frame_rate_hz"),
+        ("[limits]\npower_w_min = 5e-324\n", "limits.power_w_min"),
+    ] {
+        let e = OptimizerConfig::from_toml(toml, "t.toml")
+            .unwrap()
+            .problem()
+            .unwrap_err();
+        assert!(e.is_input_error(), "{toml:?}: {e}");
+        assert!(e.to_string().contains(key), "{toml:?}: {e}");
+    }
+}
