@@ -1294,14 +1294,14 @@ impl PowerLp {
             let v = self.point(&q).ok_or(CertificateError::NotALevel)?;
             // The point meets the solved program (the margins inside the
             // limits) exactly; its bound is the user's problem's.
-            let inner = Certified::new(
-                Step::Power,
-                self.lp.clone(),
-                v.clone(),
-                self.y.clone(),
-                self.solver_dual_bound,
-            );
-            match inner.and_then(|_| {
+            let inner = if super::certificate::primal_feasible(&self.lp, &v) {
+                Ok(())
+            } else {
+                Err(CertificateError::NotFeasible(
+                    "the power step's point breaks a row or bound of its solved program".into(),
+                ))
+            };
+            match inner.and_then(|()| {
                 Certified::new(
                     Step::Power,
                     self.outer.clone(),
