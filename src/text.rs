@@ -12,7 +12,16 @@ pub fn toml_error(text: &str, e: &toml::de::Error) -> String {
     match e.span() {
         Some(span) => {
             let (line, column) = line_column(text, span.start);
-            format!("{line}:{column}: {message}")
+            // toml names no key in "duplicate key": the span's does.
+            let key = text
+                .get(span)
+                .and_then(|t| t.split('=').next())
+                .map(|k| k.trim().trim_matches(|c| c == '[' || c == ']').trim())
+                .filter(|k| message.starts_with("duplicate key") && !k.is_empty());
+            match key {
+                Some(k) => format!("{line}:{column}: {message} `{k}`"),
+                None => format!("{line}:{column}: {message}"),
+            }
         }
         None => message,
     }

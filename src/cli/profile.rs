@@ -491,12 +491,11 @@ fn text_summary(c: &CertifiedProfile, basis: &Basis) -> String {
             }
         );
         if let Some(f) = o.eye_safety_tightening {
-            // The power step's figures are for a program whose eye-safety
-            // limits were divided by up to `f`: profiles within the true
-            // limits may score more (the global bound covers them).
+            // The answer meets eye-safety limits divided by up to `f`; the
+            // upper bound is the user's problem's (the true limits).
             let _ = write!(
                 out,
-                " for the program with eye-safety limits divided by up to {f:.4} (a profile within the true limits may score more; the global bound covers it)"
+                " (the answer meets eye-safety limits divided by up to {f:.4}; the upper bound is for the true limits)"
             );
         }
         if let Some(g) = &o.global {

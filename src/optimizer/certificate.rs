@@ -588,8 +588,8 @@ impl Certified {
         CertificateFile {
             format: "gaze-lidar/certificate@1".into(),
             problem: match (self.step, self.lp.is_mip()) {
-                (Step::Power, true) => "the final power step (a MILP over hardware power levels); y are the row duals of its LP relaxation, so upper_bound bounds the MILP too".into(),
-                (Step::Power, false) => "the final power step (an LP)".into(),
+                (Step::Power, true) => "the final power step (a MILP over hardware power levels) with the user's limits as the checker accepts them (the answer also meets the solved program's rows, which keep margins inside them); y are the row duals of the solved program's LP relaxation, so upper_bound bounds the MILP too".into(),
+                (Step::Power, false) => "the final power step (an LP) with the user's limits as the checker accepts them (the answer also meets the solved program's rows, which keep margins inside them and may divide eye-safety limits by eye_safety_tightening); y are the solved program's row duals".into(),
                 (Step::Dwell, true) => "the final dwell step (a MILP over spin set-points; rows widened by HiGHS's feasibility tolerance, specs/optimizer.md); y are the row duals of its LP relaxation, so upper_bound bounds the MILP too".into(),
                 (Step::Dwell, false) => "the final dwell step (an LP; rows widened by HiGHS's feasibility tolerance, specs/optimizer.md)".into(),
             },

@@ -12,6 +12,8 @@
 //! power_w_max = 1.3e-3
 //! spin_accel_rad_s2_max = 400.0    # or "unlimited"
 //! power_slew_w_per_deg_max = "unlimited"
+//! # [limits.eye_safety] replaces the preset's laser figures; without a
+//! # `head` key of its own it keeps the preset's multi-beam head
 //!
 //! [focus]                          # region of focus: acuity model and η
 //! threshold = 0.083
@@ -93,6 +95,32 @@ pub struct LimitsSection {
     pub eye_safety: Option<EyeSafetyParams>,
 }
 
+/// The most `lidar.average_power_w` may exceed `limits.power_w_max` by
+/// (a factor). The programs measure power in units of the budget
+/// (`x = p/P̄`, HiGHS's tolerances being absolute, 1e-7): a budget 10⁶
+/// times the highest power puts every power below that tolerance, and the
+/// answer was 0 W "optimal"; at 10³ the answers are still right. A budget
+/// above the highest power never binds anyway.
+pub const MAX_BUDGET_OVER_POWER_MAX: f64 = 1e3;
+
+/// `lidar.average_power_w` within [`MAX_BUDGET_OVER_POWER_MAX`] of
+/// `limits.power_w_max`.
+fn budget_in_scale(lid: &crate::model::lidar::LidarSpec) -> Result<(), OptError> {
+    let (p, hi) = (lid.average_power_w, lid.limits.power_w_max);
+    if p > hi * MAX_BUDGET_OVER_POWER_MAX {
+        return Err(OptError::Invalid {
+            field: "lidar.average_power_w".into(),
+            reason: format!(
+                "{} W is more than {} times limits.power_w_max ({} W): the budget cannot bind, and powers in units of it fall below the solver's tolerance; lower it to at most that",
+                Num(p),
+                Num(MAX_BUDGET_OVER_POWER_MAX),
+                Num(hi)
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The whole file.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -130,24 +158,28 @@ fn limit(field: &str, v: &LimitValue) -> Result<Option<f64>, OptError> {
     }
 }
 
+/// A normal number `> 0` (a subnormal, such as `5e-324`, has no physical
+/// size and reached the solver as an "optimized" profile that violates
+/// its own limits).
 fn positive(field: &str, v: f64) -> Result<f64, OptError> {
-    if v.is_finite() && v > 0.0 {
+    if v.is_normal() && v > 0.0 {
         Ok(v)
     } else {
         Err(OptError::Invalid {
             field: field.into(),
-            reason: format!("{} must be finite and > 0", Num(v)),
+            reason: format!("{} must be finite, normal and > 0", Num(v)),
         })
     }
 }
 
+/// Zero or a normal number `> 0` (see [`positive`]).
 fn nonneg(field: &str, v: f64) -> Result<f64, OptError> {
-    if v.is_finite() && v >= 0.0 {
+    if v == 0.0 || (v.is_normal() && v > 0.0) {
         Ok(v)
     } else {
         Err(OptError::Invalid {
             field: field.into(),
-            reason: format!("{} must be finite and >= 0", Num(v)),
+            reason: format!("{} must be finite and zero or normal and > 0", Num(v)),
         })
     }
 }
@@ -207,6 +239,7 @@ impl OptimizerConfig {
         let mut preset = self.preset()?;
         self.apply_lidar(&mut preset.lidar)?;
         self.apply_limits(&mut preset.lidar.limits)?;
+        budget_in_scale(&preset.lidar)?;
         let focus = self.focus.clone().unwrap_or(preset.focus);
         focus.validate().map_err(|e| OptError::Invalid {
             field: "focus".into(),
@@ -290,7 +323,13 @@ impl OptimizerConfig {
                 field: "limits.eye_safety".into(),
                 reason: e.to_string(),
             })?;
-            lim.eye_safety = Some(v.clone());
+            // The table overrides what it names: a preset's multi-beam
+            // head stays unless the table gives its own.
+            let head = v
+                .head
+                .clone()
+                .or_else(|| lim.eye_safety.as_ref().and_then(|e| e.head.clone()));
+            lim.eye_safety = Some(EyeSafetyParams { head, ..v.clone() });
         }
         Ok(())
     }

@@ -94,8 +94,17 @@ impl FastPlanner {
                     .or_insert_with(|| c.into_inner())
             }
         };
-        let rotated = rotate(canonical, k, quantized_gaze(self.problem.bins, gaze_deg));
-        Ok(certify(rotated)?)
+        let gaze = quantized_gaze(self.problem.bins, gaze_deg);
+        let rotated = rotate(canonical, k, gaze);
+        match certify(rotated) {
+            Ok(c) => Ok(c),
+            // A rotated answer at the limit (hardware levels keep no
+            // head-room) whose bound rounds the other way: a fresh solve.
+            Err(_) => {
+                self.fresh_solves += 1;
+                optimize(&self.problem, gaze)
+            }
+        }
     }
 }
 

@@ -42,6 +42,28 @@ fn level_rhs() -> f64 {
     (1.0 - S.eye_safety_headroom) / (1.0 + RATIO_MARGIN)
 }
 
+/// What `check` accepts of a limit `v ≥ 0`: its relative `REL_TOL`, and a
+/// relative 1e-12 more for the rounding of the checker's floating-point
+/// sums. The power step's rows and boxes sit inside the limits (margins);
+/// its certificate's bound is taken on the program with these sides
+/// (`Program::relax_row`), so it bounds every profile `check` certifies,
+/// not only the tightened program's points.
+fn accepted(v: f64) -> f64 {
+    v * (1.0 + crate::checker::REL_TOL) * (1.0 + 1e-12)
+}
+
+/// The bound's figure at or below which an answer counts as eye-safe:
+/// continuous powers keep `eye_safety_headroom` below the Class 1 limit;
+/// hardware levels are exact, so a level the checker accepts (the bound's
+/// figure at most 1) stays available, however close to the limit it is.
+fn eye_accept(problem: &Problem) -> f64 {
+    if problem.levels.power_w.is_empty() {
+        1.0 - S.eye_safety_headroom
+    } else {
+        1.0
+    }
+}
+
 /// Whether the dwell `next` is within `settings::slp_settled` of `t` in every bin.
 fn settled(next: &[f64], t: &[f64]) -> bool {
     next.iter()
@@ -348,7 +370,10 @@ fn power_step(
         let p = powers(problem, g, t, &program, &solved.x);
         let checkpoint = match eye {
             None => Checkpoint::Certified,
-            Some(e) => power_checkpoint(e, g, spins, &p, pool, &factor, round)?,
+            Some(e) => {
+                let at = (round, eye_accept(problem));
+                power_checkpoint(e, g, spins, &p, pool, &factor, at)?
+            }
         };
         match checkpoint {
             Checkpoint::Certified => {
@@ -357,6 +382,7 @@ fn power_step(
                     p,
                     PowerLp {
                         lp: program.lp.view(),
+                        outer: program.lp.outer_view(),
                         bins: program.bins,
                         one: program.one,
                         tightening: (top > 1.0).then_some(top),
@@ -418,12 +444,12 @@ fn power_checkpoint(
     p: &[f64],
     pool: &[Cut],
     factor: &[f64; 2],
-    round: usize,
+    (round, accept): (usize, f64),
 ) -> Result<Checkpoint, OptError> {
     let s = segs(g, spins, p);
     let report = e.report(&s)?;
     let (ratio, witness) = (report.worst_ratio, report.worst_azimuth_deg);
-    if ratio <= 1.0 - S.eye_safety_headroom {
+    if ratio <= accept {
         return Ok(Checkpoint::Certified);
     }
     let round = round + 1;
@@ -438,6 +464,13 @@ fn power_checkpoint(
     let mut fresh = new_cuts(&[]);
     if fresh.is_empty() {
         fresh = new_cuts(&[witness]);
+    }
+    // No cut separates the answer (or the rounds ran out) and the checker
+    // accepts it (the bound's figure at most 1): a floor within the
+    // head-room of the limit holds bins there whatever the cuts say, and
+    // the head-room is a preference, not a limit.
+    if ratio <= 1.0 && (fresh.is_empty() || round > S.cut_rounds) {
+        return Ok(Checkpoint::Certified);
     }
     if round > S.cut_rounds {
         return Ok(Checkpoint::Fail(OptError::Solver(format!(
@@ -807,10 +840,12 @@ fn eye_caps(
 ) -> (Vec<f64>, Vec<f64>) {
     // A cut on one bin's power alone is that bin's column bound (the
     // utility's chords then span the reachable powers only).
+    // Levels: a level the checker accepts (the bound's figure at most 1,
+    // its rounding margin applied) stays; the checkpoint decides.
     let rhs = if problem.levels.power_w.is_empty() {
         cut_rhs()
     } else {
-        level_rhs()
+        1.0 / (1.0 + RATIO_MARGIN)
     };
     let mut caps = vec![f64::INFINITY; g.n];
     let mut bare = vec![f64::INFINITY; g.n];
@@ -861,6 +896,7 @@ fn power_bin(
     // The utility as boxed segment columns (see `utility`).
     let shape = super::detection::range_segments(problem, g.theta[i], dwell_s, lo_x, hi_x);
     let deltas = shape.add_to(lp, xi, 1.0, lo_x, c);
+    relax_bin(lp, problem, (xi, &deltas, &shape), (lo_x, hi_x), bare_w);
     let constant = c * shape.base;
     let bin = PowerBin::Continuous {
         x: lp.col(xi),
@@ -869,6 +905,40 @@ fn power_bin(
         shape,
     };
     Ok((xi.into(), bin, constant))
+}
+
+/// The user's box of a continuous bin (as `check` accepts the floor,
+/// `power_w_max` and the bin's bare single-bin eye-safety cap) recorded on
+/// the program (`Program::relax_col`): `x` between them, and the utility's
+/// first and last segments extended by the difference (a chord of a concave
+/// utility extended past its ends lies above it, so the extended program
+/// still bounds the utility there).
+fn relax_bin(
+    lp: &mut Program,
+    problem: &Problem,
+    (xi, deltas, shape): (Variable, &[Variable], &SqrtSegments),
+    (lo_x, hi_x): (f64, f64),
+    bare_w: f64,
+) {
+    let l = &problem.lidar.limits;
+    let p_mean = problem.lidar.average_power_w;
+    let lo_o = (l.power_w_min / p_mean * (1.0 - crate::checker::REL_TOL) * (1.0 - 1e-12)).min(lo_x);
+    let hi_o = (accepted(l.power_w_max.min(bare_w)) / p_mean).max(hi_x);
+    let j = lp.col(xi);
+    lp.relax_col(j, lo_o, hi_o);
+    if let (Some(first), Some(last)) = (deltas.first(), deltas.last()) {
+        let (first, last) = (lp.col(*first), lp.col(last.to_owned()));
+        let below = (lo_x - lo_o) * (1.0 + 1e-12);
+        let above = (hi_o - hi_x) * (1.0 + 1e-12);
+        let n = shape.segments.len();
+        let len = |k: usize| shape.segments[k].1;
+        if first == last {
+            lp.relax_col(first, -below, len(0) + above);
+        } else {
+            lp.relax_col(first, -below, len(0));
+            lp.relax_col(last, 0.0, len(n - 1) + above);
+        }
+    }
 }
 
 /// `levels`: one binary column per hardware level within
@@ -952,7 +1022,12 @@ fn budget(lp: &mut Program, problem: &Problem, g: &Grid, t: &[f64], x: &[LinearF
     } else {
         budget
     };
-    lp.at_most("budget", spend, side);
+    let row = lp.at_most("budget", spend, side);
+    let full = match problem.lidar.power_accounting {
+        PowerAccounting::Angle => TAU,
+        PowerAccounting::Time => 1.0,
+    };
+    lp.relax_row(row, accepted(full).max(side));
 }
 
 /// `slew`: `|x_{i+1} − x_i| ≤ s·(Δ_i + Δ_{i+1})/2·side` around the circle
@@ -964,7 +1039,10 @@ fn slew(lp: &mut Program, g: &Grid, x: &[LinearForm], s: f64, (p_mean, side): (f
         let lim = s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean * side;
         let mut d = x[j].clone();
         d.add_mul(-1.0, &x[i]);
-        lp.between("slew", d, -lim, lim);
+        let (upper, lower) = lp.between("slew", d, -lim, lim);
+        let outer = accepted(s * 0.5 * (g.width_deg[i] + g.width_deg[j]) / p_mean).max(lim);
+        lp.relax_row(upper, outer);
+        lp.relax_row(lower, -outer);
     }
 }
 
@@ -1049,7 +1127,14 @@ fn eye_cuts(
             }
             .into());
         }
-        lp.at_most("eye_cuts", row, cut_rhs().max(at_floor * (1.0 + 1e-12)));
+        let side = cut_rhs().max(at_floor * (1.0 + 1e-12));
+        let row = lp.at_most("eye_cuts", row, side);
+        // A certified profile meets every cut at its bare limit (a cut is
+        // one concrete exposure, at most the bound's worst case, which
+        // `check` holds to 1): the row's value is the exposure's ratio
+        // times `f`. A relative 1e-9 covers the rounding of the row's
+        // coefficients.
+        lp.relax_row(row, (f * (1.0 + 1e-9)).max(side));
     }
     Ok(())
 }
@@ -1161,6 +1246,10 @@ enum PowerBin {
 /// vector against it.
 pub(super) struct PowerLp {
     lp: LinearProgram,
+    /// `lp` with the user's limits as `check` accepts them in place of the
+    /// margins (`Program::outer_view`): the program the certificate's bound
+    /// is for and the one exported.
+    outer: LinearProgram,
     bins: Vec<PowerBin>,
     /// The largest factor an eye-safety cut was tightened by, if any.
     pub(super) tightening: Option<f64>,
@@ -1214,13 +1303,24 @@ impl PowerLp {
         let mut q = p.to_vec();
         for k in 0..S.repair_tries {
             let v = self.point(&q).ok_or(CertificateError::NotALevel)?;
-            match Certified::new(
-                Step::Power,
-                self.lp.clone(),
-                v,
-                self.y.clone(),
-                self.solver_dual_bound,
-            ) {
+            // The point meets the solved program (the margins inside the
+            // limits) exactly; its bound is the user's problem's.
+            let inner = if super::certificate::primal_feasible(&self.lp, &v) {
+                Ok(())
+            } else {
+                Err(CertificateError::NotFeasible(
+                    "the power step's point breaks a row or bound of its solved program".into(),
+                ))
+            };
+            match inner.and_then(|()| {
+                Certified::new(
+                    Step::Power,
+                    self.outer.clone(),
+                    v,
+                    self.y.clone(),
+                    self.solver_dual_bound,
+                )
+            }) {
                 Ok(c) => return Ok((c, q)),
                 Err(e)
                     if k + 1 == S.repair_tries
@@ -1281,15 +1381,38 @@ fn dwell_step(
     p: &[f64],
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
-    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, false)?;
-    let solved = d.lp.solve_with(
-        "dwell",
-        &SolveOptions {
-            initial: Some(&d.start),
-            primal_feasibility_tolerance: S.dwell_feasibility_tol,
-            ..SolveOptions::default()
-        },
-    )?;
+    let build = |frame_rel: f64| {
+        dwell_program(
+            problem,
+            g,
+            binding,
+            pulse_rate_hz,
+            p,
+            current,
+            (false, frame_rel),
+        )
+    };
+    let solve = |d: &DwellProgram| {
+        d.lp.solve_with(
+            "dwell",
+            &SolveOptions {
+                initial: Some(&d.start),
+                primal_feasibility_tolerance: S.dwell_feasibility_tol,
+                ..SolveOptions::default()
+            },
+        )
+    };
+    let mut d = build(0.0)?;
+    let solved = match solve(&d) {
+        // Spin set-points that meet the frame only within the checker's
+        // tolerance (a datasheet's figures are never exact to 1e-10): the
+        // frame row widened to half of it.
+        Err(OptError::Infeasible(_)) if !problem.levels.spin_rad_s.is_empty() => {
+            d = build(0.5 * crate::checker::REL_TOL)?;
+            solve(&d)?
+        }
+        other => other?,
+    };
     let view = d.lp.view();
     let x = view.clamped(&solved.x);
     let t = dwell_answer(problem, g, &d, &x);
@@ -1322,7 +1445,7 @@ fn answer_dwell_certificate(
 ) -> Result<Certified, CertificateError> {
     let f_p = problem.lidar.pulse_rate_hz;
     let solver = |e: OptError| CertificateError::AnswerProgram(e.to_string());
-    let d = dwell_program(problem, g, &[], f_p, p, answer, true).map_err(solver)?;
+    let d = dwell_program(problem, g, &[], f_p, p, answer, (true, 0.0)).map_err(solver)?;
     let solved =
         d.lp.solve_with(
             "dwell",
@@ -1360,6 +1483,7 @@ struct DwellProgram {
 /// set-points: the `levels` family, one binary per set-point and a one-hot
 /// row), then the constraint families in a fixed order — `frame`,
 /// `budget` (time accounting), `accel`, `eye_cuts` (linearised).
+/// `frame_rel`: see [`frame`].
 /// `contain`: the program is linearised at an answer `current` and must
 /// contain it (see [`answer_dwell_certificate`]): its boxes and
 /// acceleration rows are widened to the answer where it lies outside them.
@@ -1370,7 +1494,7 @@ fn dwell_program(
     pulse_rate_hz: f64,
     p: &[f64],
     current: &[f64],
-    contain: bool,
+    (contain, frame_rel): (bool, f64),
 ) -> Result<DwellProgram, OptError> {
     let l = &problem.lidar.limits;
     let setpoints = &problem.levels.spin_rad_s;
@@ -1411,7 +1535,7 @@ fn dwell_program(
         d.lp.column(1.0, 1.0, utility_constant, false);
         d.start.push(1.0);
     }
-    frame(&mut d, g.n);
+    frame(&mut d, g.n, frame_rel);
     if problem.lidar.power_accounting == PowerAccounting::Time {
         dwell_budget(&mut d, p, problem.lidar.average_power_w, g.n);
     }
@@ -1523,14 +1647,20 @@ fn spin_levels(d: &mut DwellProgram, problem: &Problem, g: &Grid, i: usize, allo
     d.sp_cols.push(cols);
 }
 
-/// `frame`: `Σ τ_i = N` (one turn per frame period).
-fn frame(d: &mut DwellProgram, n: usize) {
+/// `frame`: `Σ τ_i = N` (one turn per frame period), or within a relative
+/// `rel` of it (`rel > 0`: spin set-points that meet the frame only within
+/// the checker's tolerance, whose dwell is not rescaled).
+fn frame(d: &mut DwellProgram, n: usize, rel: f64) {
     let n = n as f64;
     let mut turn = Expression::default();
     for form in &d.tau {
         turn.add_mul(1.0, form);
     }
-    d.lp.equal("frame", turn, n);
+    if rel > 0.0 {
+        d.lp.between("frame", turn, n * (1.0 - rel), n * (1.0 + rel));
+    } else {
+        d.lp.equal("frame", turn, n);
+    }
 }
 
 /// `budget` under time accounting at the fixed powers `p`:
@@ -1880,7 +2010,7 @@ fn shorten_for_eye_safety(
     let g = ctx.g;
     let p = &it.p;
     let safe = |sp: &[(f64, f64)]| -> Result<bool, OptError> {
-        Ok(e.verdict(&segs(g, sp, p))?.0 <= 1.0 - S.eye_safety_headroom)
+        Ok(e.verdict(&segs(g, sp, p))?.0 <= eye_accept(ctx.problem))
     };
     let mut shortened = false;
     if !ctx.problem.levels.spin_rad_s.is_empty() && !safe(&spins)? {
@@ -1901,7 +2031,7 @@ fn shorten_for_eye_safety(
         spins = spins_of(g, &ta, smooth, ctx.problem.lidar.frame_rate_hz);
     }
     let (ratio, at) = e.verdict(&segs(g, &spins, p))?;
-    if ratio > 1.0 - S.eye_safety_headroom {
+    if ratio > eye_accept(ctx.problem) {
         return Err(Infeasible::EyeAtUniformSpin {
             power_w: p[0],
             ratio,

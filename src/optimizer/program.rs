@@ -55,6 +55,12 @@ pub struct Program {
     vars: Vec<Variable>,
     index: HashMap<Variable, usize>,
     constraints: Vec<(Constraint, Sense)>,
+    /// Rows whose finite side the user's problem puts further out than
+    /// the program HiGHS solves (see [`Self::relax_row`]): row → side.
+    outer_rows: HashMap<usize, f64>,
+    /// Columns whose box the user's problem puts further out: column →
+    /// (lo, hi).
+    outer_cols: HashMap<usize, (f64, f64)>,
 }
 
 impl Program {
@@ -141,6 +147,42 @@ impl Program {
         let upper = self.at_most(name, e.clone(), hi);
         let lower = self.at_least(name, e, lo);
         (upper, lower)
+    }
+
+    /// Records that the user's problem holds row `row` only to `side` (its
+    /// finite side, in the orientation [`Self::view`] gives: the `hi` of a
+    /// `≤` row, the `lo` of a `≥` row), further out than the side HiGHS
+    /// gets: the margins the program keeps inside the limits.
+    /// [`Self::outer_view`] is the program with these sides, a relaxation
+    /// of the solved one whose dual bound bounds every point the limits
+    /// (as the checker accepts them) allow.
+    pub fn relax_row(&mut self, row: usize, side: f64) {
+        self.outer_rows.insert(row, side);
+    }
+
+    /// As [`Self::relax_row`] for column `j`'s box.
+    pub fn relax_col(&mut self, j: usize, lo: f64, hi: f64) {
+        self.outer_cols.insert(j, (lo, hi));
+    }
+
+    /// [`Self::view`] with the sides and boxes of [`Self::relax_row`] and
+    /// [`Self::relax_col`] (only ever further out).
+    #[must_use]
+    pub fn outer_view(&self) -> LinearProgram {
+        let mut lp = self.view();
+        for (&k, &side) in &self.outer_rows {
+            let r = &mut lp.rows[k];
+            if r.hi.is_finite() && r.lo.is_infinite() {
+                r.hi = r.hi.max(side);
+            } else if r.lo.is_finite() && r.hi.is_infinite() {
+                r.lo = r.lo.min(side);
+            }
+        }
+        for (&j, &(lo, hi)) in &self.outer_cols {
+            lp.col_lo[j] = lp.col_lo[j].min(lo);
+            lp.col_hi[j] = lp.col_hi[j].max(hi);
+        }
+        lp
     }
 
     /// The constraints' names, row order.

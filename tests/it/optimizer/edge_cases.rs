@@ -284,3 +284,195 @@ fn the_text_summary_states_an_eye_safety_tightening() {
         None => assert!(!line.contains("divided by"), "{line}"),
     }
 }
+
+/// The optimizer's answer and its `optimality` block for a config text.
+fn answer(toml: &str, gaze_deg: f64) -> gaze_lidar::profile::Profile {
+    let problem = OptimizerConfig::from_toml(toml, "t.toml")
+        .unwrap()
+        .problem()
+        .unwrap();
+    optimize(&problem, gaze_deg).unwrap().profile().clone()
+}
+
+/// The power step's upper bound bounds every profile `check` certifies for
+/// the user's limits, not only the program's points: its budget and slew
+/// rows sit 1e-6 inside the limits, and the answer to a slew limit
+/// 1/(1 − 1e-6) looser (certified under the tighter limit too: its largest
+/// step is within it) once scored 6e-9 above the bound stated for the
+/// tighter limit, whose gap read 7e-14. Both runs score on the same
+/// objective (range mode, uniform spin, same gaze and weights).
+#[test]
+fn the_power_step_bound_covers_every_certified_profile() {
+    let cfg = |slew: f64, accounting: &str| {
+        format!(
+            "bins = 360\n[lidar]\npower_accounting = \"{accounting}\"\n[limits]\npower_slew_w_per_deg_max = {slew:?}\n[focus]\nthreshold = 0.0831\nacuity = {{ model = \"levi_e2\", e2_deg = 2.72 }}\n[objective]\nmode = \"range\"\n"
+        )
+    };
+    for accounting in ["time", "angle"] {
+        let tight = answer(&cfg(2e-5, accounting), 90.0);
+        let loose = answer(&cfg(2e-5 / (1.0 - 1e-6), accounting), 90.0);
+        let mut hand = loose.clone();
+        hand.limits = tight.limits.clone();
+        hand.optimality = None;
+        gaze_lidar::checker::certify(hand)
+            .unwrap_or_else(|e| panic!("{accounting}: the looser answer is not certified: {e:?}"));
+        let bound = tight.optimality.as_ref().unwrap().upper_bound;
+        let score = loose.optimality.as_ref().unwrap().objective;
+        assert!(
+            score <= bound,
+            "{accounting}: a certified profile scores {score}, above the bound {bound}"
+        );
+    }
+}
+
+/// A hardware level 4e-11 under the eye-safety limit (`check` accepts
+/// uniform power up to 0.0011546536827443574 W on this config) stays
+/// available: it was dropped with the head-room continuous powers keep,
+/// and uniform 0.5 mW was "proven optimal" (gap 0) while the top level
+/// everywhere is certified and scores 52 % more.
+#[test]
+fn a_level_within_the_checkers_tolerance_of_the_eye_limit_is_used() {
+    let toml = "bins = 36\n[lidar]\naverage_power_w = 0.00116\n[levels]\npower_w = [0.0005, 0.0011546536827]\n[objective]\nmode = \"range\"\n";
+    let p = powers(toml, 90.0);
+    assert!(
+        p.contains(&0.0011546536827),
+        "the top level is never used: {p:?}"
+    );
+}
+
+/// A config naming a multi-beam preset (`vls128`) that restates
+/// `[limits.eye_safety]` without a `head` key keeps the preset's head: the
+/// table once replaced it whole, and the answer was certified for one
+/// channel while the real 128-channel head was at 244.7 % of the limit.
+#[test]
+fn a_restated_eye_safety_table_keeps_the_presets_head() {
+    let toml = "bins = 36\n[lidar]\npreset = \"vls128\"\naverage_power_w = 6e-5\n[limits]\npower_w_max = 2e-4\n[limits.eye_safety]\nwavelength_nm = 903.0\npulse_duration_s = 3e-9\nbeam_diameter_mm = 10.2\n[objective]\nmode = \"range\"\n";
+    let problem = OptimizerConfig::from_toml(toml, "t.toml")
+        .unwrap()
+        .problem()
+        .unwrap();
+    let eye = problem.lidar.limits.eye_safety.as_ref().unwrap();
+    let head = eye.head.as_ref().expect("the preset's head was dropped");
+    let preset = gaze_lidar::model::presets::preset("vls128").unwrap();
+    assert_eq!(
+        Some(head),
+        preset
+            .lidar
+            .limits
+            .eye_safety
+            .as_ref()
+            .unwrap()
+            .head
+            .as_ref()
+    );
+}
+
+/// A budget far above the highest power (`average_power_w = 1e6` W against
+/// `power_w_max` 1.15 mW) put every power, in units of the budget, below
+/// the solver's tolerance: every bin 0 W, exit 0. Refused by name (exit 2).
+#[test]
+fn a_budget_out_of_scale_with_the_powers_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(
+        &cfg,
+        "bins = 36\n[lidar]\naverage_power_w = 1e6\n[objective]\nmode = \"range\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("o.json");
+    let o = run(
+        &[
+            "profile",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--gaze-deg",
+            "90",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        None,
+    );
+    common::expect(&o, 2, &["lidar.average_power_w"], "average_power_w = 1e6");
+    assert!(!out.exists());
+    // 1e3 times the budget of the default is still answered, with power.
+    let p = powers(
+        "bins = 36\n[lidar]\naverage_power_w = 1.0\n[objective]\nmode = \"range\"\n",
+        90.0,
+    );
+    assert!(p.iter().all(|&w| w > 0.0), "{p:?}");
+}
+
+/// A duplicate key in a config is named (toml's message, "duplicate
+/// key", named none), with its line and column.
+#[test]
+fn a_duplicate_key_is_named() {
+    for (toml, key, at) in [
+        ("bins = 36\nbins = 37\n", "bins", "2:1"),
+        (
+            "[objective]\nmode = \"range\"\nmode = \"joint\"\n",
+            "mode",
+            "3:1",
+        ),
+        ("[lidar]\n[lidar]\n", "lidar", "2:"),
+    ] {
+        let e = OptimizerConfig::from_toml(toml, "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("duplicate key") && e.contains(&format!("`{key}`")) && e.contains(at),
+            "{toml:?}: {e}"
+        );
+    }
+}
+
+/// A power floor within 1e-9 of the eye-safety limit (`check` accepts the
+/// uniform floor): the cut loop wanted the continuous head-room under the
+/// limit, which the floor itself breaks, and refused the request after 61
+/// rounds. The floor profile is the answer.
+#[test]
+fn a_floor_within_the_head_room_of_the_eye_limit_is_answered() {
+    let toml = "bins = 36\n[lidar]\naverage_power_w = 0.00116\n[limits]\npower_w_min = 0.001154653682\n[objective]\nmode = \"range\"\n";
+    let p = powers(toml, 90.0);
+    assert!(p.iter().all(|&w| w >= 0.001154653682), "{p:?}");
+}
+
+/// Spin set-points that meet the frame only within the checker's
+/// tolerance (180.20301935392519·(1 + 5e-10) rad/s: six bins at 50 and
+/// thirty at it make one turn 2.9e-10 off the frame period): the dwell
+/// step's frame row was an equality and the request "had no solution",
+/// although the set-point profile is certified. Answered on the
+/// set-points.
+#[test]
+fn set_points_meeting_the_frame_within_tolerance_are_answered() {
+    let toml = "bins = 36\n[levels]\nspin_rad_s = [50.0, 180.2030194440267]\npower_w = [0.0003, 0.0007]\n[objective]\nmode = \"joint\"\n";
+    let p = answer(toml, 90.0);
+    for b in &p.bins {
+        assert!(
+            [50.0, 180.2030194440267].contains(&b.spin_start_rad_s),
+            "spin {} is no set-point",
+            b.spin_start_rad_s
+        );
+    }
+}
+
+/// A subnormal power or rate in a config (`5e-324`) is bad input naming
+/// its key: it once reached the solver and came back as an "optimized"
+/// profile violating its own limits (exit 1).
+#[test]
+fn a_subnormal_config_number_is_refused_by_name() {
+    for (toml, key) in [
+        (
+            "[lidar]\naverage_power_w = 5e-324\n",
+            "lidar.average_power_w",
+        ),
+        ("[lidar]\nframe_rate_hz = 5e-324\n", "lidar.frame_rate_hz"),
+        ("[limits]\npower_w_min = 5e-324\n", "limits.power_w_min"),
+    ] {
+        let e = OptimizerConfig::from_toml(toml, "t.toml")
+            .unwrap()
+            .problem()
+            .unwrap_err();
+        assert!(e.is_input_error(), "{toml:?}: {e}");
+        assert!(e.to_string().contains(key), "{toml:?}: {e}");
+    }
+}

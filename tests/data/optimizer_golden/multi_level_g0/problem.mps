@@ -6128,7 +6128,7 @@ RHS
  rhs r357 1.0
  rhs r358 1.0
  rhs r359 1.0
- rhs r360 1.0000000002
+ rhs r360 1.0000000010010002
 BOUNDS
  LO bnd x0 0.0
  UP bnd x0 1.0

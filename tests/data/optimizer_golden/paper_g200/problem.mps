@@ -2888,7 +2888,7 @@ RHS
  rhs r357 1.0
  rhs r358 1.0
  rhs r359 1.0
- rhs r360 6.283185308436224
+ rhs r360 6.283185313469056
 BOUNDS
  LO bnd x0 0.0
  UP bnd x0 1.0
