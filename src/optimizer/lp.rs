@@ -556,30 +556,44 @@ struct LevelRing {
 
 impl Heuristic for LevelRing {
     fn start(&self, relaxed: &[f64], duals: &[f64]) -> Option<Vec<f64>> {
-        if relaxed.len() != self.columns {
+        if !relaxed.is_empty() && relaxed.len() != self.columns || duals.len() <= self.budget_row {
             return None;
         }
         // The relaxation's point rounded down: per bin, of its levels with
         // the largest binary, the first (the lowest index).
-        let rounded = self
-            .cols
-            .iter()
-            .map(|cs| {
-                let mut best = 0;
-                for (k, &c) in cs.iter().enumerate() {
-                    if relaxed[c] > relaxed[cs[best]] {
-                        best = k;
+        let rounded = (!relaxed.is_empty()).then(|| {
+            self.cols
+                .iter()
+                .map(|cs| {
+                    let mut best = 0;
+                    for (k, &c) in cs.iter().enumerate() {
+                        if relaxed[c] > relaxed[cs[best]] {
+                            best = k;
+                        }
                     }
-                }
-                best
-            })
-            .collect();
-        let choice = self.ring.heuristic(duals[self.budget_row], Some(rounded))?;
+                    best
+                })
+                .collect()
+        });
+        let choice = self.ring.heuristic(duals[self.budget_row], rounded)?;
         let mut x = vec![0.0; self.columns];
         for (cs, k) in self.cols.iter().zip(choice) {
             x[cs[k]] = 1.0;
         }
         Some(x)
+    }
+
+    /// Without a slew limit, the relaxation's multipliers in closed form
+    /// ([`Ring::relaxation`]): bin `i`'s one-hot row is row `i`, the
+    /// budget row follows them, and the program has no other rows.
+    fn duals(&self, rows: usize) -> Option<Vec<f64>> {
+        let n = self.cols.len();
+        if self.budget_row != n || rows != n + 1 {
+            return None;
+        }
+        let (lambda, mut y) = self.ring.relaxation()?;
+        y.push(lambda);
+        Some(y)
     }
 }
 
