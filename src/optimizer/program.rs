@@ -440,7 +440,11 @@ impl Program {
                 // bound of the MILP's): no branch and bound could improve
                 // it by more.
                 Some((x0, obj))
-                    if bound - obj <= S.mip_heuristic_gap * bound.abs().max(f64::MIN_POSITIVE) =>
+                    if bound - obj
+                        <= opts
+                            .heuristic
+                            .map_or(S.mip_heuristic_gap, |h| h.accept_gap())
+                            * bound.abs().max(f64::MIN_POSITIVE) =>
                 {
                     (x0, obj, Some(bound))
                 }
@@ -491,14 +495,12 @@ impl Program {
             return None;
         }
         let obj: f64 = x0.iter().zip(&self.columns).map(|(v, c)| v * c.cost).sum();
-        (bound - obj <= S.mip_heuristic_gap * bound.abs().max(f64::MIN_POSITIVE)).then_some(
-            Solved {
-                x: x0,
-                y,
-                solver_objective: obj,
-                solver_dual_bound: Some(bound),
-            },
-        )
+        (bound - obj <= h.accept_gap() * bound.abs().max(f64::MIN_POSITIVE)).then_some(Solved {
+            x: x0,
+            y,
+            solver_objective: obj,
+            solver_dual_bound: Some(bound),
+        })
     }
 }
 
@@ -608,6 +610,13 @@ pub trait Heuristic {
     fn duals(&self, rows: usize) -> Option<Vec<f64>> {
         let _ = rows;
         None
+    }
+
+    /// The relative distance from the relaxation's optimum within which the
+    /// heuristic's point is taken without a branch and bound (default
+    /// `mip_heuristic_gap`); the gap is stated either way.
+    fn accept_gap(&self) -> f64 {
+        S.mip_heuristic_gap
     }
 }
 
