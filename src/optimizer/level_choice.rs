@@ -217,7 +217,8 @@ impl Ring {
                 steps.push(((w[1].1 - w[0].1) / extra, extra));
             }
         }
-        if !(base <= self.budget) {
+        // (A NaN spend refuses too.)
+        if base.partial_cmp(&self.budget).is_none_or(|o| o.is_gt()) {
             return None;
         }
         steps.sort_by(|a, c| c.0.total_cmp(&a.0));
