@@ -170,6 +170,79 @@ impl Ring {
         keep
     }
 
+    /// Without a slew limit, the LP relaxation's multipliers in closed
+    /// form (the multiple-choice knapsack's greedy, Sinha and Zoltners
+    /// 1979): per bin the upper concave hull of its levels' (spend, value),
+    /// every bin at its cheapest hull level, then the hull's increments by
+    /// value per extra spend, best first, while the budget holds; the
+    /// budget's multiplier `λ` is the rate of the first increment that does
+    /// not fit (0 if all do), and bin `i`'s one-hot multiplier is
+    /// `u_i = max_k (value − λ·spend)`. Every level's reduced cost is then
+    /// `≤ 0` and `Σ u_i + λ·budget` is the relaxation's optimum (the
+    /// Lagrangian dual of the budget row is tight for a linear program);
+    /// any `λ ≥ 0` gives a valid bound, so rounding only loosens it by as
+    /// much. Returns `(λ, u)`; `None` under a slew limit or where even the
+    /// cheapest levels overspend (the program decides).
+    #[must_use]
+    pub fn relaxation(&self) -> Option<(f64, Vec<f64>)> {
+        if self.reach.is_some() || self.bins.iter().any(Vec::is_empty) {
+            return None;
+        }
+        let mut base = 0.0;
+        // (rate, extra spend) of every hull increment.
+        let mut steps: Vec<(f64, f64)> = Vec::new();
+        for b in &self.bins {
+            let mut pts: Vec<(f64, f64)> = b.iter().map(|l| (l.spend, l.value)).collect();
+            // By spend, the higher value first among equal spends.
+            pts.sort_by(|a, c| a.0.total_cmp(&c.0).then(c.1.total_cmp(&a.1)));
+            let mut hull: Vec<(f64, f64)> = Vec::with_capacity(pts.len());
+            for p in pts {
+                if hull.last().is_some_and(|h| p.1 <= h.1) {
+                    continue; // no more value for at least the spend
+                }
+                while hull.len() >= 2 {
+                    let (a, c) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+                    // `c` on or below the chord from `a` to `p`: not a vertex.
+                    if (c.1 - a.1) * (p.0 - a.0) <= (p.1 - a.1) * (c.0 - a.0) {
+                        hull.pop();
+                    } else {
+                        break;
+                    }
+                }
+                hull.push(p);
+            }
+            base += hull[0].0;
+            for w in hull.windows(2) {
+                let extra = w[1].0 - w[0].0;
+                steps.push(((w[1].1 - w[0].1) / extra, extra));
+            }
+        }
+        // (A NaN spend refuses too.)
+        if base.partial_cmp(&self.budget).is_none_or(|o| o.is_gt()) {
+            return None;
+        }
+        steps.sort_by(|a, c| c.0.total_cmp(&a.0));
+        let mut spent = base;
+        let mut lambda = 0.0;
+        for (rate, extra) in steps {
+            if spent + extra > self.budget {
+                lambda = rate;
+                break;
+            }
+            spent += extra;
+        }
+        let u = self
+            .bins
+            .iter()
+            .map(|b| {
+                b.iter()
+                    .map(|l| l.value - lambda * l.spend)
+                    .fold(f64::NEG_INFINITY, f64::max)
+            })
+            .collect();
+        Some((lambda, u))
+    }
+
     /// The compatible ring maximising `Σ (value − λ·spend)` (ties to the
     /// lower level index), as one level index per bin; `None` if no ring
     /// closes.
@@ -271,32 +344,57 @@ impl Ring {
             && (0..n).all(|i| self.compatible(i, choice[i], choice[(i + 1) % n]))
     }
 
+    /// Bin `i`'s best single-bin move at spend `spent`: of its levels of
+    /// higher value that the budget and the neighbours allow, the best
+    /// value per extra spend (a free move first of all; ties to the lower
+    /// level), as (rate, level).
+    fn best_move(&self, choice: &[usize], i: usize, spent: f64) -> Option<(f64, usize)> {
+        let n = self.n();
+        let cur = self.bins[i][choice[i]];
+        let prev = (i + n - 1) % n;
+        let mut best: Option<(f64, usize)> = None;
+        for (k, l) in self.bins[i].iter().enumerate() {
+            let gain = l.value - cur.value;
+            let extra = l.spend - cur.spend;
+            if gain <= 0.0
+                || spent + extra.max(0.0) * (1.0 + 1e-12) > self.budget
+                || !self.compatible(prev, choice[prev], k)
+                || !self.compatible(i, k, choice[(i + 1) % n])
+            {
+                continue;
+            }
+            let rate = if extra <= 0.0 {
+                f64::INFINITY
+            } else {
+                gain / extra
+            };
+            if best.is_none_or(|b| rate > b.0) {
+                best = Some((rate, k));
+            }
+        }
+        best
+    }
+
     /// Single-bin moves to a level of higher value while the budget and
     /// the neighbours allow, the best value per extra spend first (a free
-    /// move first of all), until none is left.
+    /// move first of all; ties to the lower bin, then the lower level),
+    /// until none is left.
+    ///
+    /// Each bin's best move is kept between moves and found again only
+    /// where it may have changed: in the bin moved and, under a slew limit,
+    /// its neighbours; everywhere when the spend fell (more moves fit);
+    /// where the kept move no longer fits when it rose (a rising spend only
+    /// removes moves, the float test `spent + extra ≤ budget` being monotone
+    /// in `spent`, so a kept move that still fits is still its bin's best).
     fn improve(&self, choice: &mut [usize]) {
         let n = self.n();
         let mut spent = self.spent(choice);
+        let mut best_of: Vec<Option<(f64, usize)>> =
+            (0..n).map(|i| self.best_move(choice, i, spent)).collect();
         for _ in 0..4 * self.bins.iter().map(Vec::len).sum::<usize>() {
             let mut best: Option<(f64, usize, usize)> = None;
-            for i in 0..n {
-                let cur = self.bins[i][choice[i]];
-                let prev = (i + n - 1) % n;
-                for (k, l) in self.bins[i].iter().enumerate() {
-                    let gain = l.value - cur.value;
-                    let extra = l.spend - cur.spend;
-                    if gain <= 0.0
-                        || spent + extra.max(0.0) * (1.0 + 1e-12) > self.budget
-                        || !self.compatible(prev, choice[prev], k)
-                        || !self.compatible(i, k, choice[(i + 1) % n])
-                    {
-                        continue;
-                    }
-                    let rate = if extra <= 0.0 {
-                        f64::INFINITY
-                    } else {
-                        gain / extra
-                    };
+            for (i, m) in best_of.iter().enumerate() {
+                if let Some((rate, k)) = *m {
                     if best.is_none_or(|b| rate > b.0) {
                         best = Some((rate, i, k));
                     }
@@ -306,7 +404,20 @@ impl Ring {
                 return;
             };
             choice[i] = k;
-            spent = self.spent(choice);
+            let next = self.spent(choice);
+            let fell = next < spent;
+            spent = next;
+            for j in 0..n {
+                let near =
+                    j == i || (self.reach.is_some() && ((j + 1) % n == i || (i + 1) % n == j));
+                let lost = best_of[j].is_some_and(|(_, m)| {
+                    let extra = self.bins[j][m].spend - self.bins[j][choice[j]].spend;
+                    spent + extra.max(0.0) * (1.0 + 1e-12) > self.budget
+                });
+                if fell || near || lost {
+                    best_of[j] = self.best_move(choice, j, spent);
+                }
+            }
         }
     }
 
@@ -494,6 +605,44 @@ mod tests {
         }
     }
 
+    /// [`Ring::improve`] written plainly: every move of every bin scanned
+    /// for each move made.
+    fn improve_plain(r: &Ring, choice: &mut [usize]) {
+        let n = r.n();
+        let mut spent = r.spent(choice);
+        for _ in 0..4 * r.bins.iter().map(Vec::len).sum::<usize>() {
+            let mut best: Option<(f64, usize, usize)> = None;
+            for i in 0..n {
+                let cur = r.bins[i][choice[i]];
+                let prev = (i + n - 1) % n;
+                for (k, l) in r.bins[i].iter().enumerate() {
+                    let gain = l.value - cur.value;
+                    let extra = l.spend - cur.spend;
+                    if gain <= 0.0
+                        || spent + extra.max(0.0) * (1.0 + 1e-12) > r.budget
+                        || !r.compatible(prev, choice[prev], k)
+                        || !r.compatible(i, k, choice[(i + 1) % n])
+                    {
+                        continue;
+                    }
+                    let rate = if extra <= 0.0 {
+                        f64::INFINITY
+                    } else {
+                        gain / extra
+                    };
+                    if best.is_none_or(|b| rate > b.0) {
+                        best = Some((rate, i, k));
+                    }
+                }
+            }
+            let Some((_, i, k)) = best else {
+                return;
+            };
+            choice[i] = k;
+            spent = r.spent(choice);
+        }
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
 
@@ -519,6 +668,84 @@ mod tests {
                 for (i, &k) in c.iter().enumerate() {
                     prop_assert!(keep[i][k], "level {k} of bin {i} dropped but used by {c:?}");
                 }
+            }
+        }
+
+        /// Differential: the kept-best-moves `improve` makes the plain
+        /// one's moves, from any start (levels on a coarse grid, so equal
+        /// rates and ties occur).
+        #[test]
+        fn improve_matches_the_plain_scan(
+            r in ring(),
+            grid in any::<bool>(),
+            start in proptest::collection::vec(0usize..4, 6),
+        ) {
+            let mut r = r;
+            if grid {
+                for b in &mut r.bins {
+                    for l in b.iter_mut() {
+                        l.x = (l.x * 4.0).round() / 4.0;
+                        l.spend = l.x;
+                        l.value = (l.value * 2.0).round() / 2.0;
+                    }
+                }
+            }
+            let mut a: Vec<usize> = (0..r.n()).map(|i| start[i] % r.bins[i].len()).collect();
+            let mut b = a.clone();
+            r.improve(&mut a);
+            improve_plain(&r, &mut b);
+            prop_assert_eq!(a, b);
+        }
+
+        /// Differential: without a slew limit, the closed-form multipliers'
+        /// bound `Σ u + λ·budget` is the LP relaxation's optimum as HiGHS
+        /// finds it, and no level choice within the budget beats it.
+        #[test]
+        fn the_closed_form_relaxation_is_the_lp_optimum(r in ring(), grid in any::<bool>()) {
+            use crate::optimizer::certificate::{LinearProgram, Row};
+            let mut r = r;
+            r.reach = None;
+            if grid {
+                for b in &mut r.bins {
+                    for l in b.iter_mut() {
+                        l.x = (l.x * 4.0).round() / 4.0;
+                        l.spend = l.x;
+                        l.value = (l.value * 2.0).round() / 2.0;
+                    }
+                }
+            }
+            let cols: Vec<(usize, Level)> = r.bins.iter().enumerate()
+                .flat_map(|(i, b)| b.iter().map(move |&l| (i, l))).collect();
+            let mut rows: Vec<Row> = (0..r.n()).map(|i| Row {
+                coefs: cols.iter().enumerate().filter(|(_, c)| c.0 == i).map(|(j, _)| (j, 1.0)).collect(),
+                lo: 1.0,
+                hi: 1.0,
+            }).collect();
+            rows.push(Row {
+                coefs: cols.iter().enumerate().map(|(j, c)| (j, c.1.spend)).filter(|t| t.1 != 0.0).collect(),
+                lo: f64::NEG_INFINITY,
+                hi: r.budget,
+            });
+            let lp = LinearProgram {
+                cost: cols.iter().map(|c| c.1.value).collect(),
+                col_lo: vec![0.0; cols.len()],
+                col_hi: vec![1.0; cols.len()],
+                integer: vec![false; cols.len()],
+                rows,
+            };
+            let solved = lp.solve("relaxation");
+            match r.relaxation() {
+                Some((lambda, u)) => {
+                    prop_assert!(lambda >= 0.0);
+                    let bound = u.iter().sum::<f64>() + lambda * r.budget;
+                    let s = solved.expect("the cheapest levels fit: feasible");
+                    prop_assert!((bound - s.solver_objective).abs() <= 1e-7 * bound.abs().max(1.0),
+                        "closed form {bound}, HiGHS {}", s.solver_objective);
+                    for c in every_choice(&r).iter().filter(|c| r.feasible(c)) {
+                        prop_assert!(r.value(c) <= bound + 1e-12 * bound.abs().max(1.0));
+                    }
+                }
+                None => prop_assert!(solved.is_err(), "closed form refused a feasible relaxation"),
             }
         }
 

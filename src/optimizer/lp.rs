@@ -600,30 +600,44 @@ struct LevelRing {
 
 impl Heuristic for LevelRing {
     fn start(&self, relaxed: &[f64], duals: &[f64]) -> Option<Vec<f64>> {
-        if relaxed.len() != self.columns {
+        if !relaxed.is_empty() && relaxed.len() != self.columns || duals.len() <= self.budget_row {
             return None;
         }
         // The relaxation's point rounded down: per bin, of its levels with
         // the largest binary, the first (the lowest index).
-        let rounded = self
-            .cols
-            .iter()
-            .map(|cs| {
-                let mut best = 0;
-                for (k, &c) in cs.iter().enumerate() {
-                    if relaxed[c] > relaxed[cs[best]] {
-                        best = k;
+        let rounded = (!relaxed.is_empty()).then(|| {
+            self.cols
+                .iter()
+                .map(|cs| {
+                    let mut best = 0;
+                    for (k, &c) in cs.iter().enumerate() {
+                        if relaxed[c] > relaxed[cs[best]] {
+                            best = k;
+                        }
                     }
-                }
-                best
-            })
-            .collect();
-        let choice = self.ring.heuristic(duals[self.budget_row], Some(rounded))?;
+                    best
+                })
+                .collect()
+        });
+        let choice = self.ring.heuristic(duals[self.budget_row], rounded)?;
         let mut x = vec![0.0; self.columns];
         for (cs, k) in self.cols.iter().zip(choice) {
             x[cs[k]] = 1.0;
         }
         Some(x)
+    }
+
+    /// Without a slew limit, the relaxation's multipliers in closed form
+    /// ([`Ring::relaxation`]): bin `i`'s one-hot row is row `i`, the
+    /// budget row follows them, and the program has no other rows.
+    fn duals(&self, rows: usize) -> Option<Vec<f64>> {
+        let n = self.cols.len();
+        if self.budget_row != n || rows != n + 1 {
+            return None;
+        }
+        let (lambda, mut y) = self.ring.relaxation()?;
+        y.push(lambda);
+        Some(y)
     }
 }
 
@@ -1381,38 +1395,16 @@ fn dwell_step(
     p: &[f64],
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
-    let build = |frame_rel: f64| {
-        dwell_program(
-            problem,
-            g,
-            binding,
-            pulse_rate_hz,
-            p,
-            current,
-            (false, frame_rel),
-        )
-    };
-    let solve = |d: &DwellProgram| {
-        d.lp.solve_with(
-            "dwell",
-            &SolveOptions {
-                initial: Some(&d.start),
-                primal_feasibility_tolerance: S.dwell_feasibility_tol,
-                ..SolveOptions::default()
-            },
-        )
-    };
-    let mut d = build(0.0)?;
-    let solved = match solve(&d) {
-        // Spin set-points that meet the frame only within the checker's
-        // tolerance (a datasheet's figures are never exact to 1e-10): the
-        // frame row widened to half of it.
-        Err(OptError::Infeasible(_)) if !problem.levels.spin_rad_s.is_empty() => {
-            d = build(0.5 * crate::checker::REL_TOL)?;
-            solve(&d)?
-        }
-        other => other?,
-    };
+    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, (false, 0.0))?;
+    let choice = SetPointChoice::new(&d, g);
+    let solved = d.lp.solve_with(
+        "dwell",
+        &SolveOptions {
+            initial: Some(&d.start),
+            primal_feasibility_tolerance: S.dwell_feasibility_tol,
+            heuristic: choice.as_ref().map(|c| c as &dyn Heuristic),
+        },
+    )?;
     let view = d.lp.view();
     let x = view.clamped(&solved.x);
     let t = dwell_answer(problem, g, &d, &x);
@@ -1647,9 +1639,10 @@ fn spin_levels(d: &mut DwellProgram, problem: &Problem, g: &Grid, i: usize, allo
     d.sp_cols.push(cols);
 }
 
-/// `frame`: `Σ τ_i = N` (one turn per frame period), or within a relative
-/// `rel` of it (`rel > 0`: spin set-points that meet the frame only within
-/// the checker's tolerance, whose dwell is not rescaled).
+/// `frame`: `Σ τ_i = N` (one turn per frame period); with spin set-points
+/// the band `N·(1 ± setpoint_frame_tol)` (the checker's tolerance, see
+/// `settings`), two rows; `rel > 0`: the band `N·(1 ± rel)` whatever the
+/// spins.
 fn frame(d: &mut DwellProgram, n: usize, rel: f64) {
     let n = n as f64;
     let mut turn = Expression::default();
@@ -1658,8 +1651,129 @@ fn frame(d: &mut DwellProgram, n: usize, rel: f64) {
     }
     if rel > 0.0 {
         d.lp.between("frame", turn, n * (1.0 - rel), n * (1.0 + rel));
-    } else {
+    } else if d.sp_cols.is_empty() {
         d.lp.equal("frame", turn, n);
+    } else {
+        let tol = S.setpoint_frame_tol;
+        d.lp.between("frame", turn, n * (1.0 - tol), n * (1.0 + tol));
+    }
+}
+
+/// The dwell step's set-point choice on equal bins, for the primal
+/// heuristic: a composition (bins per set-point) near the relaxation's
+/// counts that meets the `frame` band ([`super::setpoints::best_composition`]),
+/// its set-points given to the bins by their objective coefficients (the
+/// slowest set-point to the bins that gain most from it: with costs
+/// `C_i·v_k` the rearrangement inequality makes this the best assignment
+/// of those counts). The caller checks the point exactly against every
+/// row (budget, acceleration, eye-safety cuts included).
+struct SetPointChoice {
+    /// Per bin, its set-points' columns (the set-points' order).
+    cols: Vec<Vec<usize>>,
+    /// Per bin and set-point, the objective coefficient.
+    cost: Vec<Vec<f64>>,
+    /// Per set-point, its `τ` on every bin (equal bins).
+    r: Vec<f64>,
+    /// The `frame` band.
+    band: (f64, f64),
+    columns: usize,
+}
+
+impl SetPointChoice {
+    /// `None` unless every bin has the same set-points' `τ` (equal bins)
+    /// and the program's columns are the set-points' binaries.
+    fn new(d: &DwellProgram, g: &Grid) -> Option<Self> {
+        let n = g.n;
+        if d.sp_cols.len() != n || n == 0 || g.theta.iter().any(|&t| t != g.theta[0]) {
+            return None;
+        }
+        let r: Vec<f64> = d.sp_cols[0]
+            .iter()
+            .map(|&(w, _)| g.theta[0] / w / d.unit)
+            .collect();
+        let cols: Vec<Vec<usize>> = d
+            .sp_cols
+            .iter()
+            .map(|b| b.iter().map(|c| c.1).collect())
+            .collect();
+        if cols.iter().any(|c| c.len() != r.len()) || d.lp.len() != n * r.len() {
+            return None;
+        }
+        let cost = cols
+            .iter()
+            .map(|c| c.iter().map(|&j| d.lp.cost(j)).collect())
+            .collect();
+        let tol = S.setpoint_frame_tol;
+        let nf = n as f64;
+        Some(Self {
+            cols,
+            cost,
+            r,
+            band: (nf * (1.0 - tol * 0.5), nf * (1.0 + tol * 0.5)),
+            columns: d.lp.len(),
+        })
+    }
+
+    /// Bins by their gain from the slowest set-point over the fastest,
+    /// most first (ties to the lower bin), and set-points by `τ`, slowest
+    /// first: the assignment of counts `c` gives the first `c` of the bins
+    /// to the slowest set-point, and so on.
+    fn orders(&self) -> (Vec<usize>, Vec<usize>) {
+        let k = self.r.len();
+        let mut sp: Vec<usize> = (0..k).collect();
+        sp.sort_by(|&a, &b| self.r[b].total_cmp(&self.r[a]).then(a.cmp(&b)));
+        let (slow, fast) = (sp[0], sp[k - 1]);
+        let mut bins: Vec<usize> = (0..self.cols.len()).collect();
+        let gain = |i: usize| self.cost[i][slow] - self.cost[i][fast];
+        bins.sort_by(|&a, &b| gain(b).total_cmp(&gain(a)).then(a.cmp(&b)));
+        (bins, sp)
+    }
+
+    /// Per bin its set-point under counts `c`.
+    fn assign(&self, c: &[usize], (bins, sp): (&[usize], &[usize])) -> Vec<usize> {
+        let mut out = vec![0; bins.len()];
+        let mut at = 0;
+        for &k in sp {
+            for &i in &bins[at..at + c[k]] {
+                out[i] = k;
+            }
+            at += c[k];
+        }
+        out
+    }
+}
+
+impl Heuristic for SetPointChoice {
+    fn start(&self, relaxed: &[f64], _duals: &[f64]) -> Option<Vec<f64>> {
+        if relaxed.len() != self.columns {
+            return None;
+        }
+        let k = self.r.len();
+        let near: Vec<f64> = (0..k)
+            .map(|j| self.cols.iter().map(|c| relaxed[c[j]]).sum())
+            .collect();
+        let (bins, sp) = self.orders();
+        let score = |c: &[usize]| -> f64 {
+            let a = self.assign(c, (&bins, &sp));
+            a.iter().enumerate().map(|(i, &j)| self.cost[i][j]).sum()
+        };
+        let c = super::setpoints::best_composition(
+            &self.r,
+            self.cols.len(),
+            self.band,
+            &near,
+            &score,
+            S.setpoint_heuristic_steps,
+        )?;
+        let mut x = vec![0.0; self.columns];
+        for (i, j) in self.assign(&c, (&bins, &sp)).into_iter().enumerate() {
+            x[self.cols[i][j]] = 1.0;
+        }
+        Some(x)
+    }
+
+    fn accept_gap(&self) -> f64 {
+        S.setpoint_heuristic_gap
     }
 }
 

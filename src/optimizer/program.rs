@@ -446,6 +446,9 @@ impl Program {
         // a MILP point), so the branch and bound is skipped; the point is
         // still checked exactly by the certificate. Otherwise HiGHS's MIP
         // solver runs.
+        if let Some(done) = self.closed_form_relaxation(opts) {
+            return Ok(done);
+        }
         let relaxed = self.run_limited(true, what, opts)?;
         let rsol = relaxed.get_solution();
         let y = unscale(rsol.dual_rows().to_vec());
@@ -480,7 +483,11 @@ impl Program {
                 // bound of the MILP's): no branch and bound could improve
                 // it by more.
                 Some((x0, obj))
-                    if bound - obj <= S.mip_heuristic_gap * bound.abs().max(f64::MIN_POSITIVE) =>
+                    if bound - obj
+                        <= opts
+                            .heuristic
+                            .map_or(S.mip_heuristic_gap, |h| h.accept_gap())
+                            * bound.abs().max(f64::MIN_POSITIVE) =>
                 {
                     (x0, obj, Some(bound))
                 }
@@ -513,6 +520,65 @@ impl Program {
             solver_dual_bound,
         })
     }
+}
+
+impl Program {
+    /// A MILP whose heuristic knows the relaxation's multipliers in closed
+    /// form ([`Heuristic::duals`]): their bound (the relaxation's optimum,
+    /// in floating point) and the heuristic's point, when the point meets
+    /// every row exactly and is within `mip_heuristic_gap` of the bound;
+    /// else `None` and HiGHS solves the relaxation as for any MILP.
+    fn closed_form_relaxation(&self, opts: &SolveOptions<'_>) -> Option<Solved> {
+        let h = opts.heuristic?;
+        let y = h.duals(self.rows())?;
+        let view = self.view();
+        let bound = float_dual_bound(&view, &y)?;
+        let x0 = h.start(&[], &y)?;
+        if !super::certificate::primal_feasible(&view, &x0) {
+            return None;
+        }
+        let obj: f64 = x0.iter().zip(&self.columns).map(|(v, c)| v * c.cost).sum();
+        (bound - obj <= h.accept_gap() * bound.abs().max(f64::MIN_POSITIVE)).then_some(Solved {
+            x: x0,
+            y,
+            solver_objective: obj,
+            solver_dual_bound: Some(bound),
+        })
+    }
+}
+
+/// The dual bound of `y` over `lp` (the certificate's formula, in floating
+/// point: only to compare with a heuristic's point; the certificate
+/// computes it exactly); `None` where a side it needs is infinite.
+fn float_dual_bound(lp: &LinearProgram, y: &[f64]) -> Option<f64> {
+    if y.len() != lp.rows.len() {
+        return None;
+    }
+    let mut d = lp.cost.clone();
+    let mut ub = 0.0;
+    for (r, &yr) in lp.rows.iter().zip(y) {
+        if yr == 0.0 {
+            continue;
+        }
+        let side = if yr > 0.0 { r.hi } else { r.lo };
+        if !side.is_finite() {
+            return None;
+        }
+        for &(j, a) in &r.coefs {
+            d[j] -= yr * a;
+        }
+        ub += yr * side;
+    }
+    for (j, &dj) in d.iter().enumerate() {
+        let side = if dj > 0.0 { lp.col_hi[j] } else { lp.col_lo[j] };
+        if dj != 0.0 {
+            if !side.is_finite() {
+                return None;
+            }
+            ub += dj * side;
+        }
+    }
+    Some(ub)
 }
 
 impl LinearProgram {
@@ -575,8 +641,26 @@ fn nonzero(e: Expression) -> Expression {
 /// A MILP's primal heuristic: from the LP relaxation's point and row
 /// duals, a point of the MILP (one value per column), or `None`.
 pub trait Heuristic {
-    /// The point; the caller checks it exactly before using it.
+    /// The point; the caller checks it exactly before using it. `relaxed`
+    /// is empty when the relaxation was not solved by HiGHS (see
+    /// [`Heuristic::duals`]).
     fn start(&self, relaxed: &[f64], duals: &[f64]) -> Option<Vec<f64>>;
+
+    /// The LP relaxation's row multipliers (one per row of a program of
+    /// `rows` rows) when the heuristic knows them in closed form, else
+    /// `None` (HiGHS solves the relaxation). Only a bound: the certificate
+    /// checks them exactly like HiGHS's.
+    fn duals(&self, rows: usize) -> Option<Vec<f64>> {
+        let _ = rows;
+        None
+    }
+
+    /// The relative distance from the relaxation's optimum within which the
+    /// heuristic's point is taken without a branch and bound (default
+    /// `mip_heuristic_gap`); the gap is stated either way.
+    fn accept_gap(&self) -> f64 {
+        S.mip_heuristic_gap
+    }
 }
 
 /// How HiGHS is run on a program.

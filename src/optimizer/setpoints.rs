@@ -113,6 +113,163 @@ pub(super) fn reach(r: &[f64], n: usize, budget: u64) -> Reach {
     }
 }
 
+/// Of the compositions of `n` bins over the ratios `r` (a count per
+/// set-point) whose sum `Σ c_k·r_k` lies in `[lo, hi]`, the best by
+/// `score` among those found near `near` (fractional counts, e.g. the LP
+/// relaxation's): the counts of all set-points but two (the one with the
+/// most bins in `near` and the one nearest it in ratio) within a radius of
+/// `near`'s (1, 2, 4, … until some
+/// composition fits or `budget` steps are spent), the split of the rest
+/// between those two in closed form (the sum is monotone in it).
+pub(super) fn best_composition(
+    r: &[f64],
+    n: usize,
+    (lo, hi): (f64, f64),
+    near: &[f64],
+    score: &dyn Fn(&[usize]) -> f64,
+    budget: u64,
+) -> Option<Vec<usize>> {
+    let k = r.len();
+    if k == 0 || near.len() != k {
+        return None;
+    }
+    // The set-point with the most bins and the one nearest it in ratio
+    // take the rest (last in `order`): a line of splits between close
+    // ratios is the likeliest to meet a narrow band.
+    let top = (0..k)
+        .max_by(|&a, &b| near[a].total_cmp(&near[b]).then(b.cmp(&a)))
+        .unwrap_or(0);
+    let mate = (0..k).filter(|&j| j != top).min_by(|&a, &b| {
+        (r[a] - r[top])
+            .abs()
+            .total_cmp(&(r[b] - r[top]).abs())
+            .then(a.cmp(&b))
+    });
+    let mut order: Vec<usize> = (0..k).filter(|&j| j != top && Some(j) != mate).collect();
+    order.sort_by(|&a, &b| near[a].total_cmp(&near[b]).then(a.cmp(&b)));
+    order.extend(mate);
+    order.push(top);
+    let free = k.saturating_sub(2);
+    let mut steps = budget;
+    let mut radius = 1usize;
+    loop {
+        let mut best: Option<(f64, Vec<usize>)> = None;
+        let mut counts = vec![0usize; k];
+        let exhausted = !around(
+            &mut Around {
+                r,
+                order: &order,
+                free,
+                near,
+                radius,
+                band: (lo, hi),
+                score,
+                steps: &mut steps,
+                best: &mut best,
+            },
+            0,
+            n,
+            0.0,
+            &mut counts,
+        );
+        if let Some((_, c)) = best {
+            return Some(c);
+        }
+        // The whole box searched once the radius covers every count.
+        if exhausted || radius > n {
+            return None;
+        }
+        radius *= 2;
+    }
+}
+
+struct Around<'a> {
+    r: &'a [f64],
+    order: &'a [usize],
+    free: usize,
+    near: &'a [f64],
+    radius: usize,
+    band: (f64, f64),
+    score: &'a dyn Fn(&[usize]) -> f64,
+    steps: &'a mut u64,
+    best: &'a mut Option<(f64, Vec<usize>)>,
+}
+
+impl Around<'_> {
+    fn offer(&mut self, counts: &[usize], sum: f64) {
+        if sum < self.band.0 || sum > self.band.1 {
+            return;
+        }
+        let v = (self.score)(counts);
+        if self.best.as_ref().is_none_or(|b| v > b.0) {
+            *self.best = Some((v, counts.to_vec()));
+        }
+    }
+}
+
+/// Depth `d` of [`best_composition`]'s search: `m` bins left, partial sum
+/// `s`; false when the step budget ran out.
+fn around(a: &mut Around<'_>, d: usize, m: usize, s: f64, counts: &mut [usize]) -> bool {
+    if *a.steps == 0 {
+        return false;
+    }
+    *a.steps -= 1;
+    let k = a.order.len();
+    if d < a.free {
+        let j = a.order[d];
+        // `near`'s count, within what is left (the box then reaches every
+        // count once the radius reaches `m`).
+        let c0 = (a.near[j].round().max(0.0) as usize).min(m);
+        let from = c0.saturating_sub(a.radius);
+        let to = (c0 + a.radius).min(m);
+        for c in from..=to {
+            counts[j] = c;
+            if !around(a, d + 1, m - c, s + c as f64 * a.r[j], counts) {
+                counts[j] = 0;
+                return false;
+            }
+        }
+        counts[j] = 0;
+        return true;
+    }
+    match k - d {
+        1 => {
+            let j = a.order[d];
+            counts[j] = m;
+            a.offer(counts, s + m as f64 * a.r[j]);
+            counts[j] = 0;
+        }
+        2 => {
+            let (ja, jb) = (a.order[d], a.order[d + 1]);
+            let (ra, rb) = (a.r[ja], a.r[jb]);
+            let mf = m as f64;
+            let base = s + mf * rb;
+            // i bins at `ra`, m − i at `rb`: the integers around the ends
+            // of the band's interval of i.
+            let cands: Vec<f64> = if ra == rb {
+                vec![0.0]
+            } else {
+                let (x0, x1) = ((a.band.0 - base) / (ra - rb), (a.band.1 - base) / (ra - rb));
+                let (x0, x1) = (x0.min(x1), x0.max(x1));
+                let mut v = vec![x0.floor(), x0.ceil(), x1.floor(), x1.ceil()];
+                // A wide band: its middle too.
+                v.push((0.5 * (x0 + x1)).round());
+                v
+            };
+            for i in cands {
+                let i = i.clamp(0.0, mf);
+                counts[ja] = i as usize;
+                counts[jb] = m - i as usize;
+                a.offer(counts, s + i * ra + (mf - i) * rb);
+            }
+            counts[ja] = 0;
+            counts[jb] = 0;
+        }
+        _ => {}
+    }
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -167,6 +324,33 @@ mod tests {
                     prop_assert!(close(above, a), "{above:?} {a:?}");
                 }
                 Reach::Unknown => prop_assert!(false, "unbounded budget"),
+            }
+        }
+    }
+
+    proptest! {
+        /// Differential: with an unlimited budget the composition search
+        /// finds a composition in the band exactly when enumeration does,
+        /// and what it returns is one (counts summing to `n`, sum in band).
+        #[test]
+        fn best_composition_finds_the_band_when_enumeration_does(
+            r in proptest::collection::vec(0.3f64..3.0, 1..5),
+            n in 1usize..30,
+            width in 0.0f64..0.3,
+            near in proptest::collection::vec(0.0f64..30.0, 5),
+        ) {
+            let band = (n as f64 - width, n as f64 + width);
+            let near = &near[..r.len()];
+            let all = brute(&r, n);
+            let any = all.iter().any(|&v| v >= band.0 && v <= band.1);
+            let score = |c: &[usize]| c.iter().zip(&r).map(|(&c, &x)| c as f64 * x.sqrt()).sum();
+            match best_composition(&r, n, band, near, &score, u64::MAX) {
+                Some(c) => {
+                    prop_assert_eq!(c.iter().sum::<usize>(), n);
+                    let v: f64 = c.iter().zip(&r).map(|(&c, &x)| c as f64 * x).sum();
+                    prop_assert!(v >= band.0 - 1e-9 && v <= band.1 + 1e-9, "{v} outside {band:?}");
+                }
+                None => prop_assert!(!any, "enumeration finds a composition in the band"),
             }
         }
     }

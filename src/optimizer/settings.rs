@@ -120,6 +120,27 @@ pub struct OptimizerSettings {
     /// set-points, 6.3·10⁷ with 5, past the default); past it the dwell
     /// step decides.
     pub setpoint_search_steps: u64,
+    /// With spin set-points, the dwell step's `frame` row is the band
+    /// `N·(1 ± setpoint_frame_tol)` (default 0.99·10⁻⁹, inside the
+    /// checker's relative 10⁻⁹ on the frame period by far more than the
+    /// float sums' 10⁻¹³): set-points read from a datasheet meet the frame
+    /// period only to the checker's tolerance, never to HiGHS's absolute
+    /// 10⁻¹⁰ of an equality.
+    pub setpoint_frame_tol: f64,
+    /// Steps of the set-point heuristic's search for a composition near the
+    /// relaxation's counts that meets the `frame` band (default 2·10⁷,
+    /// about 0.3 s; one step per count of all set-points but the last
+    /// two).
+    pub setpoint_heuristic_steps: u64,
+    /// The set-point heuristic's point is taken without a branch and bound
+    /// within this relative distance of the relaxation's optimum (default
+    /// 10⁻², the 1 % a step's gap may be; stated in the certificate).
+    /// Set-points meet the frame band only in rare compositions (measured:
+    /// six set-points on 360 bins, none within 16 bins of the relaxation's
+    /// counts), so the relaxation is out of reach by a few 10⁻³, and
+    /// HiGHS's search on such an equality knapsack took over 14 s of CPU
+    /// without a point.
+    pub setpoint_heuristic_gap: f64,
     /// HiGHS's `mip_feasibility_tolerance` for every MILP (default 1e-10,
     /// its minimum): its default, 1e-6, lets a level choice overspend the
     /// budget by far more than the checker's relative 1e-9.
@@ -183,6 +204,9 @@ impl OptimizerSettings {
         primal_feasibility_tol: 1e-7,
         dwell_feasibility_tol: 1e-9,
         setpoint_search_steps: 50_000_000,
+        setpoint_frame_tol: 0.99e-9,
+        setpoint_heuristic_steps: 20_000_000,
+        setpoint_heuristic_gap: 1e-2,
         mip_max_nodes: 100,
         mip_heuristic_gap: 1e-3,
         mip_max_nodes_without_incumbent: 5000,
