@@ -651,3 +651,177 @@ fn vertical_overlap_meets_within_the_touch_widening() {
     );
     assert_eq!(vertical_slots(&[fp(0.0), fp(10.0 + 3e-9)], &[0.0, 1e-5]), 1);
 }
+
+/// The figures of `head` that `head/bound.rs` `head_overlaps` keeps per
+/// thread (`HeadOverlaps`: everything of `HeadFigures` but what the spin,
+/// the channel count, the cycle and the aperture distance add), and the whole
+/// `HeadFigures`, both as text, evaluated in the calling thread.
+fn figures_here(head: &Head, wavelength_nm: f64, pulse_duration_s: f64) -> (String, String) {
+    let p = EyeSafetyParams {
+        wavelength_nm,
+        pulse_duration_s,
+        beam_diameter_mm: 5.0,
+        head: Some(head.clone()),
+    };
+    let segs = [seg(0.0, 360.0, 1e-3, 10.0)];
+    let r = evaluate_segments(&segs, &p, 1.0 / head.cycle_s).unwrap();
+    let f = r.head.expect("head figures");
+    let kept = format!(
+        "{:?}",
+        (
+            (f.channels_at_worst, f.worst_height_mm),
+            (f.weight_vertical, f.count_vertical, f.slots_vertical),
+            f.union_passes,
+            (f.weight_simultaneous, f.count_simultaneous),
+            (f.weight_stalled, f.count_stalled),
+            (f.weight_stalled_group, f.stalled_group_spans_time),
+            (f.footprint_max_mm, f.pass_angle_deg, f.power_scale_max),
+            &f.separations,
+        )
+    );
+    (kept, format!("{f:?}"))
+}
+
+/// [`figures_here`] of `head` in a fresh thread (an empty memo), after
+/// `before` (if any) with the same laser.
+fn overlaps_after(
+    before: Option<&Head>,
+    head: &Head,
+    wavelength_nm: f64,
+    pulse_duration_s: f64,
+) -> (String, String) {
+    let (before, head) = (before.cloned(), head.clone());
+    std::thread::spawn(move || {
+        if let Some(b) = &before {
+            figures_here(b, wavelength_nm, pulse_duration_s);
+        }
+        figures_here(&head, wavelength_nm, pulse_duration_s)
+    })
+    .join()
+    .unwrap()
+}
+
+/// Kills the mutants of `head/bound.rs` `same_bits` and `head_overlaps`, the
+/// per-thread memo of a head's overlap figures, that let one head (or one
+/// aperture, or one grouping window) take the figures kept for another:
+/// `same_bits` → `true`, an `&&` of its chain of field comparisons → `||`,
+/// a field's `==` → `!=`, and the memo's aperture and window comparisons.
+/// Figures of another head can be lower (a smaller `W_v`, `K_v`, `S_v`,
+/// fewer union passes), and a stream or an optimizer run evaluates many
+/// heads in one thread.
+///
+/// By construction, no value worked out: each variant of a three-channel
+/// head changes one field (or the laser's aperture alone, or its grouping
+/// window alone), and its kept figures, evaluated alone in a fresh thread,
+/// differ from the base head's (asserted, so a memo that returned the base
+/// head's would show); evaluated right after the base head in one thread,
+/// its whole `HeadFigures` is the one it has alone. Not pinned here:
+/// `Channel::id` (not an input of the figures: two heads that differ only in
+/// ids may share them) and `cycle_s` (on this head no kept figure depends
+/// on it; `specs/mutants.md`).
+#[test]
+fn head_memo_keeps_each_head_s_own_figures() {
+    let base = Head {
+        cycle_s: 1e-5,
+        origin_radius_mm: 40.0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 5.0,
+        divergence_mrad: 1.0,
+        aperture_distance_mm: 100.0,
+        channels: [
+            (0.0, 0.0, 0.0, 1.0),
+            (0.5, 0.2, 1e-6, 0.8),
+            (1.0, 0.4, 2e-6, 0.6),
+        ]
+        .iter()
+        .enumerate()
+        .map(
+            |(i, &(elevation_deg, azimuth_offset_deg, slot_s, power_scale))| Channel {
+                id: i as u32,
+                elevation_deg,
+                azimuth_offset_deg,
+                slot_s,
+                power_scale,
+            },
+        )
+        .collect(),
+    };
+    let variant = |f: &dyn Fn(&mut Head)| {
+        let mut h = base.clone();
+        f(&mut h);
+        h
+    };
+    let heads: Vec<(&str, Head)> = vec![
+        ("origin_radius_mm", variant(&|h| h.origin_radius_mm = 20.0)),
+        ("origin_height_mm", variant(&|h| h.origin_height_mm = 3.0)),
+        ("exit_diameter_mm", variant(&|h| h.exit_diameter_mm = 6.0)),
+        ("divergence_mrad", variant(&|h| h.divergence_mrad = 2.0)),
+        (
+            "aperture_distance_mm",
+            variant(&|h| h.aperture_distance_mm = 150.0),
+        ),
+        (
+            "channels (one more)",
+            variant(&|h| {
+                let mut c = h.channels[2].clone();
+                c.id = 3;
+                c.slot_s = 3e-6;
+                h.channels.push(c);
+            }),
+        ),
+        (
+            "elevation_deg",
+            variant(&|h| h.channels[2].elevation_deg = 20.0),
+        ),
+        (
+            "azimuth_offset_deg",
+            variant(&|h| h.channels[2].azimuth_offset_deg = 30.0),
+        ),
+        ("slot_s", variant(&|h| h.channels[1].slot_s = 0.0)),
+        ("power_scale", variant(&|h| h.channels[2].power_scale = 0.9)),
+    ];
+    // The base head: 905 nm, 5 ns (aperture 7 mm, window T_i = 5 µs).
+    let (base_kept, _) = overlaps_after(None, &base, 905.0, 5e-9);
+    let mut wrong = Vec::new();
+    for (field, h) in &heads {
+        let (kept, alone) = overlaps_after(None, h, 905.0, 5e-9);
+        if kept == base_kept {
+            wrong.push(format!(
+                "{field}: the variant's figures are the base head's: {kept}"
+            ));
+        }
+        let (_, after) = overlaps_after(Some(&base), h, 905.0, 5e-9);
+        if after != alone {
+            wrong.push(format!(
+                "{field}: after the base head {after}, alone {alone}"
+            ));
+        }
+    }
+    // The same head with another aperture alone (905 nm, 7 mm, and 1450 nm,
+    // APERTURE_IR_MM; both with a window of the pulse duration, 6 µs > T_i)
+    // and with another window alone (1450 nm: the pulse duration, 5 ns and
+    // 3 µs).
+    for (what, (l0, t0), (l1, t1)) in [
+        ("aperture", (905.0, 6e-6), (1450.0, 6e-6)),
+        ("window", (1450.0, 5e-9), (1450.0, 3e-6)),
+    ] {
+        let (k0, _) = overlaps_after(None, &base, l0, t0);
+        let (k1, alone) = overlaps_after(None, &base, l1, t1);
+        if k0 == k1 {
+            wrong.push(format!("{what}: the figures do not depend on it: {k0}"));
+        }
+        let b = base.clone();
+        let (_, after) = std::thread::spawn(move || {
+            figures_here(&b, l0, t0);
+            figures_here(&b, l1, t1)
+        })
+        .join()
+        .unwrap();
+        if after != alone {
+            wrong.push(format!(
+                "{what}: after the other laser {after}, alone {alone}"
+            ));
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
+}
