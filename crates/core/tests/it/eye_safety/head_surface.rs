@@ -6,7 +6,7 @@
 //!
 //! Run: `cargo test --release -p gaze-lidar-core --test it eye_safety::head_surface`.
 
-use crate::common;
+use gaze_lidar_core::testing as common;
 
 use gaze_lidar_core::eye_safety::bound::Seg;
 use gaze_lidar_core::eye_safety::exposure::evaluate_segments_at_declared_distance;
