@@ -8,12 +8,17 @@ use gaze_lidar::model::angle::diff_deg;
 use gaze_lidar::profile::{Profile, Region};
 
 fn profile(mode: &str, gaze: &str) -> Profile {
-    common::profile_from(&common::profile_args(
+    common::profile_from(&[
+        "profile",
+        "--preset",
         "paper",
+        "--mode",
         mode,
+        "--gaze-deg",
         gaze,
-        &["--format", "json"],
-    ))
+        "--format",
+        "json",
+    ])
 }
 
 fn distinct(values: impl Iterator<Item = f64>) -> Vec<f64> {

@@ -5,6 +5,7 @@
 
 use gaze_lidar_core::eye_safety::ael::APERTURE_IR_MM;
 use gaze_lidar_core::eye_safety::bound::{Seg, WALK_MAX_PIECES};
+use gaze_lidar_core::eye_safety::exposure::evaluate_segments_at_declared_distance;
 use gaze_lidar_core::eye_safety::head::{Channel, Head};
 use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams, Rule};
 
@@ -664,7 +665,7 @@ fn figures_here(head: &Head, wavelength_nm: f64, pulse_duration_s: f64) -> (Stri
         head: Some(head.clone()),
     };
     let segs = [seg(0.0, 360.0, 1e-3, 10.0)];
-    let r = evaluate_segments(&segs, &p, 1.0 / head.cycle_s).unwrap();
+    let r = evaluate_segments_at_declared_distance(&segs, &p, 1.0 / head.cycle_s).unwrap();
     let f = r.head.expect("head figures");
     let kept = format!(
         "{:?}",
