@@ -1395,7 +1395,7 @@ fn dwell_step(
     p: &[f64],
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
-    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, (false, 0.0))?;
+    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, false)?;
     let choice = SetPointChoice::new(&d, g);
     let solved = d.lp.solve_with(
         "dwell",
@@ -1437,7 +1437,7 @@ fn answer_dwell_certificate(
 ) -> Result<Certified, CertificateError> {
     let f_p = problem.lidar.pulse_rate_hz;
     let solver = |e: OptError| CertificateError::AnswerProgram(e.to_string());
-    let d = dwell_program(problem, g, &[], f_p, p, answer, (true, 0.0)).map_err(solver)?;
+    let d = dwell_program(problem, g, &[], f_p, p, answer, true).map_err(solver)?;
     let solved =
         d.lp.solve_with(
             "dwell",
@@ -1475,7 +1475,6 @@ struct DwellProgram {
 /// set-points: the `levels` family, one binary per set-point and a one-hot
 /// row), then the constraint families in a fixed order — `frame`,
 /// `budget` (time accounting), `accel`, `eye_cuts` (linearised).
-/// `frame_rel`: see [`frame`].
 /// `contain`: the program is linearised at an answer `current` and must
 /// contain it (see [`answer_dwell_certificate`]): its boxes and
 /// acceleration rows are widened to the answer where it lies outside them.
@@ -1486,7 +1485,7 @@ fn dwell_program(
     pulse_rate_hz: f64,
     p: &[f64],
     current: &[f64],
-    (contain, frame_rel): (bool, f64),
+    contain: bool,
 ) -> Result<DwellProgram, OptError> {
     let l = &problem.lidar.limits;
     let setpoints = &problem.levels.spin_rad_s;
@@ -1527,7 +1526,7 @@ fn dwell_program(
         d.lp.column(1.0, 1.0, utility_constant, false);
         d.start.push(1.0);
     }
-    frame(&mut d, g.n, frame_rel);
+    frame(&mut d, g.n);
     if problem.lidar.power_accounting == PowerAccounting::Time {
         dwell_budget(&mut d, p, problem.lidar.average_power_w, g.n);
     }
@@ -1641,17 +1640,14 @@ fn spin_levels(d: &mut DwellProgram, problem: &Problem, g: &Grid, i: usize, allo
 
 /// `frame`: `Σ τ_i = N` (one turn per frame period); with spin set-points
 /// the band `N·(1 ± setpoint_frame_tol)` (the checker's tolerance, see
-/// `settings`), two rows; `rel > 0`: the band `N·(1 ± rel)` whatever the
-/// spins.
-fn frame(d: &mut DwellProgram, n: usize, rel: f64) {
+/// `settings`), two rows.
+fn frame(d: &mut DwellProgram, n: usize) {
     let n = n as f64;
     let mut turn = Expression::default();
     for form in &d.tau {
         turn.add_mul(1.0, form);
     }
-    if rel > 0.0 {
-        d.lp.between("frame", turn, n * (1.0 - rel), n * (1.0 + rel));
-    } else if d.sp_cols.is_empty() {
+    if d.sp_cols.is_empty() {
         d.lp.equal("frame", turn, n);
     } else {
         let tol = S.setpoint_frame_tol;
