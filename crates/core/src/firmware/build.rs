@@ -1,9 +1,9 @@
 //! Building a table from a certified profile (floating point: `std` only).
 
 use super::{
-    apportion, check_table, eye, floor_code, lower_to_budget, FirmwareConfig, FirmwareTable, FwBin,
-    FwViolation, IntLimits, QuantizeError, TickTarget, FIRMWARE_FORMAT, FULL_TURN_MDEG,
-    MAX_TABLE_BINS,
+    apportion, ceil_code, check_table, eye, floor_code, lower_to_budget, FirmwareConfig,
+    FirmwareTable, FwBin, FwViolation, IntLimits, QuantizeError, TickTarget, FIRMWARE_FORMAT,
+    FULL_TURN_MDEG, MAX_TABLE_BINS,
 };
 use crate::checker::CertifiedProfile;
 use crate::model::accounting::PowerAccounting;
@@ -180,6 +180,12 @@ impl FirmwareTable {
             });
         }
         let max_code = floor_code(l.power_w_max, step).unwrap_or(u32::MAX);
+        // No bin below the minimum power: the least code at or above it.
+        // (Within the checker's `REL_TOL`, as the profile's own comparison.)
+        let min_code = ceil_code(l.power_w_min * (1.0 - crate::checker::REL_TOL), step)
+            .unwrap_or(0)
+            .min(max_code);
+        let codes: Vec<u32> = codes.into_iter().map(|c| c.max(min_code)).collect();
         // Budget in code units per tick (time) or per millidegree (angle):
         // floor(P̄/step) exactly (as the codes are rounded), plus the
         // remainder's share, so a uniform profile at P̄ always fits.
@@ -213,7 +219,7 @@ impl FirmwareTable {
             pulse_rate_hz: p.pulse_rate_hz,
             eye_safety: l.eye_safety.clone(),
             limits: IntLimits {
-                power_code_min: floor_code(l.power_w_min, step).unwrap_or(0),
+                power_code_min: min_code,
                 power_code_max: max_code,
                 energy_budget,
                 // The window sums are superseded by the eye-safety bound
@@ -323,7 +329,7 @@ fn lower_codes_for_eye_safety(table: &mut FirmwareTable) {
         }
     }
     // Each bin's cap: rule 1 of the integer check (what a sensor may clamp to).
-    let cap = u32::try_from(limits.pulse_code_max).unwrap_or(u32::MAX);
+    let cap = u32::try_from(limits.pulse_code_cap()).unwrap_or(u32::MAX);
     for b in &mut table.bins {
         b.power_code_cap = b.power_code_cap.min(cap);
     }

@@ -87,6 +87,25 @@ pub struct IntEyeLimits {
     pub pass_energy_max_quanta: u64,
     /// The rule binding `pass_energy_max_quanta`.
     pub pass_energy_rule: IntRule,
+    /// The limits of a second aperture surface the table must also pass
+    /// (a head declaring `aperture_distance_mm` other than 100 mm: these
+    /// limits are the 100 mm surface's, the other are the declared
+    /// distance's); at most one level deep.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other_surface: Option<alloc::boxed::Box<IntEyeLimits>>,
+}
+
+impl IntEyeLimits {
+    /// The largest code any pulse may have under Rule 1 on every surface
+    /// the limits hold (`pulse_code_max`, and the other surface's).
+    #[must_use]
+    pub fn pulse_code_cap(&self) -> u64 {
+        self.other_surface
+            .as_ref()
+            .map_or(self.pulse_code_max, |o| {
+                self.pulse_code_max.min(o.pulse_code_max)
+            })
+    }
 }
 
 /// Why a table could not be evaluated (it is then not Class 1 evidence).
@@ -491,7 +510,38 @@ fn ratio_ppm(energy: u128, limit: u64) -> u64 {
 /// of any `k` pulses of the pass (see the module docs). Errors when the
 /// table is outside the integer bounds or the limits were derived for
 /// another timing.
+///
+/// With [`IntEyeLimits::other_surface`] the table is evaluated against both
+/// limit sets: Class 1 when both accept, the report the worse one's (ties
+/// take the first set's).
 pub fn evaluate(table: &FirmwareTable, limits: &IntEyeLimits) -> Result<IntEyeReport, IntEyeError> {
+    let first = evaluate_surface(table, limits)?;
+    let Some(other) = &limits.other_surface else {
+        return Ok(first);
+    };
+    if other.other_surface.is_some() {
+        return Err(IntEyeError::Bounds {
+            field: "other_surface",
+            value: 2,
+            reason: "the limits hold at most two aperture surfaces",
+        });
+    }
+    let second = evaluate_surface(table, other)?;
+    let class1 = first.class1 && second.class1;
+    let mut worse = if second.worst_ratio_ppm > first.worst_ratio_ppm {
+        second
+    } else {
+        first
+    };
+    worse.class1 = class1;
+    Ok(worse)
+}
+
+/// [`evaluate`] against one limit set (one aperture surface).
+fn evaluate_surface(
+    table: &FirmwareTable,
+    limits: &IntEyeLimits,
+) -> Result<IntEyeReport, IntEyeError> {
     let mismatch = |field, found, allowed| IntEyeError::Mismatch {
         field,
         found,
@@ -698,12 +748,16 @@ impl Greedy<'_> {
 mod derive {
     use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
     use crate::eye_safety::ael::{APERTURE_DISTANCE_MM, T2_S, TIME_BASE_S};
+    use crate::eye_safety::bound::Laser;
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
     use crate::eye_safety::head::bound::{
-        head_figures, single_pulse_ratio as single_pulse_ratio_head, SingleFigures,
+        head_figures, single_pulse_ratio as single_pulse_ratio_head, HeadFigures, SingleFigures,
     };
-    use crate::eye_safety::EyeSafetyError;
+    use crate::eye_safety::head::Head;
+    use crate::eye_safety::{EyeSafetyError, EyeSafetyParams};
     use crate::firmware::FirmwareTable;
+    use alloc::boxed::Box;
+    use alloc::vec::Vec;
 
     /// Relative head-room every limit loses before it is rounded down, so
     /// float rounding in the AEL and the quotient can never raise it.
@@ -768,6 +822,41 @@ mod derive {
         /// energy quantum and rounded down after a `LIMIT_MARGIN` cut.
         pub fn derive(table: &FirmwareTable) -> Result<Self, DeriveError> {
             let params = table.eye_safety.as_ref().ok_or(DeriveError::Missing)?;
+            match &params.head {
+                // A certificate covers the 100 mm surface; a declared other
+                // distance is evaluated too, as the float checker does
+                // (`exposure::evaluate_head`): two limit sets, both must
+                // accept ([`evaluate`]).
+                #[allow(clippy::float_cmp)]
+                Some(h) if h.aperture_distance_mm != APERTURE_DISTANCE_MM => {
+                    let declared = Self::derive_at(table, params, Some(h))?;
+                    // Not `< 100` written as a negation: NaN was refused by
+                    // the declared derivation's validation above.
+                    if h.origin_radius_mm >= APERTURE_DISTANCE_MM {
+                        return Err(DeriveError::Range {
+                            field: "eye_safety.head.origin_radius_mm",
+                            reason: "must be < 100 mm: a certificate covers the Condition 3 surface 100 mm from the spin axis",
+                        });
+                    }
+                    let standard = Head {
+                        aperture_distance_mm: APERTURE_DISTANCE_MM,
+                        ..h.clone()
+                    };
+                    let mut limits = Self::derive_at(table, params, Some(&standard))?;
+                    limits.other_surface = Some(Box::new(declared));
+                    Ok(limits)
+                }
+                head => Self::derive_at(table, params, head.as_ref()),
+            }
+        }
+
+        /// The limits of one aperture surface (`head.aperture_distance_mm`
+        /// from the spin axis; one channel without a head).
+        fn derive_at(
+            table: &FirmwareTable,
+            params: &EyeSafetyParams,
+            head: Option<&Head>,
+        ) -> Result<Self, DeriveError> {
             let f_p = table.pulse_rate_hz;
             let laser = laser(params, f_p)?;
             let millihz = millihz_ceil(f_p).ok_or(DeriveError::Range {
@@ -776,34 +865,23 @@ mod derive {
             })?;
             // The head (absent: one channel): its figures at the table's
             // fastest spin (rounded up: a faster spin only widens the
-            // grouping footprints), its widest pass, and the factors its
-            // bound puts on the single-channel figures.
+            // grouping footprints and shortens the windows a separation
+            // bounds), its widest pass, and the factors its bound puts on
+            // the single-channel figures.
             let tick_hz_f = table.tick_hz as f64;
-            let head = match &params.head {
+            let spin_max = table
+                .bins
+                .iter()
+                .filter(|b| b.width_mdeg > 0 && b.dwell_ticks > 0)
+                .map(|b| {
+                    (f64::from(b.width_mdeg) / 1000.0).to_radians() * tick_hz_f
+                        / b.dwell_ticks as f64
+                })
+                .fold(0.0, f64::max)
+                * (1.0 + WIDEN);
+            let head = match head {
                 None => None,
-                // A certificate covers the 100 mm surface; the float checker
-                // evaluates a declared other distance *and* 100 mm, which one
-                // set of integer limits cannot hold: refused by name.
-                #[allow(clippy::float_cmp)]
-                Some(h) if h.aperture_distance_mm != APERTURE_DISTANCE_MM => {
-                    return Err(DeriveError::Range {
-                        field: "eye_safety.head.aperture_distance_mm",
-                        reason: "must be 100 mm in a firmware table (the integer checker evaluates the Condition 3 surface, 100 mm from the spin axis, only)",
-                    });
-                }
-                Some(h) => {
-                    let spin_max = table
-                        .bins
-                        .iter()
-                        .filter(|b| b.width_mdeg > 0 && b.dwell_ticks > 0)
-                        .map(|b| {
-                            (f64::from(b.width_mdeg) / 1000.0).to_radians() * tick_hz_f
-                                / b.dwell_ticks as f64
-                        })
-                        .fold(0.0, f64::max)
-                        * (1.0 + WIDEN);
-                    Some(head_figures(h, params, &laser, spin_max)?)
-                }
+                Some(h) => Some(head_figures(h, params, &laser, spin_max)?),
             };
             let pass_deg = head.as_ref().map_or_else(
                 || pass_angle_deg(params, &laser),
@@ -867,12 +945,18 @@ mod derive {
                     rule_one(1.0, 0.0) * per_code_one + rule_one(0.0, step)
                 }
             };
-            // The energy rules: `W_v` times the single-channel figures, the
-            // head bound's first candidate (`head::bound::energy_ratios`);
-            // the float bound may take a tighter one (a separation's), so
-            // this check is at least as strict as the float checker's.
+            // The energy rules: a window of length `T` holds channels of
+            // total `power_scale` at most `W*(T)`, the smallest weight any
+            // candidate of the head bound (`head::bound::energy_ratios`)
+            // proves for that length (`weight_steps`: `W_v`, a separation's
+            // `W(L)` up to `L/ω_max`, the firing slots' weights below one
+            // cycle), each channel at most the single-channel energy of the
+            // window; so the single channel is held to `AEL(T)/W*(T)`.
             let w_v = head.as_ref().map_or(1.0, |hf| hf.weight_vertical);
-            let to_quanta = |energy_j: f64| to_quanta(energy_j / w_v);
+            let steps = head
+                .as_ref()
+                .map_or_else(Vec::new, |hf| weight_steps(hf, spin_max));
+            let per_weight = PerWeight::new(&laser, &steps, w_v);
             let pulse_code_max = if per_code > 0.0 {
                 let x = (1.0 - LIMIT_MARGIN) / per_code;
                 if x >= 1.8e19 {
@@ -883,14 +967,16 @@ mod derive {
             } else {
                 u64::MAX
             };
-            // Rule 2 within a pass: k pulses span at least (k − 1)/f_p.
+            // Rule 2 within a pass: k pulses span at least (k − 1)/f_p, so a
+            // window holding them is held to `inf AEL(T)/W*(T)` over
+            // `T ≥ (k − 1)/f_p` (shortened).
             let mut train = Vec::new();
             let mut k: u64 = 1;
             loop {
                 let t = (k - 1) as f64 / f_p * (1.0 - WIDEN);
                 train.push(TrainLimit {
                     pulses_from: k,
-                    energy_max_quanta: to_quanta(laser.ael_inf_j(t, TIME_BASE_S)),
+                    energy_max_quanta: to_quanta(per_weight.inf_from(t)),
                 });
                 if k >= k_max {
                     break;
@@ -901,6 +987,14 @@ mod derive {
                     k / EXACT_PULSE_BUCKETS
                 };
             }
+            // Nondecreasing (as `evaluate` requires): each limit lowered to
+            // the smallest of the later ones (lowering is the safe side).
+            let mut later = u64::MAX;
+            for b in train.iter_mut().rev() {
+                b.energy_max_quanta = b.energy_max_quanta.min(later);
+                later = b.energy_max_quanta;
+            }
+            let to_quanta = |energy_j: f64| to_quanta(energy_j / w_v);
             // Rule 2 over m ≥ 2 passes: such a window lasts at least
             // (m − 1)·T_f − τ_max and receives at most m pass energies.
             let frame = u128::from(table.frame_ticks);
@@ -942,7 +1036,115 @@ mod derive {
                 train,
                 pass_energy_max_quanta,
                 pass_energy_rule,
+                other_surface: None,
             })
+        }
+    }
+
+    /// The head's channel weight by window length, as pieces
+    /// `(lo_s, hi_s, weight)`: every window whose length lies in
+    /// `[lo_s, hi_s)` receives channels of total `power_scale` at most
+    /// `weight` (a window of any length at most `W_v`). From the head
+    /// bound's candidates (`head::bound::energy_ratios`), the same figures:
+    /// - the firing slots (`HeadFigures::slot_windows`): a window shorter
+    ///   than one cycle holds one pulse per channel, of the channels of the
+    ///   range's weight; the last range ends at `cycle·(1 − 1e-9)`, and a
+    ///   longer window is left to `W_v`;
+    /// - a separation `L` (`HeadFigures::separations`): a window up to
+    ///   `L/ω_max` (shortened by 1e-12, as the float bound does) turns the
+    ///   head by at most `L`, so it reaches channels of `W(L)`; `ω_max` is
+    ///   the table's fastest spin as it runs, rounded up.
+    fn weight_steps(hf: &HeadFigures, spin_max_rad_s: f64) -> Vec<(f64, f64, f64)> {
+        let mut steps: Vec<(f64, f64, f64)> = hf
+            .slot_windows
+            .iter()
+            .map(|r| (r.lo_s, r.hi_s, r.weight))
+            .collect();
+        if spin_max_rad_s > 0.0 {
+            for sep in &hf.separations {
+                let t_sep = sep.angle_rad / spin_max_rad_s * (1.0 - 1e-12);
+                if t_sep.is_finite() && t_sep > 0.0 {
+                    // Windows of exactly `t_sep` fall in the next cell
+                    // (`W_v`): the safe side.
+                    steps.push((0.0, t_sep, sep.weight));
+                }
+            }
+        }
+        steps.retain(|&(lo, hi, w)| lo.is_finite() && hi.is_finite() && lo < hi && w >= 0.0);
+        steps
+    }
+
+    /// `inf AEL(T)/W*(T)` over the window lengths from a given one, with
+    /// `W*(T)` the smallest weight of the pieces holding `T` and `W_v`
+    /// (`weight_steps`): `W*` is a step function on the pieces' ends, so
+    /// the infimum is the smallest of `AEL_inf` over each elementary
+    /// interval (closed: its end is also the next one's start) divided by
+    /// its weight, and `AEL_inf` from the last end to the time base over
+    /// `W_v`.
+    struct PerWeight {
+        /// Elementary intervals `(lo_s, hi_s, W*)`, increasing.
+        cells: Vec<(f64, f64, f64)>,
+        /// `AEL_inf(lo, hi)/W*` of each cell, then the suffix minimum.
+        suffix: Vec<f64>,
+        /// Where `W_v` alone holds on (the last end; 0 without pieces).
+        tail_s: f64,
+        w_v: f64,
+        laser: Laser,
+    }
+
+    impl PerWeight {
+        fn new(laser: &Laser, steps: &[(f64, f64, f64)], w_v: f64) -> Self {
+            let mut ends: Vec<f64> = steps.iter().flat_map(|&(lo, hi, _)| [lo, hi]).collect();
+            ends.push(0.0);
+            ends.retain(|x| *x >= 0.0);
+            ends.sort_by(f64::total_cmp);
+            ends.dedup();
+            let cells: Vec<(f64, f64, f64)> = ends
+                .windows(2)
+                .map(|e| {
+                    let (lo, hi) = (e[0], e[1]);
+                    // A piece holds the whole half-open cell [lo, hi).
+                    let w = steps
+                        .iter()
+                        .filter(|&&(a, b, _)| a <= lo && hi <= b)
+                        .map(|&(_, _, w)| w)
+                        .fold(w_v, f64::min);
+                    (lo, hi, w)
+                })
+                .collect();
+            let tail_s = ends.last().copied().unwrap_or(0.0);
+            let mut suffix: Vec<f64> = cells
+                .iter()
+                .map(|&(lo, hi, w)| laser.ael_inf_j(lo, hi) / w)
+                .collect();
+            let mut later = f64::INFINITY;
+            for x in suffix.iter_mut().rev() {
+                *x = x.min(later);
+                later = *x;
+            }
+            Self {
+                cells,
+                suffix,
+                tail_s,
+                w_v,
+                laser: *laser,
+            }
+        }
+
+        /// `inf AEL(T)/W*(T)` over `T ≥ t_s`, J per unit weight.
+        fn inf_from(&self, t_s: f64) -> f64 {
+            let tail = self.laser.ael_inf_j(t_s.max(self.tail_s), TIME_BASE_S) / self.w_v;
+            // The first cell reaching past `t_s`: it is cut at `t_s`, every
+            // later cell is whole (its suffix minimum).
+            match self.cells.iter().position(|&(_, hi, _)| hi >= t_s) {
+                None => tail,
+                Some(i) => {
+                    let (lo, hi, w) = self.cells[i];
+                    let first = self.laser.ael_inf_j(lo.max(t_s), hi) / w;
+                    let rest = self.suffix.get(i + 1).copied().unwrap_or(f64::INFINITY);
+                    first.min(rest).min(tail)
+                }
+            }
         }
     }
 }
@@ -1051,6 +1253,7 @@ mod verification {
             ],
             pass_energy_max_quanta: e_pass,
             pass_energy_rule: IntRule::T2Train,
+            other_surface: None,
         }
     }
 

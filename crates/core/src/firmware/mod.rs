@@ -8,7 +8,11 @@
 //!   tick bounds implied by the spin limits, and the dwells sum to
 //!   `frame_ticks` exactly ([`quantize::apportion`]);
 //! - power codes are rounded down: never above the certified power, within
-//!   one code of it (`quantize::floor_code`), then lowered further only if the
+//!   one code of it (`quantize::floor_code`; a bin whose power lies within one
+//!   code of `power_w_min` is raised to `power_code_min`, `power_w_min` rounded
+//!   up to a code, so no bin runs below the minimum power: at most one code above
+//!   its certified power, and the integer eye-safety check below decides on
+//!   the table as it runs), then lowered further only if the
 //!   table **as it will run** (quantized dwell, quantized codes) is over its
 //!   energy budget as the integer checker reads it ([`lower_to_budget`]:
 //!   rounding dwells to whole ticks can add a few code·ticks) or over the
@@ -49,9 +53,9 @@ pub use build::{
 pub use check::{check_header, check_integer, check_table_with, FwViolation, TICK_HZ_MAX};
 #[cfg(feature = "std")]
 pub use check::{check_table, check_table_evaluated};
-#[cfg(feature = "std")]
-pub use quantize::floor_code;
 pub use quantize::{apportion, lower_to_budget, QuantizeError, TickTarget};
+#[cfg(feature = "std")]
+pub use quantize::{ceil_code, floor_code};
 #[cfg(feature = "std")]
 pub use sensor::check_table_for_sensor;
 
@@ -85,7 +89,8 @@ impl Default for FirmwareConfig {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntLimits {
-    /// `floor(power_w_min / step)`.
+    /// `ceil(power_w_min·(1 − REL_TOL) / step)`: no bin runs below the
+    /// minimum power (within the checker's tolerance).
     pub power_code_min: u32,
     /// `floor(power_w_max / step)`.
     pub power_code_max: u32,
@@ -115,7 +120,7 @@ pub struct FwBin {
     /// Largest dwell the spin limit allows, ticks.
     pub dwell_ticks_max: u64,
     /// Largest code this bin may hold: `power_code_max`, and the integer
-    /// eye-safety check's rule-1 limit (`eye::IntEyeLimits::pulse_code_max`).
+    /// eye-safety check's rule-1 limit on every surface (`eye::IntEyeLimits::pulse_code_cap`).
     pub power_code_cap: u32,
 }
 

@@ -181,6 +181,21 @@ pub fn lower_to_budget(codes: &mut [u32], weights: &[u64], min: u32, budget: u64
     energy
 }
 
+/// `ceil(value / step)` for a non-negative power and a positive step, exact
+/// at the boundaries as [`floor_code`]: the smallest code whose power
+/// `code·step` is at least `value`. `None` if it does not fit a `u32` or
+/// the inputs are not finite and non-negative.
+#[cfg(feature = "std")]
+#[must_use]
+pub fn ceil_code(value: f64, step: f64) -> Option<u32> {
+    let code = floor_code(value, step)?;
+    if f64::from(code) * step >= value {
+        Some(code)
+    } else {
+        code.checked_add(1)
+    }
+}
+
 /// `floor(value / step)` for a non-negative power and a positive step, exact
 /// at the boundaries (a float quotient that rounds across an integer is
 /// corrected): `code·step <= value < (code+1)·step`. `None` if it does not

@@ -11,7 +11,7 @@ use alloc::format;
 use alloc::vec::Vec;
 
 use super::build::{budget_weight_total, energy_budget, frame_ticks_for};
-use super::{check_table_evaluated, eye, floor_code, FirmwareTable, FwViolation};
+use super::{ceil_code, check_table_evaluated, eye, floor_code, FirmwareTable, FwViolation};
 use crate::checker::REL_TOL;
 use crate::model::lidar::{laser_mismatches, no_looser, LidarSpec, LimitSide};
 
@@ -82,7 +82,9 @@ pub fn against_sensor(table: &FirmwareTable, sensor: &LidarSpec) -> Vec<FwViolat
     looser(
         "limits.power_code_min",
         u64::from(l.power_code_min),
-        floor_code(s.power_w_min, step).map(u64::from),
+        // A lower limit rounds up: the table's least code must reach the
+        // sensor's minimum power (within `REL_TOL`, as a profile's power).
+        ceil_code(s.power_w_min * (1.0 - REL_TOL), step).map(u64::from),
         LimitSide::Lower,
     );
     let weight = budget_weight_total(table.power_accounting, table.frame_ticks);

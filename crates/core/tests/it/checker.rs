@@ -886,6 +886,61 @@ fn profile_and_its_table_name_the_same_sensor_mismatches() {
     }
 }
 
+/// A table's `power_code_min` is a lower limit: against a sensor it must be
+/// at least the sensor's minimum power rounded **up** to a code (the loose
+/// direction would let a bin run below the sensor's minimum). A minimum of
+/// 2.5 codes needs a table minimum of 3: 2 is looser than the sensor, 3
+/// is not; a minimum of exactly 2 codes accepts 2. The quantizer rounds
+/// its own minimum the same way, so a table built for a sensor passes it.
+#[test]
+fn table_minimum_code_is_the_sensors_minimum_power_rounded_up() {
+    use gaze_lidar_core::firmware::sensor::against_sensor;
+    use gaze_lidar_core::firmware::{ceil_code, FirmwareConfig, FirmwareTable, FwViolation};
+    let certified = certify(uniform()).expect("uniform certifies");
+    let mut table = FirmwareTable::from_certified(&certified, &FirmwareConfig::default())
+        .expect("table builds");
+    let step = table.power_w_per_code;
+    let looser = |t: &FirmwareTable, s: &LidarSpec| {
+        against_sensor(t, s).iter().any(|x| {
+            matches!(
+                x,
+                FwViolation::LooserThanSensor {
+                    field: "limits.power_code_min",
+                    ..
+                }
+            )
+        })
+    };
+    for (min_codes, table_min, want_looser) in [
+        (2.5, 2, true),
+        (2.5, 3, false),
+        (2.0, 2, false),
+        (2.0, 1, true),
+    ] {
+        let mut s = sensor();
+        s.limits.power_w_min = min_codes * step;
+        table.limits.power_code_min = table_min;
+        assert_eq!(
+            looser(&table, &s),
+            want_looser,
+            "{min_codes} codes, table {table_min}"
+        );
+    }
+    assert_eq!(ceil_code(2.5 * step, step), Some(3));
+    assert_eq!(ceil_code(2.0 * step, step), Some(2));
+    assert_eq!(ceil_code(0.0, step), Some(0));
+    // Built against a limit of 2.5 codes: the table's minimum is 3 and it
+    // passes the sensor.
+    let mut p = uniform();
+    p.limits.power_w_min = 2.5 * step;
+    let mut s = sensor();
+    s.limits.power_w_min = p.limits.power_w_min;
+    let c = certify_for_sensor(p, &s).expect("certifies");
+    let t = FirmwareTable::from_certified(&c, &FirmwareConfig::default()).expect("builds");
+    assert_eq!(t.limits.power_code_min, 3);
+    assert!(!looser(&t, &s));
+}
+
 /// The one serialisable verdict: certified and rejected alike, built from
 /// the checker's own evaluation. A profile rejected for a non-eye-safety
 /// limit still carries the eye-safety figures the checker computed, and

@@ -51,33 +51,33 @@ use gaze_lidar_core::profile::kinematics::Timeline;
 use reference_defs::{def_ael_j, def_c5, DBand};
 
 /// Deterministic generator (SplitMix64).
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 impl Rng {
-    fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
         z ^ (z >> 31)
     }
-    fn unit(&mut self) -> f64 {
+    pub(crate) fn unit(&mut self) -> f64 {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit()
     }
-    fn below(&mut self, n: usize) -> usize {
+    pub(crate) fn below(&mut self, n: usize) -> usize {
         (self.next() % n as u64) as usize
     }
 }
 
-struct Case {
-    segs: Vec<Seg>,
-    params: EyeSafetyParams,
-    f_p: f64,
+pub(crate) struct Case {
+    pub(crate) segs: Vec<Seg>,
+    pub(crate) params: EyeSafetyParams,
+    pub(crate) f_p: f64,
 }
 
-fn random_case(rng: &mut Rng) -> Case {
+pub(crate) fn random_case(rng: &mut Rng) -> Case {
     let big = rng.below(50) == 0;
     let n_ch = if big {
         64 + rng.below(65)
@@ -242,7 +242,7 @@ fn receives(h: &Hit, az: f64, z: f64, r: f64, a: f64) -> bool {
 }
 
 /// The reference's worst ratio of a case.
-fn reference(case: &Case, phases: usize, rng: &mut Rng) -> f64 {
+pub(crate) fn reference(case: &Case, phases: usize, rng: &mut Rng) -> f64 {
     let head = case.params.head.as_ref().unwrap();
     let band = DBand::of(case.params.wavelength_nm);
     let lambda = case.params.wavelength_nm;

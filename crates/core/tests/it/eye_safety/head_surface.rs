@@ -1,8 +1,8 @@
 //! The surface a head's certificate covers (`specs/eye_safety.md`, "The
 //! head", "The aperture's surface"): the Condition 3 surface 100 mm from the
 //! spin axis always, and a declared other `aperture_distance_mm` as well, the
-//! worse report being the verdict; the integer firmware checker refuses a
-//! declared other distance by name.
+//! worse report being the verdict; the integer firmware checker evaluates
+//! both surfaces too.
 //!
 //! Run: `cargo test --release -p gaze-lidar-core --test it eye_safety::head_surface`.
 
@@ -12,7 +12,7 @@ use gaze_lidar_core::eye_safety::bound::Seg;
 use gaze_lidar_core::eye_safety::exposure::evaluate_segments_at_declared_distance;
 use gaze_lidar_core::eye_safety::head::{Channel, Head};
 use gaze_lidar_core::eye_safety::{evaluate_segments, EyeSafetyParams};
-use gaze_lidar_core::firmware::eye::{DeriveError, IntEyeLimits};
+use gaze_lidar_core::firmware::eye::{evaluate, DeriveError, IntEyeLimits};
 use gaze_lidar_core::firmware::{check_table, FwViolation};
 
 const F_P: f64 = 100_000.0;
@@ -119,34 +119,87 @@ fn a_crossing_point_beyond_100_mm_is_refused_by_name() {
     assert!(msg.contains("100 mm"), "{msg}");
 }
 
-/// The integer firmware checker holds one set of limits: a table whose
-/// head declares another distance is refused naming the field, never
-/// certified at that distance alone; at 100 mm it derives.
+/// The integer firmware checker evaluates a head declared at another
+/// distance on both surfaces, as the float checker does: `derive` gives the
+/// 100 mm surface's limits with the declared distance's as `other_surface`,
+/// and the verdict is the worse of the two. The outside tester's 12.67 mW
+/// profile as a table (360 bins of 1°, 2778 ticks each at 1 MHz: 1.00008 s
+/// per turn): declared at 10 000 mm it is judged on the 100 mm surface
+/// (over 2.85, refused), where the 10 000 mm surface alone passes it; declared
+/// at 50 mm the nearer surface's wider pass binds. A crossing point at or
+/// beyond 100 mm is refused naming `eye_safety.head.origin_radius_mm`.
 #[test]
-fn firmware_refuses_a_head_declared_at_another_distance() {
-    // 360 bins of 1°, 1 s frame at 1 MHz ticks, 1 mW codes.
-    let bins: Vec<(u32, u64, u32)> = (0..360).map(|_| (1000, 2778, 1)).collect();
-    for r in [99.0, 10_000.0] {
-        let t = common::open_table(1_000_000, F_P, Some(params(r, 0.0)), &bins);
-        let err = IntEyeLimits::derive(&t).unwrap_err();
-        assert!(
-            matches!(
-                err,
-                DeriveError::Range {
-                    field: "eye_safety.head.aperture_distance_mm",
-                    ..
-                }
-            ),
-            "{err:?}"
+fn firmware_evaluates_a_head_declared_at_another_distance_on_both_surfaces() {
+    let code = (0.012_670_675_543_394_85f64 / 1e-6).floor() as u32;
+    let bins: Vec<(u32, u64, u32)> = (0..360).map(|_| (1000, 2778, code)).collect();
+    let table = |r: f64, origin: f64| {
+        let mut t = common::open_table(1_000_000, F_P, Some(params(r, origin)), &bins);
+        t.power_w_per_code = 1e-6;
+        t
+    };
+    let std_t = table(100.0, 0.0);
+    let std_l = IntEyeLimits::derive(&std_t).unwrap();
+    assert!(std_l.other_surface.is_none());
+    let at_100 = evaluate(&std_t, &std_l).unwrap();
+    assert!(
+        !at_100.class1 && at_100.worst_ratio_ppm > 2_850_000,
+        "{at_100:?}"
+    );
+    for r in [10_000.0, 50.0] {
+        let t = table(r, 0.0);
+        let l = IntEyeLimits::derive(&t).unwrap();
+        let declared = l
+            .other_surface
+            .clone()
+            .expect("the declared surface's limits");
+        let mut standard = l.clone();
+        standard.other_surface = None;
+        assert_eq!(
+            standard, std_l,
+            "{r} mm: the first set is the 100 mm surface's"
+        );
+        let alone = evaluate(&t, &declared).unwrap();
+        let both = evaluate(&t, &l).unwrap();
+        assert!(!both.class1);
+        assert_eq!(
+            both.worst_ratio_ppm,
+            alone.worst_ratio_ppm.max(at_100.worst_ratio_ppm)
+        );
+        if r > 100.0 {
+            // The far surface alone would pass the table.
+            assert!(alone.class1, "{alone:?}");
+            assert_eq!(both, at_100);
+        } else {
+            assert!(alone.worst_ratio_ppm > at_100.worst_ratio_ppm, "{alone:?}");
+            assert_eq!(both, alone);
+        }
+        assert_eq!(
+            l.pulse_code_cap(),
+            l.pulse_code_max.min(declared.pulse_code_max)
         );
         let v = check_table(&t);
         assert!(
-            v.iter()
-                .any(|x| matches!(x, FwViolation::EyeSafetyParams { reason }
-                if reason.contains("aperture_distance_mm"))),
+            v.iter().any(|x| matches!(x, FwViolation::EyeSafety { .. })),
             "{v:?}"
         );
     }
-    let t = common::open_table(1_000_000, F_P, Some(params(100.0, 0.0)), &bins);
-    assert!(IntEyeLimits::derive(&t).is_ok());
+    let t = table(10_000.0, 150.0);
+    let err = IntEyeLimits::derive(&t).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            DeriveError::Range {
+                field: "eye_safety.head.origin_radius_mm",
+                ..
+            }
+        ),
+        "{err:?}"
+    );
+    let v = check_table(&t);
+    assert!(
+        v.iter()
+            .any(|x| matches!(x, FwViolation::EyeSafetyParams { reason }
+            if reason.contains("origin_radius_mm"))),
+        "{v:?}"
+    );
 }

@@ -12,7 +12,7 @@ mod exposure;
 mod head;
 mod head_figures_golden;
 mod head_oracle;
-mod head_reference;
+pub(crate) mod head_reference;
 mod head_surface;
 mod open_readings;
 mod reference;

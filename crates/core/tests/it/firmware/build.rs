@@ -75,8 +75,9 @@ fn uniform_profile_quantizes_by_hand() {
         assert_eq!(t.power_accounting, accounting);
         assert_eq!(t.pulse_rate_hz, 20_000.0);
         assert_eq!(t.eye_safety, Some(params()));
-        // power_code_min = ⌊0.5e-4 / step⌋ = ⌊1023.75⌋, max = 4095 exactly.
-        assert_eq!(t.limits.power_code_min, 1023);
+        // power_code_min = ⌈0.5e-4 / step⌉ = ⌈1023.75⌉ (a lower limit rounds
+        // up), max = 4095 exactly.
+        assert_eq!(t.limits.power_code_min, 1024);
         assert_eq!(t.limits.power_code_max, 4095);
         // Budget: ⌊P̄/step⌋ = ⌊2047.5⌋ = 2047 per unit of weight, plus the
         // remainder's share 0.5 × weight; the weight is 360,000 mdeg (angle)
@@ -159,7 +160,8 @@ fn zero_spin_minimum_leaves_the_dwell_unbounded_above() {
 #[test]
 fn explicit_step_sets_the_codes() {
     // step 2e-6 W: ⌊1e-4/2e-6⌋ = 50 (exact in floating point: 50·2e-6 ≤ 1e-4 < 51·2e-6);
-    // min ⌊0.5e-4/2e-6⌋ = 25, max ⌊2e-4/2e-6⌋ = 100.
+    // min ⌈0.5e-4/2e-6⌉ = 25 (25·2e-6 is 5e-5 within the checker's REL_TOL),
+    // max ⌊2e-4/2e-6⌋ = 100.
     let t = build(uniform(PowerAccounting::Angle), 3_600_000, Some(2e-6)).expect("quantizes");
     assert_eq!(t.power_w_per_code, 2e-6);
     assert_eq!(t.limits.power_code_min, 25);
