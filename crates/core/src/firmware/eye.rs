@@ -24,6 +24,12 @@
 //! - rule 1: the hottest code `≤ pulse_code_max`; rule 2 within a pass:
 //!   `G(k) ≤` the limit of the `k`-pulse bucket; several passes: `G(K) ≤
 //!   pass_energy_max`. All sums are `u128`.
+//!
+//! With a head the limits hold the single channel's windows of length `T`
+//! to `AEL(T)/W*(T)`, `W*` the smallest channel weight any candidate of the
+//! float head bound proves for that length (derived on the host); a head
+//! declared at another distance than 100 mm adds the second surface's
+//! limits ([`IntEyeLimits::other_surface`]), and the table must pass both.
 
 use alloc::vec::Vec;
 
