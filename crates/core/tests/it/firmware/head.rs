@@ -234,3 +234,25 @@ fn integer_head_check_is_never_below_the_definitions_reference() {
     assert!(evaluated * 10 >= cases * 9, "{evaluated} of {cases}");
     assert!(far > 0);
 }
+
+/// The limits serialize as before for a 100 mm head (no `other_surface`
+/// key, so limits written before it read unchanged), and a head declared at
+/// another distance round-trips with its second surface.
+#[test]
+fn limits_serialize_as_before_without_a_second_surface() {
+    let table = |r: f64| {
+        let mut p = mini_vls([0.0, 1e-5]);
+        p.head.as_mut().unwrap().aperture_distance_mm = r;
+        let mut t = common::open_table(1_000_000, 1e4, Some(p), &[(360_000, 100_000, 1)]);
+        t.power_w_per_code = 1e-7;
+        t
+    };
+    let near = IntEyeLimits::derive(&table(100.0)).unwrap();
+    let j = serde_json::to_string(&near).unwrap();
+    assert!(!j.contains("other_surface"), "{j}");
+    assert_eq!(serde_json::from_str::<IntEyeLimits>(&j).unwrap(), near);
+    let far = IntEyeLimits::derive(&table(300.0)).unwrap();
+    let j = serde_json::to_string(&far).unwrap();
+    assert!(j.contains("other_surface"), "{j}");
+    assert_eq!(serde_json::from_str::<IntEyeLimits>(&j).unwrap(), far);
+}
