@@ -454,11 +454,22 @@ fn power_checkpoint(
     }
     let round = round + 1;
     // Every bin edge ± h first (rotation-equivariant: a rotated problem gets
-    // the rotated cuts); the bound's witness only when those hold.
+    // the rotated cuts); the bound's witness only when those hold. A
+    // tightened class's program divides its cuts' limits by its factor, so
+    // a cut of that class breaks the answer there from `cut_rhs / factor`
+    // on: those come too (before any further tightening), with every cut at
+    // or above `cut_rhs` and every Rule 1 cut the core gives.
+    let scale = factor[0].max(factor[1]);
     let new_cuts = |extra: &[f64]| -> Vec<Cut> {
-        e.cuts(&s, extra, cut_rhs())
+        e.cuts(&s, extra, cut_rhs() / scale)
             .into_iter()
-            .filter(|c| !pool.contains(c))
+            .filter(|c| {
+                let r = c.ratio(p, e.pulse_rate_hz);
+                (r >= cut_rhs()
+                    || r * factor[cut_class(c)] >= cut_rhs()
+                    || c.rule == Rule::SinglePulse)
+                    && !pool.contains(c)
+            })
             .collect()
     };
     let mut fresh = new_cuts(&[]);

@@ -3,7 +3,10 @@
 //! (`specs/optimizer.md`, "Eye safety as cuts").
 
 use gaze_lidar::checker::certify;
-use gaze_lidar::eye_safety::{cuts::cuts, exposure};
+use gaze_lidar::eye_safety::{
+    cuts::{cuts, cuts_for},
+    exposure,
+};
 use gaze_lidar::optimizer::{exact_objective, optimize, Levels, OptimizerConfig, Problem};
 use gaze_lidar::profile::Profile;
 
@@ -95,6 +98,18 @@ fn cuts_never_exceed_the_bound_on_optimized_profiles() {
                 cut.ratio(&pw, p.pulse_rate_hz) <= b,
                 "{name}: {cut:?} above {b}"
             );
+        }
+        // With a head, the head's cuts (each energy cut scaled by its own
+        // factor) are at most the head's bound too.
+        if params.head.is_some() {
+            let head = cuts_for(&segs, params, &laser, &[], 0.0, 0.0).unwrap();
+            assert!(!head.is_empty());
+            for cut in &head {
+                assert!(
+                    cut.ratio(&pw, p.pulse_rate_hz) <= b,
+                    "{name}: head cut {cut:?} above {b}"
+                );
+            }
         }
     }
 }

@@ -521,37 +521,94 @@ pub fn rule_one_cap_w(laser: &Laser, half_deg: f64, spin_max_rad_s: f64, frame_s
     f_p / per_j
 }
 
-/// How the head's bound scales the single-channel figures. Rule 1 is
-/// `a·r₁ + b·E` with `r₁` the single-channel Rule 1 figure and `E` the
-/// largest pulse energy (J); only one of `a`, `b` is nonzero
+/// How the head's bound scales the single-channel figures
+/// (`specs/optimizer.md`, "With a head: what is proved optimal").
+///
+/// **Rule 1** is `a·r₁ + b·E` with `r₁` the single-channel Rule 1 figure
+/// and `E` the largest pulse energy (J); only one of `a`, `b` is nonzero
 /// (`head::bound::single_pulse_ratio` is linear in the single-channel
 /// Rule 1 ratio when no two channels share an aperture position, else
-/// linear in the largest pulse energy). Each energy rule of the head is
-/// at least `W·r` with `r` the single-channel figure of that rule and `W`
-/// the smallest channel weight any of its candidates takes
-/// (`head::bound::energy_ratios`: `W_v`, or a separation's `W(L)`, times
-/// the single-channel figure, the larger of that and a multi-pass figure).
+/// linear in the largest pulse energy).
 ///
-/// Not covered: the head bound's instantaneous-overlap candidate
-/// (`W_inst · P̂` per unit time up to `T*`, added after these cuts were
-/// written) is not of the form `W · r`; where it is the smallest, a cut
-/// scaled by `W` may exceed the head's figure, which can only make the
-/// optimizer conservative (every answer is still decided by the checker),
-/// never unsafe. `tests/it/optimizer/eye_cuts.rs::cuts_never_exceed_the_bound_on_optimized_profiles`
-/// holds on the shipped configs.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// **The energy rules** are the smallest of several candidates' peaks
+/// (`head::bound::energy_ratios`): a minimum, so a cut scaled by some
+/// factor stays a relaxation of "the head bound certifies" only if it is at
+/// most *every* candidate's peak, for every power vector of the spin. Take
+/// a single-channel energy cut (a concrete exposure at the head's widest
+/// pass) of `n` pulses, limit `L` and window lengths from `lo`; `r` its
+/// single-channel ratio, at most each single-channel energy figure. Each
+/// candidate charges it at least `F_c·r`:
+///
+/// - `W_v ×` the single-channel figures: `F = W_v`.
+/// - A separation (`W(L) ×` the single-channel figures, and from
+///   `t_sep = L/ω_max` on `W_v ×` the multi-pass bounds, which bound every
+///   single-channel window from `t_sep` on, the cut's too when
+///   `lo ≥ t_sep`): `F = W(L)`, or `W_v` when `lo ≥ t_sep`.
+/// - The short windows by firing slots (`SlotWindow`: at least
+///   `max_j W_j/AEL_inf_j · P̂/f_p`, and `W_v ×` the multi-pass bounds
+///   from the last range's end): a cut carries at most `n·P̂/f_p`, so
+///   `F = L·max_j(W_j/AEL_inf_j)/n`, or at least `W_v` when `lo` is past
+///   the last range.
+/// - The instantaneous overlap (for each `T*` the bound takes: at least
+///   `W_inst·P̂·sup_{T ≤ T*} (T + Δ)/AEL(T)`, and `W_v ×` the multi-pass
+///   bounds from `T*`): every `T*` above `lo` charges at least
+///   `W_inst·P̂·S(lo)` with `S(lo) = sup_{T ≤ lo} (T + Δ)/AEL(T)`, every
+///   `T*` at or below it `W_v ×` the cut, so `F = min(W_v, L·W_inst·f_p·S(lo)/n)`
+///   whichever `T*` the bound takes.
+///
+/// The cut's factor is the smallest of these ([`HeadScale::energy_factor`]):
+/// the cut scaled by it is at most every candidate's peak, so at most the
+/// head's energy figure, and the scaled cuts are a relaxation of the head
+/// bound whichever candidate binds. A 1-pulse cut on one bin is then
+/// exactly the slot candidate's short-window figure at that bin's power,
+/// so where that candidate binds the cuts reach it.
+#[derive(Debug, Clone)]
 pub struct HeadScale {
-    /// `W`: the energy rules' factor on the single-channel figures (a
-    /// lower bound of the head's: its cuts stay below the head's figure
-    /// whichever candidate the head bound takes).
-    pub energy: f64,
+    /// `W_v`: the largest factor (the vertical candidate puts it on every
+    /// window).
+    pub weight_vertical: f64,
+    /// The other candidates of the head's energy figure.
+    pub energy: Vec<EnergyCandidate>,
+    /// `W_inst · f_p` (0 without the instantaneous candidate): its factor
+    /// on a cut is `L·W_inst·f_p·S(lo)/n`.
+    pub instant_per_j: f64,
     /// Rule 1's factor on the single-channel Rule 1 figure.
     pub rule_one_single: f64,
     /// Rule 1's ratio per joule of the largest pulse energy.
     pub rule_one_per_j: f64,
     /// Half the head's widest pass angle, deg (the bound's `half_deg`).
     pub half_deg: f64,
+    laser: Laser,
 }
+
+/// One candidate of the head's energy figure as the factor it allows on a
+/// single-channel energy cut of `n` pulses, limit `L` and shortest window
+/// `lo`: `max(weight, L·short_per_j/n)`, and at least `W_v` when
+/// `lo ≥ long_from_s`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergyCandidate {
+    /// The candidate's weight on every single-channel energy figure.
+    pub weight: f64,
+    /// The candidate's figure per joule of the largest pulse energy
+    /// (`P̂/f_p`), 1/J.
+    pub short_per_j: f64,
+    /// Windows from this length on are charged `W_v ×` the single-channel
+    /// multi-pass bounds, s.
+    pub long_from_s: f64,
+}
+
+/// Relative margin by which every head factor is lowered (and the head's
+/// Rule 1 per-joule limit raised): a cut and the head's figure are computed
+/// by different float operations (a product of the factor and the cut's sum
+/// against the bound's own products and maxima), a few ulps apart, so the
+/// scaled cut stays at or below the figure for every power vector, not only
+/// up to rounding. Far below the optimizer's head-room (1e-9).
+pub const HEAD_FACTOR_MARGIN: f64 = 1e-12;
+
+/// Relative margin by which a separation's window length is raised before
+/// a cut's shortest window is compared with it (the cut then takes `W_v`
+/// only when surely past it).
+const SEPARATION_MARGIN: f64 = 1e-9;
 
 impl HeadScale {
     /// The scales of the head bound for the spins of `segs` (the head's
@@ -582,31 +639,110 @@ impl HeadScale {
                 },
             )
         };
-        let energy = hf
-            .separations
+        // The head bound's fastest spin, as it takes it.
+        let spin_max = segs
             .iter()
-            .map(|sep| sep.weight)
-            .fold(hf.weight_vertical, f64::min);
+            .map(|s| s.spin_start_rad_s.max(s.spin_end_rad_s))
+            .fold(0.0, f64::max);
+        let w = hf.weight_vertical;
+        let mut energy = Vec::new();
+        for sep in &hf.separations {
+            if sep.weight < w && spin_max > 0.0 {
+                energy.push(EnergyCandidate {
+                    weight: sep.weight,
+                    short_per_j: 0.0,
+                    long_from_s: sep.angle_rad / spin_max * (1.0 + SEPARATION_MARGIN),
+                });
+            }
+        }
+        let several = hf.count_vertical > 1;
+        if let (true, Some(last)) = (several, hf.slot_windows.last()) {
+            let per_j = hf
+                .slot_windows
+                .iter()
+                .map(|r| r.weight / laser.ael_inf_j(r.lo_s, r.hi_s))
+                .fold(0.0, f64::max);
+            energy.push(EnergyCandidate {
+                weight: 0.0,
+                short_per_j: per_j,
+                long_from_s: last.hi_s,
+            });
+        }
         Ok(Some(Self {
+            weight_vertical: w,
             energy,
+            instant_per_j: if several {
+                hf.weight_instant * laser.pulse_rate_hz
+            } else {
+                0.0
+            },
             rule_one_single: rule_one(1.0, 0.0),
             // Power `f_p` W is a pulse of 1 J.
             rule_one_per_j: rule_one(0.0, laser.pulse_rate_hz),
             half_deg: 0.5 * report.pass_angle_deg,
+            laser: *laser,
         }))
+    }
+
+    /// The factor of a single-channel energy cut (its limit not yet
+    /// divided): the smallest over the head's energy candidates (see the
+    /// type's docs), at most `W_v`.
+    #[must_use]
+    pub fn energy_factor(&self, cut: &Cut) -> f64 {
+        let w = self.weight_vertical;
+        let n: f64 = cut.pulses.iter().map(|&(_, k)| k).sum();
+        if n <= 0.0 {
+            return w;
+        }
+        let lo = cut.window_s.0;
+        let mut f = self
+            .energy
+            .iter()
+            .map(|c| {
+                let f = c.weight.max(cut.limit_j * c.short_per_j / n);
+                if lo >= c.long_from_s {
+                    f.max(w)
+                } else {
+                    f
+                }
+            })
+            .fold(w, f64::min);
+        if self.instant_per_j > 0.0 {
+            f = f.min(cut.limit_j * self.instant_per_j * self.instant_short(lo) / n);
+        }
+        f
+    }
+
+    /// `S(t) = sup_{T ≤ t} (T + Δ)/AEL(T)`, s/J: on a row of Table 3
+    /// (`c·T^p`, `0 ≤ p ≤ 1`) `(T + Δ)/T^p` has no interior maximum, so
+    /// `t`, the row edges below it and the pulse duration (below which the
+    /// AEL is constant) are every candidate — the head bound's own argument
+    /// for its instantaneous candidate.
+    fn instant_short(&self, t: f64) -> f64 {
+        let l = &self.laser;
+        let delta = 1.0 / l.pulse_rate_hz;
+        let mut s = (t + delta) / l.ael_j(t);
+        for row in l.rows() {
+            for e in [row.t_lo_s, row.t_hi_s, l.pulse_duration_s] {
+                if e > 0.0 && e < t {
+                    s = s.max((e + delta) / l.ael_j(e));
+                }
+            }
+        }
+        s
     }
 }
 
 /// [`cuts_with`] for the bound `params` describe: the single-channel cuts
 /// without a head; with one, the cuts of the head's bound (still linear in
-/// the bin powers): every energy cut's limit divided by `W`
-/// ([`HeadScale::energy`]), and Rule 1
-/// either the single-channel Rule 1 cuts divided by its factor or, where
-/// channels share an aperture position, one cut per bin against the head's
-/// Rule 1 per joule. Each is at most the head bound's figure of its rule
-/// (the energy rules are at least `W` times the single-channel figures the
-/// single-channel cuts never exceed; the head's Rule 1 takes the largest
-/// bin power), so the cuts stay a relaxation of "the head bound certifies".
+/// the bin powers): every energy cut's limit divided by its own factor
+/// ([`HeadScale::energy_factor`]: the smallest any candidate of the head's
+/// energy figure puts on a window of the cut's lengths), and Rule 1 either
+/// the single-channel Rule 1 cuts divided by its factor or, where channels
+/// share an aperture position, one cut per bin against the head's Rule 1
+/// per joule. Each is at most the head bound's figure of its rule, so the
+/// cuts stay a relaxation of "the head bound certifies"; the head cuts come
+/// strongest first (their head ratios at the powers of `segs`).
 pub fn cuts_for(
     segs: &[Seg],
     params: &super::EyeSafetyParams,
@@ -626,9 +762,10 @@ pub fn cuts_for(
             rule_one_threshold,
         ));
     };
-    // A cut's head ratio is its single-channel ratio times the factor, so
-    // a head threshold `t` is a single-channel threshold `t / factor` (a
-    // zero factor: the rule cannot bind, no cut).
+    // A cut's head ratio is its single-channel ratio times its factor, at
+    // most `W_v` (Rule 1: its one factor), so a head threshold `t` asks for
+    // the single-channel cuts at or above `t / W_v` and keeps those whose
+    // head ratio reaches `t` (a zero factor: the rule cannot bind, no cut).
     let below = |t: f64, factor: f64| {
         if factor > 0.0 {
             t / factor
@@ -639,41 +776,63 @@ pub fn cuts_for(
     let rule_one_factor = if s.rule_one_per_j > 0.0 {
         0.0
     } else {
-        s.rule_one_single
+        s.rule_one_single * (1.0 - HEAD_FACTOR_MARGIN)
     };
-    let mut found = cuts_with(
+    let found = cuts_with(
         segs,
         s.half_deg,
         laser,
         extra_azimuths_deg,
-        below(threshold, s.energy),
+        below(threshold, s.weight_vertical),
         below(rule_one_threshold, rule_one_factor),
     );
-    found.retain_mut(|c| {
-        let factor = if c.rule == Rule::SinglePulse {
-            rule_one_factor
+    let f_p = laser.pulse_rate_hz;
+    let p: Vec<f64> = segs.iter().map(|s| s.power_w).collect();
+    let mut keyed: Vec<(f64, Cut)> = Vec::with_capacity(found.len());
+    for mut c in found {
+        let (factor, t) = if c.rule == Rule::SinglePulse {
+            (rule_one_factor, rule_one_threshold)
         } else {
-            s.energy
+            (s.energy_factor(&c) * (1.0 - HEAD_FACTOR_MARGIN), threshold)
         };
+        if factor <= 0.0 {
+            continue;
+        }
         c.limit_j /= factor;
-        factor > 0.0
-    });
+        let r = c.ratio(&p, f_p);
+        if r >= t {
+            keyed.push((r, c));
+        }
+    }
     if s.rule_one_per_j > 0.0 {
-        let f_p = laser.pulse_rate_hz;
-        let limit_j = 1.0 / s.rule_one_per_j;
+        let limit_j = (1.0 + HEAD_FACTOR_MARGIN) / s.rule_one_per_j;
         for (b, seg) in segs.iter().enumerate() {
-            if seg.power_w / f_p / limit_j >= rule_one_threshold {
-                found.push(Cut {
-                    rule: Rule::SinglePulse,
-                    azimuth_deg: seg.start_deg + 0.5 * seg.width_deg,
-                    window_s: (laser.pulse_duration_s, laser.pulse_duration_s),
-                    pulses: vec![(b, 1.0)],
-                    limit_j,
-                });
+            let r = seg.power_w / f_p / limit_j;
+            if r >= rule_one_threshold {
+                keyed.push((
+                    r,
+                    Cut {
+                        rule: Rule::SinglePulse,
+                        azimuth_deg: seg.start_deg + 0.5 * seg.width_deg,
+                        window_s: (laser.pulse_duration_s, laser.pulse_duration_s),
+                        pulses: vec![(b, 1.0)],
+                        limit_j,
+                    },
+                ));
             }
         }
     }
-    Ok(found)
+    // Strongest first, as `cuts_with` orders its own.
+    keyed.sort_by(|(ra, a), (rb, b)| {
+        rb.total_cmp(ra)
+            .then_with(|| a.limit_j.total_cmp(&b.limit_j))
+            .then_with(|| {
+                a.pulses
+                    .partial_cmp(&b.pulses)
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+    });
+    Ok(keyed.into_iter().map(|(_, c)| c).collect())
 }
 
 /// [`rule_one_cap_w`] for the bound `params` describe. With a head, no cap

@@ -388,3 +388,88 @@ proptest! {
         prop_assert_eq!(got, want);
     }
 }
+
+/// A random head: `n` channels in `groups` firing groups (channels of a
+/// group fire together; the groups' slots spread over the cycle), their
+/// elevations within `±spread_el`, offsets within `±spread_az`, two power
+/// scales; `cycle_s` the firing cycle.
+fn random_head(
+    n: usize,
+    groups: usize,
+    cycle_s: f64,
+    (spread_el, spread_az): (f64, f64),
+    draws: &[f64],
+) -> gaze_lidar_core::eye_safety::head::Head {
+    use gaze_lidar_core::eye_safety::head::{Channel, Head};
+    let d = |i: usize| draws[i % draws.len()];
+    Head {
+        cycle_s,
+        origin_radius_mm: 40.0 * d(0),
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 2.0 + 8.0 * d(1),
+        divergence_mrad: 3.0 * d(2),
+        aperture_distance_mm: 100.0,
+        channels: (0..n)
+            .map(|i| Channel {
+                id: i as u32,
+                elevation_deg: spread_el * (2.0 * d(3 * i + 3) - 1.0),
+                azimuth_offset_deg: spread_az * (2.0 * d(3 * i + 4) - 1.0),
+                slot_s: cycle_s * ((i % groups) as f64 / groups as f64),
+                power_scale: if d(3 * i + 5) < 0.5 { 1.0 } else { 0.5 },
+            })
+            .collect(),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases() / 4))]
+
+    /// With a head, every cut of `cuts_for` (single-channel cuts scaled by
+    /// their own factor: the smallest any candidate of the head's energy
+    /// figure puts on the cut's windows, or Rule 1's) is at most the head
+    /// bound's worst ratio — at the powers it was found at and at a second
+    /// random power vector of the same spins (the factors depend on the
+    /// spins only, so a cut holds for every power vector the head bound
+    /// certifies). Random heads of 2–40 channels in 1–16 firing groups,
+    /// 905 nm (the short windows by firing slots and `T_i` groups) and
+    /// 1550 nm, steps and in-bin acceleration.
+    #[test]
+    fn head_cuts_never_exceed_the_head_bound(
+        bins in proptest::collection::vec((0.05f64..1.0, 1e-4f64..0.02, 20.0f64..120.0, any::<bool>()), 1..10),
+        other in proptest::collection::vec(1e-4f64..0.02, 10),
+        n in 2usize..40,
+        groups in 1usize..16,
+        cycle_s in 1.5e-5f64..1e-4,
+        spread in (0.2f64..10.0, prop_oneof![Just(0.0), 0.0f64..20.0]),
+        draws in proptest::collection::vec(0.0f64..1.0, 16..64),
+        lambda in prop_oneof![Just(905.0), Just(905.0), Just(1550.0)],
+        extra in 0.0f64..360.0,
+    ) {
+        use gaze_lidar_core::eye_safety::cuts::cuts_for;
+        use gaze_lidar_core::eye_safety::{evaluate_segments, exposure, EyeSafetyParams};
+        let head = random_head(n, groups.min(n), cycle_s, spread, &draws);
+        let f_p = 1.0 / cycle_s;
+        let params = EyeSafetyParams {
+            wavelength_nm: lambda,
+            pulse_duration_s: 5e-9,
+            beam_diameter_mm: head.exit_diameter_mm,
+            head: Some(head),
+        };
+        let laser = exposure::laser(&params, f_p).unwrap();
+        let segs = segments(&bins);
+        let b = evaluate_segments(&segs, &params, f_p).unwrap().worst_ratio;
+        let all = cuts_for(&segs, &params, &laser, &[extra], 0.0, 0.0).unwrap();
+        prop_assert!(!all.is_empty());
+        let p = powers(&segs);
+        let mut segs2 = segs.clone();
+        for (s, &q) in segs2.iter_mut().zip(&other) {
+            s.power_w = q;
+        }
+        let b2 = evaluate_segments(&segs2, &params, f_p).unwrap().worst_ratio;
+        let p2 = powers(&segs2);
+        for c in &all {
+            prop_assert!(c.ratio(&p, f_p) <= b, "{c:?}: {} above the head bound {b}", c.ratio(&p, f_p));
+            prop_assert!(c.ratio(&p2, f_p) <= b2, "{c:?}: {} above the head bound {b2} at other powers", c.ratio(&p2, f_p));
+        }
+    }
+}
