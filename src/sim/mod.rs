@@ -63,7 +63,7 @@ pub enum SimError {
     },
     /// A closed-form variant the sensor's limits reject (the sensor cannot
     /// run it): the first violated limit and how many more.
-    #[error("variant {variant} (model {model}, gaze {gaze_deg}°): the closed form violates the sensor's limits: {first}{}", more_text(*.more))]
+    #[error("variant {variant} (model {model}, gaze {gaze_deg}°): infeasible on this sensor: the closed form violates its limits: {first}{}", more_text(*.more))]
     ClosedFormRejected {
         /// Variant.
         variant: &'static str,
