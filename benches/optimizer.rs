@@ -2,6 +2,8 @@
 //! and 1440 bins (`MAX_OPTIMIZER_BINS`; 3600 is refused since the cap); the fast path's speed-up over a fresh HiGHS solve is
 //! measured in the same run, and its p50/p99 latency (gaze sample →
 //! certified profile, cache warm) is printed from 2000 samples.
+//! The shipped configs (`examples/configs/`) at 360 bins, gaze 90°, under
+//! both objectives (`shipped_C/sqrt`, `shipped_C/detection`).
 //! Run: `cargo bench --bench optimizer`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -10,7 +12,7 @@ use std::time::Instant;
 
 use gaze_lidar::model::presets;
 use gaze_lidar::optimizer::fast::FastPlanner;
-use gaze_lidar::optimizer::{optimize, OptimizerConfig, Problem};
+use gaze_lidar::optimizer::{optimize, ObjectiveKind, OptimizerConfig, Problem};
 use gaze_lidar::planner::{closed_form, Mode};
 
 fn continuous(n: usize) -> Problem {
@@ -33,6 +35,21 @@ fn milp(n: usize) -> Problem {
         .problem()
         .unwrap();
     p.bins = n;
+    p
+}
+
+/// The shipped config `name` (`examples/configs/`) at 360 bins with the
+/// power step's value `kind`.
+fn shipped(name: &str, kind: ObjectiveKind) -> Problem {
+    let path = format!(
+        "{}/examples/configs/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut p = OptimizerConfig::read(std::path::Path::new(&path))
+        .unwrap()
+        .problem()
+        .unwrap();
+    p.objective.kind = kind;
     p
 }
 
@@ -111,6 +128,23 @@ fn bench(c: &mut Criterion) {
         g.bench_with_input(BenchmarkId::new("fast_path_joint", n), &n, |b, _| {
             b.iter(|| fast.plan(black_box(91.3 + 2.0)).unwrap())
         });
+    }
+    // The shipped configs under both objectives at gaze 90° (one solve:
+    // the power step's segment cache is warm after the first iteration, so
+    // the detection value's sampling is paid only there; the whole process,
+    // cold, is `scripts/bench-profile.sh`).
+    for name in ["paper", "multi_level", "vls128_eye", "smooth"] {
+        for (kind, tag) in [
+            (ObjectiveKind::Sqrt, "sqrt"),
+            (ObjectiveKind::Detection, "detection"),
+        ] {
+            let p = shipped(name, kind);
+            g.bench_with_input(
+                BenchmarkId::new(format!("shipped_{name}"), tag),
+                &p,
+                |b, p| b.iter(|| optimize(p, black_box(90.0)).unwrap()),
+            );
+        }
     }
     g.finish();
 }

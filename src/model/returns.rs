@@ -391,21 +391,65 @@ impl ReturnModel {
         spacing_rad: f64,
         detect: f64,
     ) -> f64 {
+        self.detection_range_near_m(
+            power_ratio,
+            reflectivity,
+            width_m,
+            spacing_rad,
+            detect,
+            Guess::NONE,
+        )
+    }
+
+    /// [`Self::detection_range_m`], bit for bit, with [`narrow`]'s bracket
+    /// walked out from `guess` (e.g. the detection ranges at neighbouring
+    /// powers, extrapolated) instead of started from the whole `[0.01,
+    /// R_max]`: the guess decides only where the evaluations fall, never
+    /// the answer (a wrong guess costs evaluations). Under `argus` a guess
+    /// of its own is used when none is given: the range where the
+    /// intensity meets the threshold, `ln(x·fog_factor/threshold)/0.004`
+    /// (the end of the detecting ranges whenever the pulses' cap is not
+    /// reached first).
+    #[must_use]
+    pub fn detection_range_near_m(
+        &self,
+        power_ratio: f64,
+        reflectivity: f64,
+        width_m: f64,
+        spacing_rad: f64,
+        detect: f64,
+        guess: Guess,
+    ) -> f64 {
         let returns =
             |r: f64| self.expected_returns(power_ratio, reflectivity, width_m, spacing_rad, r);
-        let ok = |r: f64| returns(r) >= detect;
         let mut hi = (width_m / (spacing_rad * detect)).min(10_000.0);
         if let Self::Argus { .. } = self {
             hi = hi.min(ARGUS_RANGE_M);
         }
         let mut lo = 0.01;
-        if !(hi > lo && ok(lo)) {
+        if !(hi > lo) {
             return 0.0;
         }
-        if ok(hi) {
+        let at_lo = returns(lo);
+        if at_lo < detect || at_lo.is_nan() {
+            return 0.0;
+        }
+        let at_hi = returns(hi);
+        if at_hi >= detect {
             return hi;
         }
-        let (yes, no) = narrow(&returns, detect, lo, hi);
+        let guess = match *self {
+            Self::Argus {
+                fog_factor,
+                threshold,
+            } if !guess.range_m.is_finite() && threshold > 0.0 => Guess {
+                range_m: (power_ratio * fog_factor / threshold).ln() / CARLA_ATTENUATION_PER_M,
+                rel_err: 1e-13,
+            },
+            _ => guess,
+        };
+        let (yes, no) = narrow(&returns, detect, (lo, at_lo), (hi, at_hi), guess);
+        let ok = |r: f64| returns(r) >= detect;
         for _ in 0..100 {
             if hi - lo <= 1e-12 * hi {
                 break;
@@ -432,17 +476,64 @@ impl ReturnModel {
 /// side's value is not finite), each side decided by `returns ≥ detect` as
 /// the caller decides it. Where the widened ends do not check, `(lo, hi)`:
 /// the caller evaluates every midpoint.
-fn narrow(returns: &impl Fn(f64) -> f64, detect: f64, lo: f64, hi: f64) -> (f64, f64) {
+///
+/// `(lo, at_lo)` and `(hi, at_hi)` are the bracket's ends and their
+/// returns. A `guess` inside it is tried first: the regula falsi starts
+/// from the bracket found by stepping out from the guess by its relative
+/// error, growing the step eightfold, until the end is crossed.
+fn narrow(
+    returns: &impl Fn(f64) -> f64,
+    detect: f64,
+    (lo, at_lo): (f64, f64),
+    (hi, at_hi): (f64, f64),
+    guess: Guess,
+) -> (f64, f64) {
     let ln_detect = detect.ln();
     let (mut a, mut b) = (lo, hi);
+    let (mut at_a, mut at_b) = (at_lo, at_hi);
+    let g = guess.range_m;
+    if g > lo && g < hi {
+        let at_g = returns(g);
+        let up = at_g >= detect;
+        if up {
+            (a, at_a) = (g, at_g);
+        } else {
+            (b, at_b) = (g, at_g);
+        }
+        let mut step = guess.rel_err.max(1e-13);
+        while step < 1.0 {
+            let r = if up {
+                g * (1.0 + step)
+            } else {
+                g * (1.0 - step)
+            };
+            if !(r > a && r < b) {
+                break;
+            }
+            let at_r = returns(r);
+            match (at_r >= detect, up) {
+                (true, true) => (a, at_a) = (r, at_r),
+                (false, false) => (b, at_b) = (r, at_r),
+                (true, false) => {
+                    (a, at_a) = (r, at_r);
+                    break;
+                }
+                (false, true) => {
+                    (b, at_b) = (r, at_r);
+                    break;
+                }
+            }
+            step *= 8.0;
+        }
+    }
     let (mut ga, mut gb) = (
-        (returns(a).ln() - ln_detect).max(0.0),
-        (returns(b).ln() - ln_detect).min(0.0),
+        (at_a.ln() - ln_detect).max(0.0),
+        (at_b.ln() - ln_detect).min(0.0),
     );
     // −1: `a` moved last, +1: `b` did.
     let mut last = 0;
     for _ in 0..NARROW_STEPS {
-        if b - a <= 1e-13 * b {
+        if b - a <= NARROW_MARGIN * b {
             break;
         }
         let secant = a + (b - a) * (ga / (ga - gb));
@@ -482,13 +573,32 @@ fn narrow(returns: &impl Fn(f64) -> f64, detect: f64, lo: f64, hi: f64) -> (f64,
     }
 }
 
+/// Where [`ReturnModel::detection_range_near_m`] starts looking: a range
+/// and its relative error (the first step out from it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Guess {
+    /// The guessed end of the detecting ranges, m (not finite: no guess).
+    pub range_m: f64,
+    /// How far off it may be, relative.
+    pub rel_err: f64,
+}
+
+impl Guess {
+    /// No guess: the bracket starts from `[0.01, R_max]`.
+    pub const NONE: Self = Self {
+        range_m: f64::NAN,
+        rel_err: 0.0,
+    };
+}
+
 /// [`narrow`]'s widening of its bracket, relative: far above the model's
 /// rounding (about 1e-14 of the range), far below the bisection's
 /// 1e-12-wide answer's cost (`log2(2·NARROW_MARGIN / 1e-12)` evaluations).
 const NARROW_MARGIN: f64 = 1e-11;
 
 /// [`narrow`]'s most regula falsi steps (it stops once its bracket is a
-/// relative 1e-13 wide, usually after fewer than 20).
+/// relative [`NARROW_MARGIN`] wide: a narrower bracket would save no
+/// bisection midpoint, since its ends are widened by that much anyway).
 const NARROW_STEPS: usize = 40;
 
 /// Relative error allowed for `libm::erfc` in [`ReturnModel::expected_returns_upper`]:
@@ -1046,6 +1156,36 @@ mod tests {
             let got = m.detection_range_m(x, rho, w, s, d);
             let want = plain_detection_range(&m, x, rho, w, s, d);
             proptest::prop_assert_eq!(got.to_bits(), want.to_bits(), "{} vs {}", got, want);
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+        /// A guess, good or bad, moves only where the model is evaluated:
+        /// the answer is the plain bisection's, bit for bit.
+        #[test]
+        fn a_guessed_detection_range_is_the_plain_bisection(
+            physical in proptest::bool::ANY,
+            fog_i in 0usize..3,
+            x in 0.0f64..3.0,
+            rho in 0.02f64..1.0,
+            w in 0.3f64..5.0,
+            log_s in -5.0f64..-1.0,
+            d in 0.5f64..20.0,
+            off in -1.0f64..1.0,
+            log_err in -14.0f64..0.0,
+        ) {
+            let kind = if physical { ModelKind::Physical } else { ModelKind::Argus };
+            let m = model(kind, FOG_LEVELS_PCT[fog_i]);
+            let s = 10f64.powf(log_s);
+            let want = plain_detection_range(&m, x, rho, w, s, d);
+            // Guesses near the answer (off by up to ±10^log_err), and far.
+            let near = want * (1.0 + off * 10f64.powf(log_err));
+            for range_m in [near, 1.0 + 200.0 * off.abs(), 0.0, f64::INFINITY] {
+                let guess = Guess { range_m, rel_err: 10f64.powf(log_err) };
+                let got = m.detection_range_near_m(x, rho, w, s, d, guess);
+                proptest::prop_assert_eq!(got.to_bits(), want.to_bits(), "{} vs {} (guess {})", got, want, range_m);
+            }
         }
     }
 

@@ -44,7 +44,7 @@ use serde::{Deserialize, Serialize};
 
 use super::utility::SqrtSegments;
 use super::{OptError, Problem};
-use crate::model::returns::{FogLevel, ModelKind, ReturnModel};
+use crate::model::returns::{FogLevel, Guess, ModelKind, ReturnModel};
 
 /// Samples of `u` on a bin's power box from which the segments are built.
 pub const SAMPLES: usize = 64;
@@ -195,6 +195,56 @@ pub fn value(problem: &Problem, theta_rad: f64, dwell_s: f64, power_ratio: f64) 
         .sum()
 }
 
+/// [`value`] at each of `xs` (ascending power ratios), bit for bit: each
+/// condition's detection range at `xs[j]` starts its search from the
+/// ranges at `xs[j - 1]` and `xs[j - 2]` extrapolated linearly
+/// ([`ReturnModel::detection_range_near_m`]; the guess moves only where
+/// the model is evaluated, never the range found).
+pub fn values_at(problem: &Problem, theta_rad: f64, dwell_s: f64, xs: &[f64]) -> Vec<f64> {
+    let d = &problem.objective.detection;
+    let spacing = spacing_rad(problem, theta_rad, dwell_s);
+    let r0 = problem.lidar.rated_range_m;
+    let mut sum = vec![0.0; xs.len()];
+    let mut ranges = vec![0.0; xs.len()];
+    for (w, m) in d.conditions(problem) {
+        for (j, &x) in xs.iter().enumerate() {
+            let guess = match j {
+                0 => Guess::NONE,
+                1 => Guess {
+                    range_m: ranges[0],
+                    rel_err: 1e-2,
+                },
+                _ => {
+                    let (r1, r2) = (ranges[j - 1], ranges[j - 2]);
+                    let range_m = 2.0 * r1 - r2;
+                    let rel_err = if j >= 3 {
+                        // The last extrapolation's miss.
+                        ((2.0 * r2 - ranges[j - 3] - r1) / range_m).abs()
+                    } else {
+                        1e-3
+                    };
+                    Guess {
+                        range_m,
+                        rel_err: rel_err.clamp(1e-9, 1e-1),
+                    }
+                }
+            };
+            ranges[j] = m.detection_range_near_m(
+                x,
+                d.reflectivity,
+                d.target_width_m,
+                spacing,
+                d.detect,
+                guess,
+            );
+        }
+        for (s, r) in sum.iter_mut().zip(&ranges) {
+            *s += w * r / r0;
+        }
+    }
+    sum
+}
+
 /// A proven upper bound of `u(x, t)` (of the real-number model and of
 /// [`value`]'s floating-point answer) and the ranges it rests on: per
 /// condition (in [`condition_weights`]' order) a range beyond which nothing
@@ -271,7 +321,8 @@ fn spacing_rad(problem: &Problem, theta_rad: f64, dwell_s: f64) -> f64 {
 
 /// The power step's per-bin utility on `[lo, hi]` (power ratios) as
 /// segments: `√` chords ([`super::utility::sqrt_segments`]) or the
-/// detection value's chords/envelope ([`detection_segments`]).
+/// detection value's chords/envelope ([`hull_segments`] of [`values_at`] at
+/// [`nodes`]).
 pub(super) fn range_segments(
     problem: &Problem,
     theta_rad: f64,
@@ -327,12 +378,9 @@ fn cached(problem: &Problem, theta_rad: f64, dwell_s: f64, lo: f64, hi: f64) -> 
     if let Some(s) = CACHE.with(|c| c.borrow().get(&key).cloned()) {
         return s;
     }
-    let s = detection_segments(
-        |x| value(problem, theta_rad, dwell_s, x),
-        lo,
-        hi,
-        super::UTILITY_SEGMENTS,
-    );
+    let v = nodes(lo, hi);
+    let y = values_at(problem, theta_rad, dwell_s, &v);
+    let s = hull_segments(&v, &y, super::UTILITY_SEGMENTS);
     CACHE.with(|c| {
         let mut c = c.borrow_mut();
         if c.len() > 4096 {
@@ -344,7 +392,7 @@ fn cached(problem: &Problem, theta_rad: f64, dwell_s: f64, lo: f64, hi: f64) -> 
 }
 
 /// The sample nodes of `[lo, hi]`: [`SAMPLES`] + 1, evenly spaced in `√`.
-pub(super) fn nodes(lo: f64, hi: f64) -> Vec<f64> {
+pub fn nodes(lo: f64, hi: f64) -> Vec<f64> {
     let (a, b) = (lo.max(0.0).sqrt(), hi.max(lo).sqrt());
     (0..=SAMPLES)
         .map(|j| {
@@ -359,9 +407,8 @@ pub(super) fn nodes(lo: f64, hi: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The upper concave hull of the samples of a nondecreasing `f` at
-/// [`nodes`], as segments: chords where `f` is concave (runs of consecutive
-/// samples thinned to about `k` chords), the envelope where it is not.
+/// [`hull_segments`] of a nondecreasing `f` sampled at [`nodes`].
+#[cfg(test)]
 pub(super) fn detection_segments(
     f: impl Fn(f64) -> f64,
     lo: f64,
@@ -370,6 +417,14 @@ pub(super) fn detection_segments(
 ) -> SqrtSegments {
     let v = nodes(lo, hi);
     let y: Vec<f64> = v.iter().map(|&x| f(x)).collect();
+    hull_segments(&v, &y, k)
+}
+
+/// The upper concave hull of the samples `y` of a nondecreasing function at
+/// the nodes `v`, as segments: chords where it is concave (runs of
+/// consecutive samples thinned to about `k` chords), the envelope where it
+/// is not.
+fn hull_segments(v: &[f64], y: &[f64], k: usize) -> SqrtSegments {
     // Monotone chain: the upper hull of (v_j, y_j), as sample indices.
     let mut hull: Vec<usize> = Vec::new();
     for j in 0..v.len() {
@@ -480,6 +535,23 @@ mod tests {
             let slow = brute_value(&p, theta, dwell, x);
             let tol = 0.0101 / p.lidar.rated_range_m;
             prop_assert!(fast >= slow - 1e-12 && fast <= slow + tol, "{x} {density}: {fast} vs {slow}");
+        }
+
+        /// The chained search along a bin's nodes gives every node's value
+        /// bit for bit (the guesses move only where the model is evaluated).
+        #[test]
+        fn values_at_the_nodes_are_the_values(
+            lo in 0.0f64..0.6, width in 0.01f64..4.0, density in 0.2f64..5.0,
+        ) {
+            let p = problem();
+            let theta = std::f64::consts::TAU / 360.0;
+            let dwell = density * p.lidar.frame_period_s() / 360.0;
+            let v = nodes(lo, lo + width);
+            let chained = values_at(&p, theta, dwell, &v);
+            for (&x, y) in v.iter().zip(&chained) {
+                let one = value(&p, theta, dwell, x);
+                prop_assert_eq!(y.to_bits(), one.to_bits(), "{} at {}", y, x);
+            }
         }
 
         /// More power or more density never detects less.

@@ -524,7 +524,8 @@ fn spin_walk(rng: &mut impl rand::Rng, n: usize, cap: f64, extreme: bool) -> Vec
     s.iter().map(|v| v / top * cap * scale).collect()
 }
 
-/// The 12-bin `smooth` problem, its answer and its global bound.
+/// The 12-bin `smooth` problem under the `√` range utility (the objective
+/// the tests below reason about), its answer and its global bound.
 fn small_smooth() -> (
     gaze_lidar::optimizer::Problem,
     gaze_lidar::profile::Profile,
@@ -537,6 +538,7 @@ fn small_smooth() -> (
         .problem()
         .unwrap();
     problem.bins = 12;
+    problem.objective.kind = gaze_lidar::optimizer::ObjectiveKind::Sqrt;
     let answer = optimize(&problem, 90.0).unwrap().profile().clone();
     let ub = gaze_lidar::optimizer::global::upper_bound(&problem, 90.0).unwrap();
     (problem, answer, ub)

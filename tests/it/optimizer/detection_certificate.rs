@@ -25,10 +25,14 @@ fn q(v: f64) -> BigRational {
 }
 
 /// The shipped config `name` with `kind = "detection"` (its text, and the
-/// problem it poses).
+/// problem it poses; the kind set where the config leaves it out).
 fn detection_config(name: &str) -> (String, Problem) {
     let text = std::fs::read_to_string(format!("examples/configs/{name}.toml")).unwrap();
-    let text = text.replacen("[objective]", "[objective]\nkind = \"detection\"", 1);
+    let text = if text.contains("\nkind = ") {
+        text
+    } else {
+        text.replacen("[objective]", "[objective]\nkind = \"detection\"", 1)
+    };
     let problem = OptimizerConfig::from_toml(&text, name)
         .unwrap()
         .problem()

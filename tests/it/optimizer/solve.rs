@@ -67,7 +67,9 @@ fn every_shipped_config_gives_certified_profiles() {
             let levels: std::collections::BTreeSet<u64> =
                 p.bins.iter().map(|b| b.power_w.to_bits()).collect();
             match c {
-                "multi_level" => assert!(levels.len() > 2, "{c} {gaze}: {} levels", levels.len()),
+                // The detection value has a knee: its optimum takes the
+                // lowest level in the focus and the highest outside.
+                "multi_level" => assert!(levels.len() >= 2, "{c} {gaze}: {} levels", levels.len()),
                 "smooth" => {
                     let a = p
                         .limits
