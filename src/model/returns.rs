@@ -427,7 +427,7 @@ impl ReturnModel {
             hi = hi.min(ARGUS_RANGE_M);
         }
         let mut lo = 0.01;
-        if !(hi > lo) {
+        if hi.is_nan() || hi <= lo {
             return 0.0;
         }
         let at_lo = returns(lo);
