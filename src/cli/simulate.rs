@@ -34,9 +34,17 @@ pub struct Args {
     /// Variants; default the paper's four (`optimized` adds the optimizer's profile).
     #[arg(long, value_parser = super::args::named::<Variant>())]
     variant: Vec<Variant>,
-    /// Optimizer configuration (TOML) for the `optimized` variant (no priors).
+    /// Optimizer configuration (TOML) for the `optimized` variant; the
+    /// closed-form variants then run on its sensor, limits and driver model
+    /// too (with the levels of the preset it names), the basis
+    /// `profile --config FILE --format text` compares with.
     #[arg(long)]
     optimizer_config: Option<PathBuf>,
+    /// LiDAR preset of the closed-form variants: paper, vls128, vlp16,
+    /// os1-128 [default: paper]; with --optimizer-config, replaces the
+    /// file's `[lidar] preset`.
+    #[arg(long)]
+    preset: Option<String>,
     /// Fog levels in % (paper labels 0, 25, 50); default all.
     #[arg(long, allow_hyphen_values = true)]
     fog: Vec<i64>,
@@ -227,6 +235,9 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     } else {
         a.variant.clone()
     };
+    #[cfg_attr(not(feature = "solver"), allow(unused_mut))]
+    let mut sensor = gaze_lidar::model::presets::preset(a.preset.as_deref().unwrap_or("paper"))
+        .map_err(|e| CliError::input(format!("--preset: {e}")))?;
     #[cfg(feature = "solver")]
     let optimizer = match &a.optimizer_config {
         Some(path) => {
@@ -235,10 +246,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                     "--optimizer-config configures the optimized variant: add --variant optimized",
                 ));
             }
-            Some(super::config::optimizer_problem(
-                path,
-                &super::config::Overrides::default(),
-            )?)
+            let overrides = super::config::Overrides {
+                preset: a.preset.as_deref(),
+                ..super::config::Overrides::default()
+            };
+            let (problem, named) = super::config::optimizer_problem_and_preset(path, &overrides)?;
+            sensor = gaze_lidar::optimizer::figures::closed_form_basis(&problem, named.levels);
+            Some(problem)
         }
         None => None,
     };
@@ -274,6 +288,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         sampling: a.sampling,
         #[cfg(feature = "solver")]
         optimizer,
+        sensor,
         ..SimConfig::default()
     };
     if !a.sweep.is_empty() && a.report.is_none() {

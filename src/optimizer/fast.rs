@@ -148,52 +148,109 @@ pub fn rotate(p: &Profile, k: usize, gaze_deg: f64) -> Profile {
     }
 }
 
-/// Canonical solutions for a set of gazes, built in parallel, shared
-/// read-only across threads (the simulator's `optimized` variant).
+/// The solutions a set of gazes needs, built in parallel, shared read-only
+/// across threads (the simulator's `optimized` variant). A
+/// rotation-invariant problem (no priors) keeps one canonical solution per
+/// phase and rotates it by whole bins; a problem with priors keeps one
+/// solution per quantized gaze (no rotation: the priors break the symmetry).
+/// Either way each solve is the one [`super::optimize`] makes at that gaze,
+/// and the table is the same whatever the number of threads.
 #[derive(Debug, Clone)]
 pub struct PhaseTable {
     problem: Problem,
-    canonical: BTreeMap<u32, Profile>,
+    rotation_invariant: bool,
+    /// Invariant: phase `q` → canonical profile (certified again after
+    /// every rotation). With priors: the quantized gaze's key → its
+    /// certified profile.
+    canonical: BTreeMap<u64, Profile>,
+    per_gaze: BTreeMap<u64, CertifiedProfile>,
 }
 
 impl PhaseTable {
-    /// Solves every phase the `gazes` need (rotation-invariant problems only).
+    /// Solves every phase (rotation-invariant problem) or every quantized
+    /// gaze (a problem with priors) the `gazes` need.
     pub fn build(problem: &Problem, gazes: &[f64]) -> Result<Self, OptError> {
         use rayon::prelude::*;
-        if !problem.objective.priors.is_empty() {
-            return Err(OptError::Invalid {
-                field: "objective.priors".into(),
-                reason: "a phase table needs a rotation-invariant problem (no priors)".into(),
-            });
+        for &g in gazes {
+            crate::planner::validate_gaze(g).map_err(|e| OptError::Invalid {
+                field: "gaze-deg".into(),
+                reason: e.to_string(),
+            })?;
         }
-        let mut phases: Vec<u32> = gazes.iter().map(|&g| split(problem.bins, g).1).collect();
-        phases.sort_unstable();
-        phases.dedup();
-        let width = FULL_TURN_DEG / problem.bins as f64;
-        let solved: Vec<(u32, Profile)> = phases
-            .par_iter()
-            .map(|&q| {
-                optimize_unrated(problem, f64::from(q) * width / f64::from(PHASE_STEPS))
-                    .map(|c| (q, c.into_inner()))
-            })
-            .collect::<Result<_, _>>()?;
-        Ok(Self {
+        let rotation_invariant = problem.objective.priors.is_empty();
+        let n = problem.bins;
+        let width = FULL_TURN_DEG / n as f64;
+        let mut keys: Vec<u64> = gazes
+            .iter()
+            .map(|&g| table_key(n, g, rotation_invariant))
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        let mut table = Self {
             problem: problem.clone(),
-            canonical: solved.into_iter().collect(),
-        })
+            rotation_invariant,
+            canonical: BTreeMap::new(),
+            per_gaze: BTreeMap::new(),
+        };
+        if rotation_invariant {
+            let solved: Vec<(u64, Profile)> = keys
+                .par_iter()
+                .map(|&q| {
+                    optimize_unrated(problem, q as f64 * width / f64::from(PHASE_STEPS))
+                        .map(|c| (q, c.into_inner()))
+                })
+                .collect::<Result<_, _>>()?;
+            table.canonical = solved.into_iter().collect();
+        } else {
+            let solved: Vec<(u64, CertifiedProfile)> = keys
+                .par_iter()
+                .map(|&key| optimize_unrated(problem, key_gaze(n, key)).map(|c| (key, c)))
+                .collect::<Result<_, _>>()?;
+            table.per_gaze = solved.into_iter().collect();
+        }
+        Ok(table)
     }
 
-    /// The certified profile for `gaze_deg` (its phase must have been built).
-    pub fn plan(&self, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
-        let (k, q) = split(self.problem.bins, gaze_deg);
-        let canonical = self.canonical.get(&q).ok_or_else(|| OptError::Invalid {
-            field: "gaze-deg".into(),
-            reason: format!("phase {q} of gaze {gaze_deg} was not built"),
-        })?;
-        Ok(certify(rotate(
-            canonical,
-            k,
-            quantized_gaze(self.problem.bins, gaze_deg),
-        ))?)
+    /// How many solves the table holds (distinct phases, or distinct
+    /// quantized gazes with priors).
+    #[must_use]
+    pub fn solves(&self) -> usize {
+        self.canonical.len() + self.per_gaze.len()
     }
+
+    /// The certified profile for `gaze_deg` (its phase, or with priors its
+    /// quantized gaze, must have been built).
+    pub fn plan(&self, gaze_deg: f64) -> Result<CertifiedProfile, OptError> {
+        let n = self.problem.bins;
+        let key = table_key(n, gaze_deg, self.rotation_invariant);
+        let missing = || OptError::Invalid {
+            field: "gaze-deg".into(),
+            reason: format!("gaze {gaze_deg} was not built into the table"),
+        };
+        if !self.rotation_invariant {
+            return self.per_gaze.get(&key).cloned().ok_or_else(missing);
+        }
+        let (k, _) = split(n, gaze_deg);
+        let canonical = self.canonical.get(&key).ok_or_else(missing)?;
+        Ok(certify(rotate(canonical, k, quantized_gaze(n, gaze_deg)))?)
+    }
+}
+
+/// The table's key of a gaze: its phase step (rotation-invariant problems)
+/// or its whole bins and phase step (with priors).
+fn table_key(n: usize, gaze_deg: f64, rotation_invariant: bool) -> u64 {
+    let (k, q) = split(n, gaze_deg);
+    if rotation_invariant {
+        u64::from(q)
+    } else {
+        (k as u64) << 32 | u64::from(q)
+    }
+}
+
+/// The quantized gaze of a with-priors key.
+fn key_gaze(n: usize, key: u64) -> f64 {
+    let width = FULL_TURN_DEG / n as f64;
+    let k = (key >> 32) as f64;
+    let q = (key & 0xffff_ffff) as f64;
+    wrap_deg(k * width + q * width / f64::from(PHASE_STEPS))
 }

@@ -61,6 +61,22 @@ pub enum SimError {
         #[source]
         source: PlanError,
     },
+    /// A closed-form variant the sensor's limits reject (the sensor cannot
+    /// run it): the first violated limit and how many more.
+    #[error("variant {variant} (model {model}, gaze {gaze_deg}°): infeasible on this sensor: the closed form violates its limits: {first}{}", more_text(*.more))]
+    ClosedFormRejected {
+        /// Variant.
+        variant: &'static str,
+        /// Return model (`argus` runs resolution and joint on the paper
+        /// code's faster spin).
+        model: ModelKind,
+        /// The gaze it was planned for, degrees.
+        gaze_deg: f64,
+        /// The first violated limit.
+        first: String,
+        /// How many more violations.
+        more: usize,
+    },
     /// Bad argument.
     #[error("{0}")]
     Argument(String),
@@ -111,6 +127,7 @@ impl SimError {
     pub fn is_input_error(&self) -> bool {
         match self {
             Self::Plan { source, .. } => source.is_input_error(),
+            Self::ClosedFormRejected { .. } => false,
             Self::Optimizer { input, .. } => *input,
             _ => true,
         }
@@ -124,6 +141,37 @@ impl From<crate::optimizer::OptError> for SimError {
             input: e.is_input_error(),
             message: e.to_string(),
         }
+    }
+}
+
+/// " (and N more)", or nothing for none.
+fn more_text(more: usize) -> String {
+    match more {
+        0 => String::new(),
+        n => format!(" (and {n} more)"),
+    }
+}
+
+/// A closed-form variant's planning error: a checker rejection becomes
+/// [`SimError::ClosedFormRejected`] (one line, the first violated limit).
+fn closed_form_error(
+    variant: &'static str,
+    model: ModelKind,
+    gaze_deg: f64,
+    source: PlanError,
+) -> SimError {
+    match source {
+        PlanError::Rejected(r) => SimError::ClosedFormRejected {
+            variant,
+            model,
+            gaze_deg,
+            first: r
+                .violations
+                .first()
+                .map_or_else(String::new, ToString::to_string),
+            more: r.violations.len().saturating_sub(1),
+        },
+        source => SimError::Plan { variant, source },
     }
 }
 
@@ -543,12 +591,8 @@ fn plan_variant(
     table: Option<&OptTable>,
 ) -> Result<(CertifiedProfile, f64), SimError> {
     match (variant.mode(), table) {
-        (Some(m), _) => {
-            variant_profile_for(sensor, model, m, gaze_deg, bins).map_err(|source| SimError::Plan {
-                variant: variant.name(),
-                source,
-            })
-        }
+        (Some(m), _) => variant_profile_for(sensor, model, m, gaze_deg, bins)
+            .map_err(|source| closed_form_error(variant.name(), model, gaze_deg, source)),
         (None, Some(t)) => t.plan(gaze_deg),
         (None, None) => Err(SimError::Argument(
             "the optimized variant needs the `solver` feature".into(),
@@ -799,11 +843,9 @@ impl<'c> Prepared<'c> {
         // Plan every variant once up front so a bad one fails before any work.
         for &m in &config.models {
             for v in config.variants.iter().filter_map(|v| v.mode()) {
-                variant_profile_for(&config.sensor, m, v, config.scenario.gaze_deg, config.bins)
-                    .map_err(|source| SimError::Plan {
-                        variant: v.name(),
-                        source,
-                    })?;
+                let gaze = config.scenario.gaze_deg;
+                variant_profile_for(&config.sensor, m, v, gaze, config.bins)
+                    .map_err(|source| closed_form_error(v.name(), m, gaze, source))?;
             }
         }
         let table = OptTable::build(config)?;

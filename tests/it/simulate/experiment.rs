@@ -288,6 +288,157 @@ fn optimized_variant_runs_on_shared_phase_solutions() {
     assert_eq!(sim::run(&config, &|| {}).unwrap().rows, r.rows);
 }
 
+#[cfg(feature = "solver")]
+#[test]
+fn optimized_variant_with_priors_solves_each_quantized_gaze() {
+    use gaze_lidar::optimizer::fast::{rotate, FastPlanner, PhaseTable};
+    use gaze_lidar::optimizer::OptimizerConfig;
+    use gaze_lidar::profile::Profile;
+    use gaze_lidar::sim::Variant;
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/configs/vls128_eye.toml"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let problem = OptimizerConfig::from_toml(&text, path)
+        .and_then(|c| c.problem())
+        .unwrap();
+    assert!(
+        !problem.objective.priors.is_empty(),
+        "the config has priors"
+    );
+    // Through the simulator: every trial's plan certified (a plan that does
+    // not is an error), the same seed the same records.
+    let config = SimConfig {
+        models: vec![ModelKind::Physical],
+        variants: vec![Variant::Optimized],
+        fog_pcts: vec![0],
+        trials: 4,
+        optimizer: Some(problem.clone()),
+        ..SimConfig::default()
+    };
+    let r = sim::run(&config, &|| {}).unwrap();
+    assert_eq!(r.trials.len(), 4);
+    assert_eq!(sim::run(&config, &|| {}).unwrap().trials, r.trials);
+    // One solve per distinct quantized gaze, each `profile --config C
+    // --gaze-deg g` at that gaze.
+    let mut gazes: Vec<f64> = (0..4)
+        .map(|t| sim::draw(config.seed, t, &config.scenario).gaze_deg)
+        .collect();
+    // The same quantized gaze again, and one whole bin on.
+    gazes.push(gazes[0] + 1e-9);
+    gazes.push(gazes[0] + 360.0 / problem.bins as f64);
+    let table = PhaseTable::build(&problem, &gazes).unwrap();
+    let q = FastPlanner::new(problem.clone());
+    let mut distinct: Vec<u64> = gazes
+        .iter()
+        .map(|&g| q.quantized_gaze(g).to_bits())
+        .collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert_eq!(table.solves(), distinct.len());
+    for &g in &gazes[..2] {
+        let plan = table.plan(g).unwrap();
+        let qg = q.quantized_gaze(g);
+        assert_eq!(plan.profile().gaze_deg, Some(qg));
+        let o = run(
+            &["profile", "--config", path, "--gaze-deg", &qg.to_string()],
+            None,
+        );
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let cli = Profile::from_json(&stdout(&o), "profile").unwrap();
+        assert_eq!(cli.bins, plan.profile().bins, "gaze {qg}");
+    }
+    // The priors are fixed in azimuth: the plan one bin on is not the first
+    // one rotated (what a phase table would hand out).
+    let first = table.plan(gazes[0]).unwrap();
+    let next = table.plan(gazes[5]).unwrap();
+    assert_ne!(
+        rotate(first.profile(), 1, q.quantized_gaze(gazes[5])).bins,
+        next.profile().bins
+    );
+}
+
+/// `simulate`'s closed forms run on the sensor of `--preset` or of
+/// `--optimizer-config`; one the sensor rejects fails in one line.
+#[cfg(feature = "solver")]
+#[test]
+fn closed_forms_run_on_the_configs_sensor() {
+    let configs = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/configs/");
+    let cell = |extra: &[&str]| {
+        let mut args = vec![
+            "simulate", "--trials", "2", "--fog", "25", "--model", "physical", "--format", "csv",
+        ];
+        args.extend_from_slice(extra);
+        run(&args, None)
+    };
+    let baseline_row = |o: &std::process::Output| {
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        stdout(o)
+            .lines()
+            .find(|l| l.starts_with("physical,baseline,"))
+            .unwrap()
+            .to_owned()
+    };
+    let paper = baseline_row(&cell(&["--variant", "baseline"]));
+    // The paper config's sensor is the paper preset's.
+    let paper_cfg = format!("{configs}paper.toml");
+    let o = cell(&[
+        "--variant",
+        "baseline",
+        "--variant",
+        "optimized",
+        "--optimizer-config",
+        &paper_cfg,
+    ]);
+    assert_eq!(baseline_row(&o), paper);
+    // Another preset, another sensor (10 Hz, its own channels and range).
+    let vls = baseline_row(&cell(&["--variant", "baseline", "--preset", "vls128"]));
+    assert_ne!(vls, paper);
+    let vls_cfg = format!("{configs}vls128_eye.toml");
+    let o = cell(&[
+        "--variant",
+        "baseline",
+        "--variant",
+        "optimized",
+        "--optimizer-config",
+        &vls_cfg,
+    ]);
+    assert_ne!(baseline_row(&o), paper);
+    assert_bad_input(&cell(&["--preset", "nope"]), "--preset");
+    // smooth's slew limit rejects the range closed form's power step.
+    let smooth = format!("{configs}smooth.toml");
+    let o = cell(&[
+        "--variant",
+        "range",
+        "--variant",
+        "optimized",
+        "--optimizer-config",
+        &smooth,
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    for needle in [
+        "variant range",
+        "model physical",
+        "limits.power_slew_w_per_deg_max",
+        "more)",
+    ] {
+        assert!(err.contains(needle), "{needle} in {err}");
+    }
+}
+
 // ---- The `carla` geometry. ----
 
 use gaze_lidar::sim::carla::geometry::{
