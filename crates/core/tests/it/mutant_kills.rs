@@ -826,3 +826,58 @@ fn head_memo_keeps_each_head_s_own_figures() {
     }
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
+
+/// Kills `eye_safety/exposure.rs` `evaluate_head`: `declared.worst_ratio >
+/// standard.worst_ratio` → `>=` (a tie of the declared surface's worst
+/// ratio with the 100 mm surface's took the declared report; the rule, as
+/// specified, is that ties take the 100 mm report, so a verdict's worst
+/// position, pass angle and rule figures are the Condition 3 surface's).
+///
+/// One radial channel from the axis (10 mm exit beam, no divergence), 905 nm,
+/// 5 ns, 1 kHz (cycle 1 ms), 1 mW, uniform 1000 rad/s; declared at 200 mm.
+/// By hand: one pass is `(7 + 10)/R` rad, 9.7403° (0.17 ms) at 100 mm and
+/// 4.8701° (0.085 ms) at 200 mm; both are shorter than the 1 ms between
+/// pulses, so at either distance a pass holds at most one pulse, every
+/// pulse count behind Rule 1's C5 is the same and Rule 1 (binding on both
+/// surfaces) gives the same figure: the two worst ratios tie, bit for bit,
+/// while the reports differ (the pass angle).
+#[test]
+fn a_tie_of_both_surfaces_takes_the_100_mm_report() {
+    let f_p = 1000.0;
+    let at = |aperture_distance_mm: f64| {
+        let mut p = params(905.0, 10.0);
+        p.head = Some(Head {
+            cycle_s: 1.0 / f_p,
+            origin_radius_mm: 0.0,
+            origin_height_mm: 0.0,
+            exit_diameter_mm: 10.0,
+            divergence_mrad: 0.0,
+            aperture_distance_mm,
+            channels: vec![Channel {
+                id: 0,
+                elevation_deg: 0.0,
+                azimuth_offset_deg: 0.0,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            }],
+        });
+        p
+    };
+    let segs = [seg(0.0, 360.0, 1e-3, 1000.0)];
+    let declared = evaluate_segments_at_declared_distance(&segs, &at(200.0), f_p).unwrap();
+    let standard = evaluate_segments(&segs, &at(100.0), f_p).unwrap();
+    assert_eq!(declared.binding_rule, Rule::SinglePulse);
+    assert_eq!(standard.binding_rule, Rule::SinglePulse);
+    assert_eq!(
+        declared.worst_ratio.to_bits(),
+        standard.worst_ratio.to_bits(),
+        "no tie: {} vs {}",
+        declared.worst_ratio,
+        standard.worst_ratio
+    );
+    let pass_deg = |r: f64| (17.0 / r).to_degrees();
+    assert!((standard.pass_angle_deg - pass_deg(100.0)).abs() < 1e-9);
+    assert!((declared.pass_angle_deg - pass_deg(200.0)).abs() < 1e-9);
+    let verdict = evaluate_segments(&segs, &at(200.0), f_p).unwrap();
+    assert_eq!(verdict, standard);
+}
