@@ -881,3 +881,26 @@ fn a_tie_of_both_surfaces_takes_the_100_mm_report() {
     let verdict = evaluate_segments(&segs, &at(200.0), f_p).unwrap();
     assert_eq!(verdict, standard);
 }
+
+/// Kills `head/overlap.rs` `pulses_in`: `first > window_s + eps` → `>=`
+/// (and → `==`): a pulse exactly at the widened end of the window (`eps` =
+/// 1e-9 of a cycle past `t0 + window`) is counted, as every touching end is
+/// rounded up; the mutant drops it, one pulse fewer in a firing group (the
+/// head's `W_inst`, `W_T` and their `multi_time` flag).
+///
+/// By hand: a clock of period 1 s at phase `0.25 + 1e-9` s, the closed
+/// window `[0, 0.25]`: `eps` = 1e-9 s, so the pulse at `0.25 + 1e-9` is at
+/// the widened end `0.25 + eps` (the same float), counted: 1. The next float
+/// past it is outside: 0. The same pulse a cycle later is inside a window of
+/// `1.25` s: 2.
+#[test]
+fn pulses_in_counts_a_pulse_at_the_widened_window_end() {
+    use gaze_lidar_core::eye_safety::head::overlap::pulses_in;
+    let (t0_s, window_s, cycle_s) = (0.0, 0.25, 1.0);
+    let slot_s = 0.25 + 1e-9;
+    assert_eq!(slot_s, window_s + 1e-9 * cycle_s);
+    assert_eq!(pulses_in(slot_s, t0_s, window_s, cycle_s), 1);
+    let beyond = f64::from_bits(slot_s.to_bits() + 1);
+    assert_eq!(pulses_in(beyond, t0_s, window_s, cycle_s), 0);
+    assert_eq!(pulses_in(slot_s, t0_s, 1.25, cycle_s), 2);
+}
