@@ -904,3 +904,48 @@ fn pulses_in_counts_a_pulse_at_the_widened_window_end() {
     assert_eq!(pulses_in(beyond, t0_s, window_s, cycle_s), 0);
     assert_eq!(pulses_in(slot_s, t0_s, 1.25, cycle_s), 2);
 }
+
+/// Kills `head/overlap.rs` `multi_time_overlap`: `k > 1` → `k < 1` (a
+/// channel firing twice or more within one grouping window no longer marks
+/// the group as spanning time, so, with no two slots meeting, the head's
+/// Rule 1 drops its group term `W_g·E/(C5·AEL)` and keeps only the
+/// one-instant term: at two channels fired together, fired `k` times in the
+/// window, a figure `k` times too low).
+///
+/// By hand: one footprint, weight 1, slot 0, a clock of period 1 µs and
+/// the closed window `[0, 2.5 µs]`: pulses at 0, 1 and 2 µs, `k` = 3 (weight
+/// 3, one channel); the position receives pulses of three times, so the
+/// group spans time. Two such footprints in one place with one slot: weight
+/// 6, two channels, spanning time. A window of half a cycle holds one pulse
+/// each: weight 2, not spanning time (one slot).
+#[test]
+fn a_channel_firing_twice_in_the_window_spans_time() {
+    use gaze_lidar_core::eye_safety::head::geometry::Footprint;
+    use gaze_lidar_core::eye_safety::head::overlap::{group, SUM_MARGIN};
+    let fp = Footprint {
+        index: 0,
+        psi_rad: 0.0,
+        z_mm: 0.0,
+        slant_mm: 100.0,
+        width_mm: 3.0,
+        cos_beta: 1.0,
+        half_arc_mm: 5.0,
+        half_height_mm: 5.0,
+        pass_angle_deg: 0.1f64.to_degrees(),
+    };
+    let circ = std::f64::consts::TAU * 100.0;
+    let (m, spans) = group(&[fp], &[1.0], &[0.0], 1e-6, 2.5e-6, 0.0, circ);
+    assert_eq!((m.weight, m.count), (3.0, 1), "{m:?}");
+    assert!(spans, "three pulses of one channel in one window");
+    let two = [fp, Footprint { index: 1, ..fp }];
+    let (m, spans) = group(&two, &[1.0, 1.0], &[0.0, 0.0], 1e-6, 2.5e-6, 0.0, circ);
+    assert_eq!(m.count, 2, "{m:?}");
+    assert!(
+        m.weight >= 6.0 && m.weight <= 6.0 * (1.0 + 2.0 * SUM_MARGIN),
+        "{m:?}"
+    );
+    assert!(spans, "three pulses of each of two channels in one window");
+    let (m, spans) = group(&two, &[1.0, 1.0], &[0.0, 0.0], 1e-6, 0.5e-6, 0.0, circ);
+    assert_eq!(m.count, 2, "{m:?}");
+    assert!(!spans, "one pulse of each, fired together");
+}
