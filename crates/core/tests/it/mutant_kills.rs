@@ -826,3 +826,126 @@ fn head_memo_keeps_each_head_s_own_figures() {
     }
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
+
+/// Kills `eye_safety/exposure.rs` `evaluate_head`: `declared.worst_ratio >
+/// standard.worst_ratio` → `>=` (a tie of the declared surface's worst
+/// ratio with the 100 mm surface's took the declared report; the rule, as
+/// specified, is that ties take the 100 mm report, so a verdict's worst
+/// position, pass angle and rule figures are the Condition 3 surface's).
+///
+/// One radial channel from the axis (10 mm exit beam, no divergence), 905 nm,
+/// 5 ns, 1 kHz (cycle 1 ms), 1 mW, uniform 1000 rad/s; declared at 200 mm.
+/// By hand: one pass is `(7 + 10)/R` rad, 9.7403° (0.17 ms) at 100 mm and
+/// 4.8701° (0.085 ms) at 200 mm; both are shorter than the 1 ms between
+/// pulses, so at either distance a pass holds at most one pulse, every
+/// pulse count behind Rule 1's C5 is the same and Rule 1 (binding on both
+/// surfaces) gives the same figure: the two worst ratios tie, bit for bit,
+/// while the reports differ (the pass angle).
+#[test]
+fn a_tie_of_both_surfaces_takes_the_100_mm_report() {
+    let f_p = 1000.0;
+    let at = |aperture_distance_mm: f64| {
+        let mut p = params(905.0, 10.0);
+        p.head = Some(Head {
+            cycle_s: 1.0 / f_p,
+            origin_radius_mm: 0.0,
+            origin_height_mm: 0.0,
+            exit_diameter_mm: 10.0,
+            divergence_mrad: 0.0,
+            aperture_distance_mm,
+            channels: vec![Channel {
+                id: 0,
+                elevation_deg: 0.0,
+                azimuth_offset_deg: 0.0,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            }],
+        });
+        p
+    };
+    let segs = [seg(0.0, 360.0, 1e-3, 1000.0)];
+    let declared = evaluate_segments_at_declared_distance(&segs, &at(200.0), f_p).unwrap();
+    let standard = evaluate_segments(&segs, &at(100.0), f_p).unwrap();
+    assert_eq!(declared.binding_rule, Rule::SinglePulse);
+    assert_eq!(standard.binding_rule, Rule::SinglePulse);
+    assert_eq!(
+        declared.worst_ratio.to_bits(),
+        standard.worst_ratio.to_bits(),
+        "no tie: {} vs {}",
+        declared.worst_ratio,
+        standard.worst_ratio
+    );
+    let pass_deg = |r: f64| (17.0 / r).to_degrees();
+    assert!((standard.pass_angle_deg - pass_deg(100.0)).abs() < 1e-9);
+    assert!((declared.pass_angle_deg - pass_deg(200.0)).abs() < 1e-9);
+    let verdict = evaluate_segments(&segs, &at(200.0), f_p).unwrap();
+    assert_eq!(verdict, standard);
+}
+
+/// Kills `head/overlap.rs` `pulses_in`: `first > window_s + eps` → `>=`
+/// (and → `==`): a pulse exactly at the widened end of the window (`eps` =
+/// 1e-9 of a cycle past `t0 + window`) is counted, as every touching end is
+/// rounded up; the mutant drops it, one pulse fewer in a firing group (the
+/// head's `W_inst`, `W_T` and their `multi_time` flag).
+///
+/// By hand: a clock of period 1 s at phase `0.25 + 1e-9` s, the closed
+/// window `[0, 0.25]`: `eps` = 1e-9 s, so the pulse at `0.25 + 1e-9` is at
+/// the widened end `0.25 + eps` (the same float), counted: 1. The next float
+/// past it is outside: 0. The same pulse a cycle later is inside a window of
+/// `1.25` s: 2.
+#[test]
+fn pulses_in_counts_a_pulse_at_the_widened_window_end() {
+    use gaze_lidar_core::eye_safety::head::overlap::pulses_in;
+    let (t0_s, window_s, cycle_s) = (0.0, 0.25, 1.0);
+    let slot_s = 0.25 + 1e-9;
+    assert_eq!(slot_s, window_s + 1e-9 * cycle_s);
+    assert_eq!(pulses_in(slot_s, t0_s, window_s, cycle_s), 1);
+    let beyond = f64::from_bits(slot_s.to_bits() + 1);
+    assert_eq!(pulses_in(beyond, t0_s, window_s, cycle_s), 0);
+    assert_eq!(pulses_in(slot_s, t0_s, 1.25, cycle_s), 2);
+}
+
+/// Kills `head/overlap.rs` `multi_time_overlap`: `k > 1` → `k < 1` (a
+/// channel firing twice or more within one grouping window no longer marks
+/// the group as spanning time, so, with no two slots meeting, the head's
+/// Rule 1 drops its group term `W_g·E/(C5·AEL)` and keeps only the
+/// one-instant term: at two channels fired together, fired `k` times in the
+/// window, a figure `k` times too low).
+///
+/// By hand: one footprint, weight 1, slot 0, a clock of period 1 µs and
+/// the closed window `[0, 2.5 µs]`: pulses at 0, 1 and 2 µs, `k` = 3 (weight
+/// 3, one channel); the position receives pulses of three times, so the
+/// group spans time. Two such footprints in one place with one slot: weight
+/// 6, two channels, spanning time. A window of half a cycle holds one pulse
+/// each: weight 2, not spanning time (one slot).
+#[test]
+fn a_channel_firing_twice_in_the_window_spans_time() {
+    use gaze_lidar_core::eye_safety::head::geometry::Footprint;
+    use gaze_lidar_core::eye_safety::head::overlap::{group, SUM_MARGIN};
+    let fp = Footprint {
+        index: 0,
+        psi_rad: 0.0,
+        z_mm: 0.0,
+        slant_mm: 100.0,
+        width_mm: 3.0,
+        cos_beta: 1.0,
+        half_arc_mm: 5.0,
+        half_height_mm: 5.0,
+        pass_angle_deg: 0.1f64.to_degrees(),
+    };
+    let circ = std::f64::consts::TAU * 100.0;
+    let (m, spans) = group(&[fp], &[1.0], &[0.0], 1e-6, 2.5e-6, 0.0, circ);
+    assert_eq!((m.weight, m.count), (3.0, 1), "{m:?}");
+    assert!(spans, "three pulses of one channel in one window");
+    let two = [fp, Footprint { index: 1, ..fp }];
+    let (m, spans) = group(&two, &[1.0, 1.0], &[0.0, 0.0], 1e-6, 2.5e-6, 0.0, circ);
+    assert_eq!(m.count, 2, "{m:?}");
+    assert!(
+        m.weight >= 6.0 && m.weight <= 6.0 * (1.0 + 2.0 * SUM_MARGIN),
+        "{m:?}"
+    );
+    assert!(spans, "three pulses of each of two channels in one window");
+    let (m, spans) = group(&two, &[1.0, 1.0], &[0.0, 0.0], 1e-6, 0.5e-6, 0.0, circ);
+    assert_eq!(m.count, 2, "{m:?}");
+    assert!(!spans, "one pulse of each, fired together");
+}
