@@ -148,9 +148,9 @@ fn slot_windows_subsample_keeps_the_first_and_last_evenly() {
 ///
 /// By hand: 256 channels at one height, 64 distinct slots (four channels
 /// each, slot `j` µs of a 100 µs cycle): `256² · 64 = 2²²`, exactly the
-/// budget: the ranges are formed (64 differences, `0 … 63` µs; the last
-/// range holds all 256 channels). 257 channels (one more at slot 0): over
-/// it, no ranges.
+/// budget: the ranges are formed (the differences mod the cycle are `0 …
+/// 99` µs, subsampled to 64 ranges; the last holds all 256 channels). 257
+/// channels (one more at slot 0): over it, no ranges.
 #[test]
 fn slot_windows_budget_is_inclusive() {
     assert_eq!(SLOT_WINDOWS_BUDGET, 1 << 22);
