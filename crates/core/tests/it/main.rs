@@ -8,6 +8,7 @@ mod checker;
 mod eye_safety;
 mod firmware;
 mod mutant_kills;
+mod mutant_kills_head_bound;
 mod profile;
 
 // Definitions references only this crate's tests use.
