@@ -99,9 +99,10 @@ pub enum Infeasible {
         at_deg: f64,
     },
     /// Resolution mode with spin set-points: the set-point answer is over
-    /// the limit, and a move shortened for eye safety would leave the
-    /// set-points.
-    #[error("eye safety: the spin set-points' answer (levels.spin_rad_s; resolution mode does not move the power) is {:.4} % of the Class 1 limit at {at_deg:.3}°, and a shorter move would leave the set-points", 100.0 * .ratio)]
+    /// the limit, a move shortened for eye safety would leave the
+    /// set-points, and the swaps of bins' set-points found no arrangement
+    /// under it (not a proof that none exists).
+    #[error("eye safety: the spin set-points' answer (levels.spin_rad_s; resolution mode does not move the power) is {:.4} % of the Class 1 limit at {at_deg:.3}°; a shorter move would leave the set-points, and no rearrangement of them over the bins (each set-point's count kept, so the frame period) was found under the limit", 100.0 * .ratio)]
     EyeAtSetPoints {
         /// The bound's ratio to the limit.
         ratio: f64,
@@ -169,7 +170,13 @@ fn frame_unreachable(
             below_s,
             above_s,
         } => {
-            let side = |v: Option<f64>| v.map_or_else(|| "none".to_owned(), |t| format!("{t:.9} s"));
+            // The offset too: a period 10⁻⁸ off prints as the frame's at 9 digits.
+            let side = |v: Option<f64>| {
+                v.map_or_else(
+                    || "none".to_owned(),
+                    |t| format!("{t:.9} s ({:+.3e} relative)", t * frame_rate_hz - 1.0),
+                )
+            };
             format!(
                 "levels.spin_rad_s: no choice of the {count} spin set-points on {bins} equal bins makes one turn take the frame period 1/frame_rate_hz = {:.9} s (mean spin {mean_spin_rad_s:.3} rad/s); the nearest periods they reach are {} below and {} above; change the set-points, bins or frame_rate_hz",
                 1.0 / frame_rate_hz,
@@ -246,7 +253,7 @@ mod tests {
         };
         assert_eq!(
             e.to_string(),
-            "levels.spin_rad_s: no choice of the 4 spin set-points on 24 equal bins makes one turn take the frame period 1/frame_rate_hz = 0.100000000 s (mean spin 62.832 rad/s); the nearest periods they reach are 0.099999000 s below and none above; change the set-points, bins or frame_rate_hz"
+            "levels.spin_rad_s: no choice of the 4 spin set-points on 24 equal bins makes one turn take the frame period 1/frame_rate_hz = 0.100000000 s (mean spin 62.832 rad/s); the nearest periods they reach are 0.099999000 s (-1.000e-5 relative) below and none above; change the set-points, bins or frame_rate_hz"
         );
         assert_eq!(
             CertificateError::DwellStep(Box::new(CertificateError::Unbounded)).to_string(),

@@ -476,3 +476,79 @@ fn a_subnormal_config_number_is_refused_by_name() {
         assert!(e.to_string().contains(key), "{toml:?}: {e}");
     }
 }
+
+/// Evenly spread spin set-points, `resolution` mode, 360 bins: the only
+/// compositions meeting the frame need many bins at the slowest set-point,
+/// which the eye-safety bound refuses where they sit together. The answer
+/// was once refused ("102.99 % of the Class 1 limit"), although the same
+/// counts spread over the bins certify: answered, at set-points only, and
+/// certified.
+#[test]
+fn set_points_over_the_eye_limit_together_are_spread_not_refused() {
+    for k in [5usize, 6] {
+        let sp: Vec<f64> = (0..k)
+            .map(|i| 60.123 + i as f64 * 240.0 / (k - 1) as f64)
+            .collect();
+        let list: Vec<String> = sp.iter().map(|w| format!("{w:?}")).collect();
+        let toml = format!(
+            "bins = 360\n[levels]\nspin_rad_s = [{}]\n[objective]\nmode = \"resolution\"\n",
+            list.join(", ")
+        );
+        let p = answer(&toml, 90.0);
+        for b in &p.bins {
+            assert!(
+                sp.iter()
+                    .any(|w| (b.spin_start_rad_s - w).abs() <= 1e-12 * w),
+                "{k} set-points: spin {} is no set-point",
+                b.spin_start_rad_s
+            );
+        }
+        let o = p.optimality.as_ref().expect("an optimality block");
+        assert!(o.gap <= 0.05 * o.upper_bound.abs(), "{k}: gap {o:?}");
+    }
+}
+
+/// Equal bins whose widths differ by ulps (`360/N` not exact in binary:
+/// 37 or 216 bins) once skipped the set-point reachability check: a
+/// 60-s branch and bound, or "the dwell step has no solution", instead of
+/// the frame period and the nearest periods, now with their offsets.
+#[test]
+fn unreachable_set_points_on_inexact_bins_are_diagnosed_before_any_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(
+        &cfg,
+        "bins = 216\n[levels]\nspin_rad_s = [60.123, 120.123, 180.123, 240.123, 300.123]\n[objective]\nmode = \"resolution\"\n",
+    )
+    .unwrap();
+    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/configs/paper.toml");
+    for (config, bins) in [(cfg.to_str().unwrap(), "216"), (paper, "37")] {
+        let out = dir.path().join("o.json");
+        let o = run(
+            &[
+                "profile",
+                "--config",
+                config,
+                "--bins",
+                bins,
+                "--gaze-deg",
+                "90",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            None,
+        );
+        common::expect(
+            &o,
+            1,
+            &[
+                "levels.spin_rad_s",
+                "frame period",
+                "nearest periods",
+                "relative)",
+            ],
+            &format!("{config} on {bins} bins"),
+        );
+        assert!(!out.exists());
+    }
+}
