@@ -263,7 +263,7 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
 
 /// The hardware levels and spin set-points are finite, ≥ 0 (powers) and
 /// > 0 (spins).
-fn levels_valid(problem: &Problem) -> Result<(), OptError> {
+pub(super) fn levels_valid(problem: &Problem) -> Result<(), OptError> {
     for (k, &lv) in problem.levels.power_w.iter().enumerate() {
         if !(lv.is_finite() && lv >= 0.0) {
             return Err(OptError::Invalid {

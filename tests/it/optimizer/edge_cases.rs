@@ -552,3 +552,84 @@ fn unreachable_set_points_on_inexact_bins_are_diagnosed_before_any_solve() {
         assert!(!out.exists());
     }
 }
+
+/// `profile --config` with `toml`: exit code and stderr (one line).
+fn config_error(toml: &str) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(&cfg, toml).unwrap();
+    let out = dir.path().join("o.json");
+    let o = run(
+        &[
+            "profile",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--gaze-deg",
+            "90",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(!out.exists(), "{toml:?}: an output was written");
+    (o.status.code(), common::stderr(&o))
+}
+
+/// A config's semantic errors (a value out of range, not a type error)
+/// once named the key without its line and column, some without the file
+/// either: each names file, line:column of the value, and key.
+#[test]
+fn a_config_value_out_of_range_is_named_with_its_line_and_column() {
+    for (toml, at) in [
+        ("bins = 3\n", "t.toml:1:8: bins"),
+        (
+            "[limits]\npower_w_max = nan\n",
+            "t.toml:2:15: limits.power_w_max",
+        ),
+        (
+            "[levels]\npower_w = [0.001, nan]\n",
+            "t.toml:2:19: levels.power_w[1]",
+        ),
+    ] {
+        let (code, err) = config_error(toml);
+        assert_eq!(code, Some(2), "{toml:?}: {err}");
+        assert!(err.contains(at), "{toml:?}: expected '{at}' in: {err}");
+    }
+}
+
+/// `[lidar] pulse_rate_hz` out of range was reported as
+/// `limits.eye_safety: eye_safety.pulse_rate_hz`, a key the file does not
+/// have: the key written is named.
+#[test]
+fn a_pulse_rate_out_of_range_names_the_key_written() {
+    let (code, err) = config_error("[lidar]\npulse_rate_hz = 1e13\n");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("t.toml:2:17: lidar.pulse_rate_hz"), "{err}");
+    assert!(!err.contains("limits.eye_safety"), "{err}");
+}
+
+/// `[focus] threshold` outside (0, 1) made the region of focus empty or
+/// everything, silently: refused by name.
+#[test]
+fn a_focus_threshold_outside_the_acuity_scale_is_refused() {
+    for v in ["2.0", "-0.1", "1.0", "0.0"] {
+        let (code, err) = config_error(&format!(
+            "[focus]\nthreshold = {v}\nacuity = {{ model = \"box\", half_width_deg = 30 }}\n"
+        ));
+        assert_eq!(code, Some(2), "{v}: {err}");
+        assert!(err.contains("focus.threshold"), "{v}: {err}");
+    }
+}
+
+/// `[objective.detection]` with the default `kind = "sqrt"` was silently
+/// ignored: refused, naming both keys.
+#[test]
+fn a_detection_table_without_the_detection_kind_is_refused() {
+    let (code, err) =
+        config_error("[objective]\nmode = \"joint\"\n[objective.detection]\nfog_pct = [0, 25]\n");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("objective.detection") && err.contains("kind"),
+        "{err}"
+    );
+}
