@@ -633,3 +633,35 @@ fn a_detection_table_without_the_detection_kind_is_refused() {
         "{err}"
     );
 }
+
+/// `--mode baseline --optimize --gaze-deg G` once said "--optimize needs
+/// --gaze-deg" although it was given; `--config` without a gaze named the
+/// closed forms' default mode (`range`) rather than the file's. Both name
+/// what is actually wrong.
+#[test]
+fn a_missing_or_ignored_gaze_is_named_as_such() {
+    let o = run(
+        &[
+            "profile",
+            "--preset",
+            "paper",
+            "--mode",
+            "baseline",
+            "--optimize",
+            "--gaze-deg",
+            "137.3",
+        ],
+        None,
+    );
+    common::expect(
+        &o,
+        2,
+        &["--mode baseline", "nothing to optimize"],
+        "baseline --optimize",
+    );
+    assert!(!common::stderr(&o).contains("needs --gaze-deg"));
+    let smooth = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/configs/smooth.toml");
+    let o = run(&["profile", "--config", smooth], None);
+    common::expect(&o, 2, &["--gaze-deg", "--config"], "config without gaze");
+    assert!(!common::stderr(&o).contains("--mode range"));
+}
