@@ -63,7 +63,7 @@ pub enum Infeasible {
         power_w_min: f64,
     },
     /// The power floor everywhere at the mean spin is over the Class 1 limit.
-    #[error("eye safety: power_w_min {power_w_min:.4e} W everywhere at the mean spin is {:.1} % of the Class 1 limit (worst at {at_deg:.3}°) at {wavelength_nm} nm", 100.0 * .ratio)]
+    #[error("eye safety: power_w_min {power_w_min:.4e} W everywhere at the mean spin is {} % of the Class 1 limit (worst at {at_deg:.3}°) at {wavelength_nm} nm", over_pct(*.ratio))]
     EyeFloorOverLimit {
         /// `limits.power_w_min`, W.
         power_w_min: f64,
@@ -89,7 +89,7 @@ pub enum Infeasible {
         rule: String,
     },
     /// Resolution mode: the fixed power is over the limit even at the uniform spin.
-    #[error("eye safety: the power ({power_w:.4e} W in every bin; resolution mode does not move it) is {:.1} % of the Class 1 limit at {at_deg:.3}° even at the uniform spin", 100.0 * .ratio)]
+    #[error("eye safety: the power ({power_w:.4e} W in every bin; resolution mode does not move it) is {} % of the Class 1 limit at {at_deg:.3}° even at the uniform spin", over_pct(*.ratio))]
     EyeAtUniformSpin {
         /// The power, W.
         power_w: f64,
@@ -185,6 +185,19 @@ fn frame_unreachable(
             )
         }
     }
+}
+
+/// A ratio to a limit as a percentage, one decimal, or as many more as
+/// it takes for a ratio over the limit not to read as `100.0` (at most 12).
+fn over_pct(ratio: f64) -> String {
+    let pct = 100.0 * ratio;
+    for d in 1..12 {
+        let s = format!("{pct:.d$}");
+        if ratio <= 1.0 || s.parse::<f64>().is_ok_and(|v| v > 100.0) {
+            return s;
+        }
+    }
+    format!("{pct:.12}")
 }
 
 /// Why a program's answer carries no exact certificate.

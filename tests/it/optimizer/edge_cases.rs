@@ -665,3 +665,16 @@ fn a_missing_or_ignored_gaze_is_named_as_such() {
     common::expect(&o, 2, &["--gaze-deg", "--config"], "config without gaze");
     assert!(!common::stderr(&o).contains("--mode range"));
 }
+
+/// A floor just over the eye-safety limit was reported as "100.0 % of the
+/// Class 1 limit", which reads as at the limit: the percentage shows the
+/// excess.
+#[test]
+fn a_floor_just_over_the_eye_limit_reads_as_over() {
+    let (code, err) = config_error(
+        "bins = 36\n[lidar]\naverage_power_w = 0.00116\n[limits]\npower_w_min = 0.00115466\n[objective]\nmode = \"range\"\n",
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("% of the Class 1 limit"), "{err}");
+    assert!(!err.contains(" 100.0 %"), "{err}");
+}
