@@ -82,9 +82,13 @@ pub fn optimizer_problem_and_preset(
         config.lidar.power_accounting = Some(acc);
     }
     let mut problem = config.problem().map_err(|e| match e {
-        OptError::Invalid { field, reason } => {
-            CliError::input(format!("{}: {field}: {reason}", path.display()))
-        }
+        OptError::Invalid { field, reason } => match locate(&text, &field) {
+            Some((line, column)) => CliError::input(format!(
+                "{}:{line}:{column}: {field}: {reason}",
+                path.display()
+            )),
+            None => CliError::input(format!("{}: {field}: {reason}", path.display())),
+        },
         other => err(other),
     })?;
     if let Some(m) = overrides.mode {
@@ -98,6 +102,44 @@ pub fn optimizer_problem_and_preset(
     }
     let preset = config.preset().map_err(err)?;
     Ok((problem, preset))
+}
+
+/// Where the key `field` (`a.b`, `a.b[2]`, as the optimizer's errors name
+/// it) is written in `text`: the 1-based line and column of its value, or
+/// of the deepest part of the path the file writes (a table); `None` when
+/// the file writes none of it (a value from a preset or a flag).
+#[cfg(feature = "solver")]
+fn locate(text: &str, field: &str) -> Option<(usize, usize)> {
+    use toml::de::{DeTable, DeValue};
+    let doc = DeTable::parse(text).ok()?;
+    let mut at: Option<usize> = None;
+    let mut table: &DeTable<'_> = doc.get_ref();
+    let mut parts = field.split('.').peekable();
+    while let Some(part) = parts.next() {
+        let (key, index) = match part.split_once('[') {
+            Some((k, rest)) => (k, rest.trim_end_matches(']').parse::<usize>().ok()),
+            None => (part, None),
+        };
+        let Some((_, v)) = table.iter().find(|(k, _)| k.get_ref().as_ref() == key) else {
+            break;
+        };
+        at = Some(v.span().start);
+        let mut v = v;
+        if let (Some(i), DeValue::Array(a)) = (index, v.get_ref()) {
+            match a.get(i) {
+                Some(item) => {
+                    at = Some(item.span().start);
+                    v = item;
+                }
+                None => break,
+            }
+        }
+        match v.get_ref() {
+            DeValue::Table(t) if parts.peek().is_some() => table = t,
+            _ => break,
+        }
+    }
+    at.map(|o| gaze_lidar::text::line_column(text, o))
 }
 
 /// Without the solver there is no optimizer configuration.

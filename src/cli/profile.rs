@@ -148,6 +148,12 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
         preset.lidar.power_accounting = acc;
     }
     let mode = a.mode.unwrap_or(Mode::Range);
+    if a.gaze_deg.is_none() && a.config.is_some() && a.mode.is_none() {
+        // The file's mode decides, not the closed forms' default.
+        return Err(CliError::input(
+            "--gaze-deg is required with --config (the optimizer builds a profile for a gaze)",
+        ));
+    }
     if a.gaze_deg.is_none() && mode != Mode::Baseline {
         return Err(CliError::input(format!(
             "--gaze-deg is required for --mode {}",
@@ -357,9 +363,11 @@ fn optimized(
         }
     };
     let Some(gaze) = gaze else {
-        return Err(CliError::input(
-            "--optimize needs --gaze-deg (the baseline has nothing to optimize)",
-        ));
+        return Err(CliError::input(if a.gaze_deg.is_some() {
+            "--optimize and --mode baseline: the baseline has nothing to optimize (use range, resolution or joint)"
+        } else {
+            "--optimize needs --gaze-deg (the baseline has nothing to optimize)"
+        }));
     };
     let (problem, named) = match &a.config {
         Some(path) => super::config::optimizer_problem_and_preset(path, overrides)?,

@@ -172,6 +172,14 @@ fn positive(field: &str, v: f64) -> Result<f64, OptError> {
     }
 }
 
+/// A rate within the crate's one rate range ([`crate::model::valid::rate_hz`]).
+fn rate(field: &str, v: f64) -> Result<f64, OptError> {
+    crate::model::valid::rate_hz(v).map_err(|reason| OptError::Invalid {
+        field: field.into(),
+        reason: format!("{} {reason}", Num(v)),
+    })
+}
+
 /// Zero or a normal number `> 0` (see [`positive`]).
 fn nonneg(field: &str, v: f64) -> Result<f64, OptError> {
     if v == 0.0 || (v.is_normal() && v > 0.0) {
@@ -245,25 +253,41 @@ impl OptimizerConfig {
             field: "focus".into(),
             reason: e.to_string(),
         })?;
+        // η of eq. 1 on the acuity's scale (V(0) = 1): at or outside [0, 1]
+        // the region of focus is everything or nothing.
+        if !(focus.threshold > 0.0 && focus.threshold < 1.0) {
+            return Err(OptError::Invalid {
+                field: "focus.threshold".into(),
+                reason: format!(
+                    "{} must lie strictly between 0 and 1 (the acuity's scale: V(0) = 1)",
+                    Num(focus.threshold)
+                ),
+            });
+        }
         self.validate_objective()?;
         let bins = self.bins.unwrap_or(360);
         super::validate_bins(bins, "bins")?;
-        Ok(Problem {
+        let problem = Problem {
             lidar: preset.lidar,
             focus,
             levels: self.levels.clone(),
             objective: self.objective.clone(),
             bins,
-        })
+        };
+        // Named as bad input here, with the file (the solve checks again).
+        super::lp::levels_valid(&problem)?;
+        Ok(problem)
     }
 
     /// `[lidar]`'s overrides onto the preset's sensor.
     fn apply_lidar(&self, lid: &mut crate::model::lidar::LidarSpec) -> Result<(), OptError> {
         if let Some(v) = self.lidar.frame_rate_hz {
-            lid.frame_rate_hz = positive("lidar.frame_rate_hz", v)?;
+            lid.frame_rate_hz = rate("lidar.frame_rate_hz", positive("lidar.frame_rate_hz", v)?)?;
         }
         if let Some(v) = self.lidar.pulse_rate_hz {
-            lid.pulse_rate_hz = positive("lidar.pulse_rate_hz", v)?;
+            // Named here, as written: the eye-safety model refuses it later
+            // under its own name.
+            lid.pulse_rate_hz = rate("lidar.pulse_rate_hz", positive("lidar.pulse_rate_hz", v)?)?;
         }
         if let Some(v) = self.lidar.average_power_w {
             lid.average_power_w = positive("lidar.average_power_w", v)?;
@@ -353,6 +377,12 @@ impl OptimizerConfig {
             }
         }
         o.detection.validate()?;
+        if o.kind == super::ObjectiveKind::Sqrt && o.detection != super::Detection::default() {
+            return Err(OptError::Invalid {
+                field: "objective.detection".into(),
+                reason: "is given but objective.kind is \"sqrt\" (the default), which does not read it; set kind = \"detection\" or drop the table".into(),
+            });
+        }
         if o.mode == crate::model::Mode::Baseline {
             return Err(OptError::Invalid {
                 field: "objective.mode".into(),

@@ -63,7 +63,7 @@ pub enum Infeasible {
         power_w_min: f64,
     },
     /// The power floor everywhere at the mean spin is over the Class 1 limit.
-    #[error("eye safety: power_w_min {power_w_min:.4e} W everywhere at the mean spin is {:.1} % of the Class 1 limit (worst at {at_deg:.3}°) at {wavelength_nm} nm", 100.0 * .ratio)]
+    #[error("eye safety: power_w_min {power_w_min:.4e} W everywhere at the mean spin is {} % of the Class 1 limit (worst at {at_deg:.3}°) at {wavelength_nm} nm", over_pct(*.ratio))]
     EyeFloorOverLimit {
         /// `limits.power_w_min`, W.
         power_w_min: f64,
@@ -89,7 +89,7 @@ pub enum Infeasible {
         rule: String,
     },
     /// Resolution mode: the fixed power is over the limit even at the uniform spin.
-    #[error("eye safety: the power ({power_w:.4e} W in every bin; resolution mode does not move it) is {:.1} % of the Class 1 limit at {at_deg:.3}° even at the uniform spin", 100.0 * .ratio)]
+    #[error("eye safety: the power ({power_w:.4e} W in every bin; resolution mode does not move it) is {} % of the Class 1 limit at {at_deg:.3}° even at the uniform spin", over_pct(*.ratio))]
     EyeAtUniformSpin {
         /// The power, W.
         power_w: f64,
@@ -99,9 +99,10 @@ pub enum Infeasible {
         at_deg: f64,
     },
     /// Resolution mode with spin set-points: the set-point answer is over
-    /// the limit, and a move shortened for eye safety would leave the
-    /// set-points.
-    #[error("eye safety: the spin set-points' answer (levels.spin_rad_s; resolution mode does not move the power) is {:.4} % of the Class 1 limit at {at_deg:.3}°, and a shorter move would leave the set-points", 100.0 * .ratio)]
+    /// the limit, a move shortened for eye safety would leave the
+    /// set-points, and the swaps of bins' set-points found no arrangement
+    /// under it (not a proof that none exists).
+    #[error("eye safety: the spin set-points' answer (levels.spin_rad_s; resolution mode does not move the power) is {:.4} % of the Class 1 limit at {at_deg:.3}°; a shorter move would leave the set-points, and no rearrangement of them over the bins (each set-point's count kept, so the frame period) was found under the limit", 100.0 * .ratio)]
     EyeAtSetPoints {
         /// The bound's ratio to the limit.
         ratio: f64,
@@ -169,7 +170,13 @@ fn frame_unreachable(
             below_s,
             above_s,
         } => {
-            let side = |v: Option<f64>| v.map_or_else(|| "none".to_owned(), |t| format!("{t:.9} s"));
+            // The offset too: a period 10⁻⁸ off prints as the frame's at 9 digits.
+            let side = |v: Option<f64>| {
+                v.map_or_else(
+                    || "none".to_owned(),
+                    |t| format!("{t:.9} s ({:+.3e} relative)", t * frame_rate_hz - 1.0),
+                )
+            };
             format!(
                 "levels.spin_rad_s: no choice of the {count} spin set-points on {bins} equal bins makes one turn take the frame period 1/frame_rate_hz = {:.9} s (mean spin {mean_spin_rad_s:.3} rad/s); the nearest periods they reach are {} below and {} above; change the set-points, bins or frame_rate_hz",
                 1.0 / frame_rate_hz,
@@ -178,6 +185,19 @@ fn frame_unreachable(
             )
         }
     }
+}
+
+/// A ratio to a limit as a percentage, one decimal, or as many more as
+/// it takes for a ratio over the limit not to read as `100.0` (at most 12).
+fn over_pct(ratio: f64) -> String {
+    let pct = 100.0 * ratio;
+    for d in 1..12 {
+        let s = format!("{pct:.d$}");
+        if ratio <= 1.0 || s.parse::<f64>().is_ok_and(|v| v > 100.0) {
+            return s;
+        }
+    }
+    format!("{pct:.12}")
 }
 
 /// Why a program's answer carries no exact certificate.
@@ -246,7 +266,7 @@ mod tests {
         };
         assert_eq!(
             e.to_string(),
-            "levels.spin_rad_s: no choice of the 4 spin set-points on 24 equal bins makes one turn take the frame period 1/frame_rate_hz = 0.100000000 s (mean spin 62.832 rad/s); the nearest periods they reach are 0.099999000 s below and none above; change the set-points, bins or frame_rate_hz"
+            "levels.spin_rad_s: no choice of the 4 spin set-points on 24 equal bins makes one turn take the frame period 1/frame_rate_hz = 0.100000000 s (mean spin 62.832 rad/s); the nearest periods they reach are 0.099999000 s (-1.000e-5 relative) below and none above; change the set-points, bins or frame_rate_hz"
         );
         assert_eq!(
             CertificateError::DwellStep(Box::new(CertificateError::Unbounded)).to_string(),

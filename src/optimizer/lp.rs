@@ -263,7 +263,7 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
 
 /// The hardware levels and spin set-points are finite, ≥ 0 (powers) and
 /// > 0 (spins).
-fn levels_valid(problem: &Problem) -> Result<(), OptError> {
+pub(super) fn levels_valid(problem: &Problem) -> Result<(), OptError> {
     for (k, &lv) in problem.levels.power_w.iter().enumerate() {
         if !(lv.is_finite() && lv >= 0.0) {
             return Err(OptError::Invalid {
@@ -296,7 +296,7 @@ fn setpoints_reach_frame(problem: &Problem) -> Result<(), OptError> {
         return Ok(());
     }
     let g = grid(problem, 0.0)?;
-    if g.theta.iter().any(|&th| th != g.theta[0]) {
+    if !equal_bins(&g) {
         return Ok(());
     }
     let w_mean = problem.lidar.mean_spin_rad_s();
@@ -318,6 +318,19 @@ fn setpoints_reach_frame(problem: &Problem) -> Result<(), OptError> {
         frame_rate_hz: problem.lidar.frame_rate_hz,
     }
     .into())
+}
+
+/// Whether the grid's bins are equal: their widths within a relative
+/// `10⁻¹²` of the first's (`N` equal bins' widths, `360·(i+1)/N − 360·i/N`
+/// in doubles, differ by ulps unless `N` divides 360 evenly in binary).
+/// A frame sum over such bins moves by less than `10⁻¹²` relative, far
+/// inside the `0.2·10⁻⁹` between [`super::setpoints::reach`]'s tolerance
+/// and the checker's.
+fn equal_bins(g: &Grid) -> bool {
+    let th0 = g.theta.first().copied().unwrap_or(0.0);
+    g.theta
+        .iter()
+        .all(|&th| (th - th0).abs() <= 1e-12 * th0.abs())
 }
 
 /// Dwell of each bin under `spins` (constant acceleration within a bin), s.
@@ -1691,7 +1704,7 @@ impl SetPointChoice {
     /// and the program's columns are the set-points' binaries.
     fn new(d: &DwellProgram, g: &Grid) -> Option<Self> {
         let n = g.n;
-        if d.sp_cols.len() != n || n == 0 || g.theta.iter().any(|&t| t != g.theta[0]) {
+        if d.sp_cols.len() != n || n == 0 || !equal_bins(g) {
             return None;
         }
         let r: Vec<f64> = d.sp_cols[0]
@@ -1976,6 +1989,15 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
     }
     let mut shortened = false;
     if let (Some(e), Mode::Resolution) = (ctx.eye, mode) {
+        if !smooth && !problem.levels.spin_rad_s.is_empty() {
+            if let Some((t, cert)) = spread_setpoints(&ctx, e, &it)? {
+                spins = spins_of(&g, &t, false, lid.frame_rate_hz);
+                it.t = t;
+                if let Some(d) = it.dwell.as_mut() {
+                    d.last = cert;
+                }
+            }
+        }
         (spins, shortened) = shorten_for_eye_safety(&ctx, e, &it, &t_base, spins, smooth)?;
     }
     let profile = build_profile(problem, &g, gaze_deg, &it.p, &spins);
@@ -2161,6 +2183,123 @@ fn shorten_for_eye_safety(
         .into());
     }
     Ok((spins, shortened))
+}
+
+/// What [`spread_setpoints`] found: the dwell (s) and its certificate.
+type Spread = Option<(Vec<f64>, Result<Certified, CertificateError>)>;
+
+/// `resolution` mode with spin set-points whose answer the eye-safety bound
+/// refuses: the answer's set-points moved between bins, the count of each
+/// kept (so the frame period is the answer's), until the bound certifies.
+/// Each swap takes the slowest bin of the binding exposure's bins (the
+/// bound's worst azimuth, the concrete exposure there) and trades its
+/// set-point for a faster one's in a bin outside them whose neighbourhood
+/// (as many bins) is left cooler than the exposure's, the trade that loses
+/// the least objective first; at most `setpoint_spread_swaps` swaps.
+/// `None` when the answer already certifies, when its program is not the
+/// plain set-point one (one binary per set-point and bin), or when no swap
+/// is left; otherwise the new dwell (s) and its certificate: the point of
+/// the last dwell program with the bins' binaries moved, checked exactly
+/// with that program's multipliers (the bound stands: the program is the
+/// same).
+fn spread_setpoints(ctx: &Ctx<'_>, e: &Eye, it: &Iterate) -> Result<Spread, OptError> {
+    let (g, p, problem) = (ctx.g, &it.p, ctx.problem);
+    let l = &problem.lidar.limits;
+    let allowed: Vec<f64> = (problem.levels.spin_rad_s.iter().copied())
+        .filter(|&w| w >= l.spin_rad_s_min && w <= l.spin_rad_s_max)
+        .collect();
+    let Some(Ok(cert)) = it.dwell.as_ref().map(|d| &d.last) else {
+        return Ok(None);
+    };
+    let (n, kk) = (g.n, allowed.len());
+    if kk < 2 || cert.lp.cost.len() != n * kk || cert.x.len() != n * kk {
+        return Ok(None);
+    }
+    let col = |i: usize, k: usize| i * kk + k;
+    let mut k_of: Vec<usize> = (0..n)
+        .map(|i| {
+            (0..kk)
+                .max_by(|&a, &b| cert.x[col(i, a)].total_cmp(&cert.x[col(i, b)]))
+                .unwrap_or(0)
+        })
+        .collect();
+    let accept = eye_accept(problem);
+    let dwell = |i: usize, k: usize| g.theta[i] / allowed[k];
+    let spins_at = |k_of: &[usize]| -> Vec<(f64, f64)> {
+        k_of.iter().map(|&k| (allowed[k], allowed[k])).collect()
+    };
+    let first = e.verdict(&segs(g, &spins_at(&k_of), p))?;
+    if first.0 <= accept {
+        return Ok(None);
+    }
+    for _ in 0..S.setpoint_spread_swaps {
+        let sg = segs(g, &spins_at(&k_of), p);
+        let (ratio, at) = e.verdict(&sg)?;
+        if ratio <= accept {
+            let mut x = vec![0.0; n * kk];
+            for (i, &k) in k_of.iter().enumerate() {
+                x[col(i, k)] = 1.0;
+            }
+            let t = (0..n).map(|i| dwell(i, k_of[i])).collect();
+            let c = Certified::new(
+                Step::Dwell,
+                cert.lp.clone(),
+                x,
+                cert.y.clone(),
+                cert.solver_dual_bound,
+            );
+            return Ok(Some((t, c)));
+        }
+        // The bins around the worst azimuth (the bound's windows there span
+        // a few degrees; the single-pulse cuts name one bin each).
+        let i0 = g.start_deg.partition_point(|&s0| s0 <= wrap_deg(at)).max(1) - 1;
+        let reach = (S.setpoint_spread_window_deg / g.width_deg[i0])
+            .round()
+            .max(1.0) as usize;
+        let reach = reach.min((n - 1) / 2);
+        let hot: Vec<usize> = (0..=2 * reach).map(|o| (i0 + n + o - reach) % n).collect();
+        let in_hot = |i: usize| hot.contains(&i);
+        // Slowest first, then nearest the worst azimuth (`hot` is
+        // centred on it).
+        let Some(&j) = hot
+            .iter()
+            .enumerate()
+            .max_by(|(oa, &a), (ob, &b)| {
+                dwell(a, k_of[a])
+                    .total_cmp(&dwell(b, k_of[b]))
+                    .then(oa.abs_diff(reach).cmp(&ob.abs_diff(reach)).reverse())
+            })
+            .map(|(_, j)| j)
+        else {
+            break;
+        };
+        let (a, dj) = (k_of[j], dwell(j, k_of[j]));
+        let half = hot.len() / 2;
+        let hot_sum: f64 = hot.iter().map(|&i| dwell(i, k_of[i])).sum();
+        let near_sum = |q: usize| -> f64 {
+            (0..=2 * half)
+                .map(|o| (q + n + o - half) % n)
+                .map(|i| dwell(i, k_of[i]))
+                .sum()
+        };
+        let cost = |i: usize, k: usize| cert.lp.cost[col(i, k)];
+        let pick = (0..n)
+            .filter(|&q| !in_hot(q) && allowed[k_of[q]] > allowed[a])
+            .filter(|&q| {
+                let moved = dj - dwell(q, k_of[q]);
+                near_sum(q) + moved < hot_sum - moved
+            })
+            .map(|q| {
+                let b = k_of[q];
+                (q, cost(j, a) + cost(q, b) - cost(j, b) - cost(q, a))
+            })
+            .min_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)));
+        let Some((q, _)) = pick else {
+            break;
+        };
+        k_of.swap(j, q);
+    }
+    Ok(None)
 }
 
 /// The (uncertified) profile of powers `p` and `spins`.

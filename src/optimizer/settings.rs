@@ -141,6 +141,15 @@ pub struct OptimizerSettings {
     /// HiGHS's search on such an equality knapsack took over 14 s of CPU
     /// without a point.
     pub setpoint_heuristic_gap: f64,
+    /// At most this many swaps of two bins' set-points when a
+    /// `resolution`-mode set-point answer is over the eye-safety limit
+    /// (default 360; each costs one evaluation of the bound).
+    pub setpoint_spread_swaps: usize,
+    /// The neighbourhood of the worst azimuth whose slowest bin a swap
+    /// moves, and the size of the neighbourhoods compared, degrees either
+    /// side (default 5°: the bound's windows span a few degrees; a
+    /// heuristic's choice only, the bound decides every answer).
+    pub setpoint_spread_window_deg: f64,
     /// HiGHS's `mip_feasibility_tolerance` for every MILP (default 1e-10,
     /// its minimum): its default, 1e-6, lets a level choice overspend the
     /// budget by far more than the checker's relative 1e-9.
@@ -207,6 +216,8 @@ impl OptimizerSettings {
         setpoint_frame_tol: 0.99e-9,
         setpoint_heuristic_steps: 20_000_000,
         setpoint_heuristic_gap: 1e-2,
+        setpoint_spread_swaps: 360,
+        setpoint_spread_window_deg: 5.0,
         mip_max_nodes: 100,
         mip_heuristic_gap: 1e-3,
         mip_max_nodes_without_incumbent: 5000,

@@ -476,3 +476,205 @@ fn a_subnormal_config_number_is_refused_by_name() {
         assert!(e.to_string().contains(key), "{toml:?}: {e}");
     }
 }
+
+/// Evenly spread spin set-points, `resolution` mode, 360 bins: the only
+/// compositions meeting the frame need many bins at the slowest set-point,
+/// which the eye-safety bound refuses where they sit together. The answer
+/// was once refused ("102.99 % of the Class 1 limit"), although the same
+/// counts spread over the bins certify: answered, at set-points only, and
+/// certified.
+#[test]
+fn set_points_over_the_eye_limit_together_are_spread_not_refused() {
+    for k in [5usize, 6] {
+        let sp: Vec<f64> = (0..k)
+            .map(|i| 60.123 + i as f64 * 240.0 / (k - 1) as f64)
+            .collect();
+        let list: Vec<String> = sp.iter().map(|w| format!("{w:?}")).collect();
+        let toml = format!(
+            "bins = 360\n[levels]\nspin_rad_s = [{}]\n[objective]\nmode = \"resolution\"\n",
+            list.join(", ")
+        );
+        let p = answer(&toml, 90.0);
+        for b in &p.bins {
+            assert!(
+                sp.iter()
+                    .any(|w| (b.spin_start_rad_s - w).abs() <= 1e-12 * w),
+                "{k} set-points: spin {} is no set-point",
+                b.spin_start_rad_s
+            );
+        }
+        let o = p.optimality.as_ref().expect("an optimality block");
+        assert!(o.gap <= 0.05 * o.upper_bound.abs(), "{k}: gap {o:?}");
+    }
+}
+
+/// Equal bins whose widths differ by ulps (`360/N` not exact in binary:
+/// 37 or 216 bins) once skipped the set-point reachability check: a
+/// 60-s branch and bound, or "the dwell step has no solution", instead of
+/// the frame period and the nearest periods, now with their offsets.
+#[test]
+fn unreachable_set_points_on_inexact_bins_are_diagnosed_before_any_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(
+        &cfg,
+        "bins = 216\n[levels]\nspin_rad_s = [60.123, 120.123, 180.123, 240.123, 300.123]\n[objective]\nmode = \"resolution\"\n",
+    )
+    .unwrap();
+    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/configs/paper.toml");
+    for (config, bins) in [(cfg.to_str().unwrap(), "216"), (paper, "37")] {
+        let out = dir.path().join("o.json");
+        let o = run(
+            &[
+                "profile",
+                "--config",
+                config,
+                "--bins",
+                bins,
+                "--gaze-deg",
+                "90",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            None,
+        );
+        common::expect(
+            &o,
+            1,
+            &[
+                "levels.spin_rad_s",
+                "frame period",
+                "nearest periods",
+                "relative)",
+            ],
+            &format!("{config} on {bins} bins"),
+        );
+        assert!(!out.exists());
+    }
+}
+
+/// `profile --config` with `toml`: exit code and stderr (one line).
+fn config_error(toml: &str) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(&cfg, toml).unwrap();
+    let out = dir.path().join("o.json");
+    let o = run(
+        &[
+            "profile",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--gaze-deg",
+            "90",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(!out.exists(), "{toml:?}: an output was written");
+    (o.status.code(), common::stderr(&o))
+}
+
+/// A config's semantic errors (a value out of range, not a type error)
+/// once named the key without its line and column, some without the file
+/// either: each names file, line:column of the value, and key.
+#[test]
+fn a_config_value_out_of_range_is_named_with_its_line_and_column() {
+    for (toml, at) in [
+        ("bins = 3\n", "t.toml:1:8: bins"),
+        (
+            "[limits]\npower_w_max = nan\n",
+            "t.toml:2:15: limits.power_w_max",
+        ),
+        (
+            "[levels]\npower_w = [0.001, nan]\n",
+            "t.toml:2:19: levels.power_w[1]",
+        ),
+    ] {
+        let (code, err) = config_error(toml);
+        assert_eq!(code, Some(2), "{toml:?}: {err}");
+        assert!(err.contains(at), "{toml:?}: expected '{at}' in: {err}");
+    }
+}
+
+/// `[lidar] pulse_rate_hz` out of range was reported as
+/// `limits.eye_safety: eye_safety.pulse_rate_hz`, a key the file does not
+/// have: the key written is named.
+#[test]
+fn a_pulse_rate_out_of_range_names_the_key_written() {
+    let (code, err) = config_error("[lidar]\npulse_rate_hz = 1e13\n");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("t.toml:2:17: lidar.pulse_rate_hz"), "{err}");
+    assert!(!err.contains("limits.eye_safety"), "{err}");
+}
+
+/// `[focus] threshold` outside (0, 1) made the region of focus empty or
+/// everything, silently: refused by name.
+#[test]
+fn a_focus_threshold_outside_the_acuity_scale_is_refused() {
+    for v in ["2.0", "-0.1", "1.0", "0.0"] {
+        let (code, err) = config_error(&format!(
+            "[focus]\nthreshold = {v}\nacuity = {{ model = \"box\", half_width_deg = 30 }}\n"
+        ));
+        assert_eq!(code, Some(2), "{v}: {err}");
+        assert!(err.contains("focus.threshold"), "{v}: {err}");
+    }
+}
+
+/// `[objective.detection]` with the default `kind = "sqrt"` was silently
+/// ignored: refused, naming both keys.
+#[test]
+fn a_detection_table_without_the_detection_kind_is_refused() {
+    let (code, err) =
+        config_error("[objective]\nmode = \"joint\"\n[objective.detection]\nfog_pct = [0, 25]\n");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("objective.detection") && err.contains("kind"),
+        "{err}"
+    );
+}
+
+/// `--mode baseline --optimize --gaze-deg G` once said "--optimize needs
+/// --gaze-deg" although it was given; `--config` without a gaze named the
+/// closed forms' default mode (`range`) rather than the file's. Both name
+/// what is actually wrong.
+#[test]
+fn a_missing_or_ignored_gaze_is_named_as_such() {
+    let o = run(
+        &[
+            "profile",
+            "--preset",
+            "paper",
+            "--mode",
+            "baseline",
+            "--optimize",
+            "--gaze-deg",
+            "137.3",
+        ],
+        None,
+    );
+    common::expect(
+        &o,
+        2,
+        &["--mode baseline", "nothing to optimize"],
+        "baseline --optimize",
+    );
+    assert!(!common::stderr(&o).contains("needs --gaze-deg"));
+    let smooth = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/configs/smooth.toml");
+    let o = run(&["profile", "--config", smooth], None);
+    common::expect(&o, 2, &["--gaze-deg", "--config"], "config without gaze");
+    assert!(!common::stderr(&o).contains("--mode range"));
+}
+
+/// A floor just over the eye-safety limit was reported as "100.0 % of the
+/// Class 1 limit", which reads as at the limit: the percentage shows the
+/// excess.
+#[test]
+fn a_floor_just_over_the_eye_limit_reads_as_over() {
+    let (code, err) = config_error(
+        "bins = 36\n[lidar]\naverage_power_w = 0.00116\n[limits]\npower_w_min = 0.00115466\n[objective]\nmode = \"range\"\n",
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("% of the Class 1 limit"), "{err}");
+    assert!(!err.contains(" 100.0 %"), "{err}");
+}
