@@ -1136,12 +1136,12 @@ mod tests {
         lo
     }
 
-    proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(4000))]
-        /// The narrowed bisection gives the plain bisection's answer, bit
-        /// for bit, on both models at every fog level.
-        #[test]
-        fn the_narrowed_detection_range_is_the_plain_bisection(
+    proptest::prop_compose! {
+        /// One detection-range question over the whole domain the optimizer
+        /// asks: either model at every fog level, relative power `x`,
+        /// reflectivity, target width (m), beam spacing (rad, log-uniform)
+        /// and the returns needed.
+        fn detection_case()(
             physical in proptest::bool::ANY,
             fog_i in 0usize..3,
             x in 0.0f64..3.0,
@@ -1149,10 +1149,20 @@ mod tests {
             w in 0.3f64..5.0,
             log_s in -5.0f64..-1.0,
             d in 0.5f64..20.0,
-        ) {
+        ) -> (ReturnModel, f64, f64, f64, f64, f64) {
             let kind = if physical { ModelKind::Physical } else { ModelKind::Argus };
-            let m = model(kind, FOG_LEVELS_PCT[fog_i]);
-            let s = 10f64.powf(log_s);
+            (model(kind, FOG_LEVELS_PCT[fog_i]), x, rho, w, 10f64.powf(log_s), d)
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(4000))]
+        /// The narrowed bisection gives the plain bisection's answer, bit
+        /// for bit, on both models at every fog level.
+        #[test]
+        fn the_narrowed_detection_range_is_the_plain_bisection(
+            (m, x, rho, w, s, d) in detection_case(),
+        ) {
             let got = m.detection_range_m(x, rho, w, s, d);
             let want = plain_detection_range(&m, x, rho, w, s, d);
             proptest::prop_assert_eq!(got.to_bits(), want.to_bits(), "{} vs {}", got, want);
@@ -1165,19 +1175,10 @@ mod tests {
         /// the answer is the plain bisection's, bit for bit.
         #[test]
         fn a_guessed_detection_range_is_the_plain_bisection(
-            physical in proptest::bool::ANY,
-            fog_i in 0usize..3,
-            x in 0.0f64..3.0,
-            rho in 0.02f64..1.0,
-            w in 0.3f64..5.0,
-            log_s in -5.0f64..-1.0,
-            d in 0.5f64..20.0,
+            (m, x, rho, w, s, d) in detection_case(),
             off in -1.0f64..1.0,
             log_err in -14.0f64..0.0,
         ) {
-            let kind = if physical { ModelKind::Physical } else { ModelKind::Argus };
-            let m = model(kind, FOG_LEVELS_PCT[fog_i]);
-            let s = 10f64.powf(log_s);
             let want = plain_detection_range(&m, x, rho, w, s, d);
             // Guesses near the answer (off by up to ±10^log_err), and far.
             let near = want * (1.0 + off * 10f64.powf(log_err));

@@ -211,6 +211,15 @@ pub fn cuts_with(
     // Each cut's ratio once (a cut sums over all its pulses), not once per
     // comparison: the same keys, so the same order.
     let mut keyed: Vec<(f64, Cut)> = found.into_iter().map(|c| (c.ratio(&p, f_p), c)).collect();
+    sort_strongest_first(&mut keyed);
+    keyed.dedup_by(|(_, a), (_, b)| a.pulses == b.pulses && a.limit_j == b.limit_j);
+    keyed.into_iter().map(|(_, c)| c).collect()
+}
+
+/// Cuts keyed by their ratio, strongest first: the largest ratio, then the
+/// smallest limit, then the pulse list, so that equal ratios keep one order
+/// and the program built from the cuts is deterministic.
+fn sort_strongest_first(keyed: &mut [(f64, Cut)]) {
     keyed.sort_by(|(ra, a), (rb, b)| {
         rb.total_cmp(ra)
             .then_with(|| a.limit_j.total_cmp(&b.limit_j))
@@ -220,8 +229,6 @@ pub fn cuts_with(
                     .unwrap_or(std::cmp::Ordering::Equal)
             })
     });
-    keyed.dedup_by(|(_, a), (_, b)| a.pulses == b.pulses && a.limit_j == b.limit_j);
-    keyed.into_iter().map(|(_, c)| c).collect()
 }
 
 /// One aperture's pass: its azimuth, when it starts (unwrapped), how long
@@ -822,16 +829,7 @@ pub fn cuts_for(
             }
         }
     }
-    // Strongest first, as `cuts_with` orders its own.
-    keyed.sort_by(|(ra, a), (rb, b)| {
-        rb.total_cmp(ra)
-            .then_with(|| a.limit_j.total_cmp(&b.limit_j))
-            .then_with(|| {
-                a.pulses
-                    .partial_cmp(&b.pulses)
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            })
-    });
+    sort_strongest_first(&mut keyed);
     Ok(keyed.into_iter().map(|(_, c)| c).collect())
 }
 
