@@ -178,21 +178,30 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_gaze-lidar"))
 }
 
-fn replay_cli(input: &std::path::Path, out: &std::path::Path) -> std::process::Output {
+/// The gaze and cloud topics of [`bag`].
+const TOPICS: [&str; 4] = ["--gaze-topic", GAZE, "--cloud-topic", CLOUD];
+/// The topics of [`tf_bag`]: the gaze is a yaw on `/yaw`.
+const YAW_TOPICS: [&str; 5] = [
+    "--gaze-topic",
+    "/yaw",
+    "--gaze-yaw-deg",
+    "--cloud-topic",
+    CLOUD,
+];
+
+/// `gaze-lidar replay INPUT ARGS… EXTRA… --out OUT`, run to its end.
+fn replay_with(
+    input: &std::path::Path,
+    args: &[&str],
+    extra: &[&str],
+    out: impl AsRef<std::ffi::OsStr>,
+) -> std::process::Output {
     bin()
-        .args(["replay"])
+        .arg("replay")
         .arg(input)
-        .args([
-            "--gaze-topic",
-            GAZE,
-            "--cloud-topic",
-            CLOUD,
-            "--preset",
-            "paper",
-            "--mode",
-            "range",
-            "--out",
-        ])
+        .args(args)
+        .args(extra)
+        .arg("--out")
         .arg(out)
         .output()
         .unwrap()
@@ -210,7 +219,7 @@ fn replay_copies_every_message_adapts_every_cloud_and_fails_safe_through_the_gap
         let out = dir.path().join(format!("{name}-out.mcap"));
         let bag = bag(compression);
         std::fs::write(&input, &bag).unwrap();
-        let o = replay_cli(&input, &out);
+        let o = run_replay(&input, &out, &[]);
         common::no_panic(&o, "replay");
         assert_eq!(
             o.status.code(),
@@ -333,7 +342,7 @@ fn a_truncated_or_corrupt_bag_is_exit_2_naming_the_offset_and_leaves_no_output()
     std::fs::write(&out, b"old").unwrap();
     let input = dir.path().join("cut.mcap");
     std::fs::write(&input, &bag[..bag.len() / 2]).unwrap();
-    let o = replay_cli(&input, &out);
+    let o = run_replay(&input, &out, &[]);
     common::no_panic(&o, "truncated");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -348,7 +357,7 @@ fn a_truncated_or_corrupt_bag_is_exit_2_naming_the_offset_and_leaves_no_output()
     let mid = bag.len() / 3;
     bad[mid] ^= 0xFF;
     std::fs::write(&input, &bad).unwrap();
-    let o = replay_cli(&input, &out);
+    let o = run_replay(&input, &out, &[]);
     common::no_panic(&o, "corrupt");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -363,7 +372,7 @@ fn a_truncated_or_corrupt_bag_is_exit_2_naming_the_offset_and_leaves_no_output()
     assert!(left.is_empty(), "{left:?}");
     // Not an MCAP at all.
     std::fs::write(&input, b"hello").unwrap();
-    let o = replay_cli(&input, &out);
+    let o = run_replay(&input, &out, &[]);
     assert_eq!(o.status.code(), Some(2));
 }
 
@@ -373,13 +382,12 @@ fn a_topic_of_the_wrong_type_is_exit_2_naming_it() {
     let input = dir.path().join("in.mcap");
     std::fs::write(&input, bag(None)).unwrap();
     let out = dir.path().join("out.mcap");
-    let o = bin()
-        .arg("replay")
-        .arg(&input)
-        .args(["--gaze-topic", CLOUD, "--cloud-topic", GAZE, "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = replay_with(
+        &input,
+        &["--gaze-topic", CLOUD, "--cloud-topic", GAZE],
+        &[],
+        &out,
+    );
     common::no_panic(&o, "wrong type");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -389,7 +397,7 @@ fn a_topic_of_the_wrong_type_is_exit_2_naming_it() {
     );
     assert!(!out.exists());
     // --out is the input.
-    let o = replay_cli(&input, &input);
+    let o = run_replay(&input, &input, &[]);
     assert_eq!(o.status.code(), Some(2));
 }
 
@@ -399,8 +407,8 @@ fn replay_is_deterministic() {
     let input = dir.path().join("in.mcap");
     std::fs::write(&input, bag(Some(mcap::Compression::Lz4))).unwrap();
     let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
-    assert_eq!(replay_cli(&input, &a).status.code(), Some(0));
-    assert_eq!(replay_cli(&input, &b).status.code(), Some(0));
+    assert_eq!(run_replay(&input, &a, &[]).status.code(), Some(0));
+    assert_eq!(run_replay(&input, &b, &[]).status.code(), Some(0));
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     // Compressed output (zstd, lz4): the same messages, deterministic too.
     let plain = read_all(&std::fs::read(&a).unwrap());
@@ -408,15 +416,7 @@ fn replay_is_deterministic() {
         let runs: Vec<Vec<u8>> = (0..2)
             .map(|k| {
                 let out = dir.path().join(format!("{c}{k}.mcap"));
-                let o = bin()
-                    .arg("replay")
-                    .arg(&input)
-                    .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD])
-                    .args(["--preset", "paper", "--mode", "range"])
-                    .args(["--compression", c, "--out"])
-                    .arg(&out)
-                    .output()
-                    .unwrap();
+                let o = run_replay(&input, &out, &["--compression", c]);
                 assert_eq!(
                     o.status.code(),
                     Some(0),
@@ -498,21 +498,7 @@ fn check_mounting(bag: &[u8], extra: &[&str], yaw_deg: f64) -> String {
     let dir = tempfile::tempdir().unwrap();
     let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
     std::fs::write(&input, bag).unwrap();
-    let o = bin()
-        .arg("replay")
-        .arg(&input)
-        .args([
-            "--gaze-topic",
-            "/yaw",
-            "--gaze-yaw-deg",
-            "--cloud-topic",
-            CLOUD,
-        ])
-        .args(extra)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = replay_with(&input, &YAW_TOPICS, extra, &out);
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(0), "{err}");
     let got = read_all(&std::fs::read(&out).unwrap());
@@ -604,23 +590,7 @@ fn a_tilted_static_transform_is_refused_by_name() {
         axis_angle([0.0, 1.0, 0.0], 10.0),
     );
     std::fs::write(&input, tf_bag(&[("base_link", "lidar", q)])).unwrap();
-    let run = |extra: &[&str]| {
-        bin()
-            .arg("replay")
-            .arg(&input)
-            .args([
-                "--gaze-topic",
-                "/yaw",
-                "--gaze-yaw-deg",
-                "--cloud-topic",
-                CLOUD,
-            ])
-            .args(extra)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap()
-    };
+    let run = |extra: &[&str]| replay_with(&input, &YAW_TOPICS, extra, &out);
     let o = run(&[]);
     common::no_panic(&o, "tilted");
     let err = String::from_utf8_lossy(&o.stderr);
@@ -719,24 +689,12 @@ fn float64_yaw_gaze_and_a_mounting_yaw() {
     let dir = tempfile::tempdir().unwrap();
     let (input, out) = (dir.path().join("in.mcap"), dir.path().join("out.mcap"));
     std::fs::write(&input, &buf).unwrap();
-    let o = bin()
-        .arg("replay")
-        .arg(&input)
-        .args([
-            "--gaze-topic",
-            "/yaw",
-            "--gaze-yaw-deg",
-            "--cloud-topic",
-            CLOUD,
-            "--sensor-yaw-deg",
-            "90",
-            "--seed",
-            "7",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = replay_with(
+        &input,
+        &YAW_TOPICS,
+        &["--sensor-yaw-deg", "90", "--seed", "7"],
+        &out,
+    );
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -800,7 +758,7 @@ fn devices_fifos_and_symlinks_as_out_are_written_through_never_replaced() {
     let input = dir.path().join("in.mcap");
     std::fs::write(&input, bag(None)).unwrap();
     let plain = dir.path().join("plain.mcap");
-    let o = replay_cli(&input, &plain);
+    let o = run_replay(&input, &plain, &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let expected = std::fs::read(&plain).unwrap();
 
@@ -815,7 +773,7 @@ fn devices_fifos_and_symlinks_as_out_are_written_through_never_replaced() {
         made.is_ok_and(|m| m.status.success()).then_some(p)
     };
     if let Some(null) = node("null", "3") {
-        let o = replay_cli(&input, &null);
+        let o = run_replay(&input, &null, &[]);
         common::no_panic(&o, "null device");
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         assert!(std::fs::symlink_metadata(&null)
@@ -825,7 +783,7 @@ fn devices_fifos_and_symlinks_as_out_are_written_through_never_replaced() {
     }
     if let Some(full) = node("full", "7") {
         // A full device is an output error, exit 1.
-        let o = replay_cli(&input, &full);
+        let o = run_replay(&input, &full, &[]);
         common::no_panic(&o, "full device");
         assert_eq!(
             o.status.code(),
@@ -847,7 +805,7 @@ fn devices_fifos_and_symlinks_as_out_are_written_through_never_replaced() {
         let fifo = fifo.clone();
         std::thread::spawn(move || std::fs::read(fifo).unwrap())
     };
-    let o = replay_cli(&input, &fifo);
+    let o = run_replay(&input, &fifo, &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(reader.join().unwrap(), expected);
     assert!(std::fs::symlink_metadata(&fifo)
@@ -860,7 +818,7 @@ fn devices_fifos_and_symlinks_as_out_are_written_through_never_replaced() {
     std::fs::write(&target, b"old").unwrap();
     let link = dir.path().join("link.mcap");
     std::os::unix::fs::symlink(&target, &link).unwrap();
-    let o = replay_cli(&input, &link);
+    let o = run_replay(&input, &link, &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(std::fs::symlink_metadata(&link)
         .unwrap()
@@ -952,16 +910,9 @@ fn run_replay(
     out: &std::path::Path,
     extra: &[&str],
 ) -> std::process::Output {
-    let o = bin()
-        .arg("replay")
-        .arg(input)
-        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD])
-        .args(["--preset", "paper", "--mode", "range"])
-        .args(extra)
-        .arg("--out")
-        .arg(out)
-        .output()
-        .unwrap();
+    let mut args = TOPICS.to_vec();
+    args.extend(["--preset", "paper", "--mode", "range"]);
+    let o = replay_with(input, &args, extra, out);
     common::no_panic(&o, "replay");
     o
 }
@@ -1080,12 +1031,7 @@ fn out_dash_is_stdout_and_a_missing_folder_is_exit_2_naming_out() {
     assert!(!dir.path().join("-").exists());
     // A bad input writes nothing to stdout.
     std::fs::write(&input, b"not an mcap").unwrap();
-    let o = bin()
-        .arg("replay")
-        .arg(&input)
-        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD, "--out", "-"])
-        .output()
-        .unwrap();
+    let o = replay_with(&input, &TOPICS, &[], "-");
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty());
     // A missing output folder: bad input, named.
@@ -1545,14 +1491,8 @@ fn frames_that_fall_back_to_the_baseline_are_reported() {
     let input = dir.path().join("in.mcap");
     std::fs::write(&input, bag(None)).unwrap();
     let out = dir.path().join("out.mcap");
-    let o = bin()
-        .arg("replay")
-        .arg(&input)
-        .args(["--gaze-topic", GAZE, "--cloud-topic", CLOUD])
-        .args(["--preset", "vls128", "--mode", "resolution", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let vls = ["--preset", "vls128", "--mode", "resolution"];
+    let o = replay_with(&input, &TOPICS, &vls, &out);
     common::no_panic(&o, "replay");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{err}");
@@ -2314,7 +2254,7 @@ fn single_byte_corruptions_of_compressed_bags_never_abort_or_leave_a_temp_file()
             b[at] ^= [0xff, 0x01, 0x80, 0x55][n % 4];
             std::fs::write(&input, &b).unwrap();
             let _ = std::fs::remove_file(&out);
-            let o = replay_cli(&input, &out);
+            let o = run_replay(&input, &out, &[]);
             let stderr = String::from_utf8_lossy(&o.stderr);
             assert!(
                 matches!(o.status.code(), Some(0..=2)),
