@@ -96,21 +96,19 @@ fn optimized_presets_with_a_head_certify_as_the_head_in_every_mode() {
     }
 }
 
-/// A configuration with a head whose bound binds (the `vls128` head at a
-/// budget its eye safety cannot carry everywhere): the answer sits at the
-/// head's limit, `check` certifies it as the head, and since the head cuts
-/// (single-channel cuts scaled by the head's weights) do not reach the
-/// head's figure here, the loop's tightening is stated.
-#[test]
-fn a_config_whose_head_binds_is_certified_as_the_head() {
-    let dir = std::env::temp_dir().join(format!("gaze-lidar-head-bind-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let cfg = dir.join("head_binds.toml");
+/// `profile --config C --gaze-deg 90` for a configuration whose head binds
+/// (the `vls128` head at a budget its eye safety cannot carry everywhere) on
+/// `bins` bins: its JSON output, read back.
+fn head_binding_profile(bins: usize) -> (String, Profile) {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("head_binds.toml");
     std::fs::write(
         &cfg,
-        "bins = 72\n[lidar]\npreset = \"vls128\"\naverage_power_w = 6.0e-5\n\
-         [limits]\npower_w_min = 2.4e-6\npower_w_max = 1.0e-3\n\
-         spin_accel_rad_s2_max = \"unlimited\"\n[objective]\nmode = \"range\"\n",
+        format!(
+            "bins = {bins}\n[lidar]\npreset = \"vls128\"\naverage_power_w = 6.0e-5\n\
+             [limits]\npower_w_min = 2.4e-6\npower_w_max = 1.0e-3\n\
+             spin_accel_rad_s2_max = \"unlimited\"\n[objective]\nmode = \"range\"\n"
+        ),
     )
     .unwrap();
     let o = run(
@@ -126,6 +124,16 @@ fn a_config_whose_head_binds_is_certified_as_the_head() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let json = stdout(&o);
     let p = Profile::from_json(&json, "out").unwrap();
+    (json, p)
+}
+
+/// The head-binding configuration at 72 bins: the answer sits at the
+/// head's limit, `check` certifies it as the head, and since the head cuts
+/// (single-channel cuts scaled by the head's weights) do not reach the
+/// head's figure here, the loop's tightening is stated.
+#[test]
+fn a_config_whose_head_binds_is_certified_as_the_head() {
+    let (json, p) = head_binding_profile(72);
     let c = gaze_lidar::checker::certify(p.clone()).unwrap();
     let es = c.eye_safety().unwrap();
     assert_eq!(es.head.as_ref().unwrap().channels, 128);
@@ -138,7 +146,6 @@ fn a_config_whose_head_binds_is_certified_as_the_head() {
     assert!(opt.upper_bound >= opt.objective);
     assert!(opt.eye_safety_tightening.is_some_and(|f| f > 1.0));
     check_names_the_head(&json, "vls128 head binds", 128);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The same configuration at 360 bins, where the head's short-window
@@ -149,28 +156,7 @@ fn a_config_whose_head_binds_is_certified_as_the_head() {
 /// 5.2655 against 5.9255 now) and ends at the head's limit.
 #[test]
 fn per_cut_head_factors_reach_the_head_limit_without_a_large_tightening() {
-    let dir = std::env::temp_dir().join(format!("gaze-lidar-head-short-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let cfg = dir.join("head_binds_360.toml");
-    std::fs::write(
-        &cfg,
-        "bins = 360\n[lidar]\npreset = \"vls128\"\naverage_power_w = 6.0e-5\n\
-         [limits]\npower_w_min = 2.4e-6\npower_w_max = 1.0e-3\n\
-         spin_accel_rad_s2_max = \"unlimited\"\n[objective]\nmode = \"range\"\n",
-    )
-    .unwrap();
-    let o = run(
-        &[
-            "profile",
-            "--config",
-            cfg.to_str().unwrap(),
-            "--gaze-deg",
-            "90",
-        ],
-        None,
-    );
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let p = Profile::from_json(&stdout(&o), "out").unwrap();
+    let (_, p) = head_binding_profile(360);
     let c = gaze_lidar::checker::certify(p.clone()).unwrap();
     let es = c.eye_safety().unwrap();
     assert!(
@@ -182,5 +168,4 @@ fn per_cut_head_factors_reach_the_head_limit_without_a_large_tightening() {
     let f = opt.eye_safety_tightening.unwrap_or(1.0);
     assert!(f < 1.01, "tightened by {f}");
     assert!(opt.objective > 5.9, "{}", opt.objective);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
