@@ -393,39 +393,29 @@ fn closed_forms_run_on_the_configs_sensor() {
     let paper = baseline_row(&cell(&["--variant", "baseline"]));
     // The paper config's sensor is the paper preset's.
     let paper_cfg = format!("{configs}paper.toml");
-    let o = cell(&[
-        "--variant",
-        "baseline",
-        "--variant",
-        "optimized",
-        "--optimizer-config",
-        &paper_cfg,
-    ]);
+    // `variant` and the optimized variant of `cfg`, in one cell.
+    let beside_optimized = |variant: &str, cfg: &str| {
+        cell(&[
+            "--variant",
+            variant,
+            "--variant",
+            "optimized",
+            "--optimizer-config",
+            cfg,
+        ])
+    };
+    let o = beside_optimized("baseline", &paper_cfg);
     assert_eq!(baseline_row(&o), paper);
     // Another preset, another sensor (10 Hz, its own channels and range).
     let vls = baseline_row(&cell(&["--variant", "baseline", "--preset", "vls128"]));
     assert_ne!(vls, paper);
     let vls_cfg = format!("{configs}vls128_eye.toml");
-    let o = cell(&[
-        "--variant",
-        "baseline",
-        "--variant",
-        "optimized",
-        "--optimizer-config",
-        &vls_cfg,
-    ]);
+    let o = beside_optimized("baseline", &vls_cfg);
     assert_ne!(baseline_row(&o), paper);
     assert_bad_input(&cell(&["--preset", "nope"]), "--preset");
     // smooth's slew limit rejects the range closed form's power step.
     let smooth = format!("{configs}smooth.toml");
-    let o = cell(&[
-        "--variant",
-        "range",
-        "--variant",
-        "optimized",
-        "--optimizer-config",
-        &smooth,
-    ]);
+    let o = beside_optimized("range", &smooth);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
