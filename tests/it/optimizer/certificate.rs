@@ -269,10 +269,10 @@ fn the_mps_export_round_trips_through_highs() {
 /// it.
 #[test]
 fn the_global_bound_is_never_exceeded_on_small_instances() {
-    use gaze_lidar::model::lidar::PowerAccounting;
+    use super::perturb::{never_above_the_bound, Moves};
     use gaze_lidar::optimizer::global::{model_objective, upper_bound};
-    use gaze_lidar::optimizer::{optimize, OptimizerConfig};
-    use rand::{Rng, SeedableRng};
+    use gaze_lidar::optimizer::{optimize, ObjectiveKind, OptimizerConfig};
+    use rand::SeedableRng;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(24);
     for name in CONFIGS {
         let text = std::fs::read_to_string(format!("examples/configs/{name}.toml")).unwrap();
@@ -281,121 +281,21 @@ fn the_global_bound_is_never_exceeded_on_small_instances() {
             .problem()
             .unwrap();
         problem.bins = 12;
+        // The √ utility's bound (the shipped configs default to detection,
+        // whose bound `detection_global.rs` tests).
+        problem.objective.kind = ObjectiveKind::Sqrt;
         let gaze = 90.0;
         let answer = optimize(&problem, gaze).unwrap().profile().clone();
         let ub = upper_bound(&problem, gaze).unwrap();
         let j0 = model_objective(&problem, gaze, &answer).unwrap();
         assert!(j0 <= ub, "{name}: answer {j0} above the bound {ub}");
-        let lid = &problem.lidar;
-        let l = &lid.limits;
-        let mode = problem.objective.mode;
-        let accel = l.spin_accel_rad_s2_max.is_some();
-        let n = answer.bins.len();
-        let theta: Vec<f64> = answer
-            .bins
-            .iter()
-            .map(|b| b.width_deg.to_radians())
-            .collect();
-        let period = 1.0 / lid.frame_rate_hz;
-        let (p_lo, p_hi) = if problem.levels.power_w.is_empty() {
-            (l.power_w_min, l.power_w_max)
-        } else {
-            let v = &problem.levels.power_w;
-            (
-                v.iter()
-                    .copied()
-                    .fold(f64::INFINITY, f64::min)
-                    .max(l.power_w_min),
-                v.iter().copied().fold(0.0, f64::max).min(l.power_w_max),
-            )
+        let moves = Moves {
+            level_jumps: false,
+            spins_in_setpoint_hull: false,
+            draws: 4000,
         };
-        let feasible = |p: &[f64], t: &[f64]| -> bool {
-            let frame: f64 = t.iter().sum();
-            let spend = match lid.power_accounting {
-                PowerAccounting::Angle => {
-                    p.iter().zip(&theta).map(|(a, b)| a * b).sum::<f64>() / std::f64::consts::TAU
-                }
-                PowerAccounting::Time => p.iter().zip(t).map(|(a, b)| a * b).sum::<f64>() / period,
-            };
-            let slew_ok = l.power_slew_w_per_deg_max.is_none_or(|s| {
-                (0..n).all(|i| {
-                    let j = (i + 1) % n;
-                    (p[j] - p[i]).abs()
-                        <= s * 0.5 * (answer.bins[i].width_deg + answer.bins[j].width_deg)
-                })
-            });
-            let spin_ok = (0..n).all(|i| {
-                let w = theta[i] / t[i];
-                w >= l.spin_rad_s_min * (1.0 - 1e-12) && w <= l.spin_rad_s_max * (1.0 + 1e-12)
-            });
-            (frame - period).abs() <= 1e-12 * period
-                && spend <= lid.average_power_w
-                && p.iter().all(|&v| v >= p_lo && v <= p_hi)
-                && slew_ok
-                && spin_ok
-        };
-        let p0: Vec<f64> = answer.bins.iter().map(|b| b.power_w).collect();
-        let t0: Vec<f64> = answer.bins.iter().map(|b| b.dwell_s.unwrap()).collect();
-        let mut tried = 0;
-        let mut best = j0;
-        for _ in 0..4000 {
-            let (mut p, mut t) = (p0.clone(), t0.clone());
-            let (i, j) = (rng.random_range(0..n), rng.random_range(0..n));
-            if i == j {
-                continue;
-            }
-            let scale: f64 = rng.random_range(-0.3..0.3);
-            if mode.controls_range() {
-                // Trade power between i and j at equal spend.
-                let dp = scale * (p_hi - p_lo);
-                let wi = if lid.power_accounting == PowerAccounting::Angle {
-                    theta[i]
-                } else {
-                    t[i]
-                };
-                let wj = if lid.power_accounting == PowerAccounting::Angle {
-                    theta[j]
-                } else {
-                    t[j]
-                };
-                p[i] += dp;
-                p[j] -= dp * wi / wj;
-            }
-            // Under an acceleration limit a dwell trade steps the spin, which
-            // the checker rejects: spin moves are the next test's.
-            if mode.controls_resolution() && !accel && rng.random_bool(0.5) {
-                let dt = scale * t[i].min(t[j]);
-                t[i] += dt;
-                t[j] -= dt;
-            }
-            if !feasible(&p, &t) {
-                continue;
-            }
-            let mut prof = answer.clone();
-            for (k, b) in prof.bins.iter_mut().enumerate() {
-                b.power_w = p[k];
-                if !accel {
-                    b.dwell_s = Some(t[k]);
-                    b.spin_start_rad_s = theta[k] / t[k];
-                    b.spin_end_rad_s = theta[k] / t[k];
-                }
-            }
-            // The relaxation keeps eye safety's Rule 1 cap (valid for every
-            // certifiable profile): points the bound rejects are not feasible.
-            if let Some(params) = prof.limits.eye_safety.as_ref() {
-                let r = gaze_lidar::eye_safety::evaluate_profile(&prof, params).unwrap();
-                if r.worst_ratio > 1.0 {
-                    continue;
-                }
-            }
-            tried += 1;
-            let jv = model_objective(&problem, gaze, &prof).unwrap();
-            best = best.max(jv);
-            assert!(
-                jv <= ub,
-                "{name}: a feasible point reaches {jv} above the bound {ub}"
-            );
-        }
+        let (tried, best) =
+            never_above_the_bound(name, &problem, gaze, &answer, (j0, ub), moves, &mut rng);
         eprintln!("{name} (12 bins): answer {j0}, best of {tried} feasible perturbations {best}, bound {ub}");
         assert!(tried > 100, "{name}: only {tried} feasible perturbations");
     }

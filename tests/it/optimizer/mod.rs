@@ -12,6 +12,7 @@ mod family;
 mod global_adversarial;
 mod golden;
 mod head;
+mod perturb;
 mod setpoints;
 mod solve;
 mod units;
