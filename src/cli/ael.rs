@@ -135,11 +135,10 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     let pass = match a.beam_diameter_mm {
         Some(d) => {
             let p = scan_pass_angle_deg(r.band, d);
-            if p > 360.0 {
+            if p >= 360.0 {
                 return Err(CliError::input(format!(
-                    "--beam-diameter-mm: {} mm gives a scan pass angle of {}° (aperture {} mm + beam, at {} mm), more than a turn (> 360°): the beam cannot be that wide",
+                    "--beam-diameter-mm: {} mm reaches the aperture at every head angle (aperture {} mm + beam, half of it at least the {} mm distance: a scan pass of 360°): the beam cannot be that wide",
                     Num(d),
-                    Num(p),
                     Num(r.aperture_diameter_mm),
                     Num(r.aperture_distance_mm)
                 )));

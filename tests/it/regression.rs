@@ -952,11 +952,13 @@ fn a_beam_wider_than_a_turn_is_refused() {
         )
     };
     for d in ["1e300", "1e5", "700"] {
-        expect(&ael(d), 2, &["--beam-diameter-mm", "360"], d);
+        expect(&ael(d), 2, &["--beam-diameter-mm", "360°"], d);
     }
-    // The largest beam within a turn: (7 mm + d) / 100 mm = 2π rad.
-    let edge = 200.0 * std::f64::consts::PI - 7.0;
-    for d in [8.0, 600.0, edge - 1e-9] {
+    // The widest beam that does not reach the aperture at every head
+    // angle: (7 mm + d)/2 < 100 mm (the pass, 2·asin((7 + d)/200), below a
+    // whole turn).
+    let edge = 200.0 - 7.0;
+    for d in [8.0, 150.0, edge - 1e-9] {
         let o = ael(&d.to_string());
         assert_eq!(o.status.code(), Some(0), "{d}: {}", stderr(&o));
         let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -964,9 +966,9 @@ fn a_beam_wider_than_a_turn_is_refused() {
         assert!(pass > 0.0 && pass <= 360.0, "{d}: {pass}");
     }
     expect(
-        &ael(&(edge + 1e-6).to_string()),
+        &ael(&edge.to_string()),
         2,
-        &["--beam-diameter-mm"],
+        &["--beam-diameter-mm", "every head angle"],
         "edge",
     );
 }

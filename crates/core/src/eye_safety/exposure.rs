@@ -88,12 +88,18 @@ pub fn pass_angle_deg(params: &EyeSafetyParams, laser: &Laser) -> f64 {
 }
 
 /// The angle the head turns while the beam (diameter `beam_diameter_mm` at
-/// the aperture) sweeps across the Condition 3 aperture of `band`, 100 mm
-/// from the scan centre: (aperture + beam) / 100 mm, in degrees — not
-/// clamped (above 360° the beam is wider than the scan circle allows).
+/// the aperture, on a ray from the spin axis) overlaps the Condition 3
+/// aperture of `band`, 100 mm from the scan centre: the aperture centre
+/// within (aperture + beam)/2 of the ray in 3-D,
+/// [`super::head::geometry::radial_pass_angle_deg`], degrees (360 once the beam
+/// reaches the aperture at every turn).
 #[must_use]
 pub fn scan_pass_angle_deg(band: ael::Band, beam_diameter_mm: f64) -> f64 {
-    ((band.aperture_mm() + beam_diameter_mm) / APERTURE_DISTANCE_MM).to_degrees()
+    super::head::geometry::radial_pass_angle_deg(
+        band.aperture_mm(),
+        beam_diameter_mm,
+        APERTURE_DISTANCE_MM,
+    )
 }
 
 /// The bins of a profile as the bound sees them.

@@ -28,12 +28,19 @@ fn seg(start_deg: f64, width_deg: f64, power_w: f64, spin_rad_s: f64) -> Seg {
     }
 }
 
-/// 1450 nm, 200 kHz, beam 1 mm: pass arc `2h = (3.5571 + 1)/100` rad =
-/// 2.6110°. At 1 rad/s everywhere, 100 pairs of a hot bin (0.9 of a pair,
+/// The pass angle, rad, from its definition: the head turn while the
+/// aperture centre, 100 mm from the axis, is within `(a + D)/2` of the ray,
+/// `2·asin((a + D)/200)`.
+fn pass_rad(aperture_mm: f64, beam_mm: f64) -> f64 {
+    2.0 * ((aperture_mm + beam_mm) / 200.0).asin()
+}
+
+/// 1450 nm, 200 kHz, beam 1 mm: pass arc `2h = 2·asin((3.5571 + 1)/200)` rad
+/// = 2.6113°. At 1 rad/s everywhere, 100 pairs of a hot bin (0.9 of a pair,
 /// `p` W) and a cold one (0.1, dark) fill half the pass arc from 10°; the
 /// rest is dark.
 fn alternating_pass(p: f64) -> (Vec<Seg>, f64, f64) {
-    let two_h_deg = ((APERTURE_IR_MM + 1.0) / 100.0f64).to_degrees();
+    let two_h_deg = pass_rad(APERTURE_IR_MM, 1.0).to_degrees();
     let region = 0.5 * two_h_deg;
     let pair = region / 100.0;
     let mut segs = vec![seg(0.0, 10.0, 0.0, 1.0)];
@@ -98,7 +105,7 @@ fn long_walk_inside_one_pass_is_not_under_counted() {
 /// 0.9789 would certify it.
 #[test]
 fn pass_count_rule_evaluates_the_first_step_of_a_row() {
-    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let two_h = pass_rad(APERTURE_IR_MM, 1.0);
     let frame = 1.0 / 11.0;
     let tau = 0.9 * frame;
     let w_s = two_h / tau;
@@ -263,7 +270,7 @@ fn head_validation_edges_by_hand() {
 /// about `(5.8838/7.5)^0.75` = 0.83 of that (it certified).
 #[test]
 fn walk_spans_the_whole_pass_arc() {
-    let two_h_deg = ((APERTURE_IR_MM + 10.0) / 100.0f64).to_degrees();
+    let two_h_deg = pass_rad(APERTURE_IR_MM, 10.0).to_degrees();
     assert!(two_h_deg > 4.0 + 1.5, "{two_h_deg}");
     let (f_p, p) = (1e5, 0.020624);
     let hot_deg = 7.5;
@@ -372,12 +379,12 @@ fn multi_pass_figures_carry_the_rounding_pads() {
 /// The bound snaps every pass edge by `s` (the cuts are computed, so an
 /// aperture within `2s` of a touch cut may be the one that touches): Rule 1
 /// covers every aperture within `2s` of a cut with the bins touched there.
-/// 905 nm, beam 0.5 mm: `2h` = 0.075 rad (4.2972°). A dark bin
+/// 905 nm, beam 0.5 mm: `2h` = `2·asin(0.0375)` = 0.0750176 rad (4.2982°). A dark bin
 /// `[0°, 10°)` at `ω_S` = 1e-3 rad/s, a dark bin `[10°, 10° + a)` and a hot
 /// one (`p`) of 5° after it at `ω_A` = 100 rad/s, the rest dark at
 /// `ω_A`; `a = 2h − δ`, `δ` = 5e-4°. The aperture at `θ_c = 10° + a − h`
 /// touches the hot bin with its right edge while its left edge is `δ`
-/// inside the slow bin: `τ_c = δ/ω_S + a/ω_A` = 9.47652e-3 s (passes to
+/// inside the slow bin: `τ_c = δ/ω_S + a/ω_A` = 9.476735e-3 s (passes to
 /// the right, into the hot bin, are shorter: the left edge leaves the slow
 /// bin). `f_p` puts `τ_c·f_p` at 948 − 1.5e-3: 948 pulses. The aperture
 /// `2s` before the cut: `τ = τ_c + 2s·(1/ω_S − 1/ω_A)` = τ_c + 3.4906e-8 s,
@@ -389,13 +396,13 @@ fn multi_pass_figures_carry_the_rounding_pads() {
 fn rule_one_counts_the_touching_pass_within_the_snap() {
     use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
     let prm = params(905.0, 0.5);
-    let two_h = 0.075;
+    let two_h = pass_rad(7.0, 0.5);
     let two_h_deg = f64::to_degrees(two_h);
     let (w_s, w_a) = (1e-3, 100.0);
     let delta_deg = 5e-4;
     let a_deg = two_h_deg - delta_deg;
     let tau_c = delta_deg.to_radians() / w_s + a_deg.to_radians() / w_a;
-    assert!((tau_c / 9.47652e-3 - 1.0).abs() < 1e-5, "{tau_c}");
+    assert!((tau_c / 9.476735e-3 - 1.0).abs() < 1e-6, "{tau_c}");
     let f_p = (948.0 - 1.5e-3) / tau_c;
     assert!(f_p < 2e5, "one pulse per T_i group: {f_p}");
     let s_rad = 1e-9f64.to_radians();
@@ -415,7 +422,7 @@ fn rule_one_counts_the_touching_pass_within_the_snap() {
         seg(hot + 5.0, 355.0 - hot, 0.0, w_a),
     ];
     let l = laser(&prm, f_p).unwrap();
-    assert!((pass_angle_deg(&prm, &l) / two_h_deg - 1.0).abs() < 1e-12);
+    assert!((pass_angle_deg(&prm, &l) / two_h_deg - 1.0).abs() < 1e-11);
     let truth = e_pulse / ael_j;
     let r = evaluate_segments(&segs, &prm, f_p).unwrap();
     assert!(
@@ -496,7 +503,7 @@ fn whole_pass_figure_at_a_row_edge_covers_the_cut_error() {
     use gaze_lidar_core::eye_safety::exposure::{laser, pass_angle_deg};
     let prm = params(1450.0, 1.0);
     let (f_p, p) = (1e4, 1e-3);
-    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let two_h = pass_rad(APERTURE_IR_MM, 1.0);
     let (w1, w2) = (two_h / 0.3, two_h / 0.4);
     let ten = 10f64.to_radians();
     let frame_s = 1e5;
@@ -508,7 +515,7 @@ fn whole_pass_figure_at_a_row_edge_covers_the_cut_error() {
     ];
     let l = laser(&prm, f_p).unwrap();
     let half_deg = 0.5 * pass_angle_deg(&prm, &l);
-    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-12);
+    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-11);
     let t_err = 2.0 * 1e-12 * frame_s;
     let ael_edge = 4.4e-3 * 0.35f64.powf(0.25);
     assert!((ael_edge / 3.38431e-3 - 1.0).abs() < 1e-5, "{ael_edge}");
@@ -563,7 +570,7 @@ fn whole_pass_figure_takes_the_cap_s_kink() {
     let prm = params(1450.0, 1.0);
     let (f_p, p) = (99.5, 1e-3);
     let delta = 1.0 / f_p;
-    let two_h = (APERTURE_IR_MM + 1.0) / 100.0;
+    let two_h = pass_rad(APERTURE_IR_MM, 1.0);
     let (tau_a, tau_b) = (0.01, 0.2);
     let segs = vec![
         seg(0.0, 10.0, 2.0 * p, two_h / tau_a),
@@ -572,7 +579,7 @@ fn whole_pass_figure_takes_the_cap_s_kink() {
     ];
     let l = laser(&prm, f_p).unwrap();
     let half_deg = 0.5 * pass_angle_deg(&prm, &l);
-    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-12);
+    assert!((2.0 * half_deg / two_h.to_degrees() - 1.0).abs() < 1e-11);
     let b = bound::evaluate(&segs, half_deg, &l);
     let e_cap = b.max_pass_energy_j;
     let twenty = 21.0 * p * delta;
@@ -835,8 +842,8 @@ fn head_memo_keeps_each_head_s_own_figures() {
 ///
 /// One radial channel from the axis (10 mm exit beam, no divergence), 905 nm,
 /// 5 ns, 1 kHz (cycle 1 ms), 1 mW, uniform 1000 rad/s; declared at 200 mm.
-/// By hand: one pass is `(7 + 10)/R` rad, 9.7403° (0.17 ms) at 100 mm and
-/// 4.8701° (0.085 ms) at 200 mm; both are shorter than the 1 ms between
+/// By hand: one pass is `2·asin(8.5/R)` rad, 9.7521° (0.17 ms) at 100 mm and
+/// 4.8716° (0.085 ms) at 200 mm; both are shorter than the 1 ms between
 /// pulses, so at either distance a pass holds at most one pulse, every
 /// pulse count behind Rule 1's C5 is the same and Rule 1 (binding on both
 /// surfaces) gives the same figure: the two worst ratios tie, bit for bit,
@@ -875,7 +882,7 @@ fn a_tie_of_both_surfaces_takes_the_100_mm_report() {
         declared.worst_ratio,
         standard.worst_ratio
     );
-    let pass_deg = |r: f64| (17.0 / r).to_degrees();
+    let pass_deg = |r: f64| (2.0 * (8.5 / r).asin()).to_degrees();
     assert!((standard.pass_angle_deg - pass_deg(100.0)).abs() < 1e-9);
     assert!((declared.pass_angle_deg - pass_deg(200.0)).abs() < 1e-9);
     let verdict = evaluate_segments(&segs, &at(200.0), f_p).unwrap();

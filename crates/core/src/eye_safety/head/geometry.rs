@@ -12,22 +12,33 @@
 //! where the beam is `w_c = exit + divergence·d_c` wide.
 //!
 //! **The footprint.** A pulse counts (whole) at an aperture position when
-//! the aperture (diameter `a`) and the beam overlap: the aperture centre is
-//! within `ρ_c = (a + w_c)/2` of the ray, measured in the surface's tangent
-//! plane at the hit point and laid along the surface (arc length and height:
-//! the convention of the single-channel pass angle `(a + D)/R`, which is
-//! exactly this for a radial ray). In that plane the set is an ellipse whose
-//! bounding box has half-width `ρ_c / cos β_c` along the arc (`β_c` the
-//! horizontal incidence, between the ray's horizontal direction and the
-//! radial at the hit point) and half-height
-//! `ρ_c·sqrt(1 + tan²ε_c / cos²β_c)`. The bound uses the box (it holds the
-//! ellipse), so the pass of channel `c` is `(a + w_c)/(R·cos β_c)` rad.
+//! the aperture (diameter `a`) and the beam overlap. Whatever way the
+//! aperture faces, that needs its centre within `ρ_c = (a + w_c)/2` of the
+//! ray in 3-D (the aperture facing the beam is the case where the set is
+//! largest: a tilted aperture's disc, seen along the beam, lies inside the
+//! facing one's). With `α = φ_c − θ` (`θ` the aperture centre's head-frame
+//! angle), the centre's horizontal distance to the ray's horizontal line is
+//! `|R·sin α − r0·sin φ_c|`, and along it `a(α) = R·cos α − r0·cos φ_c`;
+//! in 3-D the distance is `sqrt(b² + (a·sin ε − Z·cos ε)²)` (`b` the
+//! horizontal one, `Z` the height above the crossing point) while the
+//! centre is ahead of the crossing point. So, with `s = r0·sin φ_c / R`
+//! (`= sin β_c`, `β_c = φ_c − ψ_c` the horizontal incidence) and
+//! `q = ρ_c/R`, the set lies in `α ∈ [asin(s − q), asin(s + q)]` (each end
+//! clamped to ±90°: beyond it the centre is behind the crossing point,
+//! at least `R − r0 > ρ_c` from it) and, at each `α`, in heights
+//! `Z ∈ a(α)·tan ε ± ρ_c/cos ε`. The bound uses the box centred on the hit
+//! point that holds that set: half-turn `h_c = max(asin(s+q) − β_c,
+//! β_c − asin(s−q))`, half-height `ρ_c/cos ε + |tan ε|·max|a(α) − s_c|`. A
+//! radial ray (`s = 0`) has the single-channel pass angle `2·asin(ρ/R)`
+//! ([`radial_pass_angle_deg`]). When `R − r0 ≤ ρ_c` the crossing point
+//! itself is within reach: the box is the whole turn and every height the
+//! ray and the ball around the crossing point can reach.
 //!
 //! **Rounding.** The trigonometry is rounded outward by
-//! [`GEOMETRY_MARGIN`] (relative) wherever it is not exact: a radial ray
-//! (`r0 = 0` or `φ_c = 0`, `ε_c = 0`, no divergence) has `cos β = 1`,
-//! `w = exit` exactly, so a 1-channel head of that shape has exactly the
-//! single-channel pass angle.
+//! [`GEOMETRY_MARGIN`] (relative) wherever it is not exact: a flat ray
+//! without divergence has `w = exit` exactly and half-height `ρ` exactly; a
+//! radial ray has exactly the single-channel pass angle (both are
+//! [`radial_pass_angle_deg`]).
 
 use super::Head;
 
@@ -48,7 +59,8 @@ pub struct Footprint {
     pub slant_mm: f64,
     /// Beam diameter there, mm.
     pub width_mm: f64,
-    /// `cos β_c`, the horizontal incidence (rounded down).
+    /// `cos β_c`, the horizontal incidence (rounded down; reported, the
+    /// box does not use it).
     pub cos_beta: f64,
     /// Half-width of the footprint box along the arc, mm (aperture
     /// included).
@@ -56,8 +68,56 @@ pub struct Footprint {
     /// Half-height of the footprint box, mm (aperture included).
     pub half_height_mm: f64,
     /// The head turn while the aperture is inside the box: the pass angle,
-    /// deg, `((a + w)/(R·cos β)).to_degrees()` (not clamped).
+    /// deg, `2·h_c` (360 when the box is the whole turn).
     pub pass_angle_deg: f64,
+}
+
+/// The head turn, deg, while the Condition 3 aperture (diameter
+/// `aperture_mm`) `r_mm` from the spin axis overlaps a beam `width_mm` wide
+/// on a ray leaving the axis: its centre within `ρ = (a + w)/2` of the ray
+/// in 3-D, `2·asin(ρ/R)`, rounded up by [`GEOMETRY_MARGIN`]; 360 once
+/// `ρ ≥ R` (the beam reaches the aperture at every turn). The one pass
+/// angle of the single-channel bound and of a radial channel of a head.
+#[must_use]
+pub fn radial_pass_angle_deg(aperture_mm: f64, width_mm: f64, r_mm: f64) -> f64 {
+    let q = 0.5 * (aperture_mm + width_mm) / r_mm;
+    if q >= 1.0 {
+        360.0
+    } else {
+        (2.0 * q.asin()).to_degrees() * (1.0 + GEOMETRY_MARGIN)
+    }
+}
+
+/// The box holding the aperture positions (head-frame angle, height) at
+/// which a ray meets the aperture: half-turn (rad) and half-height (mm)
+/// around the hit point. `s = r0·sin φ/R`, `q = ρ/R`, `s_c` the horizontal
+/// distance to the hit point, `cos_phi_r0 = r0·cos φ`, `eps` the elevation
+/// (module docs).
+fn footprint_box(
+    r: f64,
+    s: f64,
+    q: f64,
+    s_c: f64,
+    cos_phi_r0: f64,
+    eps: f64,
+    rho: f64,
+) -> (f64, f64) {
+    let lo = (s - q).max(-1.0).asin();
+    let hi = (s + q).min(1.0).asin();
+    let beta = s.asin();
+    let half_turn = (hi - beta).max(beta - lo);
+    if eps == 0.0 {
+        return (half_turn, rho);
+    }
+    let a = |alpha: f64| r * alpha.cos() - cos_phi_r0;
+    let a_max = if lo <= 0.0 && 0.0 <= hi {
+        r - cos_phi_r0
+    } else {
+        a(lo).max(a(hi))
+    };
+    let a_min = a(lo).min(a(hi));
+    let spread = (a_max - s_c).max(s_c - a_min).max(0.0);
+    (half_turn, rho / eps.cos() + eps.tan().abs() * spread)
 }
 
 /// The footprint of every channel of `head` for an aperture of `aperture_mm`.
@@ -91,21 +151,34 @@ pub fn footprints(head: &Head, aperture_mm: f64) -> Vec<Footprint> {
                 ((phi - psi).cos() * (1.0 - GEOMETRY_MARGIN)).min(1.0)
             };
             let rho = 0.5 * (aperture_mm + width);
-            let half_arc_mm = if radial {
-                rho
+            let (pass_angle_deg, half_arc_mm, half_height_mm) = if r - r0 <= rho {
+                // The crossing point is within reach: every turn, and every
+                // height the ray (|a| ≤ R + r0 along it) or the ball of
+                // radius ρ around the crossing point reaches.
+                let spread = r + r0 + s.abs();
+                let hh = rho / eps.cos() + eps.tan().abs() * spread + rho;
+                (
+                    360.0,
+                    r * std::f64::consts::PI,
+                    hh * (1.0 + GEOMETRY_MARGIN),
+                )
             } else {
-                rho / cos_beta * (1.0 + GEOMETRY_MARGIN)
-            };
-            let half_height_mm = if radial_flat {
-                rho
-            } else {
-                let t = eps.tan() / cos_beta;
-                rho * (1.0 + t * t).sqrt() * (1.0 + GEOMETRY_MARGIN)
-            };
-            let pass_angle_deg = if radial {
-                ((aperture_mm + width) / r).to_degrees()
-            } else {
-                ((aperture_mm + width) / (r * cos_beta)).to_degrees() * (1.0 + GEOMETRY_MARGIN)
+                let (h, hh) = footprint_box(r, r0 * sp / r, rho / r, s, r0 * cp, eps, rho);
+                let pass = if radial {
+                    radial_pass_angle_deg(aperture_mm, width, r)
+                } else {
+                    (2.0 * h).to_degrees() * (1.0 + GEOMETRY_MARGIN)
+                };
+                let hh = if radial_flat {
+                    hh
+                } else {
+                    hh * (1.0 + GEOMETRY_MARGIN)
+                };
+                (
+                    pass,
+                    0.5 * pass.to_radians() * r * (1.0 + GEOMETRY_MARGIN),
+                    hh,
+                )
             };
             Footprint {
                 index,
@@ -180,15 +253,83 @@ mod tests {
     }
 
     /// A radial flat ray without divergence: the single-channel pass angle,
-    /// bit for bit.
+    /// bit for bit; by hand `2·asin(6/100)` = 6.8797°, the arc's half-width
+    /// `100·asin(0.06)` = 6.0036 mm (the chord laid as an arc, 6.8755° and
+    /// 6 mm, was short), half-height `ρ` = 6 mm exactly.
     #[test]
     fn radial_ray_is_the_single_channel_pass() {
         let mut h = head(0.0, vec![ch(0, 0.0, 0.0)]);
         h.divergence_mrad = 0.0;
         let f = footprints(&h, 7.0)[0];
-        assert_eq!(f.pass_angle_deg, ((7.0f64 + 5.0) / 100.0).to_degrees());
-        assert_eq!(f.half_arc_mm, 6.0);
+        let single = crate::eye_safety::exposure::scan_pass_angle_deg(
+            crate::eye_safety::ael::Band::of(905.0).unwrap(),
+            5.0,
+        );
+        assert_eq!(f.pass_angle_deg.to_bits(), single.to_bits());
+        assert!(
+            (f.pass_angle_deg - 6.8797).abs() < 1e-4,
+            "{}",
+            f.pass_angle_deg
+        );
+        assert!(f.pass_angle_deg > ((7.0f64 + 5.0) / 100.0).to_degrees());
+        assert!((f.half_arc_mm - 6.0036).abs() < 1e-4, "{}", f.half_arc_mm);
         assert_eq!(f.half_height_mm, 6.0);
         assert_eq!(f.width_mm, 5.0);
+    }
+
+    /// The 3-D reading by brute force: on a grid of aperture centres on the
+    /// cylinder, every one within `ρ` of the ray (3-D distance to the
+    /// half-line) lies in the footprint box, for oblique, steep and grazing
+    /// rays (the grazing one, `r0` = 90 mm at 80°, `s + q > 1`).
+    #[test]
+    fn the_box_holds_every_position_within_reach_of_the_ray() {
+        let cases = [
+            (60.0, 10.0, 30.0, 5.0, 3.0),
+            (90.0, 0.0, 80.0, 20.0, 0.0),
+            (40.0, 25.0, -20.0, 10.0, 1.0),
+            (0.0, 30.0, 0.0, 150.0, 0.0),
+            (58.63, -25.0, 5.0, 10.0, 2.0),
+        ];
+        for (r0, el, az, exit, div) in cases {
+            let mut h = head(r0, vec![ch(0, el, az)]);
+            h.exit_diameter_mm = exit;
+            h.divergence_mrad = div;
+            let f = footprints(&h, 7.0)[0];
+            let rho = 0.5 * (7.0 + f.width_mm);
+            let (phi, eps) = (az.to_radians(), el.to_radians());
+            let u = [eps.cos() * phi.cos(), eps.cos() * phi.sin(), eps.sin()];
+            let mut inside = 0;
+            for i in 0..=3600 {
+                let theta = f.psi_rad + (f64::from(i) / 1800.0 - 1.0) * std::f64::consts::PI;
+                for k in 0..=400 {
+                    let z = f.z_mm + (f64::from(k) / 200.0 - 1.0) * 4.0 * (rho + 100.0);
+                    let d = [100.0 * theta.cos() - r0, 100.0 * theta.sin(), z];
+                    let t = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]).max(0.0);
+                    let e = [d[0] - t * u[0], d[1] - t * u[1], d[2] - t * u[2]];
+                    if (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() > rho {
+                        continue;
+                    }
+                    inside += 1;
+                    let mut dth = (theta - f.psi_rad).rem_euclid(std::f64::consts::TAU);
+                    if dth > std::f64::consts::PI {
+                        dth -= std::f64::consts::TAU;
+                    }
+                    assert!(
+                        dth.abs() * 100.0 <= f.half_arc_mm,
+                        "{r0} {el} {az}: arc {} > {}",
+                        dth.abs() * 100.0,
+                        f.half_arc_mm
+                    );
+                    assert!(dth.abs().to_degrees() <= 0.5 * f.pass_angle_deg);
+                    assert!(
+                        (z - f.z_mm).abs() <= f.half_height_mm,
+                        "{r0} {el} {az}: height {} > {}",
+                        (z - f.z_mm).abs(),
+                        f.half_height_mm
+                    );
+                }
+            }
+            assert!(inside > 10, "{r0} {el} {az}: {inside}");
+        }
     }
 }

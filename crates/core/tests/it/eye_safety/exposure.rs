@@ -46,14 +46,17 @@ fn laser_parameters_are_validated() {
 #[test]
 fn pass_angle_is_aperture_plus_beam_over_100_mm() {
     let l = laser(&params(), 20_000.0).unwrap();
-    // 905 nm: 7 mm aperture + 8 mm beam at 100 mm.
-    let expected = (15.0f64 / 100.0).to_degrees();
-    assert!((pass_angle_deg(&params(), &l) - expected).abs() < 1e-12);
+    // 905 nm: 7 mm aperture + 8 mm beam at 100 mm: the aperture centre within
+    // 7.5 mm of the ray, 2·asin(0.075) = 8.6026° (the chord laid as an arc,
+    // 15/100 rad = 8.5944°, is short).
+    let expected = (2.0 * 0.075f64.asin()).to_degrees();
+    assert!((pass_angle_deg(&params(), &l) - expected).abs() < 1e-10);
+    assert!(pass_angle_deg(&params(), &l) > (15.0f64 / 100.0).to_degrees());
     let p1550 = params_at(1550.0, 1.5);
     let l = laser(&p1550, 20_000.0).unwrap();
     // 1550 nm: Table 10's largest aperture, 1.5·10^0.375 = 3.5571 mm, + 1.5 mm.
-    let expected = ((1.5 * 10f64.powf(0.375) + 1.5) / 100.0).to_degrees();
-    assert!((pass_angle_deg(&p1550, &l) - expected).abs() < 1e-12);
+    let expected = (2.0 * ((1.5 * 10f64.powf(0.375) + 1.5) / 200.0).asin()).to_degrees();
+    assert!((pass_angle_deg(&p1550, &l) - expected).abs() < 1e-10);
     // A beam wider than the circle is capped at a full turn.
     let huge = EyeSafetyParams {
         beam_diameter_mm: 999.0,
@@ -69,8 +72,8 @@ fn report_fields_follow_from_the_bound() {
     // One hot bin at 4× the rest.
     let s = segs(36, |i| if i == 9 { 4e-4 } else { 1e-4 });
     let r = evaluate_segments(&s, &params(), 20_000.0).unwrap();
-    let pass = (15.0f64 / 100.0).to_degrees();
-    assert!((r.pass_angle_deg - pass).abs() < 1e-12);
+    let pass = (2.0 * 0.075f64.asin()).to_degrees();
+    assert!((r.pass_angle_deg - pass).abs() < 1e-10);
     assert_eq!(r.margin, 1.0 / r.worst_ratio);
     assert_eq!(
         r.worst_ratio,

@@ -756,8 +756,8 @@ fn violations_read_as_stated() {
 /// The integer limits of the four-bin table, worked out by hand: 905 nm,
 /// 5 ns, 8 mm beam, 100 Hz, 1e-7 W per code → quantum q = 1e-9 J,
 /// C4 = 10^0.41.
-/// - pass arc: (7 + 8)/100 rad = 8.5944° → 8595 mdeg; pass 8595/90000·250 =
-///   23.875 ticks → 24; ⌊2.3875⌋ + 1 = 3 pulses;
+/// - pass arc: 2·asin(7.5/100) = 8.60244° → 8603 mdeg; pass 8603/90000·250 =
+///   23.897 ticks → 24; ⌊2.3897⌋ + 1 = 3 pulses;
 /// - rule 1: N = 3 · (⌊(10,000 + 24)/1000⌋ + 1) = 33 ≤ 600, C5 = 1, one
 ///   pulse per T_i: ⌊7.7e-8·C4/q⌋ = ⌊197.92⌋;
 /// - train: k pulses span (k − 1)/100 s; AEL_inf(0) = AEL(5 µs edge) =
@@ -782,7 +782,7 @@ fn derived_limits_by_hand() {
     assert_eq!((l.tick_hz, l.frame_ticks), (1000, 1000));
     assert_eq!(
         (l.pulse_rate_millihz_ceil, l.pass_arc_mdeg),
-        (100_000, 8_595)
+        (100_000, 8_603)
     );
     assert_eq!((l.pass_ticks_max, l.pulses_per_pass_max), (24, 3));
     assert_eq!(l.pulse_code_max, 197);
@@ -799,7 +799,7 @@ fn derived_limits_by_hand() {
 }
 
 /// A 20 s turn (four bins of 5000 ticks at 1 kHz): the pass lasts
-/// 8595/90000·5000 = 477.5 ticks → 478, ⌊47.75⌋ + 1 = 48 pulses, one pass per
+/// 8603/90000·5000 = 477.9 ticks → 478, ⌊47.79⌋ + 1 = 48 pulses, one pass per
 /// T2 window; two passes span at least 20 s − 0.478 s = 19.522 s, past T2:
 /// 3.9e-4·C4·19.522 = 19569913.9 q, / 2 = 9784956 (the time-base rule). The
 /// 48th pulse bucket: 7e-4·C4·0.47^0.75 = 1021342.6 q.
@@ -862,7 +862,7 @@ fn c4_905() -> f64 {
 
 /// Rule 1 with C5 < 1: ten turns a second (four 90° bins of 25 ticks at
 /// 1 kHz), 10 kHz pulses, q = 1e-7 W / 10^4 Hz = 1e-11 J. The pass lasts
-/// 8595/90000·25 = 2.3875 ticks → 3, holds ⌊23.875⌋ + 1 = 24 pulses; a T2
+/// 8603/90000·25 = 2.3897 ticks → 3, holds ⌊23.897⌋ + 1 = 24 pulses; a T2
 /// window meets ⌊(10,000 + 3)/100⌋ + 1 = 101 passes: N = 2424 > 600, C5 =
 /// 5·2424^−¼ = 0.7126; pulses 100 µs apart, one per T_i = 5 µs. So
 /// pulse_code_max = ⌊(1 − 10⁻⁹)·C5·7.7e-8·C4/q⌋ = ⌊14,103.6⌋.
