@@ -166,3 +166,66 @@ fn slot_windows_budget_is_inclusive() {
     let w = slot_windows(&vec![fp(0.0); 257], &vec![1.0; 257], &more, cycle);
     assert!(w.is_empty(), "{w:?}");
 }
+
+/// Kills `head/bound.rs` `head_figures`: `off.is_nan() || off >
+/// RATE_CYCLE_TOLERANCE` → `&&` (the head bound's own check that the laser
+/// fires every channel once per cycle, `|f_p · cycle_s − 1| ≤ 1e-9`). With
+/// `&&` a finite mismatch passes, and the head's figures (its slots, groups
+/// and pulse counts, all per cycle) are charged to a laser firing each
+/// channel more often than they count: at twice the rate every window holds
+/// twice the pulses the figures assume.
+///
+/// By hand: a two-channel head of cycle 100 µs against lasers of 10 kHz
+/// (`off` 0) and `10 kHz·(1 + 4e-10)` (`off` ≈ 4e-10): figures; `10
+/// kHz·(1 + 4e-9)`, 20 kHz and 5 kHz (`off` ≈ 4e-9, 1 and 0.5): refused,
+/// naming `pulse_rate_hz` and the rate.
+#[test]
+fn head_figures_refuses_a_rate_other_than_one_per_cycle() {
+    use gaze_lidar_core::eye_safety::exposure::laser;
+    use gaze_lidar_core::eye_safety::head::bound::head_figures;
+    use gaze_lidar_core::eye_safety::head::{Channel, Head};
+    use gaze_lidar_core::eye_safety::{EyeSafetyError, EyeSafetyParams};
+    let params = EyeSafetyParams {
+        wavelength_nm: 905.0,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: 5.0,
+        head: None,
+    };
+    let head = Head {
+        cycle_s: 1e-4,
+        origin_radius_mm: 40.0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 5.0,
+        divergence_mrad: 1.0,
+        aperture_distance_mm: 100.0,
+        channels: (0..2)
+            .map(|id| Channel {
+                id,
+                elevation_deg: 0.0,
+                azimuth_offset_deg: 0.0,
+                slot_s: 1e-5 * f64::from(id),
+                power_scale: 1.0,
+            })
+            .collect(),
+    };
+    for (rate_hz, accepted) in [
+        (1e4, true),
+        (1e4 * (1.0 + 4e-10), true),
+        (1e4 * (1.0 + 4e-9), false),
+        (2e4, false),
+        (5e3, false),
+    ] {
+        let l = laser(&params, rate_hz).unwrap();
+        match head_figures(&head, &params, &l, 100.0) {
+            Ok(f) => {
+                assert!(accepted, "{rate_hz} Hz accepted");
+                assert_eq!(f.channels, 2);
+            }
+            Err(EyeSafetyError::Param { field, value, .. }) => {
+                assert!(!accepted, "{rate_hz} Hz refused");
+                assert_eq!((field, value), ("pulse_rate_hz", rate_hz));
+            }
+            Err(e) => panic!("{rate_hz} Hz: {e}"),
+        }
+    }
+}
