@@ -166,3 +166,83 @@ fn slot_windows_budget_is_inclusive() {
     let w = slot_windows(&vec![fp(0.0); 257], &vec![1.0; 257], &more, cycle);
     assert!(w.is_empty(), "{w:?}");
 }
+
+/// Kills `head/bound.rs` `head_figures`: the margins on the turns that
+/// widen the boxes of `W_g` (`smear = r·ω·t_g·(1 + SUM_MARGIN)`) and of
+/// `W_inst` (`turn_per_pulse = r·ω·cycle·(1 + SUM_MARGIN)`), each →
+/// `r·ω·t·(1 − SUM_MARGIN)` or `r·ω·t / (1 + SUM_MARGIN)`. The margin covers
+/// the rounding of the product (a few ulps); without it the turn can fall
+/// below the exact `r·ω·t`, so two channels whose boxes that turn joins are
+/// counted apart and the weight (every rule's factor) falls from two
+/// channels' to one's.
+///
+/// By hand: two radial channels (origin on the axis, `ψ` = the azimuth
+/// offset) 10° apart at one height and one slot, on a 100 mm surface: their
+/// boxes `[x − h − TOUCH, x + h + turn + TOUCH]` (`x = ψ·r`, `h` the half
+/// arc) meet when the turn reaches `need = (x₁ − h₁) − (x₀ + h₀) −
+/// 2·TOUCH_MM` (≈ 10 mm). At a spin whose exact turn is `need·(1 −
+/// 0.5e-12)` the margin lifts it to `need·(1 + 0.5e-12)`: both channels
+/// (weight `2·(1 + SUM_MARGIN)`); at `need·(1 − 3e-12)` it does not reach:
+/// one (weight 1, within rounding). Both for the grouping window (`weight_group`) and one cycle
+/// (`weight_instant`). The margins are 5e-12 mm, the rounding of the
+/// products about 1e-15 mm.
+#[test]
+fn head_turns_carry_their_margin() {
+    use gaze_lidar_core::eye_safety::exposure::laser;
+    use gaze_lidar_core::eye_safety::head::bound::{head_figures, HeadFigures};
+    use gaze_lidar_core::eye_safety::head::geometry::footprints;
+    use gaze_lidar_core::eye_safety::head::{Channel, Head};
+    use gaze_lidar_core::eye_safety::EyeSafetyParams;
+    let params = EyeSafetyParams {
+        wavelength_nm: 905.0,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: 5.0,
+        head: None,
+    };
+    let head = Head {
+        cycle_s: 1e-4,
+        origin_radius_mm: 0.0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 5.0,
+        divergence_mrad: 0.0,
+        aperture_distance_mm: 100.0,
+        channels: [0.0, 10.0]
+            .iter()
+            .zip(0..)
+            .map(|(&azimuth_offset_deg, id)| Channel {
+                id,
+                elevation_deg: 0.0,
+                azimuth_offset_deg,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            })
+            .collect(),
+    };
+    let l = laser(&params, 1e4).unwrap();
+    let r = head.aperture_distance_mm;
+    let fps = footprints(&head, l.band.aperture_mm());
+    let x = |i: usize| fps[i].psi_rad * r;
+    let need = (x(1) - fps[1].half_arc_mm) - (x(0) + fps[0].half_arc_mm) - 2.0 * TOUCH_MM;
+    assert!(need > 5.0 && need < 15.0, "{need}");
+    let at = |spin: f64| head_figures(&head, &params, &l, spin).unwrap();
+    let still = at(0.0);
+    // One channel's weight, two channels', each within rounding.
+    let (one, two) = (1.0, 2.0 * (1.0 + SUM_MARGIN));
+    let near = |w: f64, want: f64| (w - want).abs() < 1e-9;
+    assert!(
+        near(still.weight_group, one) && near(still.weight_instant, one),
+        "{still:?}"
+    );
+    let cases: [(f64, fn(&HeadFigures) -> f64, &str); 2] = [
+        (still.group_window_s, |f| f.weight_group, "weight_group"),
+        (head.cycle_s, |f| f.weight_instant, "weight_instant"),
+    ];
+    for (t_s, weight, name) in cases {
+        // The spin whose exact turn in `t_s` is `need·k`.
+        let spin = |k: f64| need * k / (r * t_s);
+        let f = at(spin(1.0 - 0.5e-12));
+        assert!(near(weight(&f), two), "{name}: {f:?}");
+        let f = at(spin(1.0 - 3e-12));
+        assert!(near(weight(&f), one), "{name}: {f:?}");
+    }
+}
