@@ -233,11 +233,19 @@ fn head_turns_carry_their_margin() {
         near(still.weight_group, one) && near(still.weight_instant, one),
         "{still:?}"
     );
-    let cases: [(f64, fn(&HeadFigures) -> f64, &str); 2] = [
-        (still.group_window_s, |f| f.weight_group, "weight_group"),
-        (head.cycle_s, |f| f.weight_instant, "weight_instant"),
-    ];
-    for (t_s, weight, name) in cases {
+    for (t_s, group) in [(still.group_window_s, true), (head.cycle_s, false)] {
+        let weight = |f: &HeadFigures| {
+            if group {
+                f.weight_group
+            } else {
+                f.weight_instant
+            }
+        };
+        let name = if group {
+            "weight_group"
+        } else {
+            "weight_instant"
+        };
         // The spin whose exact turn in `t_s` is `need·k`.
         let spin = |k: f64| need * k / (r * t_s);
         let f = at(spin(1.0 - 0.5e-12));
