@@ -254,3 +254,64 @@ fn head_turns_carry_their_margin() {
         assert!(near(weight(&f), one), "{name}: {f:?}");
     }
 }
+
+/// Kills `head/bound.rs` `union_passes`: `x = 1 + spread/pass·(1 + 1e-12)` →
+/// `spread/pass·(1 − 1e-12)`, the spread's share rounded down instead of
+/// up before the ceiling. The channels' passes lie inside an arc of
+/// `spread + pass`, at most `k = ⌈1 + spread/pass⌉` passes; the share is
+/// computed in floats (the difference, the conversion, the division), so at
+/// a whole number of passes it may come out a few ulps low and the ceiling
+/// one pass short. The stated rounding counts one pass more there; the
+/// mutant one fewer (a smaller union, fewer pulses counted for C5, a larger
+/// C5, a lower figure).
+///
+/// By hand: two radial channels (origin on the axis, `ψ` = the azimuth
+/// offset) on a 100 mm surface, 7 mm aperture, 5 mm beam: the pass is
+/// `12/100` rad = 6.8755°. Offsets 0 and two passes: share 2 (within
+/// rounding), `⌈1 + 2·(1 + 1e-12)⌉ = 4`; 0 and 1.5 passes: `⌈2.5⌉ = 3`.
+#[test]
+fn union_passes_rounds_a_whole_share_up() {
+    use gaze_lidar_core::eye_safety::exposure::laser;
+    use gaze_lidar_core::eye_safety::head::bound::head_figures;
+    use gaze_lidar_core::eye_safety::head::geometry::footprints;
+    use gaze_lidar_core::eye_safety::head::{Channel, Head};
+    use gaze_lidar_core::eye_safety::EyeSafetyParams;
+    let params = EyeSafetyParams {
+        wavelength_nm: 905.0,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: 5.0,
+        head: None,
+    };
+    let l = laser(&params, 1e4).unwrap();
+    let head = |offsets: &[f64]| Head {
+        cycle_s: 1e-4,
+        origin_radius_mm: 0.0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 5.0,
+        divergence_mrad: 0.0,
+        aperture_distance_mm: 100.0,
+        channels: offsets
+            .iter()
+            .zip(0..)
+            .map(|(&azimuth_offset_deg, id)| Channel {
+                id,
+                elevation_deg: 0.0,
+                azimuth_offset_deg,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            })
+            .collect(),
+    };
+    let pass_deg = (12.0f64 / 100.0).to_degrees();
+    for (share, k) in [(2.0, 4), (1.5, 3)] {
+        let h = head(&[0.0, share * pass_deg]);
+        let fps = footprints(&h, l.band.aperture_mm());
+        // The share as the code sees it: within rounding of the intended.
+        let pass = fps[0].pass_angle_deg.max(fps[1].pass_angle_deg);
+        assert!((pass - pass_deg).abs() < 1e-12, "{pass}");
+        let seen = (fps[1].psi_rad - fps[0].psi_rad).to_degrees() / pass;
+        assert!((seen - share).abs() < 1e-14, "{seen}");
+        let f = head_figures(&h, &params, &l, 100.0).unwrap();
+        assert_eq!(f.union_passes, k, "share {share}: {f:?}");
+    }
+}
