@@ -166,3 +166,152 @@ fn slot_windows_budget_is_inclusive() {
     let w = slot_windows(&vec![fp(0.0); 257], &vec![1.0; 257], &more, cycle);
     assert!(w.is_empty(), "{w:?}");
 }
+
+/// Kills `head/bound.rs` `head_figures`: the margins on the turns that
+/// widen the boxes of `W_g` (`smear = r·ω·t_g·(1 + SUM_MARGIN)`) and of
+/// `W_inst` (`turn_per_pulse = r·ω·cycle·(1 + SUM_MARGIN)`), each →
+/// `r·ω·t·(1 − SUM_MARGIN)` or `r·ω·t / (1 + SUM_MARGIN)`. The margin covers
+/// the rounding of the product (a few ulps); without it the turn can fall
+/// below the exact `r·ω·t`, so two channels whose boxes that turn joins are
+/// counted apart and the weight (every rule's factor) falls from two
+/// channels' to one's.
+///
+/// By hand: two radial channels (origin on the axis, `ψ` = the azimuth
+/// offset) 10° apart at one height and one slot, on a 100 mm surface: their
+/// boxes `[x − h − TOUCH, x + h + turn + TOUCH]` (`x = ψ·r`, `h` the half
+/// arc) meet when the turn reaches `need = (x₁ − h₁) − (x₀ + h₀) −
+/// 2·TOUCH_MM` (≈ 10 mm). At a spin whose exact turn is `need·(1 −
+/// 0.5e-12)` the margin lifts it to `need·(1 + 0.5e-12)`: both channels
+/// (weight `2·(1 + SUM_MARGIN)`); at `need·(1 − 3e-12)` it does not reach:
+/// one (weight 1, within rounding). Both for the grouping window (`weight_group`) and one cycle
+/// (`weight_instant`). The margins are 5e-12 mm, the rounding of the
+/// products about 1e-15 mm.
+#[test]
+fn head_turns_carry_their_margin() {
+    use gaze_lidar_core::eye_safety::exposure::laser;
+    use gaze_lidar_core::eye_safety::head::bound::{head_figures, HeadFigures};
+    use gaze_lidar_core::eye_safety::head::geometry::footprints;
+    use gaze_lidar_core::eye_safety::head::{Channel, Head};
+    use gaze_lidar_core::eye_safety::EyeSafetyParams;
+    let params = EyeSafetyParams {
+        wavelength_nm: 905.0,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: 5.0,
+        head: None,
+    };
+    let head = Head {
+        cycle_s: 1e-4,
+        origin_radius_mm: 0.0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 5.0,
+        divergence_mrad: 0.0,
+        aperture_distance_mm: 100.0,
+        channels: [0.0, 10.0]
+            .iter()
+            .zip(0..)
+            .map(|(&azimuth_offset_deg, id)| Channel {
+                id,
+                elevation_deg: 0.0,
+                azimuth_offset_deg,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            })
+            .collect(),
+    };
+    let l = laser(&params, 1e4).unwrap();
+    let r = head.aperture_distance_mm;
+    let fps = footprints(&head, l.band.aperture_mm());
+    let x = |i: usize| fps[i].psi_rad * r;
+    let need = (x(1) - fps[1].half_arc_mm) - (x(0) + fps[0].half_arc_mm) - 2.0 * TOUCH_MM;
+    assert!(need > 5.0 && need < 15.0, "{need}");
+    let at = |spin: f64| head_figures(&head, &params, &l, spin).unwrap();
+    let still = at(0.0);
+    // One channel's weight, two channels', each within rounding.
+    let (one, two) = (1.0, 2.0 * (1.0 + SUM_MARGIN));
+    let near = |w: f64, want: f64| (w - want).abs() < 1e-9;
+    assert!(
+        near(still.weight_group, one) && near(still.weight_instant, one),
+        "{still:?}"
+    );
+    for (t_s, group) in [(still.group_window_s, true), (head.cycle_s, false)] {
+        let weight = |f: &HeadFigures| {
+            if group {
+                f.weight_group
+            } else {
+                f.weight_instant
+            }
+        };
+        let name = if group {
+            "weight_group"
+        } else {
+            "weight_instant"
+        };
+        // The spin whose exact turn in `t_s` is `need·k`.
+        let spin = |k: f64| need * k / (r * t_s);
+        let f = at(spin(1.0 - 0.5e-12));
+        assert!(near(weight(&f), two), "{name}: {f:?}");
+        let f = at(spin(1.0 - 3e-12));
+        assert!(near(weight(&f), one), "{name}: {f:?}");
+    }
+}
+
+/// Kills `head/bound.rs` `union_passes`: `x = 1 + spread/pass·(1 + 1e-12)` →
+/// `spread/pass·(1 − 1e-12)`, the spread's share rounded down instead of
+/// up before the ceiling. The channels' passes lie inside an arc of
+/// `spread + pass`, at most `k = ⌈1 + spread/pass⌉` passes; the share is
+/// computed in floats (the difference, the conversion, the division), so at
+/// a whole number of passes it may come out a few ulps low and the ceiling
+/// one pass short. The stated rounding counts one pass more there; the
+/// mutant one fewer (a smaller union, fewer pulses counted for C5, a larger
+/// C5, a lower figure).
+///
+/// By hand: two radial channels (origin on the axis, `ψ` = the azimuth
+/// offset) on a 100 mm surface, 7 mm aperture, 5 mm beam: the pass is
+/// `12/100` rad = 6.8755°. Offsets 0 and two passes: share 2 (within
+/// rounding), `⌈1 + 2·(1 + 1e-12)⌉ = 4`; 0 and 1.5 passes: `⌈2.5⌉ = 3`.
+#[test]
+fn union_passes_rounds_a_whole_share_up() {
+    use gaze_lidar_core::eye_safety::exposure::laser;
+    use gaze_lidar_core::eye_safety::head::bound::head_figures;
+    use gaze_lidar_core::eye_safety::head::geometry::footprints;
+    use gaze_lidar_core::eye_safety::head::{Channel, Head};
+    use gaze_lidar_core::eye_safety::EyeSafetyParams;
+    let params = EyeSafetyParams {
+        wavelength_nm: 905.0,
+        pulse_duration_s: 5e-9,
+        beam_diameter_mm: 5.0,
+        head: None,
+    };
+    let l = laser(&params, 1e4).unwrap();
+    let head = |offsets: &[f64]| Head {
+        cycle_s: 1e-4,
+        origin_radius_mm: 0.0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: 5.0,
+        divergence_mrad: 0.0,
+        aperture_distance_mm: 100.0,
+        channels: offsets
+            .iter()
+            .zip(0..)
+            .map(|(&azimuth_offset_deg, id)| Channel {
+                id,
+                elevation_deg: 0.0,
+                azimuth_offset_deg,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            })
+            .collect(),
+    };
+    let pass_deg = (12.0f64 / 100.0).to_degrees();
+    for (share, k) in [(2.0, 4), (1.5, 3)] {
+        let h = head(&[0.0, share * pass_deg]);
+        let fps = footprints(&h, l.band.aperture_mm());
+        // The share as the code sees it: within rounding of the intended.
+        let pass = fps[0].pass_angle_deg.max(fps[1].pass_angle_deg);
+        assert!((pass - pass_deg).abs() < 1e-12, "{pass}");
+        let seen = (fps[1].psi_rad - fps[0].psi_rad).to_degrees() / pass;
+        assert!((seen - share).abs() < 1e-14, "{seen}");
+        let f = head_figures(&h, &params, &l, 100.0).unwrap();
+        assert_eq!(f.union_passes, k, "share {share}: {f:?}");
+    }
+}
