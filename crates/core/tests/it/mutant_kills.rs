@@ -956,3 +956,48 @@ fn a_channel_firing_twice_in_the_window_spans_time() {
     assert_eq!(m.count, 2, "{m:?}");
     assert!(!spans, "one pulse of each, fired together");
 }
+
+/// Kills `head/overlap.rs` `GroupPlan::max`: `smear_mm >= 0.5 * circumference`
+/// → `smear_mm >= 0.5 + circumference` (when the boxes are taken to wrap the
+/// circle). Argued not to lower a figure (every box's arc centre lies within
+/// a quarter circle of 0, so at a smear of half the circle every widened box
+/// already holds one arc point: weight, counts and `spans` are the wrapped
+/// ones), but it changes the worst position's arc: wrapped boxes have one left
+/// end, −∞ (`GroupPlan`'s description), which `HeadFigures::worst_azimuth_deg`
+/// reports.
+///
+/// By hand: one footprint at `ψ = 0`, half-arc 5 mm, on a circle of 100 mm,
+/// one pulse in the window. At a smear of 49 mm the box is
+/// `[−5 − 10⁻⁹, 5 + 49 + 10⁻⁹]`: the worst position's arc is its left end;
+/// at 50 mm (half the circle, inclusive) and at 60 mm it wraps: −∞. The weight
+/// is the one pulse's, 1, at every smear.
+#[test]
+fn a_smear_of_half_the_circle_wraps_the_group_s_boxes() {
+    use gaze_lidar_core::eye_safety::head::geometry::Footprint;
+    use gaze_lidar_core::eye_safety::head::overlap::{group, TOUCH_MM};
+    let fp = Footprint {
+        index: 0,
+        psi_rad: 0.0,
+        z_mm: 0.0,
+        slant_mm: 100.0,
+        width_mm: 3.0,
+        cos_beta: 1.0,
+        half_arc_mm: 5.0,
+        half_height_mm: 5.0,
+        pass_angle_deg: 0.1f64.to_degrees(),
+    };
+    let at = |smear_mm: f64| group(&[fp], &[1.0], &[0.0], 1e-3, 1e-4, smear_mm, 100.0);
+    let (m, spans) = at(49.0);
+    assert_eq!(
+        (m.weight, m.count, m.arc_mm),
+        (1.0, 1, -5.0 - TOUCH_MM),
+        "{m:?}"
+    );
+    assert!(!spans);
+    for smear_mm in [50.0, 60.0] {
+        let (m, spans) = at(smear_mm);
+        assert_eq!((m.weight, m.count), (1.0, 1), "{m:?}");
+        assert_eq!(m.arc_mm, f64::NEG_INFINITY, "smear {smear_mm} mm: {m:?}");
+        assert!(!spans);
+    }
+}
