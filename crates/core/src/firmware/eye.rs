@@ -27,9 +27,12 @@
 //!
 //! With a head the limits hold the single channel's windows of length `T`
 //! to `AEL(T)/W*(T)`, `W*` the smallest channel weight any candidate of the
-//! float head bound proves for that length (derived on the host); a head
-//! declared at another distance than 100 mm adds the second surface's
-//! limits ([`IntEyeLimits::other_surface`]), and the table must pass both.
+//! float head bound proves for that length (derived on the host), or, for
+//! the windows up to some `T*`, by the head's instantaneous power when every
+//! code is small enough ([`InstantLimit`]: alternative limit sets, the
+//! smallest worst ratio reported); a head declared at another distance than
+//! 100 mm adds the second surface's limits ([`IntEyeLimits::other_surface`]),
+//! and the table must pass both.
 
 use alloc::vec::Vec;
 
@@ -1382,7 +1385,13 @@ mod verification {
             ],
             pass_energy_max_quanta: e_pass,
             pass_energy_rule: IntRule::T2Train,
-            instant: Vec::new(),
+            // One instantaneous alternative (its code cap at the Rule 1
+            // cap, its floor above the second bucket): the walk with a
+            // floor and the choice of the smaller worst are exercised too.
+            instant: alloc::vec![InstantLimit {
+                code_max,
+                energy_floor_quanta: e1.saturating_add(split).saturating_add(1),
+            }],
             other_surface: None,
         }
     }
