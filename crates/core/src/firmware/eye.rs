@@ -542,6 +542,11 @@ fn ratio_ppm(energy: u128, limit: u64) -> u64 {
 /// table is outside the integer bounds or the limits were derived for
 /// another timing.
 ///
+/// With [`IntEyeLimits::instant`] each surface is evaluated against its
+/// plain limits and against each instantaneous alternative (its code cap on
+/// the table's hottest code, every within-pass bucket raised to its floor),
+/// and reports the smallest exact worst ratio: Class 1 when any one accepts.
+///
 /// With [`IntEyeLimits::other_surface`] the table is evaluated against both
 /// limit sets: Class 1 when both accept, the report the worse one's (ties
 /// take the first set's).
