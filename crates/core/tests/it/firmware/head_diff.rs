@@ -39,11 +39,11 @@ use gaze_lidar_core::testing as common;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
-/// Relative quantization margin of the integer figure against the float
-/// one: the ratio is rounded up to a ppm (never down), every limit loses
-/// `1e-9` before it is rounded down (only raising the integer figure), so
-/// a sound integer check of the same candidates is never below the float
-/// figure by more than the float bound's own `1e-9` margins.
+/// Relative margin of the comparison: the integer ratio is rounded up to a
+/// ppm and every limit loses `1e-9` before it is rounded down (both only
+/// raise the integer figure), the float bound's margins are `1e-9`; an
+/// integer figure more than this below the float one is a difference of
+/// the two bounds, not of their rounding (checked against the reference).
 const MARGIN: f64 = 1e-6;
 
 /// Wavelengths: the head reference's three, and both sides of the band
@@ -150,6 +150,9 @@ struct Stats {
     /// smallest int/float.
     single_below: usize,
     single_lo: f64,
+    /// Seconds in `evaluate` with the limits as derived, and with the
+    /// instantaneous alternatives removed (the same tables, one run).
+    eval_s: (f64, f64),
     /// Smallest reference/integer headroom over the cases checked against
     /// the reference (integer / reference).
     ref_checked: usize,
@@ -168,8 +171,10 @@ fn one_case(d: &Drawn, stats: &RefCell<Stats>) -> Result<(), TestCaseError> {
     prop_assume!(float > 0.0);
     let limits = IntEyeLimits::derive(&table)
         .map_err(|e| TestCaseError::fail(format!("derive: {e} ({d:?})")))?;
+    let started = std::time::Instant::now();
     let report = evaluate(&table, &limits)
         .map_err(|e| TestCaseError::fail(format!("evaluate: {e} ({d:?})")))?;
+    let with_s = started.elapsed().as_secs_f64();
     let int = report.worst_ratio_ppm as f64 / 1e6;
     let q = int / float;
     let n_ch = case.params.head.as_ref().unwrap().channels.len();
@@ -209,7 +214,10 @@ fn one_case(d: &Drawn, stats: &RefCell<Stats>) -> Result<(), TestCaseError> {
     if let Some(o) = plain.other_surface.as_mut() {
         o.instant.clear();
     }
+    let started = std::time::Instant::now();
     let without = evaluate(&table, &plain).unwrap().worst_ratio_ppm as f64 / 1e6;
+    s.eval_s.0 += with_s;
+    s.eval_s.1 += started.elapsed().as_secs_f64();
     prop_assert!(
         int <= without,
         "{tag}: {int} with the instant candidate, {without} without"
@@ -299,6 +307,12 @@ fn integer_head_check_against_the_float_head_bound() {
         s.instant_gain,
         s.ref_lo,
         s.ref_checked
+    );
+    println!(
+        "evaluate: {:.1} ms with the instantaneous alternatives, {:.1} ms without ({:.2}×)",
+        s.eval_s.0 * 1e3,
+        s.eval_s.1 * 1e3,
+        s.eval_s.0 / s.eval_s.1
     );
     if let Err(e) = result {
         panic!("{e}");
