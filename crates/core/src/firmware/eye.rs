@@ -27,9 +27,12 @@
 //!
 //! With a head the limits hold the single channel's windows of length `T`
 //! to `AEL(T)/W*(T)`, `W*` the smallest channel weight any candidate of the
-//! float head bound proves for that length (derived on the host); a head
-//! declared at another distance than 100 mm adds the second surface's
-//! limits ([`IntEyeLimits::other_surface`]), and the table must pass both.
+//! float head bound proves for that length (derived on the host), or, for
+//! the windows up to some `T*`, by the head's instantaneous power when every
+//! code is small enough ([`InstantLimit`]: alternative limit sets, the
+//! smallest worst ratio reported); a head declared at another distance than
+//! 100 mm adds the second surface's limits ([`IntEyeLimits::other_surface`]),
+//! and the table must pass both.
 
 use alloc::vec::Vec;
 
@@ -64,6 +67,22 @@ pub struct TrainLimit {
     pub energy_max_quanta: u64,
 }
 
+/// The head's instantaneous-power candidate at one window length `T*`
+/// (`specs/eye_safety.md`, "The head in the integer check"): the head
+/// receives at most `W_inst · P̂` at any instant, so when every code of the
+/// table is at most `code_max` every window up to `T*` is within its AEL,
+/// and a window holding `k` pulses of one pass need only be held to the
+/// limit of the windows from `T*` on: at least `energy_floor_quanta`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InstantLimit {
+    /// Largest code of any bin for the candidate to apply:
+    /// `⌊AEL(T)/(W_inst · power_w_per_code · (T + Δ))⌋` over `T ≤ T*`.
+    pub code_max: u64,
+    /// Every within-pass bucket's limit is raised to at least this:
+    /// `⌊inf AEL(T)/W*(T)⌋` over `T ≥ T*`, in quanta.
+    pub energy_floor_quanta: u64,
+}
+
 /// Integer Class 1 limits of a table's timing, in energy quanta
 /// (`power_w_per_code / pulse_rate_hz` joules). The table is checked against
 /// them by [`evaluate`]; they are valid for a table whose timing they were
@@ -93,6 +112,12 @@ pub struct IntEyeLimits {
     pub pass_energy_max_quanta: u64,
     /// The rule binding `pass_energy_max_quanta`.
     pub pass_energy_rule: IntRule,
+    /// The head's instantaneous-power alternatives, one per `T*` (empty
+    /// without a head of several channels meeting one height): the table
+    /// passes when it passes the limits above alone or with any one of
+    /// them ([`evaluate`] reports the smallest worst ratio).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub instant: Vec<InstantLimit>,
     /// The limits of a second aperture surface the table must also pass
     /// (a head declaring `aperture_distance_mm` other than 100 mm: these
     /// limits are the 100 mm surface's, the other are the declared
@@ -517,6 +542,11 @@ fn ratio_ppm(energy: u128, limit: u64) -> u64 {
 /// table is outside the integer bounds or the limits were derived for
 /// another timing.
 ///
+/// With [`IntEyeLimits::instant`] each surface is evaluated against its
+/// plain limits and against each instantaneous alternative (its code cap on
+/// the table's hottest code, every within-pass bucket raised to its floor),
+/// and reports the smallest exact worst ratio: Class 1 when any one accepts.
+///
 /// With [`IntEyeLimits::other_surface`] the table is evaluated against both
 /// limit sets: Class 1 when both accept, the report the worse one's (ties
 /// take the first set's).
@@ -575,6 +605,48 @@ fn evaluate_surface(
             reason: "buckets must start at 1 pulse, their counts increase and their limits never decrease",
         });
     }
+    let (mut best, mut worst) = evaluate_candidate(table, limits, None)?;
+    if limits.instant.is_empty() {
+        return Ok(best);
+    }
+    // The hottest bin of the table (its centre's azimuth) for the
+    // instantaneous candidates: `P̂` is the table's largest power.
+    let mut hottest = (0u64, 0u32);
+    let mut start = 0u32;
+    for b in &table.bins {
+        if u64::from(b.power_code) > hottest.0 {
+            hottest = (u64::from(b.power_code), start + b.width_mdeg / 2);
+        }
+        start += b.width_mdeg;
+    }
+    for inst in &limits.instant {
+        // This candidate's worst is at least its own code check: skip it
+        // when that alone cannot beat the best so far.
+        if !ratio_greater(worst, (u128::from(hottest.0), inst.code_max)) {
+            continue;
+        }
+        let (r, w) = evaluate_candidate(table, limits, Some((inst, hottest)))?;
+        if ratio_greater(worst, w) {
+            (best, worst) = (r, w);
+        }
+    }
+    Ok(best)
+}
+
+/// The walk of [`evaluate_surface`] over every cell against `limits`, with
+/// one instantaneous candidate or none: `(code_max, floor)` and the table's
+/// hottest `(code, azimuth)`. Returns the report and its exact worst
+/// `(energy, limit)`.
+fn evaluate_candidate(
+    table: &FirmwareTable,
+    limits: &IntEyeLimits,
+    instant: Option<(&InstantLimit, (u64, u32))>,
+) -> Result<(IntEyeReport, (u128, u64)), IntEyeError> {
+    let mismatch = |field, found, allowed| IntEyeError::Mismatch {
+        field,
+        found,
+        allowed,
+    };
     let clock = clock_of(table, limits.pulse_rate_millihz_ceil);
     let half = limits.pass_arc_mdeg / 2;
     let mut t = Tracker {
@@ -586,6 +658,13 @@ fn evaluate_surface(
             class1: true,
         },
     };
+    // With an instantaneous candidate: every window up to its `T*` holds
+    // at most `W_inst · P̂ · (T + Δ)` (checked here once, on the hottest
+    // code), and every longer one's limit is at least its floor.
+    let floor = instant.map_or(0, |(inst, (code, azimuth))| {
+        t.note(azimuth, u128::from(code), inst.code_max, IntRule::PassTrain);
+        inst.energy_floor_quanta
+    });
     let mut sorted: Vec<(u32, u128)> = Vec::new();
     for_each_cell(table, clock, limits.pass_arc_mdeg, |c| {
         if c.tau.num > u128::from(limits.pass_ticks_max) * c.tau.den {
@@ -621,7 +700,7 @@ fn evaluate_surface(
                     .train
                     .get(j + 1)
                     .map_or(k_max, |n| (u128::from(n.pulses_from) - 1).min(k_max));
-                (to, t.energy_max_quanta)
+                (to, t.energy_max_quanta.max(floor))
             });
         // A quick upper bound first: G(k) ≤ min(Σ code × cap, k × hottest).
         // If no check can beat the worst ratio so far with it, the exact
@@ -667,7 +746,7 @@ fn evaluate_surface(
         Ok(())
     })?;
     t.report.worst_ratio_ppm = ratio_ppm(t.worst.0, t.worst.1);
-    Ok(t.report)
+    Ok((t.report, t.worst))
 }
 
 /// The worst check so far: `(energy, limit)` compared exactly by
@@ -752,7 +831,9 @@ impl Greedy<'_> {
 /// point, once per table timing; every limit rounded down).
 #[cfg(feature = "std")]
 mod derive {
-    use super::{pass_timing, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ};
+    use super::{
+        pass_timing, InstantLimit, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ,
+    };
     use crate::eye_safety::ael::{APERTURE_DISTANCE_MM, T2_S, TIME_BASE_S};
     use crate::eye_safety::bound::Laser;
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
@@ -783,6 +864,10 @@ mod derive {
     /// Most multi-pass window counts the derivation walks (frame periods
     /// shorter than 100 s / 10^7 are refused).
     pub const MAX_PASS_WINDOWS: u64 = 10_000_000;
+    /// The instantaneous candidate's window lengths `T*`, in multiples of
+    /// the longest pass (at least a pulse spacing), below the frame: the
+    /// float head bound's ladder (`head::bound::energy_ratios`).
+    pub const INSTANT_T_STAR_PASSES: [f64; 7] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 64.0];
 
     /// Why integer limits could not be derived.
     #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -1000,6 +1085,51 @@ mod derive {
                 b.energy_max_quanta = b.energy_max_quanta.min(later);
                 later = b.energy_max_quanta;
             }
+            // The head's instantaneous-power candidate (`W_inst`, as
+            // `head::bound::energy_ratios` takes it, at its `T*` ladder): a
+            // code `c` puts at most `W_inst·c·step·(T + Δ)` into a window of
+            // `T` (each pulse's energy over the spacing after it), within
+            // `AEL(T)` for every `T ≤ T*` (widened) when
+            // `c·W_inst·step·S(T*) ≤ 1`; the windows from `T*` (shortened)
+            // on are held to `inf AEL(T)/W*(T)` there. Kept where it
+            // raises the first bucket (else it cannot loosen anything).
+            let mut instant = Vec::new();
+            if let Some(hf) = head
+                .as_ref()
+                .filter(|hf| hf.count_vertical > 1 && hf.weight_instant > 0.0)
+            {
+                let delta = 1.0 / f_p;
+                let tau = (timing.pass_ticks_max as f64 / tick_hz * (1.0 + WIDEN)).max(delta);
+                let frame_s = table.frame_ticks as f64 / tick_hz;
+                let first = train[0].energy_max_quanta;
+                for m in INSTANT_T_STAR_PASSES {
+                    let t_star = m * tau;
+                    if t_star >= frame_s {
+                        break;
+                    }
+                    let per_code = hf.weight_instant
+                        * step
+                        * laser.instant_window_factor(t_star * (1.0 + WIDEN));
+                    let code_max = if per_code > 0.0 {
+                        let x = (1.0 - LIMIT_MARGIN) / per_code;
+                        if x >= 1.8e19 {
+                            u64::MAX
+                        } else {
+                            x.floor() as u64
+                        }
+                    } else {
+                        u64::MAX
+                    };
+                    let energy_floor_quanta =
+                        to_quanta(per_weight.inf_from(t_star * (1.0 - WIDEN)));
+                    if code_max > 0 && energy_floor_quanta > first {
+                        instant.push(InstantLimit {
+                            code_max,
+                            energy_floor_quanta,
+                        });
+                    }
+                }
+            }
             let to_quanta = |energy_j: f64| to_quanta(energy_j / w_v);
             // Rule 2 over m ≥ 2 passes: such a window lasts at least
             // (m − 1)·T_f − τ_max and receives at most m pass energies.
@@ -1042,6 +1172,7 @@ mod derive {
                 train,
                 pass_energy_max_quanta,
                 pass_energy_rule,
+                instant,
                 other_surface: None,
             })
         }
@@ -1259,6 +1390,13 @@ mod verification {
             ],
             pass_energy_max_quanta: e_pass,
             pass_energy_rule: IntRule::T2Train,
+            // One instantaneous alternative (its code cap at the Rule 1
+            // cap, its floor above the second bucket): the walk with a
+            // floor and the choice of the smaller worst are exercised too.
+            instant: alloc::vec![InstantLimit {
+                code_max,
+                energy_floor_quanta: e1.saturating_add(split).saturating_add(1),
+            }],
             other_surface: None,
         }
     }

@@ -129,6 +129,29 @@ impl Laser {
         k
     }
 
+    /// `S(t) = sup_{T ≤ t} (T + Δ)/AEL(T)`, s/J (`Δ = 1/f_p`): what a
+    /// received power of one watt, each pulse's energy spread over the
+    /// pulse spacing after it, puts into a window of length up to `t`, per
+    /// joule of its AEL. On a row of Table 3 (`c·T^p`, `0 ≤ p ≤ 1`)
+    /// `(T + Δ)/T^p` has no interior maximum, so `t`, the row edges below
+    /// it and the pulse duration (below which the AEL is constant) are
+    /// every candidate (the AEL at an edge is the smaller row's). The head's
+    /// instantaneous-power candidate (`head::bound::energy_ratios`) takes
+    /// this supremum.
+    #[must_use]
+    pub fn instant_window_factor(&self, t_s: f64) -> f64 {
+        let delta = 1.0 / self.pulse_rate_hz;
+        let mut s = (t_s + delta) / self.ael_j(t_s);
+        for row in self.rows() {
+            for e in [row.t_lo_s, row.t_hi_s, self.pulse_duration_s] {
+                if e > 0.0 && e < t_s {
+                    s = s.max((e + delta) / self.ael_j(e));
+                }
+            }
+        }
+        s
+    }
+
     /// Pulses grouped into one effective pulse (summed within `T_i`, 700–1050 nm):
     /// the most pulses a closed `T_i` window holds, at most `per_pass`.
     #[must_use]

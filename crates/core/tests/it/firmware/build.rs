@@ -381,3 +381,60 @@ fn table_exposure_by_hand() {
         }
     }
 }
+
+/// The quantizer raises a code below the least code at or above
+/// `power_w_min` to that code, so a bin can run one code above its
+/// certified power: the profile's certificate does not hold the table. The
+/// table is not handed out on it: `from_certified` checks the table as it
+/// runs (`check_table`, the integer Class 1 check on its own codes and
+/// ticks) and, codes never going below `power_code_min`, refuses it when
+/// over. By hand: 36 bins of 10° at 10 Hz and 3.6 MHz ticks (10,000 ticks
+/// each), every bin at `p` = `power_w_min`, step `p/1000.5`: the rounded
+/// code is ⌊1000.5⌋ = 1000, the least code at or above the minimum is
+/// ⌈1000.5·(1 − 1e-9)⌉ = 1001 (0.05 % above `p`). At 60 % of the Class 1
+/// limit the table keeps 1001 and passes both checks as it runs; at 99.99 %
+/// it would run at 1.0004 of the limit and is refused naming eye safety.
+#[test]
+fn minimum_code_above_the_certified_power_is_checked_as_it_runs() {
+    let base = profile(&[10.0; 36], PowerAccounting::Time, limits(SPIN, SPIN));
+    let ratio = certify(base.clone())
+        .expect("certified")
+        .eye_safety()
+        .expect("evaluated")
+        .worst_ratio;
+    let at = |fraction: f64| {
+        let p_w = POWER_W * fraction / ratio;
+        let mut p = base.clone();
+        for b in &mut p.bins {
+            b.power_w = p_w;
+        }
+        p.average_power_w = 2.0 * p_w;
+        p.limits.power_w_min = p_w;
+        p.limits.power_w_max = 4.0 * p_w;
+        (p, p_w)
+    };
+    let (p, p_w) = at(0.6);
+    let step = p_w / 1000.5;
+    let t = build(p, 3_600_000, Some(step)).expect("quantizes");
+    assert_eq!(t.limits.power_code_min, 1001);
+    for b in &t.bins {
+        assert_eq!((b.dwell_ticks, b.power_code), (10_000, 1001));
+        assert!(f64::from(b.power_code) * step > p_w);
+    }
+    let r = evaluate(&t, &IntEyeLimits::derive(&t).expect("limits")).expect("evaluates");
+    assert!(r.class1, "{r:?}");
+    let float = table_exposure(&t).expect("params").expect("float");
+    assert!(float.worst_ratio <= 1.0, "{}", float.worst_ratio);
+    assert!(
+        (float.worst_ratio / (0.6 * 1001.0 / 1000.5) - 1.0).abs() < 1e-3,
+        "{}",
+        float.worst_ratio
+    );
+    let (p, p_w) = at(0.9999);
+    match build(p, 3_600_000, Some(p_w / 1000.5)) {
+        Err(FirmwareError::Rejected(v)) => {
+            assert!(v.iter().any(|x| x.limit_key() == "eye_safety"), "{v:?}")
+        }
+        other => panic!("one code above the limit must be refused: {other:?}"),
+    }
+}

@@ -4,3 +4,4 @@ mod build;
 mod check;
 mod codec;
 mod head;
+mod head_diff;
