@@ -177,9 +177,33 @@ impl Detection {
 }
 
 /// `u(x, t)` of a bin `theta_rad` wide dwelt on `dwell_s` (module docs).
+/// Remembered per problem, pulse spacing and power: bins of one width and
+/// dwell (every bin of a `range`-mode problem) at one hardware level share
+/// it, and the power step, the exact objective and the global bound ask
+/// for the same values.
 pub fn value(problem: &Problem, theta_rad: f64, dwell_s: f64, power_ratio: f64) -> f64 {
-    let d = &problem.objective.detection;
     let spacing = spacing_rad(problem, theta_rad, dwell_s);
+    let key = (
+        problem_key(problem),
+        [spacing.to_bits(), power_ratio.to_bits(), 0, 0],
+    );
+    if let Some(v) = VALUES.with(|c| c.borrow().get(&key).copied()) {
+        return v;
+    }
+    let v = value_at_spacing(problem, spacing, power_ratio);
+    VALUES.with(|c| {
+        let mut c = c.borrow_mut();
+        if c.len() > 1 << 16 {
+            c.clear();
+        }
+        c.insert(key, v);
+    });
+    v
+}
+
+/// [`value`] computed, at the pulse spacing `spacing`.
+fn value_at_spacing(problem: &Problem, spacing: f64, power_ratio: f64) -> f64 {
+    let d = &problem.objective.detection;
     let r0 = problem.lidar.rated_range_m;
     d.conditions(problem)
         .iter()
@@ -350,24 +374,52 @@ pub(super) fn exact_range_utility(problem: &Problem, theta_rad: f64, dwell_s: f6
     level_value(problem, theta_rad, dwell_s, x.max(0.0))
 }
 
-type Key = (String, [u64; 4]);
+/// Everything [`value`] depends on but the bin: the problem's part
+/// ([`problem_key`]) and four numbers (the spacing, the power or box, ...).
+type Key = (Vec<u64>, [u64; 4]);
 
 thread_local! {
     /// Segments already built: a power step's bins mostly share their
     /// dwell, and the block-coordinate loop solves many power steps.
     static CACHE: RefCell<HashMap<Key, SqrtSegments>> = RefCell::new(HashMap::new());
+    /// Values already computed ([`value`]).
+    static VALUES: RefCell<HashMap<Key, f64>> = RefCell::new(HashMap::new());
+}
+
+/// The fields of `problem` that [`value`] reads besides the bin's spacing
+/// and power, as bits: the detection objective's target and conditions
+/// and the LiDAR's rating and pulse rate.
+fn problem_key(problem: &Problem) -> Vec<u64> {
+    let d = &problem.objective.detection;
+    let l = &problem.lidar;
+    let mut key = vec![
+        d.models.len() as u64,
+        d.fog_pct.len() as u64,
+        d.fog_weight.len() as u64,
+    ];
+    key.extend(d.models.iter().map(|&m| match m {
+        ModelKind::Argus => 0,
+        ModelKind::Physical => 1,
+    }));
+    key.extend(d.fog_pct.iter().map(|&f| u64::from(f)));
+    key.extend(d.fog_weight.iter().map(|w| w.to_bits()));
+    key.extend(
+        [
+            d.target_width_m,
+            d.reflectivity,
+            d.detect,
+            l.rated_range_m,
+            l.reference_reflectivity,
+            l.pulse_rate_hz,
+        ]
+        .map(f64::to_bits),
+    );
+    key
 }
 
 fn cached(problem: &Problem, theta_rad: f64, dwell_s: f64, lo: f64, hi: f64) -> SqrtSegments {
-    let l = &problem.lidar;
     let key: Key = (
-        format!(
-            "{:?}|{}|{}|{}",
-            problem.objective.detection,
-            l.rated_range_m.to_bits(),
-            l.reference_reflectivity.to_bits(),
-            l.pulse_rate_hz.to_bits()
-        ),
+        problem_key(problem),
         [
             spacing_rad(problem, theta_rad, dwell_s).to_bits(),
             lo.to_bits(),
