@@ -380,8 +380,8 @@ impl ReturnModel {
     /// where [`narrow`] has shown the end lies elsewhere: it brackets the
     /// end first by a few regula falsi steps (evaluated, so the answer is
     /// the plain bisection's, bit for bit; tested against it), and only the
-    /// bisection's last few midpoints, within a relative 1e-11 of the end,
-    /// cost an evaluation (about 20 in all instead of 60).
+    /// bisection's midpoints within a relative 1e-12 of the end (one or
+    /// two) cost an evaluation.
     #[must_use]
     pub fn detection_range_m(
         &self,
