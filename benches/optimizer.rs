@@ -4,6 +4,9 @@
 //! certified profile, cache warm) is printed from 2000 samples.
 //! The shipped configs (`examples/configs/`) at 360 bins, gaze 90°, under
 //! both objectives (`shipped_C/sqrt`, `shipped_C/detection`).
+//! The detection value's sampling, cold, on 360 bins of a smooth spin
+//! (`detection_ranges/along`: each bin's ranges guessed along its own
+//! nodes; `detection_ranges/across`: from the previous bin's ranges).
 //! Run: `cargo bench --bench optimizer`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -146,6 +149,43 @@ fn bench(c: &mut Criterion) {
             );
         }
     }
+    g.finish();
+    detection_ranges(c);
+}
+
+/// The power step's detection samples of 360 bins whose dwell ramps by
+/// ±30 % around the frame's mean (a smooth spin), cold: every bin's 65
+/// nodes under each condition, guessed along the nodes or across bins.
+fn detection_ranges(c: &mut Criterion) {
+    use gaze_lidar::optimizer::detection::{nodes, values_near};
+    let p = shipped("smooth", ObjectiveKind::Detection);
+    let theta = std::f64::consts::TAU / 360.0;
+    let spacing: Vec<f64> = (0..360)
+        .map(|i| {
+            let ramp = 1.0 + 0.3 * (std::f64::consts::TAU * i as f64 / 360.0).sin();
+            theta / (p.lidar.pulse_rate_hz * ramp * p.lidar.frame_period_s() / 360.0)
+        })
+        .collect();
+    let hi = p.lidar.limits.power_w_max / p.lidar.average_power_w;
+    let xs = nodes(p.lidar.limits.power_w_min / p.lidar.average_power_w, hi);
+    let mut g = c.benchmark_group("detection_ranges");
+    g.sample_size(10);
+    g.bench_function("along", |b| {
+        b.iter(|| {
+            for &s in &spacing {
+                black_box(values_near(&p, s, &xs, None));
+            }
+        })
+    });
+    g.bench_function("across", |b| {
+        b.iter(|| {
+            let mut near: Option<Vec<Vec<f64>>> = None;
+            for &s in &spacing {
+                near = Some(values_near(&p, s, &xs, near.as_deref()).1);
+            }
+            black_box(near)
+        })
+    });
     g.finish();
 }
 

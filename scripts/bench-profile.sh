@@ -12,7 +12,8 @@
 # then the working tree is rebuilt (its sources touched, see below, so
 # target/ holds this tree's build afterwards) as target/bench/gaze-lidar-new.
 # OLD=path / NEW=path skip the builds. RUNS (default 21) runs per binary and
-# config; the table gives the median and the minimum wall time in ms.
+# config; the table gives the medians of the child's CPU time (user +
+# system, `os.wait4`) and of the wall time, in ms.
 # Outputs of both binaries are compared byte for byte (reported, not
 # required: a new formulation may move the last bits).
 set -euo pipefail
@@ -40,25 +41,34 @@ if [[ -z "${NEW:-}" ]]; then
     NEW=target/bench/gaze-lidar-new
 fi
 python3 - "$OLD" "$NEW" "$RUNS" $CONFIGS <<'EOF'
-import statistics, subprocess, sys, time
+import os, statistics, subprocess, sys, time
 old, new, runs, configs = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
 def once(binary, config):
     args = [binary, "profile", "--config", f"examples/configs/{config}.toml",
             "--gaze-deg", "90", "--format", "json"]
     t0 = time.perf_counter()
-    out = subprocess.run(args, capture_output=True, check=True).stdout
-    return time.perf_counter() - t0, out
-print(f"baseline {old}, new {new}, {runs} runs each, alternated")
-print(f"{'config':<12} {'base med':>9} {'new med':>9} {'base min':>9} {'new min':>9} {'ratio':>7}  outputs")
+    p = subprocess.Popen(args, stdout=subprocess.PIPE)
+    out = p.stdout.read()
+    _, status, usage = os.wait4(p.pid, 0)
+    if status != 0:
+        sys.exit(f"{binary} on {config}: exit status {status}")
+    # CPU of the child (user + system): the measure under load; wall is
+    # several times it on a shared machine.
+    return time.perf_counter() - t0, usage.ru_utime + usage.ru_stime, out
+print(f"baseline {old}, new {new}, {runs} runs each, alternated; ms, medians")
+print(f"{'config':<12} {'base cpu':>9} {'new cpu':>9} {'ratio':>7} {'base wall':>10} {'new wall':>9}  outputs")
 for c in configs:
-    ts = {old: [], new: []}
+    wall = {old: [], new: []}
+    cpu = {old: [], new: []}
     outs = {}
     for _ in range(runs):
         for b in (old, new):
-            dt, out = once(b, c)
-            ts[b].append(dt * 1e3)
+            dt, dc, out = once(b, c)
+            wall[b].append(dt * 1e3)
+            cpu[b].append(dc * 1e3)
             outs[b] = out
-    mo, mn = statistics.median(ts[old]), statistics.median(ts[new])
+    co, cn = statistics.median(cpu[old]), statistics.median(cpu[new])
+    wo, wn = statistics.median(wall[old]), statistics.median(wall[new])
     same = "identical" if outs[old] == outs[new] else "differ"
-    print(f"{c:<12} {mo:9.1f} {mn:9.1f} {min(ts[old]):9.1f} {min(ts[new]):9.1f} {mo / mn:6.2f}×  {same}")
+    print(f"{c:<12} {co:9.1f} {cn:9.1f} {co / cn:6.2f}× {wo:10.1f} {wn:9.1f}  {same}")
 EOF

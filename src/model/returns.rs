@@ -380,8 +380,8 @@ impl ReturnModel {
     /// where [`narrow`] has shown the end lies elsewhere: it brackets the
     /// end first by a few regula falsi steps (evaluated, so the answer is
     /// the plain bisection's, bit for bit; tested against it), and only the
-    /// bisection's last few midpoints, within a relative 1e-11 of the end,
-    /// cost an evaluation (about 20 in all instead of 60).
+    /// bisection's midpoints within a relative 1e-12 of the end (one or
+    /// two) cost an evaluation.
     #[must_use]
     pub fn detection_range_m(
         &self,
@@ -430,14 +430,6 @@ impl ReturnModel {
         if hi.is_nan() || hi <= lo {
             return 0.0;
         }
-        let at_lo = returns(lo);
-        if at_lo < detect || at_lo.is_nan() {
-            return 0.0;
-        }
-        let at_hi = returns(hi);
-        if at_hi >= detect {
-            return hi;
-        }
         let guess = match *self {
             Self::Argus {
                 fog_factor,
@@ -448,7 +440,32 @@ impl ReturnModel {
             },
             _ => guess,
         };
-        let (yes, no) = narrow(&returns, detect, (lo, at_lo), (hi, at_hi), guess);
+        let (yes, no) = step_out(&returns, detect, (lo, hi), guess);
+        // The bracket's ends are evaluated only where the guess found no
+        // range strictly inside them on that side (`END_GAP`): a detecting
+        // range `a > lo` means `lo` detects, a failing `b < hi` that `hi`
+        // fails, and the answer is the plain bisection's either way.
+        let a = match yes {
+            Some(p) if p.0 >= lo * (1.0 + END_GAP) => p,
+            _ => {
+                let at_lo = returns(lo);
+                if at_lo < detect || at_lo.is_nan() {
+                    return 0.0;
+                }
+                yes.unwrap_or((lo, at_lo))
+            }
+        };
+        let b = match no {
+            Some(p) if p.0 <= hi * (1.0 - END_GAP) => p,
+            _ => {
+                let at_hi = returns(hi);
+                if at_hi >= detect {
+                    return hi;
+                }
+                no.unwrap_or((hi, at_hi))
+            }
+        };
+        let (yes, no) = narrow(&returns, detect, (lo, hi), a, b);
         let ok = |r: f64| returns(r) >= detect;
         for _ in 0..100 {
             if hi - lo <= 1e-12 * hi {
@@ -465,6 +482,65 @@ impl ReturnModel {
     }
 }
 
+/// How far inside `[lo, hi]` (relative) a range found by [`step_out`] must
+/// lie to decide that end without evaluating it: the returns fall at
+/// least as `1/R` (the pulses across the target), so `10⁻⁹` apart they
+/// differ by far more than the model's rounding (some `10⁻¹⁴`).
+const END_GAP: f64 = 1e-9;
+
+/// The ranges found by stepping out from `guess` inside `(lo, hi)`: the
+/// highest that detects and the lowest that does not, each with its
+/// returns (`None`: none found on that side). The step starts at the
+/// guess's relative error and grows eightfold until the end of the
+/// detecting ranges is crossed.
+#[allow(clippy::type_complexity)]
+fn step_out(
+    returns: &impl Fn(f64) -> f64,
+    detect: f64,
+    (lo, hi): (f64, f64),
+    guess: Guess,
+) -> (Option<(f64, f64)>, Option<(f64, f64)>) {
+    let (mut yes, mut no) = (None, None);
+    let g = guess.range_m;
+    if !(g > lo && g < hi) {
+        return (yes, no);
+    }
+    let (mut a, mut b) = (lo, hi);
+    let at_g = returns(g);
+    let up = at_g >= detect;
+    if up {
+        a = g;
+        yes = Some((g, at_g));
+    } else {
+        b = g;
+        no = Some((g, at_g));
+    }
+    let mut step = guess.rel_err.max(1e-13);
+    while step < 1.0 {
+        let r = if up {
+            g * (1.0 + step)
+        } else {
+            g * (1.0 - step)
+        };
+        if !(r > a && r < b) {
+            break;
+        }
+        let at_r = returns(r);
+        if at_r >= detect {
+            a = r;
+            yes = Some((r, at_r));
+        } else {
+            b = r;
+            no = Some((r, at_r));
+        }
+        if (at_r >= detect) != up {
+            break;
+        }
+        step *= 8.0;
+    }
+    (yes, no)
+}
+
 /// A bracket `(yes, no)` of the end of the detecting ranges inside
 /// `[lo, hi]` (`returns(lo) ≥ detect > returns(hi)`, `returns` falling):
 /// `returns(yes) ≥ detect > returns(no)`, each end a relative
@@ -477,55 +553,17 @@ impl ReturnModel {
 /// the caller decides it. Where the widened ends do not check, `(lo, hi)`:
 /// the caller evaluates every midpoint.
 ///
-/// `(lo, at_lo)` and `(hi, at_hi)` are the bracket's ends and their
-/// returns. A `guess` inside it is tried first: the regula falsi starts
-/// from the bracket found by stepping out from the guess by its relative
-/// error, growing the step eightfold, until the end is crossed.
+/// The regula falsi starts from `(a, at_a)` (a detecting range, at or
+/// above `lo`) and `(b, at_b)` (a failing one, at or below `hi`) with
+/// their returns: `lo` and `hi`, or the ranges [`step_out`] found.
 fn narrow(
     returns: &impl Fn(f64) -> f64,
     detect: f64,
-    (lo, at_lo): (f64, f64),
-    (hi, at_hi): (f64, f64),
-    guess: Guess,
+    (lo, hi): (f64, f64),
+    (mut a, at_a): (f64, f64),
+    (mut b, at_b): (f64, f64),
 ) -> (f64, f64) {
     let ln_detect = detect.ln();
-    let (mut a, mut b) = (lo, hi);
-    let (mut at_a, mut at_b) = (at_lo, at_hi);
-    let g = guess.range_m;
-    if g > lo && g < hi {
-        let at_g = returns(g);
-        let up = at_g >= detect;
-        if up {
-            (a, at_a) = (g, at_g);
-        } else {
-            (b, at_b) = (g, at_g);
-        }
-        let mut step = guess.rel_err.max(1e-13);
-        while step < 1.0 {
-            let r = if up {
-                g * (1.0 + step)
-            } else {
-                g * (1.0 - step)
-            };
-            if !(r > a && r < b) {
-                break;
-            }
-            let at_r = returns(r);
-            match (at_r >= detect, up) {
-                (true, true) => (a, at_a) = (r, at_r),
-                (false, false) => (b, at_b) = (r, at_r),
-                (true, false) => {
-                    (a, at_a) = (r, at_r);
-                    break;
-                }
-                (false, true) => {
-                    (b, at_b) = (r, at_r);
-                    break;
-                }
-            }
-            step *= 8.0;
-        }
-    }
     let (mut ga, mut gb) = (
         (at_a.ln() - ln_detect).max(0.0),
         (at_b.ln() - ln_detect).min(0.0),
@@ -591,10 +629,13 @@ impl Guess {
     };
 }
 
-/// [`narrow`]'s widening of its bracket, relative: far above the model's
-/// rounding (about 1e-14 of the range), far below the bisection's
-/// 1e-12-wide answer's cost (`log2(2·NARROW_MARGIN / 1e-12)` evaluations).
-const NARROW_MARGIN: f64 = 1e-11;
+/// [`narrow`]'s widening of its bracket, relative: 100 times the model's
+/// rounding of the end (at most about 1e-14 of the range: the returns'
+/// relative rounding, some 200ε where `erfc` is steepest, over their slope
+/// in `ln R`, at least 1 and there some 40), and as wide as the bisection's
+/// last interval (a relative 1e-12 of its first `hi`), so that at most one
+/// or two of its midpoints fall inside the widened bracket and are evaluated.
+const NARROW_MARGIN: f64 = 1e-12;
 
 /// [`narrow`]'s most regula falsi steps (it stops once its bracket is a
 /// relative [`NARROW_MARGIN`] wide: a narrower bracket would save no

@@ -177,9 +177,33 @@ impl Detection {
 }
 
 /// `u(x, t)` of a bin `theta_rad` wide dwelt on `dwell_s` (module docs).
+/// Remembered per problem, pulse spacing and power: bins of one width and
+/// dwell (every bin of a `range`-mode problem) at one hardware level share
+/// it, and the power step, the exact objective and the global bound ask
+/// for the same values.
 pub fn value(problem: &Problem, theta_rad: f64, dwell_s: f64, power_ratio: f64) -> f64 {
-    let d = &problem.objective.detection;
     let spacing = spacing_rad(problem, theta_rad, dwell_s);
+    let key = (
+        problem_key(problem),
+        [spacing.to_bits(), power_ratio.to_bits(), 0, 0],
+    );
+    if let Some(v) = VALUES.with(|c| c.borrow().get(&key).copied()) {
+        return v;
+    }
+    let v = value_at_spacing(problem, spacing, power_ratio);
+    VALUES.with(|c| {
+        let mut c = c.borrow_mut();
+        if c.len() > 1 << 16 {
+            c.clear();
+        }
+        c.insert(key, v);
+    });
+    v
+}
+
+/// [`value`] computed, at the pulse spacing `spacing`.
+fn value_at_spacing(problem: &Problem, spacing: f64, power_ratio: f64) -> f64 {
+    let d = &problem.objective.detection;
     let r0 = problem.lidar.rated_range_m;
     d.conditions(problem)
         .iter()
@@ -201,33 +225,36 @@ pub fn value(problem: &Problem, theta_rad: f64, dwell_s: f64, power_ratio: f64) 
 /// ([`ReturnModel::detection_range_near_m`]; the guess moves only where
 /// the model is evaluated, never the range found).
 pub fn values_at(problem: &Problem, theta_rad: f64, dwell_s: f64, xs: &[f64]) -> Vec<f64> {
-    let d = &problem.objective.detection;
     let spacing = spacing_rad(problem, theta_rad, dwell_s);
+    values_near(problem, spacing, xs, None).0
+}
+
+/// [`values_at`] at the pulse spacing `spacing`, bit for bit, and each
+/// condition's ranges at `xs`. With `near`, each condition's ranges at the
+/// same `xs` but another spacing (a neighbouring bin's), a `physical`
+/// condition's range at `xs[j]` is guessed as `near[j]` moved by the
+/// difference found at `xs[j - 1]` (bins of a smooth spin differ little:
+/// the guess is far closer than the extrapolation along `xs`); the guess
+/// still moves only where the model is evaluated.
+pub fn values_near(
+    problem: &Problem,
+    spacing: f64,
+    xs: &[f64],
+    near: Option<&[Vec<f64>]>,
+) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let d = &problem.objective.detection;
     let r0 = problem.lidar.rated_range_m;
     let mut sum = vec![0.0; xs.len()];
-    let mut ranges = vec![0.0; xs.len()];
-    for (w, m) in d.conditions(problem) {
+    let mut all = Vec::new();
+    for (c, (w, m)) in d.conditions(problem).into_iter().enumerate() {
+        let mut ranges = vec![0.0; xs.len()];
+        let near = near
+            .and_then(|n| n.get(c))
+            .filter(|n| n.len() == xs.len() && matches!(m, ReturnModel::Physical { .. }));
         for (j, &x) in xs.iter().enumerate() {
-            let guess = match j {
-                0 => Guess::NONE,
-                1 => Guess {
-                    range_m: ranges[0],
-                    rel_err: 1e-2,
-                },
-                _ => {
-                    let (r1, r2) = (ranges[j - 1], ranges[j - 2]);
-                    let range_m = 2.0 * r1 - r2;
-                    let rel_err = if j >= 3 {
-                        // The last extrapolation's miss.
-                        ((2.0 * r2 - ranges[j - 3] - r1) / range_m).abs()
-                    } else {
-                        1e-3
-                    };
-                    Guess {
-                        range_m,
-                        rel_err: rel_err.clamp(1e-9, 1e-1),
-                    }
-                }
+            let guess = match near {
+                Some(p) => across(p, &ranges, j),
+                None => along(&ranges, j),
             };
             ranges[j] = m.detection_range_near_m(
                 x,
@@ -241,8 +268,58 @@ pub fn values_at(problem: &Problem, theta_rad: f64, dwell_s: f64, xs: &[f64]) ->
         for (s, r) in sum.iter_mut().zip(&ranges) {
             *s += w * r / r0;
         }
+        all.push(ranges);
     }
-    sum
+    (sum, all)
+}
+
+/// The guess at node `j` from the ranges at the nodes below it,
+/// extrapolated linearly, its error the last extrapolation's miss.
+fn along(ranges: &[f64], j: usize) -> Guess {
+    match j {
+        0 => Guess::NONE,
+        1 => Guess {
+            range_m: ranges[0],
+            rel_err: 1e-2,
+        },
+        _ => {
+            let (r1, r2) = (ranges[j - 1], ranges[j - 2]);
+            let range_m = 2.0 * r1 - r2;
+            let rel_err = if j >= 3 {
+                // The last extrapolation's miss.
+                ((2.0 * r2 - ranges[j - 3] - r1) / range_m).abs()
+            } else {
+                1e-3
+            };
+            Guess {
+                range_m,
+                rel_err: rel_err.clamp(1e-9, 1e-1),
+            }
+        }
+    }
+}
+
+/// The guess at node `j` from another spacing's ranges `near` at the same
+/// nodes, moved by the difference at node `j - 1`; its error twice the
+/// same guess's miss at `j - 1`.
+fn across(near: &[f64], ranges: &[f64], j: usize) -> Guess {
+    if j == 0 {
+        return Guess {
+            range_m: near[0],
+            rel_err: 1e-3,
+        };
+    }
+    let shift = ranges[j - 1] - near[j - 1];
+    let range_m = near[j] + shift;
+    let miss = if j >= 2 {
+        ranges[j - 1] - (near[j - 1] + ranges[j - 2] - near[j - 2])
+    } else {
+        shift
+    };
+    Guess {
+        range_m,
+        rel_err: (2.0 * (miss / range_m).abs()).clamp(1e-10, 1e-1),
+    }
 }
 
 /// A proven upper bound of `u(x, t)` (of the real-number model and of
@@ -350,24 +427,57 @@ pub(super) fn exact_range_utility(problem: &Problem, theta_rad: f64, dwell_s: f6
     level_value(problem, theta_rad, dwell_s, x.max(0.0))
 }
 
-type Key = (String, [u64; 4]);
+/// Everything [`value`] depends on but the bin: the problem's part
+/// ([`problem_key`]) and four numbers (the spacing, the power or box, ...).
+type Key = (Vec<u64>, [u64; 4]);
 
 thread_local! {
     /// Segments already built: a power step's bins mostly share their
     /// dwell, and the block-coordinate loop solves many power steps.
     static CACHE: RefCell<HashMap<Key, SqrtSegments>> = RefCell::new(HashMap::new());
+    /// Values already computed ([`value`]).
+    static VALUES: RefCell<HashMap<Key, f64>> = RefCell::new(HashMap::new());
+    /// The ranges of the last segments built, and the problem and box
+    /// they were built for.
+    #[allow(clippy::type_complexity)]
+    static LAST: RefCell<Option<((Vec<u64>, [u64; 2]), Vec<Vec<f64>>)>> =
+        const { RefCell::new(None) };
+}
+
+/// The fields of `problem` that [`value`] reads besides the bin's spacing
+/// and power, as bits: the detection objective's target and conditions
+/// and the LiDAR's rating and pulse rate.
+fn problem_key(problem: &Problem) -> Vec<u64> {
+    let d = &problem.objective.detection;
+    let l = &problem.lidar;
+    let mut key = vec![
+        d.models.len() as u64,
+        d.fog_pct.len() as u64,
+        d.fog_weight.len() as u64,
+    ];
+    key.extend(d.models.iter().map(|&m| match m {
+        ModelKind::Argus => 0,
+        ModelKind::Physical => 1,
+    }));
+    key.extend(d.fog_pct.iter().map(|&f| u64::from(f)));
+    key.extend(d.fog_weight.iter().map(|w| w.to_bits()));
+    key.extend(
+        [
+            d.target_width_m,
+            d.reflectivity,
+            d.detect,
+            l.rated_range_m,
+            l.reference_reflectivity,
+            l.pulse_rate_hz,
+        ]
+        .map(f64::to_bits),
+    );
+    key
 }
 
 fn cached(problem: &Problem, theta_rad: f64, dwell_s: f64, lo: f64, hi: f64) -> SqrtSegments {
-    let l = &problem.lidar;
     let key: Key = (
-        format!(
-            "{:?}|{}|{}|{}",
-            problem.objective.detection,
-            l.rated_range_m.to_bits(),
-            l.reference_reflectivity.to_bits(),
-            l.pulse_rate_hz.to_bits()
-        ),
+        problem_key(problem),
         [
             spacing_rad(problem, theta_rad, dwell_s).to_bits(),
             lo.to_bits(),
@@ -379,7 +489,13 @@ fn cached(problem: &Problem, theta_rad: f64, dwell_s: f64, lo: f64, hi: f64) -> 
         return s;
     }
     let v = nodes(lo, hi);
-    let y = values_at(problem, theta_rad, dwell_s, &v);
+    // The last bin built on the same box (the same nodes) guesses the
+    // ranges ([`values_near`]).
+    let same = (key.0.clone(), [key.1[1], key.1[2]]);
+    let near = LAST.with(|l| l.borrow_mut().take().filter(|(k, _)| *k == same));
+    let spacing = spacing_rad(problem, theta_rad, dwell_s);
+    let (y, ranges) = values_near(problem, spacing, &v, near.as_ref().map(|n| &n.1[..]));
+    LAST.with(|l| *l.borrow_mut() = Some((same, ranges)));
     let s = hull_segments(&v, &y, super::UTILITY_SEGMENTS);
     CACHE.with(|c| {
         let mut c = c.borrow_mut();
@@ -522,6 +638,23 @@ mod tests {
         sum / p.lidar.rated_range_m
     }
 
+    /// A remembered value is the value of the problem asked about: a
+    /// changed target is computed afresh.
+    #[test]
+    fn a_remembered_value_is_the_problems() {
+        let mut p = problem();
+        let theta = std::f64::consts::TAU / 360.0;
+        let dwell = p.lidar.frame_period_s() / 360.0;
+        let s = spacing_rad(&p, theta, dwell);
+        let first = value(&p, theta, dwell, 0.8);
+        assert_eq!(first.to_bits(), value_at_spacing(&p, s, 0.8).to_bits());
+        assert_eq!(first.to_bits(), value(&p, theta, dwell, 0.8).to_bits());
+        p.objective.detection.reflectivity *= 2.0;
+        let second = value(&p, theta, dwell, 0.8);
+        assert_eq!(second.to_bits(), value_at_spacing(&p, s, 0.8).to_bits());
+        assert!(second > first, "{second} vs {first}");
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(24))]
         /// The value against the slow loop over ranges (1 cm grid: the
@@ -550,6 +683,24 @@ mod tests {
             let chained = values_at(&p, theta, dwell, &v);
             for (&x, y) in v.iter().zip(&chained) {
                 let one = value(&p, theta, dwell, x);
+                prop_assert_eq!(y.to_bits(), one.to_bits(), "{} at {}", y, x);
+            }
+        }
+
+        /// Guessed from a neighbouring spacing's ranges, the values are
+        /// still every node's value bit for bit.
+        #[test]
+        fn values_near_another_spacing_are_the_values(
+            lo in 0.0f64..0.6, width in 0.01f64..4.0, density in 0.2f64..5.0, step in -0.3f64..0.3,
+        ) {
+            let p = problem();
+            let theta = std::f64::consts::TAU / 360.0;
+            let dwell = density * p.lidar.frame_period_s() / 360.0;
+            let v = nodes(lo, lo + width);
+            let near = values_near(&p, spacing_rad(&p, theta, dwell * (1.0 + step)), &v, None).1;
+            let (got, _) = values_near(&p, spacing_rad(&p, theta, dwell), &v, Some(&near));
+            for (&x, y) in v.iter().zip(&got) {
+                let one = value_at_spacing(&p, spacing_rad(&p, theta, dwell), x);
                 prop_assert_eq!(y.to_bits(), one.to_bits(), "{} at {}", y, x);
             }
         }
