@@ -92,7 +92,7 @@ ORIENT = {"mode": "normal"}
 
 
 def dist_and_width(head, ch, theta_deg, alpha_deg, h):
-    if ORIENT["mode"] == "radial":
+    if ORIENT["mode"] in ("radial", "beam"):
         return dist_and_width_disc(head, ch, theta_deg, alpha_deg, h)
     return dist_and_width_centre(head, ch, theta_deg, alpha_deg, h)
 
@@ -107,6 +107,19 @@ def dist_and_width_disc(head, ch, theta_deg, alpha_deg, h):
     al = math.radians(alpha_deg)
     ey = np.array([-math.sin(al), math.cos(al), 0.0])
     ez = np.array([0.0, 0.0, 1.0])
+    if ORIENT["mode"] == "beam":
+        # a fixed disc facing the beam at its closest approach to the centre
+        grid = alpha_deg + np.linspace(-180, 180, 72001)
+        d, _ = dist_and_width_centre(head, ch, grid, alpha_deg, h)
+        thm = math.radians(grid[int(np.argmin(d))])
+        az = thm + math.radians(ch["azimuth_offset_deg"])
+        el = math.radians(ch["elevation_deg"])
+        u = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+        e1 = np.cross(u, [0.0, 0.0, 1.0])
+        if np.linalg.norm(e1) < 1e-9:
+            e1 = np.array([1.0, 0.0, 0.0])
+        ey = e1 / np.linalg.norm(e1)
+        ez = np.cross(u, ey)
     best = None
     wbest = None
     for rr in np.linspace(0, a_mm / 2, 9):
@@ -282,9 +295,10 @@ def main():
     ap.add_argument("--revs", type=int, default=2)
     ap.add_argument("--timebase", action="store_true", help="also the 100 s rule by pass sums")
     ap.add_argument("--aperture-mm", type=float, default=7.0)
-    ap.add_argument("--orientation", choices=["normal", "radial"], default="normal",
+    ap.add_argument("--orientation", choices=["normal", "radial", "beam"], default="normal",
                     help="normal: aperture facing the beam (centre within (a+w)/2 of the ray); "
-                    "radial: a fixed disc in the cylinder's tangent plane, facing the axis")
+                    "radial: a fixed disc in the cylinder's tangent plane, facing the axis; "
+                    "beam: a fixed disc facing the beam at its closest approach")
     args = ap.parse_args()
     ORIENT["mode"] = args.orientation
     ORIENT["a"] = args.aperture_mm
