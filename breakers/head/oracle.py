@@ -295,6 +295,9 @@ def main():
     ap.add_argument("--revs", type=int, default=2)
     ap.add_argument("--timebase", action="store_true", help="also the 100 s rule by pass sums")
     ap.add_argument("--aperture-mm", type=float, default=7.0)
+    ap.add_argument("--radius-mm", type=float, default=None,
+                    help="aperture positions at this distance from the spin axis instead of the head's "
+                    "aperture_distance_mm (e.g. a point of the 100 mm sphere around the scan centre)")
     ap.add_argument("--orientation", choices=["normal", "radial", "beam"], default="normal",
                     help="normal: aperture facing the beam (centre within (a+w)/2 of the ray); "
                     "radial: a fixed disc in the cylinder's tangent plane, facing the axis; "
@@ -303,6 +306,8 @@ def main():
     ORIENT["mode"] = args.orientation
     ORIENT["a"] = args.aperture_mm
     prof = Profile(json.load(open(args.profile)))
+    if args.radius_mm is not None:
+        prof.head = dict(prof.head, aperture_distance_mm=args.radius_mm)
     lam, tau = prof.lam, prof.tau
     alphas = [float(x) for x in args.alphas.split(",")] if args.alphas else list(np.arange(0, 360, 5.0))
     heights = [float(x) for x in args.heights.split(",")] if args.heights else [0.0]

@@ -133,3 +133,62 @@ fn wide_beam_firmware_table_is_rejected() {
         "certified a table {truth}x over Class 1: {v:?}"
     );
 }
+
+/// A one-channel head, crossing point on the axis, its beam 75° up (10 mm,
+/// no divergence), 905 nm, 1 MHz, 1,000 Hz spin, 12.556 mW: certified at
+/// 0.990 (single pulse), every aperture position on the 100 mm *cylinder*.
+///
+/// Condition 3 measures 100 mm from the reference point (the scan centre);
+/// the point of the 100 mm sphere on this beam, `S = 100·(cos 75°, 0,
+/// sin 75°)` mm, is 25.9 mm from the spin axis and 96.6 mm up: the beam
+/// sweeps it 3.9× slower than the cylinder. By hand (the centre within
+/// `ρ = (7 + 10)/2` of the ray, `|S| = 100` on the ray's line): the beam meets
+/// the aperture while the angle `γ` between `S` and the ray has
+/// `100·sin γ ≤ 8.5`, with `cos γ = cos²75°·cos x + sin²75°` at head turn
+/// `x`: `cos x ≥ (sqrt(1 − 0.085²) − sin²75°)/cos²75° = 0.945974`,
+/// `x* = 0.33039 rad`, on the aperture `x*/π = 10.517 %` of every turn; the
+/// 100 s time base: `12.556 mW · 0.10517 · 100 s / (3.9e-4·C4·100 J) = 1.317`.
+/// (The explicit-pulse oracle, `breakers/head/oracle.py --radius-mm 25.8819
+/// --heights 96.5926`, finds 1.328 with whole pulses, 1.315 through a fixed
+/// 7 mm disc facing the beam.)
+#[test]
+#[ignore = "bug: aperture positions only on the 100 mm cylinder; the 100 mm sphere around the scan centre is closer to a steep beam (75° up: certified 0.990, true 1.317)"]
+fn steep_beam_is_evaluated_at_100_mm_from_the_scan_centre() {
+    let power_w = 1.2556e-2;
+    let omega = 2.0 * std::f64::consts::PI * 1000.0;
+    let bins: Vec<String> = (0..4)
+        .map(|i| {
+            format!(
+                r#"{{"start_deg": {s}, "width_deg": 90.0, "power_w": {power_w:e}, "spin_start_rad_s": {omega:e}, "spin_end_rad_s": {omega:e}}}"#,
+                s = 90.0 * f64::from(i)
+            )
+        })
+        .collect();
+    let text = format!(
+        r#"{{"format": "gaze-lidar/profile@1", "frame_rate_hz": 1000.0, "pulse_rate_hz": 1000000.0,
+ "average_power_w": {power_w:e}, "power_accounting": "time", "gaze_deg": null,
+ "limits": {{"power_w_min": 0.0, "power_w_max": {power_w:e}, "spin_rad_s_min": {omega:e}, "spin_rad_s_max": {omega:e},
+  "spin_accel_rad_s2_max": null, "power_slew_w_per_deg_max": null,
+  "eye_safety": {{"wavelength_nm": 905.0, "pulse_duration_s": 5e-9, "beam_diameter_mm": 10.0,
+   "head": {{"cycle_s": 1e-6, "origin_radius_mm": 0.0, "origin_height_mm": 0.0, "exit_diameter_mm": 10.0,
+    "divergence_mrad": 0.0, "aperture_distance_mm": 100.0,
+    "channels": [{{"id": 0, "elevation_deg": 75.0, "azimuth_offset_deg": 0.0, "slot_s": 0.0}}]}}}}}},
+ "bins": [{}]}}"#,
+        bins.join(", ")
+    );
+    let profile = Profile::from_json(&text, "steep_beam").unwrap();
+    let params = profile.limits.eye_safety.clone().unwrap();
+    let report = evaluate_profile(&profile, &params).unwrap();
+    let (s, c) = 75f64.to_radians().sin_cos();
+    let cos_x = ((1.0 - 0.085f64 * 0.085).sqrt() - s * s) / (c * c);
+    let fraction = cos_x.acos() / std::f64::consts::PI;
+    let truth = power_w * fraction * 100.0 / (3.9e-4 * c4_905() * 100.0);
+    assert!(truth > 1.3, "{truth}");
+    // Whole pulses (about 105 per pass) and a fixed disc facing the beam
+    // (0.2 % less than the centre reading) stay within 2 % of the closed form.
+    assert!(
+        report.worst_ratio >= truth * 0.98,
+        "certified figure {} below the true ratio {truth} at 100 mm from the scan centre",
+        report.worst_ratio
+    );
+}
