@@ -192,3 +192,52 @@ fn steep_beam_is_evaluated_at_100_mm_from_the_scan_centre() {
         report.worst_ratio
     );
 }
+
+/// Two co-located channels (one ray) fired at the two ends of a 100 µs cycle
+/// (slots 0 and 99.9 µs) put two pulses 0.1 µs apart into one aperture:
+/// one `T_i` group across the cycle boundary, twice the energy of a lone
+/// pulse. The same head with the slots half a cycle apart (50 µs > `T_i`)
+/// has lone pulses. Held (the slot distance is taken around the cycle); kept
+/// as a regression test of the wrap-around.
+#[test]
+fn slots_at_the_two_ends_of_the_cycle_form_one_group() {
+    let text = |slot2: f64| {
+        let omega = 2.0 * std::f64::consts::PI * 10.0;
+        let bins: Vec<String> = (0..4)
+            .map(|i| {
+                format!(
+                    r#"{{"start_deg": {s}, "width_deg": 90.0, "power_w": 1e-3, "spin_start_rad_s": {omega:e}, "spin_end_rad_s": {omega:e}}}"#,
+                    s = 90.0 * f64::from(i)
+                )
+            })
+            .collect();
+        format!(
+            r#"{{"format": "gaze-lidar/profile@1", "frame_rate_hz": 10.0, "pulse_rate_hz": 10000.0,
+ "average_power_w": 1e-3, "power_accounting": "time", "gaze_deg": null,
+ "limits": {{"power_w_min": 0.0, "power_w_max": 1e-3, "spin_rad_s_min": {omega:e}, "spin_rad_s_max": {omega:e},
+  "spin_accel_rad_s2_max": null, "power_slew_w_per_deg_max": null,
+  "eye_safety": {{"wavelength_nm": 905.0, "pulse_duration_s": 5e-9, "beam_diameter_mm": 5.0,
+   "head": {{"cycle_s": 1e-4, "origin_radius_mm": 0.0, "exit_diameter_mm": 5.0, "divergence_mrad": 0.0,
+    "channels": [{{"id": 0, "elevation_deg": 0.0, "azimuth_offset_deg": 0.0, "slot_s": 0.0}},
+                 {{"id": 1, "elevation_deg": 0.0, "azimuth_offset_deg": 0.0, "slot_s": {slot2:e}}}]}}}}}},
+ "bins": [{}]}}"#,
+            bins.join(", ")
+        )
+    };
+    let eval = |slot2: f64| {
+        let p = Profile::from_json(&text(slot2), "slots").unwrap();
+        let params = p.limits.eye_safety.clone().unwrap();
+        evaluate_profile(&p, &params).unwrap()
+    };
+    let wrap = eval(9.99e-5);
+    let mid = eval(5e-5);
+    let (hw, hm) = (wrap.head.as_ref().unwrap(), mid.head.as_ref().unwrap());
+    assert!(hw.weight_group >= 2.0, "{hw:?}");
+    assert!(hm.weight_group < 2.0, "{hm:?}");
+    assert!(
+        wrap.worst_ratio >= 1.9 * mid.worst_ratio,
+        "{} vs {}",
+        wrap.worst_ratio,
+        mid.worst_ratio
+    );
+}
