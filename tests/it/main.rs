@@ -6,6 +6,7 @@
 //! the core's tests (and the brute-force eye-safety references) are
 //! `gaze_lidar_core::testing`.
 
+mod breakers;
 mod checker;
 mod cli_inputs;
 mod eye_safety;

@@ -2,6 +2,7 @@
 
 mod ael;
 mod band_edges;
+mod break_head;
 #[cfg(feature = "optimizer")]
 mod cuts;
 #[cfg(feature = "optimizer")]
