@@ -267,7 +267,7 @@ fn head_turns_carry_their_margin() {
 ///
 /// By hand: two radial channels (origin on the axis, `ψ` = the azimuth
 /// offset) on a 100 mm surface, 7 mm aperture, 5 mm beam: the pass is
-/// `12/100` rad = 6.8755°. Offsets 0 and two passes: share 2 (within
+/// `2·asin(6/100)` = 6.8797° (rounded up by the geometry's 1e-12). Offsets 0 and two passes: share 2 (within
 /// rounding), `⌈1 + 2·(1 + 1e-12)⌉ = 4`; 0 and 1.5 passes: `⌈2.5⌉ = 3`.
 #[test]
 fn union_passes_rounds_a_whole_share_up() {
@@ -302,7 +302,7 @@ fn union_passes_rounds_a_whole_share_up() {
             })
             .collect(),
     };
-    let pass_deg = (12.0f64 / 100.0).to_degrees();
+    let pass_deg = (2.0 * 0.06f64.asin()).to_degrees() * (1.0 + 1e-12);
     for (share, k) in [(2.0, 4), (1.5, 3)] {
         let h = head(&[0.0, share * pass_deg]);
         let fps = footprints(&h, l.band.aperture_mm());

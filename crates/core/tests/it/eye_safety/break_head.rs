@@ -79,7 +79,6 @@ fn wide_beam_true_ratio(exit_mm: f64, power_w: f64) -> f64 {
 /// aperture; for the beam-facing aperture every beam is short by
 /// `≈ (ρ/R)²/6` (0.12 % at the presets' 10 mm beams).
 #[test]
-#[ignore = "bug: the pass angle (a + w)/R is the chord laid as an arc; a beam wider than ~14 mm is certified while over Class 1 (150 mm: 0.991 certified, 1.113 true)"]
 fn wide_beam_pass_is_not_under_counted() {
     let (exit_mm, power_w) = (150.0, 3.97e-3);
     let text = wide_beam_profile(exit_mm, power_w);
@@ -101,7 +100,6 @@ fn wide_beam_pass_is_not_under_counted() {
 /// pulses, code 3970 × 1 µW): the integer check derives its limits from the
 /// float head bound and certifies it at 99.07 % of the limit.
 #[test]
-#[ignore = "bug: the integer firmware check inherits the chord pass; a 150 mm beam table is certified at 99.07 % while 1.113x over Class 1"]
 fn wide_beam_firmware_table_is_rejected() {
     let (exit_mm, power_w) = (150.0, 3.97e-3);
     let truth = wide_beam_true_ratio(exit_mm, power_w);
