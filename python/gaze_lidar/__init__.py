@@ -271,7 +271,9 @@ def simulate(
     options: variants (list of "baseline", "range", "resolution", "joint",
     "optimized"), fog_pct (list of 0, 25, 50), detect ("k/n"), bins,
     preset, scenario_toml (TOML text), optimizer_toml (TOML text, with the
-    "optimized" variant). Releases the GIL while it runs, runs on a thread
+    "optimized" variant; the closed-form variants then run on its sensor,
+    limits and driver model, with the levels of the preset it names, which
+    preset replaces, as the CLI's --optimizer-config). Releases the GIL while it runs, runs on a thread
     pool of its own (fork-safe) and stops at Ctrl-C.
     """
     out = _native.simulate(model, trials, _fresh_seed(seed), **options)

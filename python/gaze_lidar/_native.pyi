@@ -409,7 +409,9 @@ def simulate(
     options: variants (list of "baseline", "range", "resolution", "joint",
     "optimized"), fog_pct (list of 0, 25, 50), detect ("k/n"), bins,
     preset, scenario_toml (TOML text), optimizer_toml (TOML text, with the
-    "optimized" variant). Releases the GIL while it runs.
+    "optimized" variant; the closed-form variants then run on its sensor,
+    limits and driver model, with the levels of the preset it names, which
+    preset replaces, as the CLI's --optimizer-config). Releases the GIL while it runs.
     """
 
 def replay(

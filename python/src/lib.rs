@@ -1517,6 +1517,8 @@ fn simulate<'py>(
             seed: seed_of(seed)?,
             ..SimConfig::default()
         };
+        let mut preset_name: Option<String> = None;
+        let mut optimizer = None;
         if let Some(opts) = options {
             for (k, v) in opts.iter() {
                 let key: String = k.extract()?;
@@ -1566,6 +1568,7 @@ fn simulate<'py>(
                     "preset" => {
                         let name: String = v.extract().map_err(|_| wrong("a preset name"))?;
                         config.sensor = preset_of(&name)?;
+                        preset_name = Some(name);
                     }
                     "scenario_toml" => {
                         let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
@@ -1575,10 +1578,9 @@ fn simulate<'py>(
                     "optimizer_toml" => {
                         use gaze_lidar::optimizer::OptimizerConfig;
                         let text: String = v.extract().map_err(|_| wrong("TOML text"))?;
-                        let problem = OptimizerConfig::from_toml(&text, "optimizer_toml")
-                            .and_then(|c| c.problem())
+                        let c = OptimizerConfig::from_toml(&text, "optimizer_toml")
                             .map_err(|e| opt_error(py, e))?;
-                        config.optimizer = Some(problem);
+                        optimizer = Some(c);
                     }
                     other => {
                         return Err(value_error(format!(
@@ -1588,6 +1590,19 @@ fn simulate<'py>(
                     }
                 }
             }
+        }
+        // As the CLI's --optimizer-config: the closed forms run on the
+        // configuration's sensor, limits and driver model (with the levels
+        // of the preset it names, `preset` replacing the file's).
+        if let Some(mut c) = optimizer {
+            if let Some(name) = preset_name {
+                c.lidar.preset = Some(name);
+            }
+            let problem = c.problem().map_err(|e| opt_error(py, e))?;
+            let named = c.preset().map_err(|e| opt_error(py, e))?;
+            config.sensor =
+                gaze_lidar::optimizer::figures::closed_form_basis(&problem, named.levels);
+            config.optimizer = Some(problem);
         }
         if config.optimizer.is_some() && !config.variants.contains(&Variant::Optimized) {
             return Err(value_error(

@@ -31,6 +31,17 @@ def test_both_models_and_options() -> None:
     assert sorted(r["model"] for r in rows) == ["argus", "physical"]
 
 
+def test_optimizer_toml_runs_the_closed_forms_on_its_sensor() -> None:
+    """With optimizer_toml the closed-form variants run on the configuration's
+    sensor (as the CLI's --optimizer-config), not on the paper preset."""
+    toml = 'bins = 72\n[lidar]\npreset = "vls128"\n[objective]\nmode = "range"\n'
+    common: dict[str, Any] = {"model": "physical", "trials": 2, "seed": 3, "fog_pct": [0]}
+    rows = gl.simulate(variants=["range", "optimized"], optimizer_toml=toml, **common)
+    closed = [r for r in rows if r["variant"] == "range"]
+    assert closed == list(gl.simulate(variants=["range"], preset="vls128", **common))
+    assert closed != list(gl.simulate(variants=["range"], **common))
+
+
 @pytest.mark.parametrize(
     "kwargs, field",
     [

@@ -1735,17 +1735,29 @@ impl SetPointChoice {
     }
 
     /// Bins by their gain from the slowest set-point over the fastest,
-    /// most first (ties to the lower bin), and set-points by `τ`, slowest
-    /// first: the assignment of counts `c` gives the first `c` of the bins
-    /// to the slowest set-point, and so on.
+    /// most first, and set-points by `τ`, slowest first: the assignment of
+    /// counts `c` gives the first `c` of the bins to the slowest set-point,
+    /// and so on. Bins of equal gain (the bins outside the focus under a
+    /// box acuity, say) are taken in bit-reversed order of their index, so
+    /// that every set-point's bins among them are spread over the circle
+    /// rather than side by side (the objective is the same for any order of
+    /// ties; the eye-safety bound, which [`spread_setpoints`] checks next,
+    /// sees the slow set-points' exposure spread out).
     fn orders(&self) -> (Vec<usize>, Vec<usize>) {
         let k = self.r.len();
         let mut sp: Vec<usize> = (0..k).collect();
         sp.sort_by(|&a, &b| self.r[b].total_cmp(&self.r[a]).then(a.cmp(&b)));
         let (slow, fast) = (sp[0], sp[k - 1]);
-        let mut bins: Vec<usize> = (0..self.cols.len()).collect();
+        let n = self.cols.len();
+        let mut bins: Vec<usize> = (0..n).collect();
         let gain = |i: usize| self.cost[i][slow] - self.cost[i][fast];
-        bins.sort_by(|&a, &b| gain(b).total_cmp(&gain(a)).then(a.cmp(&b)));
+        let spread = |i: usize| bit_reversed(i, n);
+        bins.sort_by(|&a, &b| {
+            gain(b)
+                .total_cmp(&gain(a))
+                .then(spread(a).cmp(&spread(b)))
+                .then(a.cmp(&b))
+        });
         (bins, sp)
     }
 
@@ -1794,6 +1806,18 @@ impl Heuristic for SetPointChoice {
 
     fn accept_gap(&self) -> f64 {
         S.setpoint_heuristic_gap
+    }
+}
+
+/// `i` with its bits reversed over the `⌈log₂ n⌉` bits that count `0..n`
+/// (the van der Corput order: any first few of `0..n` taken by it lie
+/// spread over the range).
+fn bit_reversed(i: usize, n: usize) -> usize {
+    let bits = usize::BITS - n.saturating_sub(1).leading_zeros();
+    if bits == 0 {
+        0
+    } else {
+        i.reverse_bits() >> (usize::BITS - bits)
     }
 }
 
@@ -2338,5 +2362,29 @@ fn build_profile(
         mode: Some(format!("optimized {}", problem.objective.mode.name())),
         summary: None,
         optimality: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bit_reversed;
+
+    /// The tie order is a total order (distinct keys) on every bin count,
+    /// and on a power of two its first half is every other bin.
+    #[test]
+    fn bit_reversal_orders_ties_spread_out() {
+        for n in 1..=1024usize {
+            let mut keys: Vec<usize> = (0..n).map(|i| bit_reversed(i, n)).collect();
+            keys.sort_unstable();
+            keys.dedup();
+            assert_eq!(keys.len(), n, "{n} bins");
+        }
+        for n in [2usize, 8, 256, 512] {
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by_key(|&i| bit_reversed(i, n));
+            let mut first: Vec<usize> = order[..n / 2].to_vec();
+            first.sort_unstable();
+            assert_eq!(first, (0..n).step_by(2).collect::<Vec<_>>(), "{n} bins");
+        }
     }
 }

@@ -82,9 +82,35 @@ impl Search<'_> {
                 }
                 true
             }
-            _ => (0..=m).all(|c| self.go(k + 1, m - c, s + c as f64 * r[k])),
+            _ => {
+                // The rest's sums lie between all `m` bins at its smallest
+                // ratio and all at its largest (both reached): a subtree
+                // wholly more than a tolerance off the target holds no
+                // sum within it, and its nearest sum is that end.
+                let (lo, hi) = span(r[k..].iter().copied(), m, s);
+                if hi < self.target - 2.0 * self.tol {
+                    self.consider(hi);
+                    return true;
+                }
+                if lo > self.target + 2.0 * self.tol {
+                    self.consider(lo);
+                    return true;
+                }
+                (0..=m).all(|c| self.go(k + 1, m - c, s + c as f64 * r[k]))
+            }
         }
     }
+}
+
+/// The least and greatest of `s + Σ c_j·r_j` over the counts `c` of `m`
+/// bins on the ratios `r`: all `m` on the smallest ratio, all on the
+/// largest.
+fn span(r: impl Iterator<Item = f64>, m: usize, s: f64) -> (f64, f64) {
+    let (lo, hi) = r.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    let mf = m as f64;
+    (s + mf * lo, s + mf * hi)
 }
 
 /// Whether `n` picks (with repetition) from the ratios `r` (`ω̄/w` per
@@ -216,6 +242,13 @@ fn around(a: &mut Around<'_>, d: usize, m: usize, s: f64, counts: &mut [usize]) 
     *a.steps -= 1;
     let k = a.order.len();
     if d < a.free {
+        // No composition of the rest reaches the band (a relative 10⁻⁹ of
+        // head-room over the float sums' 10⁻¹³): nothing to offer here.
+        let (lo, hi) = span(a.order[d..].iter().map(|&j| a.r[j]), m, s);
+        let slack = 1e-9 * a.band.1.abs().max(1.0);
+        if hi < a.band.0 - slack || lo > a.band.1 + slack {
+            return true;
+        }
         let j = a.order[d];
         // `near`'s count, within what is left (the box then reaches every
         // count once the radius reaches `m`).

@@ -477,21 +477,21 @@ fn a_subnormal_config_number_is_refused_by_name() {
     }
 }
 
-/// Evenly spread spin set-points, `resolution` mode, 360 bins: the only
-/// compositions meeting the frame need many bins at the slowest set-point,
-/// which the eye-safety bound refuses where they sit together. The answer
-/// was once refused ("102.99 % of the Class 1 limit"), although the same
-/// counts spread over the bins certify: answered, at set-points only, and
-/// certified.
+/// Evenly spread spin set-points, `resolution` mode, 360 bins (and six on
+/// 720): the only compositions meeting the frame need many bins at the
+/// slowest set-point, which the eye-safety bound refuses where they sit
+/// together. The answer was once refused ("102.99 % of the Class 1
+/// limit"), although the same counts spread over the bins certify:
+/// answered, at set-points only, and certified.
 #[test]
 fn set_points_over_the_eye_limit_together_are_spread_not_refused() {
-    for k in [5usize, 6] {
+    for (k, bins) in [(5usize, 360), (6, 360), (6, 720)] {
         let sp: Vec<f64> = (0..k)
             .map(|i| 60.123 + i as f64 * 240.0 / (k - 1) as f64)
             .collect();
         let list: Vec<String> = sp.iter().map(|w| format!("{w:?}")).collect();
         let toml = format!(
-            "bins = 360\n[levels]\nspin_rad_s = [{}]\n[objective]\nmode = \"resolution\"\n",
+            "bins = {bins}\n[levels]\nspin_rad_s = [{}]\n[objective]\nmode = \"resolution\"\n",
             list.join(", ")
         );
         let p = answer(&toml, 90.0);

@@ -64,12 +64,24 @@ fn every_shipped_config_gives_certified_profiles() {
             // Independent re-check of the file: every declared limit holds.
             let broken = independent::recheck(&p);
             assert!(broken.is_empty(), "{c} {gaze}: {broken:?}");
-            let levels: std::collections::BTreeSet<u64> =
-                p.bins.iter().map(|b| b.power_w.to_bits()).collect();
             match c {
                 // The detection value has a knee: its optimum takes the
-                // lowest level in the focus and the highest outside.
-                "multi_level" => assert!(levels.len() >= 2, "{c} {gaze}: {} levels", levels.len()),
+                // configured lowest level on one arc around the gaze and
+                // one other level everywhere else.
+                "multi_level" => {
+                    let text = std::fs::read_to_string(&path).unwrap();
+                    let lowest = OptimizerConfig::from_toml(&text, &path)
+                        .unwrap()
+                        .problem()
+                        .unwrap()
+                        .levels
+                        .power_w
+                        .iter()
+                        .copied()
+                        .fold(f64::INFINITY, f64::min);
+                    let g: f64 = gaze.parse().unwrap();
+                    low_arc_around_the_gaze(&p, lowest, g, &format!("{c} {gaze}"));
+                }
                 "smooth" => {
                     let a = p
                         .limits
@@ -93,6 +105,45 @@ fn every_shipped_config_gives_certified_profiles() {
             }
         }
     }
+}
+
+/// `p` takes exactly two power levels: `lowest` on one arc of bins that
+/// holds the gaze's bin and is centred on the gaze within one bin, the
+/// other level on every other bin.
+fn low_arc_around_the_gaze(p: &Profile, lowest: f64, gaze_deg: f64, what: &str) {
+    let n = p.bins.len();
+    let levels: std::collections::BTreeSet<u64> =
+        p.bins.iter().map(|b| b.power_w.to_bits()).collect();
+    assert_eq!(levels.len(), 2, "{what}: {} levels", levels.len());
+    let low: Vec<bool> = p.bins.iter().map(|b| b.power_w == lowest).collect();
+    let count = low.iter().filter(|&&l| l).count();
+    assert!(
+        count > 0 && count < n,
+        "{what}: {count} of {n} bins at the lowest level"
+    );
+    // One arc: exactly one bin where the low run starts on the ring.
+    let starts = (0..n).filter(|&i| low[i] && !low[(i + n - 1) % n]).count();
+    assert_eq!(starts, 1, "{what}: the lowest level on {starts} arcs");
+    let holds = |b: &gaze_lidar::profile::Bin| {
+        let off = (gaze_deg - b.start_deg).rem_euclid(360.0);
+        off < b.width_deg
+    };
+    let at = p.bins.iter().position(holds).expect("a bin holds the gaze");
+    assert!(low[at], "{what}: the gaze's bin is not at the lowest level");
+    // The arc's middle (the circular mean of its bins' centres) is the gaze.
+    let (sx, sy) = p
+        .bins
+        .iter()
+        .zip(&low)
+        .filter(|(_, &l)| l)
+        .map(|(b, _)| (b.start_deg + b.width_deg / 2.0).to_radians())
+        .fold((0.0, 0.0), |(x, y), a| (x + a.cos(), y + a.sin()));
+    let mid = sy.atan2(sx).to_degrees();
+    let off = (mid - gaze_deg + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(
+        off.abs() <= p.bins[at].width_deg,
+        "{what}: the arc's middle {mid}° is {off}° off the gaze"
+    );
 }
 
 #[test]
