@@ -84,8 +84,14 @@ fn head_line(r: &ExposureReport, profile: &Profile) -> String {
                 h.channels, r.worst_azimuth_deg, height_mm, beams, r.binding_rule
             )
         }
-        None => "head: none given, evaluated for one channel (limits.eye_safety.head absent: the sensor's other channels are not counted)".to_owned(),
+        None => one_channel_line("limits.eye_safety.head"),
     }
+}
+
+/// The verdict's line for a file without a head (`field` the absent head's
+/// path in the file's format): one channel was evaluated, not the sensor.
+pub(super) fn one_channel_line(field: &str) -> String {
+    format!("head: none given, evaluated for one channel ({field} absent: the sensor's other channels are not counted)")
 }
 
 pub fn run(a: &Args) -> Result<u8, CliError> {

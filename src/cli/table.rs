@@ -115,6 +115,11 @@ pub fn check(
         violations.retain(|v| !matches!(v, FwViolation::EyeSafetyMissing));
     }
     let mut out = Stdout::new();
+    let head_channels = table
+        .eye_safety
+        .as_ref()
+        .and_then(|e| e.head.as_ref())
+        .map(|h| h.channels.len());
     if violations.is_empty() {
         let eye = report.as_ref().map(|r| {
             let ratio = r.worst_ratio_ppm as f64 / 1e6;
@@ -133,6 +138,8 @@ pub fn check(
                     "worst_azimuth_deg": az, "binding_rule": rule,
                     "worst_ratio": ratio, "margin": 1.0 / ratio,
                     "stalled_rotor_ratio": null,
+                    "evaluated_for": if head_channels.is_some() { "head" } else { "one channel" },
+                    "channels_evaluated": head_channels.unwrap_or(1),
                 })),
             }))?,
             Format::Text => {
@@ -146,7 +153,13 @@ pub fn check(
                         "eye safety: Class 1 at every azimuth as the table runs (integer check); worst {az:.3}° ({rule}), {:.4} % of the limit (margin {:.2}×)",
                         100.0 * ratio,
                         1.0 / ratio
-                    ))?,
+                    ))
+                    .and_then(|()| {
+                        out.line(match head_channels {
+                            Some(n) => format!("head: {n} channels evaluated (eye_safety.head), integer check"),
+                            None => super::check::one_channel_line("eye_safety.head"),
+                        })
+                    })?,
                     None => out.line("eye safety: NOT evaluated (--no-eye-safety; the table has no eye-safety parameters): this verdict is not Class 1 evidence")?,
                 }
             }

@@ -14,7 +14,6 @@ const BIN: &str = env!("CARGO_BIN_EXE_gaze-lidar");
 /// that 127 channels were not counted. Nor does the table's check warn of
 /// the stalled rotor (the profile's does: 431 %).
 #[test]
-#[ignore = "bug: check on a firmware table without a head certifies without saying it was evaluated for one channel (profiles say so)"]
 fn a_table_without_a_head_says_one_channel() {
     let dir = std::env::temp_dir().join(format!("bh_fw_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -46,5 +45,17 @@ fn a_table_without_a_head_says_one_channel() {
         text.contains("one channel"),
         "the verdict does not say it counted one channel:\n{text}"
     );
+    let json = Command::new(BIN)
+        .arg("check")
+        .arg(&stripped)
+        .args(["--format", "json"])
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    assert_eq!(v["eye_safety"]["evaluated_for"], "one channel", "{v}");
+    // With its head the table says how many channels were counted.
+    let out = Command::new(BIN).arg("check").arg(&table).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("head: 128 channels evaluated"), "{text}");
     std::fs::remove_dir_all(&dir).ok();
 }
