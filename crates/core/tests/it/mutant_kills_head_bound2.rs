@@ -1,12 +1,12 @@
 //! Tests that pin the head's Rule 1 and stalled-rotor figures of
-//! `eye_safety/head/bound.rs` (`single_pulse_ratio`, `stalled_ratio`) where
+//! `eye_safety/head/bound.rs` (`stalled_ratio`, `power_scale_to_certify`) where
 //! no other core test reached them (`specs/mutants.md`, "`eye_safety/head/*.rs`").
 //! Each names the mutant it kills and works its expected value out by hand.
 
 use gaze_lidar_core::eye_safety::ael::Band;
 use gaze_lidar_core::eye_safety::bound::{Laser, RATIO_MARGIN};
 use gaze_lidar_core::eye_safety::head::bound::stalled_ratio;
-use gaze_lidar_core::eye_safety::head::HeadFigures;
+use gaze_lidar_core::eye_safety::head::{power_scale_to_certify, HeadFigures};
 
 /// 905 nm, 5 ns pulses at `f_p`.
 fn laser905(f_p: f64) -> Laser {
@@ -89,4 +89,22 @@ fn stalled_rule1_counts_every_slot_s_pulses() {
         (one_slot / one / (1.0 + RATIO_MARGIN) - 1.0).abs() < 1e-9,
         "{one_slot} / {one}"
     );
+}
+
+/// Kills `head/bound.rs` `power_scale_to_certify`: `worst_ratio > 0.0` →
+/// `worst_ratio >= 0.0`. A bound of zero certifies at every scale
+/// (`+∞`), whichever the sign of the zero (that a profile's worst ratio
+/// can come out as `-0.0` is not shown; `bound::binding` keeps the first of
+/// equal ratios, so it is not excluded either). With `>=`, `-0.0` takes the
+/// quotient branch: `(1 − 10⁻⁹)/(−0) = −∞`, no scale at all.
+///
+/// By hand: `+0` and `−0` give `+∞`; 2 gives `(1 − 10⁻⁹)/2`, which times
+/// 2 is below 1; a ratio of 1 gives `1 − 10⁻⁹`.
+#[test]
+fn a_zero_bound_of_either_sign_certifies_at_every_scale() {
+    assert_eq!(power_scale_to_certify(0.0), f64::INFINITY);
+    assert_eq!(power_scale_to_certify(-0.0), f64::INFINITY);
+    assert_eq!(power_scale_to_certify(2.0), (1.0 - 1e-9) / 2.0);
+    assert!(2.0 * power_scale_to_certify(2.0) < 1.0);
+    assert_eq!(power_scale_to_certify(1.0), 1.0 - 1e-9);
 }
