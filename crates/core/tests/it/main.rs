@@ -9,6 +9,7 @@ mod eye_safety;
 mod firmware;
 mod mutant_kills;
 mod mutant_kills_head_bound;
+mod mutant_kills_head_bound2;
 mod profile;
 
 // Definitions references only this crate's tests use.
