@@ -720,23 +720,11 @@ impl HeadScale {
         f
     }
 
-    /// `S(t) = sup_{T ≤ t} (T + Δ)/AEL(T)`, s/J: on a row of Table 3
-    /// (`c·T^p`, `0 ≤ p ≤ 1`) `(T + Δ)/T^p` has no interior maximum, so
-    /// `t`, the row edges below it and the pulse duration (below which the
-    /// AEL is constant) are every candidate — the head bound's own argument
-    /// for its instantaneous candidate.
+    /// `S(t) = sup_{T ≤ t} (T + Δ)/AEL(T)`, s/J
+    /// ([`Laser::instant_window_factor`], the head bound's own argument for
+    /// its instantaneous candidate).
     fn instant_short(&self, t: f64) -> f64 {
-        let l = &self.laser;
-        let delta = 1.0 / l.pulse_rate_hz;
-        let mut s = (t + delta) / l.ael_j(t);
-        for row in l.rows() {
-            for e in [row.t_lo_s, row.t_hi_s, l.pulse_duration_s] {
-                if e > 0.0 && e < t {
-                    s = s.max((e + delta) / l.ael_j(e));
-                }
-            }
-        }
-        s
+        self.laser.instant_window_factor(t)
     }
 }
 

@@ -409,18 +409,8 @@ pub fn energy_ratios(
             if t_star >= frame_s {
                 break;
             }
-            // sup over T ≤ T* of (T + Δ)/AEL(T): on a row `c·T^p`
-            // (0 ≤ p ≤ 1) `(T + Δ)/T^p` has no interior maximum, so the
-            // row ends below T*, the pulse duration and T* are every
-            // candidate (the AEL at an edge is the smaller row's).
-            let mut short = (t_star + delta) / laser.ael_j(t_star);
-            for row in laser.rows() {
-                for t in [row.t_lo_s, row.t_hi_s, laser.pulse_duration_s] {
-                    if t > 0.0 && t < t_star {
-                        short = short.max((t + delta) / laser.ael_j(t));
-                    }
-                }
-            }
+            // sup over T ≤ T* of (T + Δ)/AEL(T).
+            let short = laser.instant_window_factor(t_star);
             let short = h.weight_instant * power_max_w * short * (1.0 + RATIO_MARGIN);
             let (r_long, t_long) = laser.windows_from_ratio(frame_s, pass, power_max_w, t_star);
             let mut cand = [0.0, short, 0.0, 0.0];
