@@ -16,6 +16,7 @@ use serde::Serialize;
 use super::ael::{self, APERTURE_DISTANCE_MM};
 pub use super::bound::Rule;
 use super::bound::{self, Laser, Search, Seg};
+use super::head::geometry::Surface;
 use super::head::{bound as head_bound, Head};
 use super::{EyeSafetyError, EyeSafetyParams};
 use crate::profile::Profile;
@@ -149,20 +150,32 @@ pub fn evaluate_segments(
     evaluate_segments_with(segs, params, pulse_rate_hz, Search::Pruned)
 }
 
-/// The bound of a head on its declared surface alone
-/// (`aperture_distance_mm`), without the 100 mm surface every verdict also
-/// covers ([`evaluate_segments`]): the bound as a function of the distance,
-/// for tests of it against references at any distance. Never a verdict.
-/// Without a head, [`evaluate_segments`].
+/// The bound of a head on its declared cylinder alone
+/// (`aperture_distance_mm` from the spin axis), without the other surfaces
+/// every verdict also covers ([`evaluate_segments`]): the bound as a
+/// function of the distance, for tests of it against references at any
+/// distance. Never a verdict. Without a head, [`evaluate_segments`].
 #[doc(hidden)]
 pub fn evaluate_segments_at_declared_distance(
     segs: &[Seg],
     params: &EyeSafetyParams,
     pulse_rate_hz: f64,
 ) -> Result<ExposureReport, EyeSafetyError> {
+    evaluate_segments_on(segs, params, pulse_rate_hz, Surface::Cylinder)
+}
+
+/// [`evaluate_segments_at_declared_distance`] on `surface` at the declared
+/// distance. Never a verdict.
+#[doc(hidden)]
+pub fn evaluate_segments_on(
+    segs: &[Seg],
+    params: &EyeSafetyParams,
+    pulse_rate_hz: f64,
+    surface: Surface,
+) -> Result<ExposureReport, EyeSafetyError> {
     let laser = laser(params, pulse_rate_hz)?;
     match &params.head {
-        Some(head) => evaluate_head_at(segs, params, head, &laser, Search::Pruned),
+        Some(head) => evaluate_head_at(segs, params, head, surface, &laser, Search::Pruned),
         None => evaluate_segments(segs, params, pulse_rate_hz),
     }
 }
@@ -222,14 +235,14 @@ fn check_pass_duration(b: &bound::Bound) -> Result<(), EyeSafetyError> {
 }
 
 /// The head's verdict (`specs/eye_safety.md`, "The head", "The aperture's
-/// surface"): a certificate always covers the Condition 3 surface, 100 mm
-/// from the spin axis. A head declaring another `aperture_distance_mm` is
-/// evaluated at its declared distance **and** at 100 mm, and the report
-/// with the larger worst ratio is the verdict (a nearer surface is not
-/// provably the stricter one for every head, so neither is skipped); the
-/// stalled-rotor figure is the larger of the two. A crossing point at or
-/// beyond 100 mm from the axis leaves no 100 mm surface to evaluate: refused
-/// by name.
+/// surface"): a certificate always covers the two Condition 3 surfaces at
+/// 100 mm, the cylinder around the spin axis and the sphere around the scan
+/// centre. A head declaring another `aperture_distance_mm` is evaluated at
+/// its declared distance **and** at 100 mm, on both surfaces, and the report
+/// with the largest worst ratio is the verdict (no surface is provably the
+/// stricter one for every head, so none is skipped); the stalled-rotor
+/// figure is the largest of them. A crossing point at or beyond 100 mm from
+/// the axis leaves no 100 mm surface to evaluate: refused by name.
 fn evaluate_head(
     segs: &[Seg],
     params: &EyeSafetyParams,
@@ -237,12 +250,13 @@ fn evaluate_head(
     laser: &Laser,
     search: Search,
 ) -> Result<ExposureReport, EyeSafetyError> {
+    let at = |h: &Head, surface| evaluate_head_at(segs, params, h, surface, laser, search);
+    let declared = at(head, Surface::Cylinder)?;
     // Exact comparison: any other distance, however near, is evaluated too.
     #[allow(clippy::float_cmp)]
     if head.aperture_distance_mm == APERTURE_DISTANCE_MM {
-        return evaluate_head_at(segs, params, head, laser, search);
+        return Ok(worst_of([declared, at(head, Surface::Sphere)?]));
     }
-    let declared = evaluate_head_at(segs, params, head, laser, search)?;
     // Not `< 100` written as a negation: NaN was refused by the declared
     // evaluation's validation above.
     if head.origin_radius_mm >= APERTURE_DISTANCE_MM {
@@ -256,22 +270,36 @@ fn evaluate_head(
         aperture_distance_mm: APERTURE_DISTANCE_MM,
         ..head.clone()
     };
-    let standard = evaluate_head_at(segs, params, &standard_head, laser, search)?;
-    let stalled_rotor_ratio = declared
-        .stalled_rotor_ratio
-        .max(standard.stalled_rotor_ratio);
-    // Ties (and a NaN, which never compares greater) take the 100 mm report.
-    let mut worse = if declared.worst_ratio > standard.worst_ratio {
-        declared
-    } else {
-        standard
-    };
-    worse.stalled_rotor_ratio = stalled_rotor_ratio;
-    Ok(worse)
+    Ok(worst_of([
+        at(&standard_head, Surface::Cylinder)?,
+        at(&standard_head, Surface::Sphere)?,
+        declared,
+        at(head, Surface::Sphere)?,
+    ]))
 }
 
-/// The head's evaluation on the surface `head.aperture_distance_mm` from the
-/// spin axis: the single-channel bound at the head's widest pass, every
+/// The report with the largest worst ratio (ties, and a NaN, which never
+/// compares greater, take the earlier: the 100 mm cylinder first), with the
+/// largest stalled-rotor figure of them all.
+fn worst_of<const N: usize>(reports: [ExposureReport; N]) -> ExposureReport {
+    let stalled = reports
+        .iter()
+        .map(|r| r.stalled_rotor_ratio)
+        .fold(0.0, f64::max);
+    let mut worst: Option<ExposureReport> = None;
+    for r in reports {
+        worst = match worst {
+            Some(w) if !(r.worst_ratio > w.worst_ratio) => Some(w),
+            _ => Some(r),
+        };
+    }
+    let mut worst = worst.expect("at least one surface");
+    worst.stalled_rotor_ratio = stalled;
+    worst
+}
+
+/// The head's evaluation on `surface`, `head.aperture_distance_mm` from the
+/// spin axis (cylinder) or the scan centre (sphere): the single-channel bound at the head's widest pass, every
 /// energy rule times `W_v`, Rule 1 from the head's groups
 /// ([`head_bound::single_pulse_ratio`]) and the stalled rotor for every
 /// channel meeting one aperture.
@@ -279,6 +307,7 @@ fn evaluate_head_at(
     segs: &[Seg],
     params: &EyeSafetyParams,
     head: &Head,
+    surface: Surface,
     laser: &Laser,
     search: Search,
 ) -> Result<ExposureReport, EyeSafetyError> {
@@ -289,7 +318,7 @@ fn evaluate_head_at(
         .iter()
         .map(|s| s.spin_start_rad_s.max(s.spin_end_rad_s))
         .fold(0.0, f64::max);
-    let hf = head_bound::head_figures(head, params, laser, spin_max)?;
+    let hf = head_bound::head_figures_on(head, surface, params, laser, spin_max)?;
     let pass = hf.pass_angle_deg.min(360.0);
     let b = bound::evaluate_with(segs, 0.5 * pass, laser, search);
     check_pass_duration(&b)?;

@@ -118,10 +118,11 @@ pub struct IntEyeLimits {
     /// them ([`evaluate`] reports the smallest worst ratio).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub instant: Vec<InstantLimit>,
-    /// The limits of a second aperture surface the table must also pass
-    /// (a head declaring `aperture_distance_mm` other than 100 mm: these
-    /// limits are the 100 mm surface's, the other are the declared
-    /// distance's); at most one level deep.
+    /// The limits of the next aperture surface the table must also pass
+    /// (with a head: the 100 mm cylinder's limits hold the 100 mm sphere's;
+    /// a head declaring `aperture_distance_mm` other than 100 mm adds its
+    /// declared distance's cylinder and sphere); a chain of at most
+    /// [`SURFACES_MAX`] sets.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub other_surface: Option<alloc::boxed::Box<IntEyeLimits>>,
 }
@@ -134,7 +135,7 @@ impl IntEyeLimits {
         self.other_surface
             .as_ref()
             .map_or(self.pulse_code_max, |o| {
-                self.pulse_code_max.min(o.pulse_code_max)
+                self.pulse_code_max.min(o.pulse_code_cap())
             })
     }
 }
@@ -551,27 +552,33 @@ fn ratio_ppm(energy: u128, limit: u64) -> u64 {
 /// limit sets: Class 1 when both accept, the report the worse one's (ties
 /// take the first set's).
 pub fn evaluate(table: &FirmwareTable, limits: &IntEyeLimits) -> Result<IntEyeReport, IntEyeError> {
-    let first = evaluate_surface(table, limits)?;
-    let Some(other) = &limits.other_surface else {
-        return Ok(first);
-    };
-    if other.other_surface.is_some() {
-        return Err(IntEyeError::Bounds {
-            field: "other_surface",
-            value: 2,
-            reason: "the limits hold at most two aperture surfaces",
-        });
+    let mut worse = evaluate_surface(table, limits)?;
+    let mut class1 = worse.class1;
+    let mut next = limits.other_surface.as_deref();
+    let mut depth = 1;
+    while let Some(other) = next {
+        depth += 1;
+        if depth > SURFACES_MAX {
+            return Err(IntEyeError::Bounds {
+                field: "other_surface",
+                value: depth as u64,
+                reason: "the limits hold at most four aperture surfaces",
+            });
+        }
+        let report = evaluate_surface(table, other)?;
+        class1 &= report.class1;
+        if report.worst_ratio_ppm > worse.worst_ratio_ppm {
+            worse = report;
+        }
+        next = other.other_surface.as_deref();
     }
-    let second = evaluate_surface(table, other)?;
-    let class1 = first.class1 && second.class1;
-    let mut worse = if second.worst_ratio_ppm > first.worst_ratio_ppm {
-        second
-    } else {
-        first
-    };
     worse.class1 = class1;
     Ok(worse)
 }
+
+/// Most aperture surfaces one chain of limits holds: the cylinder and the
+/// sphere at 100 mm and at a declared other distance.
+pub const SURFACES_MAX: usize = 4;
 
 /// [`evaluate`] against one limit set (one aperture surface).
 fn evaluate_surface(
@@ -838,8 +845,9 @@ mod derive {
     use crate::eye_safety::bound::Laser;
     use crate::eye_safety::exposure::{laser, pass_angle_deg};
     use crate::eye_safety::head::bound::{
-        head_figures, single_pulse_ratio as single_pulse_ratio_head, HeadFigures, SingleFigures,
+        head_figures_on, single_pulse_ratio as single_pulse_ratio_head, HeadFigures, SingleFigures,
     };
+    use crate::eye_safety::head::geometry::Surface;
     use crate::eye_safety::head::Head;
     use crate::eye_safety::{EyeSafetyError, EyeSafetyParams};
     use crate::firmware::FirmwareTable;
@@ -905,6 +913,25 @@ mod derive {
         Some(c as u64)
     }
 
+    /// The limit sets as one chain, the first at the top (each holds the
+    /// next in [`IntEyeLimits::other_surface`]); a set equal to an earlier
+    /// one is left out (a flat channel from the axis meets the sphere where
+    /// it meets the cylinder: one set).
+    fn chain<const N: usize>(sets: [IntEyeLimits; N]) -> IntEyeLimits {
+        let mut distinct: Vec<IntEyeLimits> = Vec::with_capacity(N);
+        for set in sets {
+            if !distinct.contains(&set) {
+                distinct.push(set);
+            }
+        }
+        let mut next: Option<Box<IntEyeLimits>> = None;
+        for mut set in distinct.into_iter().rev() {
+            set.other_surface = next;
+            next = Some(Box::new(set));
+        }
+        *next.expect("at least one surface")
+    }
+
     impl IntEyeLimits {
         /// Derives the integer limits of `table`'s timing from the one
         /// eye-safety model (`eye_safety::bound::Laser`: Table 3 rows, C5 and
@@ -914,13 +941,18 @@ mod derive {
         pub fn derive(table: &FirmwareTable) -> Result<Self, DeriveError> {
             let params = table.eye_safety.as_ref().ok_or(DeriveError::Missing)?;
             match &params.head {
-                // A certificate covers the 100 mm surface; a declared other
-                // distance is evaluated too, as the float checker does
-                // (`exposure::evaluate_head`): two limit sets, both must
-                // accept ([`evaluate`]).
-                #[allow(clippy::float_cmp)]
-                Some(h) if h.aperture_distance_mm != APERTURE_DISTANCE_MM => {
-                    let declared = Self::derive_at(table, params, Some(h))?;
+                // A certificate covers both 100 mm surfaces, the cylinder
+                // and the sphere; a declared other distance is evaluated
+                // too, as the float checker does
+                // (`exposure::evaluate_head`): a chain of limit sets, every
+                // one must accept ([`evaluate`]).
+                Some(h) => {
+                    let declared = Self::derive_at(table, params, Some(h), Surface::Cylinder)?;
+                    #[allow(clippy::float_cmp)]
+                    if h.aperture_distance_mm == APERTURE_DISTANCE_MM {
+                        let sphere = Self::derive_at(table, params, Some(h), Surface::Sphere)?;
+                        return Ok(chain([declared, sphere]));
+                    }
                     // Not `< 100` written as a negation: NaN was refused by
                     // the declared derivation's validation above.
                     if h.origin_radius_mm >= APERTURE_DISTANCE_MM {
@@ -933,11 +965,14 @@ mod derive {
                         aperture_distance_mm: APERTURE_DISTANCE_MM,
                         ..h.clone()
                     };
-                    let mut limits = Self::derive_at(table, params, Some(&standard))?;
-                    limits.other_surface = Some(Box::new(declared));
-                    Ok(limits)
+                    Ok(chain([
+                        Self::derive_at(table, params, Some(&standard), Surface::Cylinder)?,
+                        Self::derive_at(table, params, Some(&standard), Surface::Sphere)?,
+                        declared,
+                        Self::derive_at(table, params, Some(h), Surface::Sphere)?,
+                    ]))
                 }
-                head => Self::derive_at(table, params, head.as_ref()),
+                None => Self::derive_at(table, params, None, Surface::Cylinder),
             }
         }
 
@@ -947,6 +982,7 @@ mod derive {
             table: &FirmwareTable,
             params: &EyeSafetyParams,
             head: Option<&Head>,
+            surface: Surface,
         ) -> Result<Self, DeriveError> {
             let f_p = table.pulse_rate_hz;
             let laser = laser(params, f_p)?;
@@ -972,7 +1008,7 @@ mod derive {
                 * (1.0 + WIDEN);
             let head = match head {
                 None => None,
-                Some(h) => Some(head_figures(h, params, &laser, spin_max)?),
+                Some(h) => Some(head_figures_on(h, surface, params, &laser, spin_max)?),
             };
             let pass_deg = head.as_ref().map_or_else(
                 || pass_angle_deg(params, &laser),

@@ -175,3 +175,41 @@ pub fn data_dir() -> PathBuf {
 pub fn data_path(rel: &str) -> PathBuf {
     data_dir().join(rel)
 }
+
+/// Head figures of `count_vertical` channels of weight 1 each meeting one
+/// height, of `slots_vertical` distinct slots, on the cylinder: no two at
+/// once, no group, one channel stalled on any one point, 5 mm beams, a 6°
+/// pass, one pass's arc; a test that needs another figure overrides a
+/// field.
+pub fn head_figures(count_vertical: u32, slots_vertical: u32) -> crate::eye_safety::head::HeadFigures {
+    crate::eye_safety::head::HeadFigures {
+        surface: crate::eye_safety::head::geometry::Surface::Cylinder,
+        channels: count_vertical,
+        channels_at_worst: count_vertical,
+        worst_height_mm: 0.0,
+        worst_azimuth_deg: 0.0,
+        group_height_mm: 0.0,
+        weight_vertical: f64::from(count_vertical),
+        count_vertical,
+        slots_vertical,
+        union_passes: 1,
+        weight_simultaneous: 1.0,
+        count_simultaneous: 1,
+        weight_group: 1.0,
+        count_group: 1,
+        group_spans_time: false,
+        group_window_s: 5e-6,
+        weight_instant: 1.0,
+        weight_stalled: 1.0,
+        count_stalled: 1,
+        weight_stalled_group: 1.0,
+        weight_stalled_simultaneous: 1.0,
+        count_stalled_simultaneous: 1,
+        stalled_group_spans_time: false,
+        footprint_max_mm: 5.0,
+        pass_angle_deg: 6.0,
+        power_scale_max: 1.0,
+        separations: Vec::new(),
+        slot_windows: Vec::new(),
+    }
+}

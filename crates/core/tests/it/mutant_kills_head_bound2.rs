@@ -23,33 +23,10 @@ fn laser905(f_p: f64) -> Laser {
 /// `slots` distinct slots at one height, and of total weight `weight`.
 fn stalled_figures(count: u32, slots: u32, weight: f64) -> HeadFigures {
     HeadFigures {
-        channels: count,
-        channels_at_worst: count,
-        worst_height_mm: 0.0,
-        worst_azimuth_deg: 0.0,
-        group_height_mm: 0.0,
         weight_vertical: weight,
-        count_vertical: count,
-        slots_vertical: slots,
-        union_passes: 1,
-        weight_simultaneous: 1.0,
-        count_simultaneous: 1,
-        weight_group: 1.0,
-        count_group: 1,
-        group_spans_time: false,
-        group_window_s: 5e-6,
-        weight_instant: 1.0,
         weight_stalled: weight,
         count_stalled: count,
-        weight_stalled_group: 1.0,
-        weight_stalled_simultaneous: 1.0,
-        count_stalled_simultaneous: 1,
-        stalled_group_spans_time: false,
-        footprint_max_mm: 5.0,
-        pass_angle_deg: 6.0,
-        power_scale_max: 1.0,
-        separations: Vec::new(),
-        slot_windows: Vec::new(),
+        ..gaze_lidar_core::testing::head_figures(count, slots)
     }
 }
 

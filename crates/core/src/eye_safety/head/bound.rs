@@ -39,7 +39,7 @@ use serde::Serialize;
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use super::geometry::{footprints, Footprint};
+use super::geometry::{footprints_on, Footprint, Surface};
 use super::overlap;
 use super::Head;
 use crate::eye_safety::ael;
@@ -53,6 +53,10 @@ pub const RATE_CYCLE_TOLERANCE: f64 = 1e-9;
 /// meet one aperture position, over a sweep and at once.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct HeadFigures {
+    /// The aperture surface these figures are for (serialized only for the
+    /// sphere: a cylinder report reads as before surfaces were named).
+    #[serde(skip_serializing_if = "Surface::is_cylinder")]
+    pub surface: Surface,
     /// Channels of the head.
     pub channels: u32,
     /// Channels meeting the worst height (where `weight_vertical` is).
@@ -442,6 +446,17 @@ pub fn head_figures(
     laser: &Laser,
     spin_max_rad_s: f64,
 ) -> Result<HeadFigures, EyeSafetyError> {
+    head_figures_on(head, Surface::Cylinder, params, laser, spin_max_rad_s)
+}
+
+/// [`head_figures`] for the aperture positions on `surface`.
+pub fn head_figures_on(
+    head: &Head,
+    surface: Surface,
+    params: &EyeSafetyParams,
+    laser: &Laser,
+    spin_max_rad_s: f64,
+) -> Result<HeadFigures, EyeSafetyError> {
     head.validate()?;
     let _ = params;
     let f_p = laser.pulse_rate_hz;
@@ -454,7 +469,7 @@ pub fn head_figures(
         });
     }
     let t_g = group_window_s(laser);
-    let o = head_overlaps(head, laser.band.aperture_mm(), t_g);
+    let o = head_overlaps(head, surface, laser.band.aperture_mm(), t_g);
     let r = head.aperture_distance_mm;
     let smear = r * spin_max_rad_s * t_g * (1.0 + overlap::SUM_MARGIN);
     let (g, spans) = o.group_plan.max(smear);
@@ -463,6 +478,7 @@ pub fn head_figures(
     let (v, sim, disc) = (o.vertical, o.simultaneous, o.stalled);
     let (g0, spans0) = o.stalled_group;
     Ok(HeadFigures {
+        surface,
         channels: head.channels.len() as u32,
         channels_at_worst: v.count_at_worst,
         worst_height_mm: v.height_mm,
@@ -523,10 +539,10 @@ pub struct HeadOverlaps {
 
 impl HeadOverlaps {
     /// The profile-independent figures of `head` for an aperture of
-    /// `aperture_mm` and the grouping window `group_window_s`.
+    /// `aperture_mm` on `surface` and the grouping window `group_window_s`.
     #[must_use]
-    pub fn new(head: &Head, aperture_mm: f64, group_window_s: f64) -> Self {
-        let fps = footprints(head, aperture_mm);
+    pub fn new(head: &Head, surface: Surface, aperture_mm: f64, group_window_s: f64) -> Self {
+        let fps = footprints_on(head, aperture_mm, surface);
         let scales: Vec<f64> = head.channels.iter().map(|c| c.power_scale).collect();
         let slots: Vec<f64> = head.channels.iter().map(|c| c.slot_s).collect();
         let zeros = vec![0.0; slots.len()];
@@ -569,11 +585,12 @@ impl HeadOverlaps {
 
 /// Heads whose [`HeadOverlaps`] each thread keeps (the most recently
 /// computed ones).
-pub const MEMO_HEADS: usize = 4;
+pub const MEMO_HEADS: usize = 8;
 
 /// A kept head: its inputs, compared bit for bit, and its figures.
 struct Memo {
     head: Head,
+    surface: Surface,
     aperture_bits: u64,
     group_window_bits: u64,
     overlaps: Rc<HeadOverlaps>,
@@ -605,23 +622,30 @@ fn same_bits(a: &Head, b: &Head) -> bool {
 /// [`HeadOverlaps::new`], kept per thread: a head evaluated again (every
 /// frame of a stream, every profile of an optimizer run) reuses its figures,
 /// the same values as computing them again.
-fn head_overlaps(head: &Head, aperture_mm: f64, group_window_s: f64) -> Rc<HeadOverlaps> {
+fn head_overlaps(
+    head: &Head,
+    surface: Surface,
+    aperture_mm: f64,
+    group_window_s: f64,
+) -> Rc<HeadOverlaps> {
     let (aperture_bits, group_window_bits) = (aperture_mm.to_bits(), group_window_s.to_bits());
     MEMO.with(|memo| {
         let mut memo = memo.borrow_mut();
         if let Some(m) = memo.iter().find(|m| {
             m.aperture_bits == aperture_bits
+                && m.surface == surface
                 && m.group_window_bits == group_window_bits
                 && same_bits(&m.head, head)
         }) {
             return Rc::clone(&m.overlaps);
         }
-        let overlaps = Rc::new(HeadOverlaps::new(head, aperture_mm, group_window_s));
+        let overlaps = Rc::new(HeadOverlaps::new(head, surface, aperture_mm, group_window_s));
         if memo.len() >= MEMO_HEADS {
             memo.remove(0);
         }
         memo.push(Memo {
             head: head.clone(),
+            surface,
             aperture_bits,
             group_window_bits,
             overlaps: Rc::clone(&overlaps),
@@ -828,6 +852,7 @@ pub fn power_scale_to_certify(worst_ratio: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eye_safety::head::geometry::footprints;
     use crate::eye_safety::head::{Channel, Head};
 
     fn column(slots: &[f64], offsets_deg: &[f64]) -> Head {
@@ -972,33 +997,8 @@ mod tests {
 
     fn figures(count_vertical: u32, slots_vertical: u32, union_passes: u32) -> HeadFigures {
         HeadFigures {
-            channels: count_vertical,
-            channels_at_worst: count_vertical,
-            worst_height_mm: 0.0,
-            worst_azimuth_deg: 0.0,
-            group_height_mm: 0.0,
-            weight_vertical: f64::from(count_vertical),
-            count_vertical,
-            slots_vertical,
             union_passes,
-            weight_simultaneous: 1.0,
-            count_simultaneous: 1,
-            weight_group: 1.0,
-            count_group: 1,
-            group_spans_time: false,
-            group_window_s: 5e-6,
-            weight_instant: 1.0,
-            weight_stalled: 1.0,
-            count_stalled: 1,
-            weight_stalled_group: 1.0,
-            weight_stalled_simultaneous: 1.0,
-            count_stalled_simultaneous: 1,
-            stalled_group_spans_time: false,
-            footprint_max_mm: 5.0,
-            pass_angle_deg: 6.0,
-            power_scale_max: 1.0,
-            separations: Vec::new(),
-            slot_windows: Vec::new(),
+            ..crate::testing::head_figures(count_vertical, slots_vertical)
         }
     }
 

@@ -42,6 +42,8 @@
 
 use super::Head;
 
+pub mod sphere;
+
 /// Relative widening of every footprint size that comes from rounded
 /// trigonometry (a few ulps of error, 1e-12 ≫ 10·2⁻⁵²).
 pub const GEOMETRY_MARGIN: f64 = 1e-12;
@@ -120,7 +122,51 @@ fn footprint_box(
     (half_turn, rho / eps.cos() + eps.tan().abs() * spread)
 }
 
-/// The footprint of every channel of `head` for an aperture of `aperture_mm`.
+/// The aperture positions a head evaluation covers (`specs/eye_safety.md`,
+/// "The aperture's surface"): both are `R` = `aperture_distance_mm` from a
+/// reference, and a certificate covers both at 100 mm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Surface {
+    /// Every position `R` from the spin axis (the module docs).
+    Cylinder,
+    /// Every position `R` from the scan centre, the point of the spin axis
+    /// at the crossing point's height ([`sphere`]).
+    Sphere,
+}
+
+impl Surface {
+    /// Both surfaces, the cylinder first.
+    pub const ALL: [Surface; 2] = [Surface::Cylinder, Surface::Sphere];
+
+    /// Whether this is the cylinder (serialization skips it).
+    #[must_use]
+    pub fn is_cylinder(&self) -> bool {
+        *self == Surface::Cylinder
+    }
+
+    /// The surface's name in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Surface::Cylinder => "cylinder",
+            Surface::Sphere => "sphere",
+        }
+    }
+}
+
+/// The footprint of every channel of `head` for an aperture of `aperture_mm`
+/// on `surface`.
+#[must_use]
+pub fn footprints_on(head: &Head, aperture_mm: f64, surface: Surface) -> Vec<Footprint> {
+    match surface {
+        Surface::Cylinder => footprints(head, aperture_mm),
+        Surface::Sphere => sphere::footprints(head, aperture_mm),
+    }
+}
+
+/// The footprint of every channel of `head` for an aperture of `aperture_mm`
+/// on the cylinder.
 #[must_use]
 pub fn footprints(head: &Head, aperture_mm: f64) -> Vec<Footprint> {
     let r = head.aperture_distance_mm;

@@ -161,7 +161,6 @@ fn wide_beam_firmware_table_is_rejected() {
 /// --heights 96.5926`, finds 1.328 with whole pulses, 1.315 through a fixed
 /// 7 mm disc facing the beam.)
 #[test]
-#[ignore = "bug: aperture positions only on the 100 mm cylinder; the 100 mm sphere around the scan centre is closer to a steep beam (75° up: certified 0.990, true 1.317)"]
 fn steep_beam_is_evaluated_at_100_mm_from_the_scan_centre() {
     let power_w = 1.2556e-2;
     let text = uniform_head_profile(

@@ -210,9 +210,10 @@ fn one_case(d: &Drawn, stats: &RefCell<Stats>) -> Result<(), TestCaseError> {
     }
     // The same limits without the instantaneous candidate: never tighter.
     let mut plain = limits.clone();
-    plain.instant.clear();
-    if let Some(o) = plain.other_surface.as_mut() {
-        o.instant.clear();
+    let mut at = Some(&mut plain);
+    while let Some(set) = at {
+        set.instant.clear();
+        at = set.other_surface.as_deref_mut();
     }
     let started = std::time::Instant::now();
     let without = evaluate(&table, &plain).unwrap().worst_ratio_ppm as f64 / 1e6;
