@@ -6,6 +6,7 @@ use gaze_lidar::checker::verdict::worst_position;
 use gaze_lidar::checker::{certify_with, CheckOptions, Verdict, Violation};
 use gaze_lidar::eye_safety::exposure::ExposureReport;
 use gaze_lidar::eye_safety::head::bound::power_scale_to_certify;
+use gaze_lidar::eye_safety::head::geometry::Surface;
 use gaze_lidar::model::lidar::LidarSpec;
 use gaze_lidar::profile::Profile;
 
@@ -57,9 +58,9 @@ fn verdict_json(v: &Verdict) -> Result<serde_json::Value, CliError> {
 }
 
 /// One line naming what was evaluated: the head (channels, the worst
-/// aperture position, the beams meeting it, the binding rule, and both
-/// surfaces when the head declares an aperture distance other than 100 mm)
-/// or one channel.
+/// aperture position and the surface it is on, the beams meeting it, the
+/// binding rule, and the declared distance when the head declares one other
+/// than 100 mm) or one channel.
 fn head_line(r: &ExposureReport, profile: &Profile) -> String {
     match &r.head {
         Some(h) => {
@@ -75,12 +76,16 @@ fn head_line(r: &ExposureReport, profile: &Profile) -> String {
                 String::new()
             } else {
                 format!(
-                    "; evaluated on the 100 mm Condition 3 surface and on the declared {} mm one (the worse is the verdict)",
+                    "; evaluated on the 100 mm Condition 3 surfaces and on the declared {} mm ones (the worst is the verdict)",
                     gaze_lidar::text::Num(declared_mm)
                 )
             };
+            let surface = match h.surface {
+                Surface::Cylinder => "the cylinder around the spin axis",
+                Surface::Sphere => "the sphere around the scan centre",
+            };
             format!(
-                "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height; {} beam(s) meet it; binding rule: {}{surfaces}",
+                "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height on {surface}; {} beam(s) meet it; binding rule: {}{surfaces}",
                 h.channels, r.worst_azimuth_deg, height_mm, beams, r.binding_rule
             )
         }

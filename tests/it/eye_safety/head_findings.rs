@@ -190,7 +190,7 @@ fn check_of_a_far_declared_surface_names_both_surfaces() {
     let far_out = crate::common::stdout(&far);
     assert!(
         far_out.contains(
-            "evaluated on the 100 mm Condition 3 surface and on the declared 10000 mm one"
+            "evaluated on the 100 mm Condition 3 surfaces and on the declared 10000 mm ones"
         ),
         "{far_out}"
     );

@@ -286,14 +286,13 @@ fn worst_of<const N: usize>(reports: [ExposureReport; N]) -> ExposureReport {
         .iter()
         .map(|r| r.stalled_rotor_ratio)
         .fold(0.0, f64::max);
-    let mut worst: Option<ExposureReport> = None;
+    let mut reports = reports.into_iter();
+    let mut worst = reports.next().expect("at least one surface");
     for r in reports {
-        worst = match worst {
-            Some(w) if !(r.worst_ratio > w.worst_ratio) => Some(w),
-            _ => Some(r),
-        };
+        if r.worst_ratio > worst.worst_ratio {
+            worst = r;
+        }
     }
-    let mut worst = worst.expect("at least one surface");
     worst.stalled_rotor_ratio = stalled;
     worst
 }

@@ -181,7 +181,10 @@ pub fn data_path(rel: &str) -> PathBuf {
 /// once, no group, one channel stalled on any one point, 5 mm beams, a 6°
 /// pass, one pass's arc; a test that needs another figure overrides a
 /// field.
-pub fn head_figures(count_vertical: u32, slots_vertical: u32) -> crate::eye_safety::head::HeadFigures {
+pub fn head_figures(
+    count_vertical: u32,
+    slots_vertical: u32,
+) -> crate::eye_safety::head::HeadFigures {
     crate::eye_safety::head::HeadFigures {
         surface: crate::eye_safety::head::geometry::Surface::Cylinder,
         channels: count_vertical,

@@ -639,7 +639,12 @@ fn head_overlaps(
         }) {
             return Rc::clone(&m.overlaps);
         }
-        let overlaps = Rc::new(HeadOverlaps::new(head, surface, aperture_mm, group_window_s));
+        let overlaps = Rc::new(HeadOverlaps::new(
+            head,
+            surface,
+            aperture_mm,
+            group_window_s,
+        ));
         if memo.len() >= MEMO_HEADS {
             memo.remove(0);
         }

@@ -210,7 +210,10 @@ fn integer_head_check_is_never_below_the_definitions_reference() {
             surfaces += 1;
             next = l.other_surface.as_deref();
         }
-        assert!(surfaces <= if declared == 100.0 { 2 } else { 4 }, "{surfaces}");
+        assert!(
+            surfaces <= if declared == 100.0 { 2 } else { 4 },
+            "{surfaces}"
+        );
         assert!(declared == 100.0 || surfaces >= 2);
         let int = evaluate(&table, &limits).unwrap().worst_ratio_ppm as f64 / 1e6;
         let n_ch = case.params.head.as_ref().unwrap().channels.len();

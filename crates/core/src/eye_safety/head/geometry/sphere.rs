@@ -331,8 +331,8 @@ pub fn footprints(head: &Head, aperture_mm: f64) -> Vec<Footprint> {
             let Some(e) = extent(r, r0, phi, eps, rho, t_lo.max(0.0), t_hi, hit_turned) else {
                 return whole(width);
             };
-            let half_turn = e.hi_rad.max(-e.lo_rad).max(0.0) * (1.0 + GEOMETRY_MARGIN)
-                + GEOMETRY_MARGIN;
+            let half_turn =
+                e.hi_rad.max(-e.lo_rad).max(0.0) * (1.0 + GEOMETRY_MARGIN) + GEOMETRY_MARGIN;
             if half_turn >= PI {
                 return whole(width);
             }
@@ -393,7 +393,10 @@ mod tests {
         assert!((exact - 0.33462).abs() < 1e-5, "{exact}");
         let f = footprints(&head(0.0, 75.0, 0.0, 10.0, 0.0), 7.0)[0];
         let half = 0.5 * f.pass_angle_deg.to_radians();
-        assert!(half >= exact && half <= exact * (1.0 + 1e-9), "{half} {exact}");
+        assert!(
+            half >= exact && half <= exact * (1.0 + 1e-9),
+            "{half} {exact}"
+        );
         let g = 0.085f64.asin();
         let e = 75f64.to_radians();
         // The cap's lower edge is the farther: 100·(sin 75° − sin 70.124°).
@@ -409,7 +412,10 @@ mod tests {
         assert!(f.psi_rad.abs() < 1e-12);
         let s = footprints(&head(1e-3, 75.0, 0.0, 10.0, 0.0), 7.0)[0];
         let half = 0.5 * s.pass_angle_deg.to_radians();
-        assert!(half >= exact && half <= exact * 1.03, "{half} loose against {exact}");
+        assert!(
+            half >= exact && half <= exact * 1.03,
+            "{half} loose against {exact}"
+        );
     }
 
     /// A flat beam from the axis meets the sphere where it meets the
@@ -424,7 +430,11 @@ mod tests {
             let cyl = super::super::footprints(&h, 7.0)[0];
             assert_eq!(f.pass_angle_deg.to_bits(), cyl.pass_angle_deg.to_bits());
             assert_eq!(f.half_arc_mm.to_bits(), cyl.half_arc_mm.to_bits());
-            assert_eq!(f.half_height_mm.to_bits(), cyl.half_height_mm.to_bits(), "{az} {div}");
+            assert_eq!(
+                f.half_height_mm.to_bits(),
+                cyl.half_height_mm.to_bits(),
+                "{az} {div}"
+            );
             assert_eq!(f.width_mm.to_bits(), cyl.width_mm.to_bits());
             assert_eq!(f.z_mm.to_bits(), cyl.z_mm.to_bits());
         }
