@@ -93,6 +93,17 @@ fn head_line(r: &ExposureReport, profile: &Profile) -> String {
     }
 }
 
+/// The warning (stderr) of a certified input whose stalled rotor is over
+/// Class 1: the product needs a stall interlock.
+pub(super) fn stalled_rotor_warning(ratio: f64) {
+    if ratio > 1.0 {
+        warn(format_args!(
+            "warning: a stalled rotor with the laser firing reaches {:.0} % of the Class 1 limit: the product needs a stall interlock",
+            100.0 * ratio
+        ));
+    }
+}
+
 /// The verdict's line for a file without a head (`field` the absent head's
 /// path in the file's format): one channel was evaluated, not the sensor.
 pub(super) fn one_channel_line(field: &str) -> String {
@@ -168,12 +179,7 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             }
             out.finish()?;
             if let Some(r) = eye {
-                if r.stalled_rotor_ratio > 1.0 {
-                    warn(format_args!(
-                        "warning: a stalled rotor with the laser firing reaches {:.0} % of the Class 1 limit: the product needs a stall interlock",
-                        100.0 * r.stalled_rotor_ratio
-                    ));
-                }
+                stalled_rotor_warning(r.stalled_rotor_ratio);
             }
             Ok(0)
         }

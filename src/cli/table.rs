@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use gaze_lidar::eye_safety::exposure::stalled_rotor_ratio;
 use gaze_lidar::firmware::{
     binary, check_header, check_table_evaluated, check_table_for_sensor, FirmwareTable,
     FwViolation, FIRMWARE_FORMAT,
@@ -121,6 +122,13 @@ pub fn check(
         .and_then(|e| e.head.as_ref())
         .map(|h| h.channels.len());
     if violations.is_empty() {
+        // The stalled-rotor figure at the table's hottest code, as a
+        // profile's report carries it (the same float head figures).
+        let stalled = table.eye_safety.as_ref().and_then(|params| {
+            let code_max = table.bins.iter().map(|b| b.power_code).max().unwrap_or(0);
+            let power_max_w = f64::from(code_max) * table.power_w_per_code;
+            stalled_rotor_ratio(params, table.pulse_rate_hz, power_max_w).ok()
+        });
         let eye = report.as_ref().map(|r| {
             let ratio = r.worst_ratio_ppm as f64 / 1e6;
             (
@@ -137,7 +145,7 @@ pub fn check(
                 "eye_safety": eye.as_ref().map(|(az, rule, ratio)| serde_json::json!({
                     "worst_azimuth_deg": az, "binding_rule": rule,
                     "worst_ratio": ratio, "margin": 1.0 / ratio,
-                    "stalled_rotor_ratio": null,
+                    "stalled_rotor_ratio": stalled,
                     "evaluated_for": if head_channels.is_some() { "head" } else { "one channel" },
                     "channels_evaluated": head_channels.unwrap_or(1),
                 })),
@@ -165,6 +173,11 @@ pub fn check(
             }
         }
         out.finish()?;
+        if eye.is_some() {
+            if let Some(ratio) = stalled {
+                super::check::stalled_rotor_warning(ratio);
+            }
+        }
         return Ok(0);
     }
     match format {

@@ -59,3 +59,57 @@ fn a_table_without_a_head_says_one_channel() {
     assert!(text.contains("head: 128 channels evaluated"), "{text}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A firmware table's check carries the stalled-rotor figure of its head
+/// (it was `null`): the `vls128` closed-form range table gives the figure
+/// of the profile it was built from (the same hottest power, the same head
+/// on the same surfaces: 2.452, over Class 1, so both warn of a stall
+/// interlock); without its head, one channel's stationary figure, smaller.
+#[test]
+fn a_table_reports_the_stalled_rotor_figure_of_its_profile() {
+    let dir = std::env::temp_dir().join(format!("bh_stall_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let stalled = |file: &std::path::Path| -> (f64, String) {
+        let out = Command::new(BIN)
+            .arg("check")
+            .arg(file)
+            .args(["--format", "json"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{out:?}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let r = v["eye_safety"]["stalled_rotor_ratio"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("no stalled-rotor figure: {v}"));
+        (r, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (profile, table) = (dir.join("p.json"), dir.join("t.json"));
+    for (file, format) in [(&profile, "json"), (&table, "firmware")] {
+        let out = Command::new(BIN)
+            .args(["profile", "--preset", "vls128", "--mode", "range"])
+            .args(["--gaze-deg", "90", "--format", format, "--out"])
+            .arg(file)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{out:?}");
+    }
+    let (of_profile, _) = stalled(&profile);
+    let (of_table, warning) = stalled(&table);
+    assert!(of_profile > 2.4 && of_profile < 2.5, "{of_profile}");
+    assert!(
+        (of_table / of_profile - 1.0).abs() < 1e-3,
+        "table {of_table} against profile {of_profile}"
+    );
+    assert!(warning.contains("stall interlock"), "{warning}");
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&table).unwrap()).unwrap();
+    doc["eye_safety"].as_object_mut().unwrap().remove("head");
+    let stripped = dir.join("t_one.json");
+    std::fs::write(&stripped, doc.to_string()).unwrap();
+    let (one, _) = stalled(&stripped);
+    assert!(
+        one > 0.0 && one < of_table / 10.0,
+        "{one} against {of_table}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -11,6 +11,7 @@
 //! placements and window durations (see [`super::bound`] and
 //! `specs/eye_safety.md`).
 
+use core::cmp::Ordering;
 use serde::Serialize;
 
 use super::ael::{self, APERTURE_DISTANCE_MM};
@@ -250,15 +251,39 @@ fn evaluate_head(
     laser: &Laser,
     search: Search,
 ) -> Result<ExposureReport, EyeSafetyError> {
-    let at = |h: &Head, surface| evaluate_head_at(segs, params, h, surface, laser, search);
-    let declared = at(head, Surface::Cylinder)?;
+    let mut worst: Option<ExposureReport> = None;
+    let mut stalled = 0.0f64;
+    for (h, surface) in surfaces(head)? {
+        let r = evaluate_head_at(segs, params, &h, surface, laser, search)?;
+        stalled = stalled.max(r.stalled_rotor_ratio);
+        // Ties (and a NaN, which never compares greater) keep the earlier.
+        worst = Some(match worst {
+            Some(w) if r.worst_ratio.partial_cmp(&w.worst_ratio) != Some(Ordering::Greater) => w,
+            _ => r,
+        });
+    }
+    let mut worst = worst.ok_or(EyeSafetyError::Param {
+        field: "head",
+        value: f64::NAN,
+        reason: "no aperture surface to evaluate",
+    })?;
+    worst.stalled_rotor_ratio = stalled;
+    Ok(worst)
+}
+
+/// The aperture surfaces a head's verdict covers, in the order ties are
+/// settled: the 100 mm cylinder and sphere, then (a head declaring another
+/// distance) the declared distance's cylinder and sphere. Refuses an
+/// invalid head, and a crossing point at or beyond 100 mm from the axis
+/// (no 100 mm surface outside the head) naming `head.origin_radius_mm`.
+pub fn surfaces(head: &Head) -> Result<Vec<(Head, Surface)>, EyeSafetyError> {
+    head.validate()?;
     // Exact comparison: any other distance, however near, is evaluated too.
     #[allow(clippy::float_cmp)]
     if head.aperture_distance_mm == APERTURE_DISTANCE_MM {
-        return Ok(worst_of([declared, at(head, Surface::Sphere)?]));
+        return Ok(Surface::ALL.iter().map(|&s| (head.clone(), s)).collect());
     }
-    // Not `< 100` written as a negation: NaN was refused by the declared
-    // evaluation's validation above.
+    // Not `< 100` written as a negation: NaN was refused by the validation.
     if head.origin_radius_mm >= APERTURE_DISTANCE_MM {
         return Err(EyeSafetyError::Param {
             field: "head.origin_radius_mm",
@@ -266,35 +291,38 @@ fn evaluate_head(
             reason: "must be < 100 mm: a certificate covers the Condition 3 surface 100 mm from the spin axis",
         });
     }
-    let standard_head = Head {
+    let standard = Head {
         aperture_distance_mm: APERTURE_DISTANCE_MM,
         ..head.clone()
     };
-    Ok(worst_of([
-        at(&standard_head, Surface::Cylinder)?,
-        at(&standard_head, Surface::Sphere)?,
-        declared,
-        at(head, Surface::Sphere)?,
-    ]))
+    Ok(Surface::ALL
+        .iter()
+        .map(|&s| (standard.clone(), s))
+        .chain(Surface::ALL.iter().map(|&s| (head.clone(), s)))
+        .collect())
 }
 
-/// The report with the largest worst ratio (ties, and a NaN, which never
-/// compares greater, take the earlier: the 100 mm cylinder first), with the
-/// largest stalled-rotor figure of them all.
-fn worst_of<const N: usize>(reports: [ExposureReport; N]) -> ExposureReport {
-    let stalled = reports
-        .iter()
-        .map(|r| r.stalled_rotor_ratio)
-        .fold(0.0, f64::max);
-    let mut reports = reports.into_iter();
-    let mut worst = reports.next().expect("at least one surface");
-    for r in reports {
-        if r.worst_ratio > worst.worst_ratio {
-            worst = r;
-        }
+/// The stalled-rotor figure (the head stopped, the laser firing at
+/// `power_max_w`): one channel's stationary ratio, or a head's
+/// ([`head_bound::stalled_ratio`]) on every surface of [`surfaces`], the
+/// largest. The figure a profile's report carries, for inputs that are not
+/// a profile (a firmware table: its hottest code's power).
+pub fn stalled_rotor_ratio(
+    params: &EyeSafetyParams,
+    pulse_rate_hz: f64,
+    power_max_w: f64,
+) -> Result<f64, EyeSafetyError> {
+    let laser = laser(params, pulse_rate_hz)?;
+    let Some(head) = &params.head else {
+        return Ok(laser.stationary_ratio(power_max_w).0);
+    };
+    let mut worst = 0.0f64;
+    for (h, surface) in surfaces(head)? {
+        // The stalled figures do not depend on the spin (no widening).
+        let hf = head_bound::head_figures_on(&h, surface, params, &laser, 0.0)?;
+        worst = worst.max(head_bound::stalled_ratio(&hf, &laser, power_max_w));
     }
-    worst.stalled_rotor_ratio = stalled;
-    worst
+    Ok(worst)
 }
 
 /// The head's evaluation on `surface`, `head.aperture_distance_mm` from the
