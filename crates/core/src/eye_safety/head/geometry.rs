@@ -9,7 +9,10 @@
 //! `s_c = −r0·cos φ_c + sqrt(R² − r0²·sin²φ_c)`, at head-frame angle
 //! `ψ_c = atan2(s_c·sin φ_c, r0 + s_c·cos φ_c)` and height
 //! `z_c = z0 + s_c·tan ε_c`, after the slant distance `d_c = s_c / cos ε_c`,
-//! where the beam is `w_c = exit + divergence·d_c` wide.
+//! where the beam is `w_c = exit + divergence·d_c` wide; the box takes
+//! the widest beam over the footprint ([`widest_beam_mm`]: the aperture
+//! centres a diverging ray reaches are nearest to points of it up to
+//! `R + ρ` from the axis, farther out than the hit).
 //!
 //! **The footprint.** A pulse counts (whole) at an aperture position when
 //! the aperture (diameter `a`) and the beam overlap. Whatever way the
@@ -165,6 +168,36 @@ pub fn footprints_on(head: &Head, aperture_mm: f64, surface: Surface) -> Vec<Foo
     }
 }
 
+/// The widest beam, mm, at any point of a diverging ray nearest an aperture
+/// centre it reaches on the cylinder (`r0·cos φ`, `r0·sin φ`, `cos ε`
+/// given): such a point `Q` is within `ρ` of the centre, so at most `R + ρ`
+/// from the axis, at slant `t ≤ t(ρ) = (−r0·cos φ + sqrt((R + ρ)² −
+/// r0²·sin²φ))/cos ε`; `ρ = (a + w(t))/2` with `t(ρ) ≤ (r0 + R + ρ)/cos ε`
+/// bounds `ρ` by `ρ₁ = (a + e + k·(r0 + R)/cos ε)/(2 − k/cos ε)` (`k` the
+/// divergence, `e` the exit), and the beam at `t(ρ₁)` holds every reached
+/// centre's (`t(ρ)` grows with `ρ`). Rounded up by [`GEOMETRY_MARGIN`]. A
+/// beam diverging by at least `cos ε` rad (`k ≥ cos ε`, far outside any real head) is taken as reaching
+/// everything (a kilometre wide).
+fn widest_beam_mm(
+    head: &Head,
+    aperture_mm: f64,
+    r0_cos_phi: f64,
+    r0_sin_phi: f64,
+    cos_eps: f64,
+) -> f64 {
+    let r = head.aperture_distance_mm;
+    let k = head.divergence_mrad * 1e-3;
+    let kc = k / cos_eps;
+    if !(kc < 1.0) {
+        return head.exit_diameter_mm + 1e6;
+    }
+    let r0 = r0_cos_phi.hypot(r0_sin_phi);
+    let rho1 = 0.5 * (aperture_mm + head.exit_diameter_mm + kc * (r0 + r)) / (1.0 - 0.5 * kc);
+    let reach = r + rho1;
+    let t = (-r0_cos_phi + (reach * reach - r0_sin_phi * r0_sin_phi).max(0.0).sqrt()) / cos_eps;
+    (head.exit_diameter_mm + head.divergence_mrad * t * 1e-3) * (1.0 + GEOMETRY_MARGIN)
+}
+
 /// The footprint of every channel of `head` for an aperture of `aperture_mm`
 /// on the cylinder.
 #[must_use]
@@ -186,8 +219,7 @@ pub fn footprints(head: &Head, aperture_mm: f64) -> Vec<Footprint> {
             let width = if head.divergence_mrad == 0.0 {
                 head.exit_diameter_mm
             } else {
-                (head.exit_diameter_mm + head.divergence_mrad * slant * 1e-3)
-                    * (1.0 + GEOMETRY_MARGIN)
+                widest_beam_mm(head, aperture_mm, r0 * cp, r0 * sp, eps.cos())
             };
             // β = φ − ψ (angle between the ray and the radial at the hit).
             let radial = r0 == 0.0 || phi == 0.0;
@@ -241,6 +273,35 @@ pub fn footprints(head: &Head, aperture_mm: f64) -> Vec<Footprint> {
         .collect()
 }
 
+/// Aperture positions `(θ, Z)` to probe a footprint's box with: a coarse
+/// grid over the whole turn and `z_range` (3601 × 401), and a fine one
+/// over 1.5 times the box (1201 × 1201), where a short box shows.
+#[cfg(test)]
+pub(crate) fn probe_positions(f: &Footprint, z_range: (f64, f64)) -> Vec<(f64, f64)> {
+    use core::f64::consts::PI;
+    let mut out = Vec::with_capacity(3601 * 401 + 1201 * 1201);
+    for i in 0..=3600 {
+        let theta = f.psi_rad + (f64::from(i) / 1800.0 - 1.0) * PI;
+        for k in 0..=400 {
+            out.push((
+                theta,
+                z_range.0 + (z_range.1 - z_range.0) * f64::from(k) / 400.0,
+            ));
+        }
+    }
+    let half_turn = (0.5 * f.pass_angle_deg.to_radians()).min(PI / 1.5);
+    for i in 0..=1200 {
+        let theta = f.psi_rad + 1.5 * half_turn * (f64::from(i) / 600.0 - 1.0);
+        for k in 0..=1200 {
+            out.push((
+                theta,
+                f.z_mm + 1.5 * f.half_height_mm * (f64::from(k) / 600.0 - 1.0),
+            ));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -272,7 +333,12 @@ mod tests {
     /// 3600·0.25) = −51.9615 + 95.3939 = 43.4324 mm; the hit point
     /// (60 + 37.6136, 21.7162) is at ψ = atan2(21.7162, 97.6136) = 12.543°;
     /// β = 30° − 12.543° = 17.457°. With ε = 10°: z = s·tan10° = 7.6583,
-    /// d = s/cos10° = 44.1024 mm, w = 5 + 3·0.0441 = 5.1323 mm.
+    /// d = s/cos10° = 44.1024 mm (the beam there 5 + 3·0.0441 = 5.1323
+    /// mm). The widest beam over the footprint: `ρ₁ = 0.5·(7 + 5 +
+    /// 0.0030463·160)/(1 − 0.0015231)` = 6.2532 mm, the nearest points of
+    /// the ray out to `R + ρ₁` = 106.2532 mm from the axis, at slant
+    /// `(−51.9615 + sqrt(106.2532² − 30²))/cos10°` = 50.7394 mm:
+    /// w = 5 + 3·0.0507394 = 5.1522 mm.
     #[test]
     fn oblique_ray_by_hand() {
         let h = head(60.0, vec![ch(0, 10.0, 30.0)]);
@@ -286,7 +352,7 @@ mod tests {
         );
         assert!((f.z_mm - 7.6583).abs() < 1e-4, "{}", f.z_mm);
         assert!((f.slant_mm - 44.1024).abs() < 1e-4);
-        assert!((f.width_mm - 5.1323).abs() < 1e-4);
+        assert!((f.width_mm - 5.1522).abs() < 1e-4, "{}", f.width_mm);
         let beta = (30.0 - 12.543f64).to_radians();
         assert!((f.cos_beta - beta.cos()).abs() < 1e-4);
         // The hit point is on the cylinder.
@@ -324,9 +390,12 @@ mod tests {
     }
 
     /// The 3-D reading by brute force: on a grid of aperture centres on the
-    /// cylinder, every one within `ρ` of the ray (3-D distance to the
-    /// half-line) lies in the footprint box, for oblique, steep and grazing
-    /// rays (the grazing one, `r0` = 90 mm at 80°, `s + q > 1`).
+    /// cylinder, every one within `(a + w(t))/2` of the ray (3-D distance to
+    /// the half-line, `w` the beam at the nearest point) lies in the
+    /// footprint box, for oblique, steep, grazing (`r0` = 90 mm at 80°,
+    /// `s + q > 1`) and strongly diverging rays (with the beam taken at the
+    /// hit alone, the box of the 200 mrad ray 60° up is short: a centre
+    /// 58.000 mm above the hit is reached, the box held 57.957 mm).
     #[test]
     fn the_box_holds_every_position_within_reach_of_the_ray() {
         let cases = [
@@ -335,23 +404,26 @@ mod tests {
             (40.0, 25.0, -20.0, 10.0, 1.0),
             (0.0, 30.0, 0.0, 150.0, 0.0),
             (58.63, -25.0, 5.0, 10.0, 2.0),
+            (20.0, 15.0, -10.0, 5.0, 200.0),
+            (50.0, -40.0, 30.0, 2.0, 100.0),
+            (0.0, 60.0, 0.0, 5.0, 200.0),
         ];
         for (r0, el, az, exit, div) in cases {
             let mut h = head(r0, vec![ch(0, el, az)]);
             h.exit_diameter_mm = exit;
             h.divergence_mrad = div;
             let f = footprints(&h, 7.0)[0];
-            let rho = 0.5 * (7.0 + f.width_mm);
-            let (phi, eps) = (az.to_radians(), el.to_radians());
+            let (phi, eps) = (f64::to_radians(az), f64::to_radians(el));
             let u = [eps.cos() * phi.cos(), eps.cos() * phi.sin(), eps.sin()];
             let mut inside = 0;
-            for i in 0..=3600 {
-                let theta = f.psi_rad + (f64::from(i) / 1800.0 - 1.0) * std::f64::consts::PI;
-                for k in 0..=400 {
-                    let z = f.z_mm + (f64::from(k) / 200.0 - 1.0) * 4.0 * (rho + 100.0);
+            let span = 4.0 * (f.width_mm + 100.0);
+            for (theta, z) in probe_positions(&f, (f.z_mm - span, f.z_mm + span)) {
+                {
                     let d = [100.0 * theta.cos() - r0, 100.0 * theta.sin(), z];
                     let t = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]).max(0.0);
                     let e = [d[0] - t * u[0], d[1] - t * u[1], d[2] - t * u[2]];
+                    // The beam at the ray's nearest point.
+                    let rho = 0.5 * (7.0 + exit + div * 1e-3 * t);
                     if (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() > rho {
                         continue;
                     }

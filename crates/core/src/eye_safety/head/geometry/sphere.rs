@@ -419,11 +419,23 @@ mod tests {
     }
 
     /// A flat beam from the axis meets the sphere where it meets the
-    /// cylinder: the cylinder's footprint, bit for bit (a one-channel head
-    /// is the single-channel bound on both surfaces).
+    /// cylinder: without divergence the cylinder's footprint, bit for bit (a
+    /// one-channel head is the single-channel bound on both surfaces); a
+    /// diverging one's beam is at most `R` out on the sphere (the nearest
+    /// point of a ray from the centre is never farther than the centre's
+    /// `R`), narrower than the cylinder's widest (`R + ρ` from the axis).
     #[test]
     fn flat_beam_from_the_axis_is_the_cylinder_footprint() {
-        for (az, div) in [(0.0, 0.0), (30.0, 0.0), (-70.0, 2.5)] {
+        let mut h = head(0.0, 0.0, 10.0, 5.0, 2.5);
+        h.origin_height_mm = 0.0;
+        let (f, cyl) = (footprints(&h, 7.0)[0], super::super::footprints(&h, 7.0)[0]);
+        assert!(f.width_mm < cyl.width_mm && f.pass_angle_deg < cyl.pass_angle_deg);
+        assert!(
+            (f.width_mm - (5.0 + 2.5e-3 * 100.0)).abs() < 1e-9,
+            "{}",
+            f.width_mm
+        );
+        for (az, div) in [(0.0, 0.0), (30.0, 0.0), (-70.0, 0.0)] {
             let mut h = head(0.0, 0.0, az, 5.0, div);
             h.origin_height_mm = 0.0;
             let f = footprints(&h, 7.0)[0];
@@ -441,7 +453,8 @@ mod tests {
     }
 
     /// The 3-D reading by brute force on the sphere: on a grid of aperture
-    /// centres `R` from the scan centre, every one within
+    /// centres `R` from the scan centre (coarse over the sphere, fine over
+    /// 1.5 times the box), every one within
     /// `(a + w(t))/2` of the ray (3-D distance to the half-line, `w` the
     /// beam at the nearest point) lies in the footprint box, for steep,
     /// oblique, grazing, diverging and down-pointing rays.
@@ -466,11 +479,13 @@ mod tests {
             let u = [eps.cos() * phi.cos(), eps.cos() * phi.sin(), eps.sin()];
             let z_hit = f.z_mm - 3.0;
             let mut inside = 0;
-            for k in 0..=2000 {
-                let zr = -100.0 + 0.1 * f64::from(k);
+            for (theta, z) in super::super::probe_positions(&f, (-97.0, 103.0)) {
+                let zr = z - 3.0;
+                if zr.abs() > 100.0 {
+                    continue;
+                }
                 let rr = (1e4 - zr * zr).max(0.0).sqrt();
-                for i in 0..=3600 {
-                    let theta = f.psi_rad + (f64::from(i) / 1800.0 - 1.0) * PI;
+                {
                     let d = [rr * theta.cos() - r0, rr * theta.sin(), zr];
                     let t = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]).max(0.0);
                     let e = [d[0] - t * u[0], d[1] - t * u[1], d[2] - t * u[2]];
