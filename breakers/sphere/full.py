@@ -29,11 +29,17 @@ def main():
     ap.add_argument("--phases", type=int, default=4); ap.add_argument("--turns", type=int, default=2)
     ap.add_argument("--span-max", type=float, default=0.02); ap.add_argument("--nth", type=int, default=7200)
     ap.add_argument("--a", type=float, default=7.0)
+    ap.add_argument("--alphas", default="0", help="lab azimuths of the aperture, deg (non-uniform profiles)")
     a = ap.parse_args()
     doc = json.load(open(a.profile)); es = doc["limits"]["eye_safety"]; head = es["head"]
     lam = es["wavelength_nm"]; tau = es["pulse_duration_s"]
     P = doc["bins"][0]["power_w"]; om = doc["bins"][0]["spin_start_rad_s"]
-    assert all(b["power_w"] == P and b["spin_start_rad_s"] == om == b["spin_end_rad_s"] for b in doc["bins"])
+    assert all(b["spin_start_rad_s"] == om == b["spin_end_rad_s"] for b in doc["bins"]), "constant spin only"
+    starts = np.array([b["start_deg"] for b in doc["bins"]]); pows = np.array([b["power_w"] for b in doc["bins"]])
+    def power_at(tt):  # head (encoder) angle = omega t from 0 deg at t = 0
+        th = np.mod(np.degrees(om*tt), 360.0)
+        return pows[np.clip(np.searchsorted(starts, th, side="right") - 1, 0, len(pows) - 1)]
+    P = float(pows.mean())
     f = doc["pulse_rate_hz"]; cyc = head["cycle_s"]; Tf = 2*math.pi/om; R = 100.0
     z0 = head.get("origin_height_mm", 0.0)
     if a.surface == "sphere":
@@ -58,15 +64,17 @@ def main():
     nk = int(math.ceil(a.turns*Tf/cyc)) + 1
     for idx in cand:
         r = rr[idx]; z = zz[idx]
-        for p in range(a.phases):
+        for alpha in [math.radians(float(x)) for x in a.alphas.split(",")]:
+          a.alpha = alpha
+          for p in range(a.phases):
             ph = cyc*p/a.phases
             ts = []; en = []
             for c in head["channels"]:
                 tt = np.arange(nk)*cyc + c["slot_s"] + ph
                 tt = tt[tt < a.turns*Tf]
                 ang = om*tt
-                m = reach_mask(head, c, r*np.cos(-ang), r*np.sin(-ang), np.full(len(tt), z), a.a, "proj")
-                ts.append(tt[m]); en.append(np.full(m.sum(), c.get("power_scale", 1.0)*P/f))
+                m = reach_mask(head, c, r*np.cos(a.alpha - ang), r*np.sin(a.alpha - ang), np.full(len(tt), z), a.a, "proj")
+                ts.append(tt[m]); en.append(c.get("power_scale", 1.0)*power_at(tt[m])/f)
             t = np.concatenate(ts); E = np.concatenate(en)
             if len(t) == 0: continue
             o = np.argsort(t, kind="stable"); t = t[o]; E = E[o]
@@ -76,7 +84,7 @@ def main():
             c5 = 1.0 if N10 <= 600 else max(0.4, 5*N10**-0.25)
             j = np.searchsorted(t, t + T_I, side="left")
             g = (ce[j] - ce[:-1]).max()/(ael_s*c5)
-            if g > best["rule1"][0]: best["rule1"] = (float(g), (float(lab[idx]), p, int(N10), round(c5, 4)))
+            if g > best["rule1"][0]: best["rule1"] = (float(g), (float(lab[idx]), round(math.degrees(a.alpha), 3), p, int(N10), round(c5, 4)))
             # windows from pulse i to pulse j (span <= span_max)
             n = len(t); wbest = 0; wat = None
             jmax = np.searchsorted(t, t + a.span_max, side="right")
@@ -86,9 +94,9 @@ def main():
                 rat = (ce[jj + 1] - ce[i0])/ael_vec(t[jj] - t[i0] + tau, lam)
                 k = int(np.argmax(rat))
                 if rat[k] > wbest: wbest, wat = float(rat[k]), (float(t[jj[k]] - t[i0]), int(jj[k] - i0 + 1))
-            if wbest > best["window"][0]: best["window"] = (wbest, (float(lab[idx]), p) + wat)
+            if wbest > best["window"][0]: best["window"] = (wbest, (float(lab[idx]), round(math.degrees(a.alpha), 3), p) + wat)
             tb = E.sum()/a.turns*math.floor(100.0/Tf)/(3.9e-4*c4(lam)*100)
-            if tb > best["time_base"][0]: best["time_base"] = (float(tb), (float(lab[idx]), p))
+            if tb > best["time_base"][0]: best["time_base"] = (float(tb), (float(lab[idx]), round(math.degrees(a.alpha), 3), p))
     out = {k: v for k, v in best.items()}
     out["worst"] = max(v[0] for v in best.values())
     out["proxy_top"] = [(float(lab[i]), float(meas[i]), float(wsim[i])) for i in cand[:4]]
