@@ -3,6 +3,7 @@
 mod ael;
 mod band_edges;
 mod break_head;
+mod break_sphere;
 #[cfg(feature = "optimizer")]
 mod cuts;
 #[cfg(feature = "optimizer")]
