@@ -2,8 +2,8 @@
 //! 3-D reach set on random heads (off-axis crossing points, steep and down-pointing
 //! channels, wide beams near R − r0, large divergence, heights).
 //!
-//! Run: `cargo test --release -p gaze-lidar-core --test it -- break_sphere --ignored --nocapture`
-//! (`BREAK_SPHERE_CASES=N`, default 300). Measured: 300 cases, 0 failures, the farthest reached
+//! Run: `cargo test --release -p gaze-lidar-core --test it -- break_sphere --nocapture`
+//! (`BREAK_SPHERE_CASES=N`, default 20 in `cargo test`, about 0.17 s each; the tester ran 300 and 2,000). Measured: 300 cases, 0 failures, the farthest reached
 //! position 0.9989 of the box's half-turn and 0.9997 of its half-height.
 
 use gaze_lidar_core::eye_safety::head::geometry::{footprints_on, Surface};
@@ -36,20 +36,40 @@ fn reach(r0: f64, el: f64, az: f64, exit: f64, div: f64, a: f64, p: [f64; 3]) ->
 }
 
 #[test]
-#[ignore = "outside tester's brute force, ~0.17 s per case in release: run with --ignored"]
 fn break_sphere_footprint_box_holds_every_reached_position() {
-    let cases: usize = std::env::var("BREAK_SPHERE_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(300);
+    let cases: usize = std::env::var("BREAK_SPHERE_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20);
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
     let mut worst_arc = 0.0f64; // largest (reached |dθ|) / (box half-turn)
     let mut worst_h = 0.0f64;
     let mut fails = Vec::new();
     for case in 0..cases {
-        let r0 = match case % 4 { 0 => rng.range(0.0, 1.0), 1 => rng.range(10.0, 90.0), 2 => rng.range(85.0, 99.5), _ => rng.range(0.0, 99.0) };
-        let el = match case % 3 { 0 => rng.range(30.0, 89.5), 1 => -rng.range(30.0, 89.5), _ => rng.range(-89.9, 89.9) };
+        let r0 = match case % 4 {
+            0 => rng.range(0.0, 1.0),
+            1 => rng.range(10.0, 90.0),
+            2 => rng.range(85.0, 99.5),
+            _ => rng.range(0.0, 99.0),
+        };
+        let el = match case % 3 {
+            0 => rng.range(30.0, 89.5),
+            1 => -rng.range(30.0, 89.5),
+            _ => rng.range(-89.9, 89.9),
+        };
         let az = rng.range(-89.9, 89.9);
         let rmax = 100.0 - r0;
-        let exit = match case % 5 { 0 => rng.range(0.1, 5.0), 1 => (2.0 * rmax * rng.range(0.8, 0.999) - 7.0).max(0.1), 2 => rng.range(5.0, 40.0), _ => rng.range(1.0, 15.0) };
-        let div = match case % 7 { 0 => rng.range(100.0, 1000.0), 1 => rng.range(0.0, 20.0), _ => 0.0 };
+        let exit = match case % 5 {
+            0 => rng.range(0.1, 5.0),
+            1 => (2.0 * rmax * rng.range(0.8, 0.999) - 7.0).max(0.1),
+            2 => rng.range(5.0, 40.0),
+            _ => rng.range(1.0, 15.0),
+        };
+        let div = match case % 7 {
+            0 => rng.range(100.0, 1000.0),
+            1 => rng.range(0.0, 20.0),
+            _ => 0.0,
+        };
         let z0 = rng.range(-50.0, 50.0);
         let a = 7.0;
         let head = Head {
@@ -59,7 +79,13 @@ fn break_sphere_footprint_box_holds_every_reached_position() {
             exit_diameter_mm: exit,
             divergence_mrad: div,
             aperture_distance_mm: 100.0,
-            channels: vec![Channel { id: 0, elevation_deg: el, azimuth_offset_deg: az, slot_s: 0.0, power_scale: 1.0 }],
+            channels: vec![Channel {
+                id: 0,
+                elevation_deg: el,
+                azimuth_offset_deg: az,
+                slot_s: 0.0,
+                power_scale: 1.0,
+            }],
         };
         if head.validate().is_err() {
             continue;
@@ -105,7 +131,11 @@ fn break_sphere_footprint_box_holds_every_reached_position() {
         for _ in 0..400_000 {
             let t = rng.range(0.0, 250.0);
             let rho = 0.5 * (a + exit + div * 1e-3 * t) * 1.2;
-            let v = [rng.range(-rho, rho), rng.range(-rho, rho), rng.range(-rho, rho)];
+            let v = [
+                rng.range(-rho, rho),
+                rng.range(-rho, rho),
+                rng.range(-rho, rho),
+            ];
             let q = [r0 + t * u[0] + v[0], t * u[1] + v[1], t * u[2] + v[2]];
             let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
             if n < 1e-9 {
@@ -114,7 +144,10 @@ fn break_sphere_footprint_box_holds_every_reached_position() {
             check([100.0 * q[0] / n, 100.0 * q[1] / n, 100.0 * q[2] / n]);
         }
     }
-    println!("break_sphere: worst reached/box arc {worst_arc:.6}, height {worst_h:.6}; {} failures", fails.len());
+    println!(
+        "break_sphere: worst reached/box arc {worst_arc:.6}, height {worst_h:.6}; {} failures",
+        fails.len()
+    );
     for f in fails.iter().take(20) {
         println!("FAIL {f:?}");
     }
