@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use gaze_lidar::eye_safety::ael_report;
 use gaze_lidar::eye_safety::exposure::scan_pass_angle_deg;
+use gaze_lidar::eye_safety::head::geometry::Surface;
 use gaze_lidar::text::Num;
 
 use super::args::{finite, finite_positive, rate};
@@ -87,13 +88,23 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             Some(h) => {
                 let laser = gaze_lidar::eye_safety::exposure::laser(params, s.pulse_rate_hz)
                     .map_err(|e| CliError::input(format!("--preset: {e}")))?;
-                let f = gaze_lidar::eye_safety::head::bound::head_figures(
-                    h,
-                    params,
-                    &laser,
-                    s.limits.spin_rad_s_max,
-                )
-                .map_err(|e| CliError::input(format!("--preset: {e}")))?;
+                // Every surface the verdict covers (the 100 mm cylinder and
+                // sphere for a preset's head).
+                let surfaces = gaze_lidar::eye_safety::exposure::surfaces(h)
+                    .map_err(|e| CliError::input(format!("--preset: {e}")))?;
+                let f = surfaces
+                    .iter()
+                    .map(|(h, surface)| {
+                        gaze_lidar::eye_safety::head::bound::head_figures_on(
+                            h,
+                            *surface,
+                            params,
+                            &laser,
+                            s.limits.spin_rad_s_max,
+                        )
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+                    .map_err(|e| CliError::input(format!("--preset: {e}")))?;
                 Some((h.clone(), f, s.limits.spin_rad_s_max))
             }
             None => None,
@@ -163,7 +174,14 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
             if let (Some((h, f, spin)), Some(obj)) = (&head, v.as_object_mut()) {
                 obj.insert(
                     "head".into(),
-                    serde_json::json!({"description": h, "figures": f, "spin_rad_s_max": spin}),
+                    serde_json::json!({
+                        "description": h, "figures": f.first(), "spin_rad_s_max": spin,
+                        "figures_by_surface": f.iter().map(|f| serde_json::json!({
+                            "surface": f.surface.name(),
+                            "aperture_distance_mm": h.aperture_distance_mm,
+                            "figures": f,
+                        })).collect::<Vec<_>>(),
+                    }),
                 );
             }
             o!("{v}");
@@ -201,14 +219,21 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
                         "head                    {} channels, cycle {:e} s, crossing point {} mm from the axis, exit beam {} mm, divergence {:.3} mrad, aperture at {} mm",
                         h.channels.len(), h.cycle_s, h.origin_radius_mm, h.exit_diameter_mm, h.divergence_mrad, h.aperture_distance_mm
                     );
-                    o!(
-                        "head overlap            {} channels can meet one height (W_v = {:.3}, worst at {:.2} mm); a grouping window of {:e} s puts {} beam(s) in one position (W_g = {:.3}, W_sim = {:.3}) at up to {:.1} rad/s; stalled: {} beam(s) share one position",
-                        f.count_vertical, f.weight_vertical, f.worst_height_mm, f.group_window_s, f.count_group, f.weight_group, f.weight_simultaneous, spin, f.count_stalled
-                    );
-                    o!(
-                        "head pass angle         {:.3}° (the widest of its channels)",
-                        f.pass_angle_deg
-                    );
+                    for f in f {
+                        let on = match f.surface {
+                            Surface::Cylinder => "cylinder around the spin axis",
+                            Surface::Sphere => "sphere around the scan centre",
+                        };
+                        o!("head on the {on}:");
+                        o!(
+                            "  overlap               {} channels can meet one height (W_v = {:.3}, worst at {:.2} mm); a grouping window of {:e} s puts {} beam(s) in one position (W_g = {:.3}, W_sim = {:.3}) at up to {:.1} rad/s; stalled: {} beam(s) share one position",
+                            f.count_vertical, f.weight_vertical, f.worst_height_mm, f.group_window_s, f.count_group, f.weight_group, f.weight_simultaneous, spin, f.count_stalled
+                        );
+                        o!(
+                            "  pass angle            {:.3}° (the widest of its channels)",
+                            f.pass_angle_deg
+                        );
+                    }
                 }
                 None if sensor.is_some() && !given => {
                     o!("head                    none: one channel");

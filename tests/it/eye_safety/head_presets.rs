@@ -229,7 +229,10 @@ fn sensor_and_ael_show_the_head() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let t = stdout(&o);
     assert!(t.contains("head                    128 channels"), "{t}");
-    assert!(t.contains("head overlap"), "{t}");
+    // Both surfaces a certificate covers, each with its figures.
+    assert!(t.contains("head on the cylinder around the spin axis:"), "{t}");
+    assert!(t.contains("head on the sphere around the scan centre:"), "{t}");
+    assert_eq!(t.matches("  overlap ").count(), 2, "{t}");
     let o = run(&["ael", "--preset", "paper"], None);
     assert!(stdout(&o).contains("none: one channel"));
     let o = run(&["ael", "--preset", "vls128", "--format", "json"], None);
@@ -242,6 +245,15 @@ fn sensor_and_ael_show_the_head() {
         128
     );
     assert!(v["head"]["figures"]["weight_vertical"].as_f64().unwrap() >= 1.0);
+    let by = v["head"]["figures_by_surface"].as_array().unwrap();
+    assert_eq!(by.len(), 2, "{v}");
+    assert_eq!(by[0]["surface"], "cylinder");
+    assert_eq!(by[1]["surface"], "sphere");
+    assert_eq!(by[0]["figures"], v["head"]["figures"]);
+    // The VLS-128's channels reach 25° down: the sphere's widest pass is
+    // the wider.
+    let pass = |i: usize| by[i]["figures"]["pass_angle_deg"].as_f64().unwrap();
+    assert!(pass(1) > pass(0), "{v}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
