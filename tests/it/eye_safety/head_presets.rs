@@ -230,8 +230,14 @@ fn sensor_and_ael_show_the_head() {
     let t = stdout(&o);
     assert!(t.contains("head                    128 channels"), "{t}");
     // Both surfaces a certificate covers, each with its figures.
-    assert!(t.contains("head on the cylinder around the spin axis:"), "{t}");
-    assert!(t.contains("head on the sphere around the scan centre:"), "{t}");
+    assert!(
+        t.contains("head on the cylinder around the spin axis:"),
+        "{t}"
+    );
+    assert!(
+        t.contains("head on the sphere around the scan centre:"),
+        "{t}"
+    );
     assert_eq!(t.matches("  overlap ").count(), 2, "{t}");
     let o = run(&["ael", "--preset", "paper"], None);
     assert!(stdout(&o).contains("none: one channel"));

@@ -188,7 +188,7 @@ fn widest_beam_mm(
     let r = head.aperture_distance_mm;
     let k = head.divergence_mrad * 1e-3;
     let kc = k / cos_eps;
-    if !(kc < 1.0) {
+    if kc >= 1.0 || kc.is_nan() {
         return head.exit_diameter_mm + 1e6;
     }
     let r0 = r0_cos_phi.hypot(r0_sin_phi);
