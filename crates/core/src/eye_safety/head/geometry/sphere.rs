@@ -418,6 +418,67 @@ mod tests {
         );
     }
 
+    /// The angles of a box cut by an annulus, by hand, each extreme at
+    /// another kind of point (relative to +x):
+    /// - `x ∈ [1, 3]`, `y ∈ [−5, 5]`, radii `[0, 2]`: the disc right of
+    ///   `x = 1`, its ends where the edge meets the outer circle,
+    ///   `(1, ±√3)`: ±60°;
+    /// - `x ∈ [0.5, 3]`, `y ∈ [1, 1.9]`, radii `[2, 10]`: from the corner
+    ///   `(3, 1)` (18.435°) to where the top edge meets the inner circle,
+    ///   `(sqrt(4 − 1.9²), 1.9)` = `(0.6245, 1.9)`: 71.805° (the corner
+    ///   `(0.5, 1.9)` is 1.965 from the axis, inside the inner circle);
+    /// - a box holding the axis, or one holding the whole annulus: the
+    ///   whole turn; a box outside the annulus: empty.
+    #[test]
+    fn box_and_annulus_angles_by_hand() {
+        let d = (1.0, 0.0);
+        let (lo, hi) = angles((1.0, 3.0), (-5.0, 5.0), 0.0, 2.0, d)
+            .unwrap()
+            .unwrap();
+        assert!(
+            (lo + PI / 3.0).abs() < 1e-12 && (hi - PI / 3.0).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        let (lo, hi) = angles((0.5, 3.0), (1.0, 1.9), 2.0, 10.0, d)
+            .unwrap()
+            .unwrap();
+        assert!((lo - (1.0f64 / 3.0).atan()).abs() < 1e-12, "{lo}");
+        let top = 1.9f64.atan2((4.0f64 - 1.9 * 1.9).sqrt());
+        assert!((hi - top).abs() < 1e-12, "{hi} {top}");
+        assert!(
+            (top.to_degrees() - 71.805).abs() < 1e-3,
+            "{}",
+            top.to_degrees()
+        );
+        // Relative to a direction: the same set turned.
+        let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+        let (l2, h2) = angles((0.5, 3.0), (1.0, 1.9), 2.0, 10.0, (c, s))
+            .unwrap()
+            .unwrap();
+        assert!((l2 - (lo - 0.3)).abs() < 1e-12 && (h2 - (hi - 0.3)).abs() < 1e-12);
+        // The axis in the box (on an edge, too): the whole turn.
+        assert!(angles((-1.0, 1.0), (-1.0, 1.0), 0.5, 0.7, d).is_err());
+        assert!(angles((0.0, 1.0), (-1.0, 1.0), 0.5, 0.7, d).is_err());
+        assert!(angles((-1.0, 0.0), (0.0, 1.0), 0.5, 0.7, d).is_err());
+        // The annulus wholly inside the box: the whole turn, not empty.
+        assert!(angles((-5.0, 5.0), (-5.0, 5.0), 1.0, 2.0, d).is_err());
+        // Outside the annulus: empty.
+        assert_eq!(angles((3.0, 4.0), (0.0, 1.0), 0.0, 2.0, d), Ok(None));
+        assert_eq!(angles((0.1, 0.2), (0.0, 0.1), 1.0, 2.0, d), Ok(None));
+        // A set wrapping past the opposite direction: the whole turn.
+        assert!(angles((-3.0, -1.0), (-1.0, 1.0), 0.0, 10.0, d).is_err());
+    }
+
+    /// A steep channel 5 mm off the axis whose reach holds the pole (88°
+    /// up, a cap of 4.9° around it): the whole turn.
+    #[test]
+    fn a_footprint_over_the_pole_is_the_whole_turn() {
+        let f = footprints(&head(5.0, 88.0, 0.0, 10.0, 0.0), 7.0)[0];
+        assert_eq!(f.pass_angle_deg, 360.0, "{f:?}");
+        let f = footprints(&head(5.0, -88.0, 30.0, 10.0, 0.0), 7.0)[0];
+        assert_eq!(f.pass_angle_deg, 360.0, "{f:?}");
+    }
+
     /// A flat beam from the axis meets the sphere where it meets the
     /// cylinder: without divergence the cylinder's footprint, bit for bit (a
     /// one-channel head is the single-channel bound on both surfaces); a
