@@ -479,6 +479,34 @@ mod tests {
         assert_eq!(f.pass_angle_deg, 360.0, "{f:?}");
     }
 
+    /// A flat ray off the axis reaches, at the height of the scan centre,
+    /// the cylinder's positions at that height (the sphere's equator is the
+    /// cylinder's circle there), and the cylinder's widest turn is taken
+    /// there (no vertical offset): the sphere's box turns at least as far.
+    /// Grazing rays included, where the turn hangs on the equator's radius.
+    #[test]
+    fn a_flat_ray_turns_at_least_the_cylinders_turn_on_the_sphere() {
+        for (r0, az, exit) in [
+            (60.0, 30.0, 5.0),
+            (90.0, 80.0, 1.0),
+            (40.0, -60.0, 10.0),
+            (95.0, 85.0, 0.5),
+        ] {
+            let mut h = head(r0, 0.0, az, exit, 0.0);
+            h.origin_height_mm = 0.0;
+            let (f, cyl) = (footprints(&h, 7.0)[0], super::super::footprints(&h, 7.0)[0]);
+            if cyl.pass_angle_deg >= 360.0 {
+                continue;
+            }
+            assert!(
+                f.half_arc_mm >= cyl.half_arc_mm * (1.0 - 1e-11),
+                "{r0} {az}: sphere {} below the cylinder's {}",
+                f.half_arc_mm,
+                cyl.half_arc_mm
+            );
+        }
+    }
+
     /// A flat beam from the axis meets the sphere where it meets the
     /// cylinder: without divergence the cylinder's footprint, bit for bit (a
     /// one-channel head is the single-channel bound on both surfaces); a
