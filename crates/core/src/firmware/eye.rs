@@ -841,9 +841,9 @@ mod derive {
     use super::{
         pass_timing, InstantLimit, IntEyeError, IntEyeLimits, IntRule, TrainLimit, MILLIHZ_PER_HZ,
     };
-    use crate::eye_safety::ael::{APERTURE_DISTANCE_MM, T2_S, TIME_BASE_S};
+    use crate::eye_safety::ael::{T2_S, TIME_BASE_S};
     use crate::eye_safety::bound::Laser;
-    use crate::eye_safety::exposure::{laser, pass_angle_deg};
+    use crate::eye_safety::exposure::{laser, pass_angle_deg, surfaces};
     use crate::eye_safety::head::bound::{
         head_figures_on, single_pulse_ratio as single_pulse_ratio_head, HeadFigures, SingleFigures,
     };
@@ -917,8 +917,8 @@ mod derive {
     /// next in [`IntEyeLimits::other_surface`]); a set equal to an earlier
     /// one is left out (a flat channel from the axis meets the sphere where
     /// it meets the cylinder: one set).
-    fn chain<const N: usize>(sets: [IntEyeLimits; N]) -> IntEyeLimits {
-        let mut distinct: Vec<IntEyeLimits> = Vec::with_capacity(N);
+    fn chain(sets: Vec<IntEyeLimits>) -> Result<IntEyeLimits, DeriveError> {
+        let mut distinct: Vec<IntEyeLimits> = Vec::with_capacity(sets.len());
         for set in sets {
             if !distinct.contains(&set) {
                 distinct.push(set);
@@ -929,7 +929,10 @@ mod derive {
             set.other_surface = next;
             next = Some(Box::new(set));
         }
-        *next.expect("at least one surface")
+        next.map(|top| *top).ok_or(DeriveError::Range {
+            field: "eye_safety.head",
+            reason: "no aperture surface to evaluate",
+        })
     }
 
     impl IntEyeLimits {
@@ -947,30 +950,25 @@ mod derive {
                 // (`exposure::evaluate_head`): a chain of limit sets, every
                 // one must accept ([`evaluate`]).
                 Some(h) => {
-                    let declared = Self::derive_at(table, params, Some(h), Surface::Cylinder)?;
-                    #[allow(clippy::float_cmp)]
-                    if h.aperture_distance_mm == APERTURE_DISTANCE_MM {
-                        let sphere = Self::derive_at(table, params, Some(h), Surface::Sphere)?;
-                        return Ok(chain([declared, sphere]));
-                    }
-                    // Not `< 100` written as a negation: NaN was refused by
-                    // the declared derivation's validation above.
-                    if h.origin_radius_mm >= APERTURE_DISTANCE_MM {
-                        return Err(DeriveError::Range {
+                    // The surfaces' one owner: `exposure::surfaces` (it
+                    // refuses a crossing point with no 100 mm surface
+                    // outside it, here named as the table's field).
+                    let surfaces = surfaces(h).map_err(|e| match e {
+                        EyeSafetyError::Param {
+                            field: "head.origin_radius_mm",
+                            reason,
+                            ..
+                        } => DeriveError::Range {
                             field: "eye_safety.head.origin_radius_mm",
-                            reason: "must be < 100 mm: a certificate covers the Condition 3 surface 100 mm from the spin axis",
-                        });
-                    }
-                    let standard = Head {
-                        aperture_distance_mm: APERTURE_DISTANCE_MM,
-                        ..h.clone()
-                    };
-                    Ok(chain([
-                        Self::derive_at(table, params, Some(&standard), Surface::Cylinder)?,
-                        Self::derive_at(table, params, Some(&standard), Surface::Sphere)?,
-                        declared,
-                        Self::derive_at(table, params, Some(h), Surface::Sphere)?,
-                    ]))
+                            reason,
+                        },
+                        e => DeriveError::Params(e),
+                    })?;
+                    let sets = surfaces
+                        .iter()
+                        .map(|(h, surface)| Self::derive_at(table, params, Some(h), *surface))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    chain(sets)
                 }
                 None => Self::derive_at(table, params, None, Surface::Cylinder),
             }
