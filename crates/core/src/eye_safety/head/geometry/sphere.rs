@@ -407,6 +407,14 @@ mod tests {
             "{} {down}",
             f.half_height_mm
         );
+        // Pointing down, the cap's upper edge is the farther, by the same
+        // 2.5495 mm.
+        let g_down = footprints(&head(0.0, -75.0, 0.0, 10.0, 0.0), 7.0)[0];
+        assert!(
+            g_down.half_height_mm >= down && g_down.half_height_mm <= down * (1.0 + 1e-9),
+            "{}",
+            g_down.half_height_mm
+        );
         // The hit: 100·(cos 75°, 0, sin 75°) + 3 mm.
         assert!((f.z_mm - (3.0 + 100.0 * 75f64.to_radians().sin())).abs() < 1e-9);
         assert!(f.psi_rad.abs() < 1e-12);
@@ -475,6 +483,9 @@ mod tests {
     fn a_footprint_over_the_pole_is_the_whole_turn() {
         let f = footprints(&head(5.0, 88.0, 0.0, 10.0, 0.0), 7.0)[0];
         assert_eq!(f.pass_angle_deg, 360.0, "{f:?}");
+        // The whole turn along the arc, and every height of the sphere.
+        assert!(f.half_arc_mm >= PI * 100.0, "{f:?}");
+        assert!(f.half_height_mm >= 100.0 + (f.z_mm - 3.0).abs(), "{f:?}");
         let f = footprints(&head(5.0, -88.0, 30.0, 10.0, 0.0), 7.0)[0];
         assert_eq!(f.pass_angle_deg, 360.0, "{f:?}");
     }
@@ -565,6 +576,7 @@ mod tests {
             (15.8, 20.95, 4.2, 10.0, 0.5, 0.97, 0.97),
             (30.0, -60.0, 150.0, 8.0, 0.0, 0.94, 0.67),
             (20.0, 50.0, 90.0, 4.0, 10.0, 0.95, 0.81),
+            (30.0, 40.0, 20.0, 0.5, 300.0, 0.90, 0.86),
         ];
         for (r0, el, az, exit, div, arc_min, height_min) in cases {
             let h = head(r0, el, az, exit, div);
