@@ -302,6 +302,25 @@ pub(crate) fn probe_positions(f: &Footprint, z_range: (f64, f64)) -> Vec<(f64, f
     out
 }
 
+/// Whether an aperture centre `p` (mm, the crossing point's height at 0)
+/// is within `(a + w)/2` of the ray from `(r0, 0, 0)` along `u` (3-D
+/// distance to the half-line, the beam `exit + divergence·t` at the nearest
+/// point `t`, a = 7 mm): the reach the brute-force tests hold boxes to.
+#[cfg(test)]
+pub(crate) fn reached(
+    p: [f64; 3],
+    r0: f64,
+    u: [f64; 3],
+    exit_mm: f64,
+    divergence_mrad: f64,
+) -> bool {
+    let d = [p[0] - r0, p[1], p[2]];
+    let t = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]).max(0.0);
+    let e = [d[0] - t * u[0], d[1] - t * u[1], d[2] - t * u[2]];
+    let rho = 0.5 * (7.0 + exit_mm + divergence_mrad * 1e-3 * t);
+    (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() <= rho
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -419,12 +438,13 @@ mod tests {
             let span = 4.0 * (f.width_mm + 100.0);
             for (theta, z) in probe_positions(&f, (f.z_mm - span, f.z_mm + span)) {
                 {
-                    let d = [100.0 * theta.cos() - r0, 100.0 * theta.sin(), z];
-                    let t = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]).max(0.0);
-                    let e = [d[0] - t * u[0], d[1] - t * u[1], d[2] - t * u[2]];
-                    // The beam at the ray's nearest point.
-                    let rho = 0.5 * (7.0 + exit + div * 1e-3 * t);
-                    if (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() > rho {
+                    if !reached(
+                        [100.0 * theta.cos(), 100.0 * theta.sin(), z],
+                        r0,
+                        u,
+                        exit,
+                        div,
+                    ) {
                         continue;
                     }
                     inside += 1;

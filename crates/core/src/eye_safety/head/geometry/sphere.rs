@@ -593,11 +593,8 @@ mod tests {
                 }
                 let rr = (1e4 - zr * zr).max(0.0).sqrt();
                 {
-                    let d = [rr * theta.cos() - r0, rr * theta.sin(), zr];
-                    let t = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]).max(0.0);
-                    let e = [d[0] - t * u[0], d[1] - t * u[1], d[2] - t * u[2]];
-                    let rho = 0.5 * (7.0 + exit + div * 1e-3 * t);
-                    if (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() > rho {
+                    let p = [rr * theta.cos(), rr * theta.sin(), zr];
+                    if !super::super::reached(p, r0, u, exit, div) {
                         continue;
                     }
                     inside += 1;
