@@ -62,7 +62,8 @@ pub struct Footprint {
     pub z_mm: f64,
     /// Slant distance from the crossing point, mm.
     pub slant_mm: f64,
-    /// Beam diameter there, mm.
+    /// Beam diameter the box is drawn with, mm: the widest over the
+    /// footprint (no reached position's nearest point sees a wider beam).
     pub width_mm: f64,
     /// `cos β_c`, the horizontal incidence (rounded down; reported, the
     /// box does not use it).
@@ -302,23 +303,25 @@ pub(crate) fn probe_positions(f: &Footprint, z_range: (f64, f64)) -> Vec<(f64, f
     out
 }
 
-/// Whether an aperture centre `p` (mm, the crossing point's height at 0)
-/// is within `(a + w)/2` of the ray from `(r0, 0, 0)` along `u` (3-D
-/// distance to the half-line, the beam `exit + divergence·t` at the nearest
-/// point `t`, a = 7 mm): the reach the brute-force tests hold boxes to.
+/// When an aperture centre `p` (mm, the crossing point's height at 0) is
+/// within `(a + w)/2` of the ray from `(r0, 0, 0)` along `u` (3-D distance
+/// to the half-line, the beam `w = exit + divergence·t` at the nearest
+/// point `t`, a = 7 mm), the beam's width `w` there; `None` when out of
+/// reach. The reach the brute-force tests hold boxes (and their
+/// `width_mm`) to.
 #[cfg(test)]
-pub(crate) fn reached(
+pub(crate) fn reached_at(
     p: [f64; 3],
     r0: f64,
     u: [f64; 3],
     exit_mm: f64,
     divergence_mrad: f64,
-) -> bool {
+) -> Option<f64> {
     let d = [p[0] - r0, p[1], p[2]];
     let t = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]).max(0.0);
     let e = [d[0] - t * u[0], d[1] - t * u[1], d[2] - t * u[2]];
-    let rho = 0.5 * (7.0 + exit_mm + divergence_mrad * 1e-3 * t);
-    (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() <= rho
+    let width = exit_mm + divergence_mrad * 1e-3 * t;
+    ((e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() <= 0.5 * (7.0 + width)).then_some(width)
 }
 
 #[cfg(test)]
@@ -426,6 +429,8 @@ mod tests {
             (20.0, 15.0, -10.0, 5.0, 200.0),
             (50.0, -40.0, 30.0, 2.0, 100.0),
             (0.0, 60.0, 0.0, 5.0, 200.0),
+            (58.0, 0.0, 90.0, 0.1, 10.0),
+            (58.0, 10.0, 60.0, 0.2, 5.0),
         ];
         for (r0, el, az, exit, div) in cases {
             let mut h = head(r0, vec![ch(0, el, az)]);
@@ -438,16 +443,21 @@ mod tests {
             let span = 4.0 * (f.width_mm + 100.0);
             for (theta, z) in probe_positions(&f, (f.z_mm - span, f.z_mm + span)) {
                 {
-                    if !reached(
+                    let Some(width) = reached_at(
                         [100.0 * theta.cos(), 100.0 * theta.sin(), z],
                         r0,
                         u,
                         exit,
                         div,
-                    ) {
+                    ) else {
                         continue;
-                    }
+                    };
                     inside += 1;
+                    assert!(
+                        width <= f.width_mm,
+                        "{r0} {el} {az}: beam {width} > {}",
+                        f.width_mm
+                    );
                     let mut dth = (theta - f.psi_rad).rem_euclid(std::f64::consts::TAU);
                     if dth > std::f64::consts::PI {
                         dth -= std::f64::consts::TAU;

@@ -577,6 +577,8 @@ mod tests {
             (30.0, -60.0, 150.0, 8.0, 0.0, 0.94, 0.67),
             (20.0, 50.0, 90.0, 4.0, 10.0, 0.95, 0.81),
             (30.0, 40.0, 20.0, 0.5, 300.0, 0.90, 0.86),
+            (58.0, 0.0, 90.0, 0.1, 10.0, 0.97, 0.97),
+            (58.0, 10.0, 60.0, 0.2, 5.0, 0.97, 0.94),
         ];
         for (r0, el, az, exit, div, arc_min, height_min) in cases {
             let h = head(r0, el, az, exit, div);
@@ -594,10 +596,15 @@ mod tests {
                 let rr = (1e4 - zr * zr).max(0.0).sqrt();
                 {
                     let p = [rr * theta.cos(), rr * theta.sin(), zr];
-                    if !super::super::reached(p, r0, u, exit, div) {
+                    let Some(width) = super::super::reached_at(p, r0, u, exit, div) else {
                         continue;
-                    }
+                    };
                     inside += 1;
+                    assert!(
+                        width <= f.width_mm,
+                        "{r0} {el} {az}: beam {width} > {}",
+                        f.width_mm
+                    );
                     let mut dth = (theta - f.psi_rad).rem_euclid(core::f64::consts::TAU);
                     if dth > PI {
                         dth -= core::f64::consts::TAU;
