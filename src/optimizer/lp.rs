@@ -12,7 +12,7 @@
 
 use super::certificate::{Certified, LinearProgram, Step};
 use super::level_choice::{Level, Ring};
-use super::program::{Heuristic, Program, SolveOptions};
+use super::program::{Heuristic, Program, SolveOptions, Warm};
 use super::utility::{sqrt_segments_n, SqrtSegments};
 use good_lp::{Expression, IntoAffineExpression, Variable};
 use std::f64::consts::TAU;
@@ -365,6 +365,9 @@ fn power_step(
     // by a factor.
     let mut factor = [1.0f64; 2];
     let mut round = 0;
+    // A round that only added cuts re-solves the last round's HiGHS model
+    // from its optimal basis.
+    let mut warm = Warm::default();
     loop {
         let program = power_program(problem, g, eye, t, pool, &factor)?;
         let opts = SolveOptions {
@@ -373,7 +376,7 @@ fn power_step(
         };
         let solved = program
             .lp
-            .solve_with("power", &opts)
+            .solve_warm("power", &opts, &mut warm)
             .map_err(|err| match (err, eye) {
                 (OptError::Infeasible(_), Some(_)) => {
                     Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
@@ -503,6 +506,9 @@ fn power_checkpoint(
         ))));
     }
     if !fresh.is_empty() {
+        if round <= S.cut_rounds / 2 {
+            strongest_windows(&mut fresh, p, e.pulse_rate_hz);
+        }
         return Ok(Checkpoint::AddCuts(fresh));
     }
     // The bound exceeds every valid cut here: divide the limits of that
@@ -527,6 +533,28 @@ fn power_checkpoint(
         factor: f,
         cuts,
     })
+}
+
+/// Keeps Rule 1's cuts (column bounds) and the [`S`]`.cuts_per_round`
+/// window cuts the answer `p` breaks most (ratio descending, ties in the
+/// core's order): the next program grows by a few hundred rows, which
+/// HiGHS adds to the last round's model and re-solves from its basis
+/// ([`Program::solve_warm`]); the cuts left out come back in a later round
+/// if the next answer still breaks them. The first half of the loop's
+/// rounds only: after that every cut found is added, so the cap never
+/// makes the loop run out of rounds.
+fn strongest_windows(fresh: &mut Vec<Cut>, p: &[f64], pulse_rate_hz: f64) {
+    let (single, mut windows): (Vec<Cut>, Vec<Cut>) = std::mem::take(fresh)
+        .into_iter()
+        .partition(|c| c.pulses.len() == 1);
+    let mut keyed: Vec<(f64, Cut)> = windows
+        .drain(..)
+        .map(|c| (c.ratio(p, pulse_rate_hz), c))
+        .collect();
+    keyed.sort_by(|a, b| b.0.total_cmp(&a.0));
+    keyed.truncate(S.cuts_per_round);
+    *fresh = single;
+    fresh.extend(keyed.into_iter().map(|(_, c)| c));
 }
 
 /// The cuts of class `k` at the aperture `witness` and every bin edge, and
