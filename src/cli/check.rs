@@ -125,8 +125,13 @@ pub fn run(a: &Args) -> Result<u8, CliError> {
     } else {
         origin.as_str()
     };
-    let profile = match Profile::from_json(&text, name) {
-        Ok(p) => p,
+    let profile = match Profile::from_json_with_notes(&text, name) {
+        Ok((p, notes)) => {
+            for note in notes {
+                warn(format_args!("warning: {name}: {note}"));
+            }
+            p
+        }
         Err(e) => {
             let Some(table) = super::table::table_json(&text, name) else {
                 return Err(e.into());

@@ -678,3 +678,66 @@ fn a_floor_just_over_the_eye_limit_reads_as_over() {
     assert!(err.contains("% of the Class 1 limit"), "{err}");
     assert!(!err.contains(" 100.0 %"), "{err}");
 }
+
+/// F10 k: the `optimality` block is informational, so `check` certifies an
+/// optimized profile whose block a newer writer extended (or a hand edit
+/// broke) and says in one warning line that it was not read; a broken
+/// field outside the informational blocks is still refused with its line
+/// and column (exit 2).
+#[test]
+fn an_unreadable_optimality_block_is_named_not_refused() {
+    let cfg = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/configs/paper.toml");
+    let o = run(&["profile", "--config", cfg, "--gaze-deg", "90"], None);
+    assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, v: &serde_json::Value| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, serde_json::to_string_pretty(v).unwrap()).unwrap();
+        path
+    };
+    let mut extended = v.clone();
+    extended["optimality"]["solver_seconds"] = 0.25.into();
+    let mut broken = v.clone();
+    broken["optimality"]["gap"] = "small".into();
+    broken["summary"]["frame_period_s"] = serde_json::Value::Null;
+    for (name, file, field) in [
+        (
+            "extended",
+            write("extended.json", &extended),
+            "unknown field `solver_seconds`",
+        ),
+        (
+            "broken",
+            write("broken.json", &broken),
+            "invalid type: string \"small\"",
+        ),
+    ] {
+        let c = run(&["check", file.to_str().unwrap()], None);
+        assert_eq!(c.status.code(), Some(0), "{name}: {}", common::stderr(&c));
+        assert!(common::stdout(&c).starts_with("certified:"), "{name}");
+        let warning = common::stderr(&c);
+        let line = warning
+            .lines()
+            .find(|l| l.contains("optimality: not read"))
+            .unwrap_or_else(|| panic!("{name}: {warning}"));
+        assert!(line.contains(field), "{name}: {line}");
+        assert!(line.contains("the verdict does not depend on it"), "{line}");
+        assert_eq!(
+            warning.contains("summary: not read"),
+            name == "broken",
+            "{warning}"
+        );
+    }
+    // Outside the informational blocks: refused, with line and column.
+    let mut bad = extended;
+    bad["frame_rate_hz"] = "ten".into();
+    let file = write("bad.json", &bad);
+    let c = run(&["check", file.to_str().unwrap()], None);
+    assert_eq!(c.status.code(), Some(2), "{}", common::stderr(&c));
+    let e = common::stderr(&c);
+    assert!(
+        e.contains("bad.json:") && e.contains("invalid type: string \"ten\""),
+        "{e}"
+    );
+}

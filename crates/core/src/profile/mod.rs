@@ -318,23 +318,74 @@ pub(crate) fn strip_position(msg: &str) -> String {
     }
 }
 
+/// The blocks of a profile that are informational on input: the checker
+/// recomputes or ignores them.
+#[cfg(feature = "json")]
+const INFORMATIONAL: [&str; 2] = ["summary", "optimality"];
+
 #[cfg(feature = "json")]
 impl Profile {
-    /// Parses profile@1 JSON; `origin` names the source in errors.
+    /// Parses profile@1 JSON; `origin` names the source in errors. An
+    /// informational block (`summary`, `optimality`) that does not read
+    /// (e.g. a field a newer writer added) is dropped, not an error: the
+    /// verdict never depends on it ([`Self::from_json_with_notes`] says why
+    /// each was dropped).
     pub fn from_json(text: &str, origin: &str) -> Result<Self, IoError> {
-        let p: Self = serde_json::from_str(text).map_err(|e| IoError::Json {
-            path: origin.to_owned(),
-            line: e.line(),
-            column: e.column(),
-            message: strip_position(&e.to_string()),
-        })?;
-        if p.format != PROFILE_FORMAT {
+        Self::from_json_with_notes(text, origin).map(|(p, _)| p)
+    }
+
+    /// [`Self::from_json`], with one line per informational block dropped
+    /// (`"optimality: not read (unknown field `x`, …)"`). Everything else
+    /// is read strictly: an error there is the error, with its line and
+    /// column.
+    pub fn from_json_with_notes(text: &str, origin: &str) -> Result<(Self, Vec<String>), IoError> {
+        let strict = match serde_json::from_str::<Self>(text) {
+            Ok(p) => return p.of_format(origin).map(|p| (p, Vec::new())),
+            Err(e) => IoError::Json {
+                path: origin.to_owned(),
+                line: e.line(),
+                column: e.column(),
+                message: strip_position(&e.to_string()),
+            },
+        };
+        let Ok(serde_json::Value::Object(mut fields)) = serde_json::from_str(text) else {
+            return Err(strict);
+        };
+        let mut notes = Vec::new();
+        for key in INFORMATIONAL {
+            let Some(block) = fields.get(key) else {
+                continue;
+            };
+            let unread = match key {
+                "summary" => Option::<Summary>::deserialize(block).err(),
+                _ => Option::<Optimality>::deserialize(block).err(),
+            };
+            if let Some(e) = unread {
+                notes.push(format!(
+                    "{key}: not read ({}); informational, the verdict does not depend on it",
+                    strip_position(&e.to_string())
+                ));
+                fields.remove(key);
+            }
+        }
+        if notes.is_empty() {
+            return Err(strict);
+        }
+        match Self::deserialize(serde_json::Value::Object(fields)) {
+            Ok(p) => p.of_format(origin).map(|p| (p, notes)),
+            Err(_) => Err(strict),
+        }
+    }
+
+    /// `self` if its `format` is [`PROFILE_FORMAT`].
+    fn of_format(self, origin: &str) -> Result<Self, IoError> {
+        if self.format != PROFILE_FORMAT {
             return Err(IoError::Format {
                 path: origin.to_owned(),
-                found: p.format,
+                found: self.format,
             });
         }
-        Ok(p)
+        Ok(self)
     }
 
     /// Reads a profile@1 JSON file.
