@@ -128,6 +128,99 @@ fn slot_windows_by_hand() {
     assert_eq!(r.rule, gaze_lidar_core::firmware::eye::IntRule::PassTrain);
 }
 
+/// The instantaneous-power candidate by hand, on the same miniature VLS-128
+/// (one 360° bin at 10 Hz, 1 MHz ticks, 1e-7 W per code, q = 1e-11 J).
+/// All eight beams are radial and within one aperture, so `W_inst` = 8:
+/// at any instant the aperture receives at most 8·P̂. A window of `T`
+/// then holds at most `8·c·1e-7·(T + Δ)` J (Δ = 1/f_p = 100 µs, each
+/// pulse's energy spread over the spacing after it), within `AEL(T)`
+/// for every `T ≤ T*` when `c ≤ 1/(8e-7·S(T*))`, `S(t) = sup_{T ≤ t}
+/// (T + Δ)/AEL(T)`. At 905 nm (C4 = 10^0.41) `AEL` is 7.7e-8·C4 =
+/// 1.9792e-7 J below 5 µs and 7e-4·C4·T^0.75 from 5 µs (1.9025e-7 J at
+/// the edge, the stricter row there); `(T + Δ)/AEL(T)` rises to
+/// 1.05e-4/1.90250e-7 = 551.90 at 5 µs, falls until 3Δ = 300 µs and is
+/// back only to 233 at 30 ms, so `S(T*)` = 551.90 for every `T*` of the
+/// ladder and `code_max` = ⌊(1 − 1e-9)/(8e-7·551.90)⌋ = 2264. The ladder:
+/// `T* = m·τ`, `m` ∈ {0.5, 1, 2, 4, 8, 16} (64τ is past the 100 ms
+/// frame), τ the pass, 2·asin(6/100) = 6.8797° at 3600°/s = 1.9110 ms;
+/// each `T*`'s floor `AEL(T*)/W_v` = `7e-4·C4·T*^0.75/8` (AEL rises with
+/// `T`, so its infimum over `T ≥ T*` is at `T*`), e.g. 1.2235e-6 J =
+/// 122,350 q at 0.9555 ms, far above the one-pulse bucket's 3999 q, so
+/// every rung is kept.
+#[test]
+fn instant_power_limits_by_hand() {
+    let c4 = 10f64.powf(0.41);
+    let q = 1e-11;
+    let delta = 1e-4;
+    let ael = |t: f64| {
+        if t < 5e-6 {
+            7.7e-8 * c4
+        } else {
+            7e-4 * c4 * t.powf(0.75)
+        }
+    };
+    // S(T*) from its definition, on a fine grid of T below 30 ms (and
+    // the 5 µs edge itself).
+    let mut s_max = 1.05e-4 / ael(5e-6);
+    let mut t = 1e-9;
+    while t < 3.1e-2 {
+        s_max = s_max.max((t + delta) / ael(t));
+        t *= 1.0001;
+    }
+    assert!((s_max - 551.90).abs() < 0.01, "{s_max}");
+    let code_max = ((1.0 - 1e-9) / (8.0 * 1e-7 * s_max)).floor() as u64;
+    assert_eq!(code_max, 2264);
+    let tau = 2.0 * 0.06f64.asin().to_degrees() / 3600.0;
+    assert!((tau - 1.9110e-3).abs() < 1e-7, "{tau}");
+    let table = |code: u32| {
+        let mut t = common::open_table(
+            1_000_000,
+            1e4,
+            Some(mini_vls([0.0, 1e-5])),
+            &[(360_000, 100_000, code)],
+        );
+        t.power_w_per_code = 1e-7;
+        t
+    };
+    let limits = IntEyeLimits::derive(&table(1)).unwrap();
+    let rungs = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
+    assert_eq!(limits.instant.len(), rungs.len(), "{:?}", limits.instant);
+    for (got, m) in limits.instant.iter().zip(rungs) {
+        assert_eq!(got.code_max, code_max, "{m}τ");
+        let floor = quanta(ael(m * tau) / 8.0, q);
+        // τ is taken in whole ticks (1911 or 1912 µs): 0.04 % of T*,
+        // 0.03 % of the floor.
+        let rel = (got.energy_floor_quanta as f64 / floor as f64 - 1.0).abs();
+        assert!(
+            rel < 5e-4,
+            "{m}τ: {} against {floor}",
+            got.energy_floor_quanta
+        );
+    }
+    assert!(limits.instant[0].energy_floor_quanta > 120_000);
+    // Here the candidate cannot lower a figure: the plain limits' worst is
+    // the one-pulse bucket (code/3999 with Rule 1 lifted: 0.566 at 2264,
+    // measured), below the candidate's own code check (code/2264.9). A
+    // table within `code_max` is evaluated with it and without it alike.
+    let plain = |l: &IntEyeLimits| {
+        let mut l = l.clone();
+        let mut at = Some(&mut l);
+        while let Some(set) = at {
+            set.instant.clear();
+            at = set.other_surface.as_deref_mut();
+        }
+        l
+    };
+    for code in [500u32, 2264, 2265] {
+        let t = table(code);
+        assert_eq!(
+            evaluate(&t, &limits).unwrap().worst_ratio_ppm,
+            evaluate(&t, &plain(&limits)).unwrap().worst_ratio_ppm,
+            "{code}"
+        );
+    }
+}
+
 /// A case's profile as a firmware table at 10 MHz ticks and 1 µW per code
 /// (each segment at its starting spin), and the table as it runs.
 fn table_of(case: &Case) -> (FirmwareTable, Vec<Seg>) {
