@@ -363,36 +363,54 @@ fn dual_bound(lp: &LinearProgram, y: &[f64]) -> (super::exact::Wide, bool) {
     use std::cmp::Ordering::{Equal, Greater, Less};
     // Reduced costs d = c − Aᵀy, exactly, with y repaired to finite sides;
     // the bound Σ_r max(y_r lo_r, y_r hi_r) + Σ_j max(d_j lo_j, d_j hi_j).
-    let mut d: Vec<Sum> = lp
-        .cost
-        .iter()
-        .map(|&c| {
-            let mut s = Sum::default();
-            s.add(c);
-            s
-        })
-        .collect();
+    // Column by column (the rows' terms gathered per column first), so one
+    // accumulator is reused instead of one per column (each is hundreds of
+    // bytes: a vector of them for thousands of columns is megabytes).
+    let n = lp.cost.len();
     let mut ub = Wide::default();
     let mut ub_finite = true;
-    for (r, &yr) in lp.rows.iter().zip(y) {
+    let mut start = vec![0usize; n + 1];
+    let used = |r: &Row, yr: f64| {
         // A multiplier on an infinite side counts as 0.
         let usable = (yr <= 0.0 || r.hi.is_finite()) && (yr >= 0.0 || r.lo.is_finite());
-        if !usable || yr == 0.0 {
+        usable && yr != 0.0
+    };
+    for (r, &yr) in lp.rows.iter().zip(y) {
+        if !used(r, yr) {
             continue;
         }
-        for &(j, a) in &r.coefs {
-            d[j].add_product(-yr, a);
+        for &(j, _) in &r.coefs {
+            start[j + 1] += 1;
         }
         ub.add_product(yr, if yr > 0.0 { r.hi } else { r.lo });
     }
-    for (j, dj) in d.iter().enumerate() {
+    for j in 0..n {
+        start[j + 1] += start[j];
+    }
+    let mut next = start.clone();
+    let mut terms = vec![(0.0f64, 0.0f64); start[n]];
+    for (r, &yr) in lp.rows.iter().zip(y) {
+        if !used(r, yr) {
+            continue;
+        }
+        for &(j, a) in &r.coefs {
+            terms[next[j]] = (-yr, a);
+            next[j] += 1;
+        }
+    }
+    for j in 0..n {
+        let mut dj = Sum::default();
+        dj.add(lp.cost[j]);
+        for &(m, a) in &terms[start[j]..start[j + 1]] {
+            dj.add_product(m, a);
+        }
         let side = match dj.signum() {
             Equal => continue,
             Greater => lp.col_hi[j],
             Less => lp.col_lo[j],
         };
         if side.is_finite() {
-            ub.add_scaled(dj, side);
+            ub.add_scaled(&dj, side);
         } else {
             ub_finite = false;
         }

@@ -237,16 +237,38 @@ pub fn slot_windows(
         }
     }
     let mut weight = vec![0.0f64; ranges.len()];
-    let mut at: Vec<(f64, f64)> = Vec::with_capacity(n);
-    for &(z, _) in &iv {
-        let members: Vec<usize> = (0..n).filter(|&i| iv[i].0 <= z && z <= iv[i].1).collect();
-        let mut starts: Vec<f64> = members.iter().map(|&i| slots[i]).collect();
-        starts.sort_by(f64::total_cmp);
+    let mut at: Vec<(f64, f64, usize)> = Vec::with_capacity(n);
+    // The channels meeting each height lower end; a set met at several
+    // heights gives the same weights, so each set is taken once (the
+    // weights are a maximum over sets).
+    let mut sets: Vec<Vec<usize>> = iv
+        .iter()
+        .map(|&(z, _)| (0..n).filter(|&i| iv[i].0 <= z && z <= iv[i].1).collect())
+        .collect();
+    sets.sort_unstable();
+    sets.dedup();
+    let mut by_slot: Vec<usize> = Vec::with_capacity(n);
+    for members in &sets {
+        // The members by slot (then index): from a start `a` the slots at
+        // or after it, then those before it, are the differences in order
+        // (the sort below then only confirms a sorted run); differences in
+        // ascending order, ties by index (as a stable sort of the members in
+        // index order gives them).
+        by_slot.clear();
+        by_slot.extend_from_slice(members);
+        by_slot.sort_by(|&i, &j| slots[i].total_cmp(&slots[j]).then(i.cmp(&j)));
+        let mut starts: Vec<f64> = by_slot.iter().map(|&i| slots[i]).collect();
         starts.dedup();
         for &a in &starts {
+            let first = by_slot.partition_point(|&i| slots[i] < a);
             at.clear();
-            at.extend(members.iter().map(|&i| (diff(slots[i], a), scales[i])));
-            at.sort_by(|x, y| x.0.total_cmp(&y.0));
+            at.extend(
+                by_slot[first..]
+                    .iter()
+                    .chain(&by_slot[..first])
+                    .map(|&i| (diff(slots[i], a), scales[i], i)),
+            );
+            at.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
             let (mut k, mut sum, mut terms) = (0usize, 0.0f64, 0u32);
             for (j, r) in ranges.iter().enumerate() {
                 while k < at.len() && at[k].0 < r.2 {
