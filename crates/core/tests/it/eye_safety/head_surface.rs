@@ -103,6 +103,18 @@ fn the_stalled_rotor_figure_is_the_larger_of_both_surfaces() {
         assert!(
             verdict.stalled_rotor_ratio >= at_r.stalled_rotor_ratio.max(at_100.stalled_rotor_ratio)
         );
+        // The stand-alone figure (what a firmware table reports, from its
+        // hottest power) is the verdict's for a profile at that power: the
+        // same surfaces, the same head figures, by another route.
+        let alone =
+            gaze_lidar_core::eye_safety::exposure::stalled_rotor_ratio(&params(r, 0.0), F_P, p)
+                .unwrap();
+        assert_eq!(
+            alone.to_bits(),
+            verdict.stalled_rotor_ratio.to_bits(),
+            "{r} mm"
+        );
+        assert!(alone > 0.0);
     }
 }
 
