@@ -2,6 +2,7 @@
 
 mod ael;
 mod band_edges;
+mod break_beam;
 mod break_head;
 mod break_sphere;
 #[cfg(feature = "optimizer")]
