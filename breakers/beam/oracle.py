@@ -13,7 +13,7 @@ declared aperture_distance_mm when it differs (the verdict covers both).
 For one position the reached head-frame angles of each channel are found on a grid of
 --nth angles and every edge refined by bisection (to ~1e-12 rad).
 
-RULES (700-1050 nm; AEL code checked against DESIGN.md section 5, as breakers/sphere/full.py):
+RULES (700-1050 nm; AEL code checked against the design card's section 5 (outside this repository), as breakers/sphere/full.py):
  - AEL(T) = 7.7e-8*C4 J (T < 5 us), 7e-4*C4*T^0.75 J (5 us .. 10 s), 3.9e-4*C4*T J (> 10 s);
    a window of pulses spanning s is compared with the smallest AEL over [s + tau, s + tau + gap)
    (gap: to the next received pulse; the table steps down at 5 us and 10 s).

@@ -84,8 +84,17 @@ fn head_line(r: &ExposureReport, profile: &Profile) -> String {
                 Surface::Cylinder => "the cylinder around the spin axis",
                 Surface::Sphere => "the sphere around the scan centre",
             };
+            #[allow(clippy::float_cmp)]
+            let at = if h.aperture_distance_mm == 100.0 {
+                " (100 mm)".to_owned()
+            } else {
+                format!(
+                    " at the declared {} mm",
+                    gaze_lidar::text::Num(h.aperture_distance_mm)
+                )
+            };
             format!(
-                "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height on {surface}; {} beam(s) meet it; binding rule: {}{surfaces}",
+                "head: {} channels evaluated; worst aperture position {:.3}° azimuth, {:.2} mm height on {surface}{at}; {} beam(s) meet it; binding rule: {}{surfaces}",
                 h.channels, r.worst_azimuth_deg, height_mm, beams, r.binding_rule
             )
         }

@@ -953,7 +953,8 @@ mod tests {
                 let tol = num_rational::BigRational::from_float(1e-7 * scale).unwrap();
                 assert!(gap <= tol, "case {case} round {round}: gap {gap}");
             }
-            // Rounds 1 and 2 extended the held model; round 3 did not.
+            // The second and third solves extended the held model; the
+            // fourth (a changed row) did not.
             assert_eq!(warm.reused, 2, "case {case}");
         }
     }

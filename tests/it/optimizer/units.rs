@@ -269,11 +269,24 @@ fn profile_files_with_and_without_figures_read_back() {
         .unwrap();
     let old = Profile::from_json(&v.to_string(), "old").unwrap();
     assert!(old.optimality.unwrap().figures.is_none());
-    // Unknown keys inside the block are still refused, by name.
+    // Unknown keys inside the block are named, and the informational block
+    // is dropped (the profile itself reads; `check` warns with the note).
     let mut w: serde_json::Value = serde_json::from_str(&text).unwrap();
     w["optimality"]["figures"]["profile"]["rof"]["range_ft"] = 1.into();
+    let (p, notes) = Profile::from_json_with_notes(&w.to_string(), "bad").unwrap();
+    assert!(p.optimality.is_none());
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].starts_with("optimality: not read"), "{notes:?}");
+    assert!(notes[0].contains("range_ft"), "{notes:?}");
+    // A field outside the informational blocks that does not read is still
+    // the error, with its line and column.
+    w["bins"][0]["power_w"] = "high".into();
     let e = Profile::from_json(&w.to_string(), "bad").unwrap_err();
-    assert!(e.to_string().contains("range_ft"), "{e}");
+    assert!(
+        e.to_string().contains("invalid type: string \"high\""),
+        "{e}"
+    );
+    assert!(e.to_string().starts_with("bad:1:"), "{e}");
 }
 
 #[test]

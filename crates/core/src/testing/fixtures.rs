@@ -187,6 +187,7 @@ pub fn head_figures(
 ) -> crate::eye_safety::head::HeadFigures {
     crate::eye_safety::head::HeadFigures {
         surface: crate::eye_safety::head::geometry::Surface::Cylinder,
+        aperture_distance_mm: 100.0,
         channels: count_vertical,
         channels_at_worst: count_vertical,
         worst_height_mm: 0.0,

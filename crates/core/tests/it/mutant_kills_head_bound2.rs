@@ -23,6 +23,7 @@ fn laser905(f_p: f64) -> Laser {
 /// `slots` distinct slots at one height, and of total weight `weight`.
 fn stalled_figures(count: u32, slots: u32, weight: f64) -> HeadFigures {
     HeadFigures {
+        aperture_distance_mm: 100.0,
         weight_vertical: weight,
         weight_stalled: weight,
         count_stalled: count,

@@ -57,6 +57,11 @@ pub struct HeadFigures {
     /// sphere: a cylinder report reads as before surfaces were named).
     #[serde(skip_serializing_if = "Surface::is_cylinder")]
     pub surface: Surface,
+    /// The surface's radius, mm: the Condition 3 100 mm, or the distance the
+    /// head declares (serialized only when not 100 mm: a 100 mm report
+    /// reads as before distances were named).
+    #[serde(skip_serializing_if = "is_condition_3_distance")]
+    pub aperture_distance_mm: f64,
     /// Channels of the head.
     pub channels: u32,
     /// Channels meeting the worst height (where `weight_vertical` is).
@@ -134,6 +139,12 @@ pub struct HeadFigures {
     /// height or the enumeration is over its budget.
     #[serde(skip)]
     pub slot_windows: Vec<SlotWindow>,
+}
+
+/// Whether `r_mm` is Condition 3's 100 mm (for serialization).
+#[allow(clippy::float_cmp, clippy::trivially_copy_pass_by_ref)]
+fn is_condition_3_distance(r_mm: &f64) -> bool {
+    *r_mm == 100.0
 }
 
 /// The channels a window shorter than one firing cycle can receive, by its
@@ -501,6 +512,7 @@ pub fn head_figures_on(
     let (g0, spans0) = o.stalled_group;
     Ok(HeadFigures {
         surface,
+        aperture_distance_mm: head.aperture_distance_mm,
         channels: head.channels.len() as u32,
         channels_at_worst: v.count_at_worst,
         worst_height_mm: v.height_mm,
@@ -1024,6 +1036,7 @@ mod tests {
 
     fn figures(count_vertical: u32, slots_vertical: u32, union_passes: u32) -> HeadFigures {
         HeadFigures {
+            aperture_distance_mm: 100.0,
             union_passes,
             ..crate::testing::head_figures(count_vertical, slots_vertical)
         }

@@ -442,24 +442,19 @@ fn break_beam_footprint_box_and_widest_beam_hold_every_reached_position() {
     assert!(fails.is_empty());
 }
 
-/// Finding (NOT an unsafe verdict): a beam diverging by `k ≥ 2·cot ε` rad
-/// (its cone holds the spin axis' direction) reaches every position of the
-/// (unbounded) cylinder above some height, for ever; `widest_beam_mm` takes
-/// such a beam (`k ≥ cos ε`) as "a kilometre wide" (`exit + 10⁶` mm) and the
-/// whole-turn box's half-height is then finite (here 3.38·10⁶ mm around
-/// 567 mm): the position 10⁸ mm (100 km) up, at the hit's head-frame angle,
-/// is reached (3-D distance 1.74·10⁷ mm, beam 9.85·10⁷ mm wide at the
-/// nearest point) but lies outside the box, and its beam is wider than
-/// `width_mm`. The verdict is not affected (argued, and no end-to-end case
-/// found): only channels with `k/cos ε ≥ 1` reach that far, each such box is
-/// the whole turn and holds the crossing point's height `z0`
-/// (`hh ≥ |tan ε|·(R + r0 + |s|) ≥ |z_c − z0|`), so every overlap maximum
-/// (`W_v`, `K_v`, `S_v`, the groups) taken at `z0` already counts every
-/// channel a far position can receive, on a whole-turn pass. Reproducer:
-/// `cargo test --release -p gaze-lidar-core --test it -- --ignored
-/// break_beam_far_above_a_kilometre_box`.
+/// The outside tester's finding F1, fixed: a beam diverging by `k ≥
+/// 2·cot ε` rad (its cone holds the spin axis' direction) reaches every
+/// position of the (unbounded) cylinder above some height, for ever.
+/// `widest_beam_mm` took such a beam (`k ≥ cos ε`) as "a kilometre wide"
+/// (`exit + 10⁶` mm) with a finite whole-turn half-height (3.38·10⁶ mm
+/// around 567 mm here): the position 10⁸ mm (100 km) up, at the hit's
+/// head-frame angle, is reached (beam 9.85·10⁷ mm wide at the nearest
+/// point) outside the box. The verdict was not affected (every such box is
+/// the whole turn and holds the crossing point's height, so every overlap
+/// maximum taken there counts every channel a far position receives); the
+/// box is now the whole cylinder (infinitely wide and high), and this
+/// passes.
 #[test]
-#[ignore = "finding: the box invariant fails 100 km up for k >= 2·cot ε; the verdict is not affected (see the comment)"]
 fn break_beam_far_above_a_kilometre_box() {
     let head = Head {
         cycle_s: 1e-6,

@@ -88,6 +88,14 @@ fn a_nearer_declared_surface_that_is_worse_is_the_verdict() {
     assert!(declared.worst_ratio > at_100.worst_ratio);
     let verdict = evaluate_segments(&segs(p), &nearer, F_P).unwrap();
     assert_eq!(verdict, declared);
+    // The report names the distance of the binding surface (in JSON only
+    // when it is not 100 mm, so a 100 mm report reads as before).
+    let head = verdict.head.as_ref().unwrap();
+    assert_eq!(head.aperture_distance_mm, 50.0);
+    let json = serde_json::to_value(head).unwrap();
+    assert_eq!(json["aperture_distance_mm"], 50.0);
+    let json_100 = serde_json::to_value(at_100.head.as_ref().unwrap()).unwrap();
+    assert!(json_100.get("aperture_distance_mm").is_none(), "{json_100}");
 }
 
 /// Of two reports the stalled-rotor figure is the larger one even when the
