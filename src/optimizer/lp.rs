@@ -374,15 +374,17 @@ fn power_step(
             heuristic: program.ring.as_ref().map(|r| r as &dyn Heuristic),
             ..SolveOptions::default()
         };
-        let solved = program
-            .lp
-            .solve_warm("power", &opts, &mut warm)
-            .map_err(|err| match (err, eye) {
-                (OptError::Infeasible(_), Some(_)) => {
-                    Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
-                }
-                (other, _) => other,
-            })?;
+        // Without eye safety there is one round: nothing to keep.
+        let solved = match eye {
+            Some(_) => program.lp.solve_warm("power", &opts, &mut warm),
+            None => program.lp.solve_with("power", &opts),
+        }
+        .map_err(|err| match (err, eye) {
+            (OptError::Infeasible(_), Some(_)) => {
+                Infeasible::CutsLeaveNoPower { cuts: pool.len() }.into()
+            }
+            (other, _) => other,
+        })?;
         let p = powers(problem, g, t, &program, &solved.x);
         let checkpoint = match eye {
             None => Checkpoint::Certified,
