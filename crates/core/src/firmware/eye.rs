@@ -1318,6 +1318,59 @@ mod derive {
             }
         }
     }
+
+    #[cfg(test)]
+    mod tests {
+        use super::*;
+
+        /// Limits told apart by their tick rate alone.
+        fn set(tick_hz: u64) -> IntEyeLimits {
+            IntEyeLimits {
+                tick_hz,
+                frame_ticks: 1,
+                pulse_rate_millihz_ceil: 1,
+                pass_arc_mdeg: 1,
+                pass_ticks_max: 1,
+                pulses_per_pass_max: 1,
+                pulse_code_max: 1,
+                train: alloc::vec![TrainLimit {
+                    pulses_from: 1,
+                    energy_max_quanta: 1,
+                }],
+                pass_energy_max_quanta: 1,
+                pass_energy_rule: IntRule::TimeBase,
+                instant: Vec::new(),
+                other_surface: None,
+            }
+        }
+
+        /// The tick rates of a chain, top first.
+        fn ticks(top: &IntEyeLimits) -> Vec<u64> {
+            let mut out = alloc::vec![top.tick_hz];
+            let mut at = top.other_surface.as_deref();
+            while let Some(l) = at {
+                out.push(l.tick_hz);
+                at = l.other_surface.as_deref();
+            }
+            out
+        }
+
+        /// `chain` links the distinct sets in their order (a set equal to
+        /// an earlier one left out) and refuses an empty list.
+        #[test]
+        fn a_chain_holds_each_distinct_set_once_in_order() {
+            let got = chain(alloc::vec![set(1), set(2), set(1), set(3), set(2)]).unwrap();
+            assert_eq!(ticks(&got), [1, 2, 3]);
+            assert_eq!(ticks(&chain(alloc::vec![set(7), set(7)]).unwrap()), [7]);
+            assert_eq!(
+                chain(Vec::new()),
+                Err(DeriveError::Range {
+                    field: "eye_safety.head",
+                    reason: "no aperture surface to evaluate",
+                })
+            );
+        }
+    }
 }
 
 #[cfg(feature = "std")]
@@ -1432,6 +1485,74 @@ mod verification {
                 energy_floor_quanta: e1.saturating_add(split).saturating_add(1),
             }],
             other_surface: None,
+        }
+    }
+
+    /// `sets` as one chain of limits, the first at the top (each holds the
+    /// next in `other_surface`), equal sets kept.
+    fn chained(sets: &[IntEyeLimits]) -> IntEyeLimits {
+        let mut next: Option<alloc::boxed::Box<IntEyeLimits>> = None;
+        for set in sets.iter().rev() {
+            let mut set = set.clone();
+            set.other_surface = next;
+            next = Some(alloc::boxed::Box::new(set));
+        }
+        *next.expect("at least one set")
+    }
+
+    /// [`evaluate`] over a chain of limit sets (a head's aperture surfaces):
+    /// Class 1 only when every set accepts, in either order; the report is
+    /// the set's with the largest worst ratio, the first one's on a tie (two
+    /// sets whose binding pass-energy rule is named differently); a chain of
+    /// [`SURFACES_MAX`] sets is evaluated, a longer one refused naming
+    /// `other_surface`.
+    #[test]
+    fn a_chain_of_surfaces_takes_every_set_and_reports_the_worst() {
+        let t = table(
+            &[(120_000, 10, 5), (120_000, 10, 5), (120_000, 10, 5)],
+            3,
+            1_000,
+            30,
+        );
+        let (millihz, arc) = (1_000_000, 10_000);
+        let accepts = limits(&t, millihz, arc, (100, 1_000, 1, 1_000_000));
+        // Code 5 over a Rule 1 cap of 4.
+        let rejects = limits(&t, millihz, arc, (4, 1_000, 1, 1_000_000));
+        let alone = |l: &IntEyeLimits| evaluate(&t, l).unwrap();
+        let (ok, bad) = (alone(&accepts), alone(&rejects));
+        assert!(ok.class1 && !bad.class1, "{ok:?} {bad:?}");
+        assert!(bad.worst_ratio_ppm > ok.worst_ratio_ppm);
+        for sets in [
+            [accepts.clone(), rejects.clone()],
+            [rejects.clone(), accepts.clone()],
+        ] {
+            let r = evaluate(&t, &chained(&sets)).unwrap();
+            assert_eq!(r, bad, "{sets:?}");
+        }
+        let both = evaluate(&t, &chained(&[accepts.clone(), accepts.clone()])).unwrap();
+        assert_eq!(both, ok);
+        // A tie: the pass energy binds both sets at one ratio, their rules
+        // named apart.
+        let t2 = limits(&t, millihz, arc, (100, 1_000, 1, 1));
+        let mut tb = t2.clone();
+        tb.pass_energy_rule = IntRule::TimeBase;
+        let (r2, rb) = (alone(&t2), alone(&tb));
+        assert_eq!(r2.worst_ratio_ppm, rb.worst_ratio_ppm);
+        assert_eq!((r2.rule, rb.rule), (IntRule::T2Train, IntRule::TimeBase));
+        assert_eq!(
+            evaluate(&t, &chained(&[t2.clone(), tb.clone()])).unwrap(),
+            r2
+        );
+        assert_eq!(evaluate(&t, &chained(&[tb, t2])).unwrap(), rb);
+        // The chain's length.
+        let most = alloc::vec![accepts.clone(); SURFACES_MAX];
+        assert_eq!(evaluate(&t, &chained(&most)).unwrap(), ok);
+        let over = alloc::vec![accepts; SURFACES_MAX + 1];
+        match evaluate(&t, &chained(&over)) {
+            Err(IntEyeError::Bounds { field, value, .. }) => {
+                assert_eq!((field, value), ("other_surface", SURFACES_MAX as u64 + 1));
+            }
+            r => panic!("a chain of {} sets: {r:?}", SURFACES_MAX + 1),
         }
     }
 
