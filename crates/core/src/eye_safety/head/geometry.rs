@@ -390,6 +390,23 @@ mod tests {
         assert!(f.half_arc_mm > 0.5 * (7.0 + f.width_mm) / beta.cos());
     }
 
+    /// The surfaces' names, as reports and JSON spell them, and the one
+    /// serialization leaves out (the cylinder: a report without a surface
+    /// is the cylinder's).
+    #[test]
+    fn surfaces_are_named_and_only_the_cylinder_is_left_out() {
+        assert_eq!(Surface::Cylinder.name(), "cylinder");
+        assert_eq!(Surface::Sphere.name(), "sphere");
+        assert!(Surface::Cylinder.is_cylinder());
+        assert!(!Surface::Sphere.is_cylinder());
+        for s in Surface::ALL {
+            assert_eq!(
+                serde_json::to_string(&s).unwrap(),
+                format!("\"{}\"", s.name())
+            );
+        }
+    }
+
     /// A radial flat ray without divergence: the single-channel pass angle,
     /// bit for bit; by hand `2·asin(6/100)` = 6.8797°, the arc's half-width
     /// `100·asin(0.06)` = 6.0036 mm (the chord laid as an arc, 6.8755° and
@@ -421,7 +438,14 @@ mod tests {
     /// footprint box, for oblique, steep, grazing (`r0` = 90 mm at 80°,
     /// `s + q > 1`) and strongly diverging rays (with the beam taken at the
     /// hit alone, the box of the 200 mrad ray 60° up is short: a centre
-    /// 58.000 mm above the hit is reached, the box held 57.957 mm).
+    /// 58.000 mm above the hit is reached, the box held 57.957 mm); steep
+    /// oblique rays with wide and thin beams, where the ray's run between
+    /// the hit and the nearest points (`spread` in [`footprint_box`]) sets
+    /// much of the height; and crossing points within reach of the
+    /// surface (`r0` 95–99.5 mm: every turn), among them a ray grazing the
+    /// cylinder from 0.5 mm inside it, which is reached 46 mm from its hit
+    /// height (the `R + r0` of the whole-turn height is needed there:
+    /// `R − r0` leaves the box 10 mm short).
     #[test]
     fn the_box_holds_every_position_within_reach_of_the_ray() {
         // r0, elevation, offset, exit, divergence, and the least share of
@@ -443,6 +467,19 @@ mod tests {
             // cylinder), and a thin exit under it.
             (20.0, 75.0, 0.0, 2.0, 1000.0, 0.0, 0.0),
             (20.0, 70.0, 30.0, 1e-4, 800.0, 0.0, 0.0),
+            (60.0, 60.0, 60.0, 1.0, 0.0, 0.97, 0.71),
+            (80.0, 45.0, 45.0, 1.0, 0.5, 0.97, 0.71),
+            (70.0, -50.0, -75.0, 0.5, 0.0, 0.97, 0.68),
+            (95.0, 30.0, 180.0, 5.0, 0.0, 0.98, 0.46),
+            (95.0, 40.0, 90.0, 5.0, 0.0, 0.09, 0.12),
+            (97.0, -20.0, 20.0, 6.0, 0.0, 0.01, 0.06),
+            (95.0, 10.0, 0.0, 5.0, 0.0, 0.01, 0.1),
+            (99.5, 60.0, 90.0, 5.0, 0.0, 0.06, 0.1),
+            (60.0, 60.0, 60.0, 30.0, 0.0, 0.97, 0.67),
+            (30.0, 50.0, 45.0, 25.0, 0.0, 0.97, 0.8),
+            (30.0, 60.0, 10.0, 0.1, 0.0, 0.97, 0.92),
+            (96.0, 70.0, 180.0, 5.0, 0.0, 0.98, 0.47),
+            (99.5, 75.0, 90.0, 5.0, 0.0, 0.06, 0.1),
         ];
         for (r0, el, az, exit, div, arc_min, height_min) in cases {
             let mut h = head(r0, vec![ch(0, el, az)]);
@@ -501,7 +538,7 @@ mod tests {
                 arc >= arc_min && height >= height_min,
                 "{r0} {el} {az}: loose box"
             );
-            if arc_min == 0.0 {
+            if arc_min == 0.0 && f.width_mm.is_infinite() {
                 assert!(f.width_mm.is_infinite() && f.half_height_mm.is_infinite());
                 assert_eq!(f.pass_angle_deg, 360.0);
             }
