@@ -811,14 +811,22 @@ fn power_program(
 ) -> Result<PowerProgram, OptError> {
     let (caps, bare) = eye_caps(problem, g, eye, pool, factor);
     let offered = offered_levels(problem, g, t, &caps);
+    let mut shapes = bin_shapes(problem, g, t, &caps).into_iter();
     let mut lp = Program::default();
     let mut x = Vec::with_capacity(g.n);
     let mut bins = Vec::with_capacity(g.n);
     let mut utility_constant = 0.0;
     for i in 0..g.n {
         let offer = offered.as_ref().map(|o| &o[i][..]);
-        let (form, bin, constant) =
-            power_bin(&mut lp, problem, g, (i, t[i]), (caps[i], bare[i]), offer)?;
+        let shape = shapes.next().flatten();
+        let (form, bin, constant) = power_bin(
+            &mut lp,
+            problem,
+            g,
+            (i, t[i]),
+            (caps[i], bare[i]),
+            (offer, shape),
+        )?;
         x.push(form);
         bins.push(bin);
         utility_constant += constant;
@@ -938,10 +946,9 @@ fn power_bin(
     g: &Grid,
     (i, dwell_s): (usize, f64),
     (cap_w, bare_w): (f64, f64),
-    offered: Option<&[f64]>,
+    (offered, shape): (Option<&[f64]>, Option<SqrtSegments>),
 ) -> Result<(LinearForm, PowerBin, f64), OptError> {
     let l = &problem.lidar.limits;
-    let p_mean = problem.lidar.average_power_w;
     if bare_w < l.power_w_min {
         return Err(Infeasible::EyeCapBelowFloor {
             cap_w: bare_w,
@@ -951,18 +958,19 @@ fn power_bin(
         }
         .into());
     }
-    let hi = l.power_w_max.min(cap_w.max(l.power_w_min));
     let c = problem.objective.range_weight * g.theta[i] * g.weight[i];
     if !problem.levels.power_w.is_empty() {
+        let hi = l.power_w_max.min(cap_w.max(l.power_w_min));
         let value = |x: f64| super::detection::level_value(problem, g.theta[i], dwell_s, x);
         let (form, bin) = levels(lp, problem, (i, hi), offered, c, value)?;
         return Ok((form, bin, 0.0));
     }
-    let lo_x = l.power_w_min / p_mean;
-    let hi_x = (hi / p_mean * (1.0 - S.margin)).max(lo_x);
+    let (lo_x, hi_x) = bin_box(problem, cap_w);
     let xi = lp.column(lo_x, hi_x, 0.0, false);
     // The utility as boxed segment columns (see `utility`).
-    let shape = super::detection::range_segments(problem, g.theta[i], dwell_s, lo_x, hi_x);
+    let shape = shape.unwrap_or_else(|| {
+        super::detection::range_segments(problem, g.theta[i], dwell_s, lo_x, hi_x)
+    });
     let deltas = shape.add_to(lp, xi, 1.0, lo_x, c);
     relax_bin(lp, problem, (xi, &deltas, &shape), (lo_x, hi_x), bare_w);
     let constant = c * shape.base;
@@ -973,6 +981,46 @@ fn power_bin(
         shape,
     };
     Ok((xi.into(), bin, constant))
+}
+
+/// A continuous bin's power box `[lo, hi]` (ratios to `P̄`): the floor,
+/// and `power_w_max` or the bin's eye-safety cap less the margin.
+fn bin_box(problem: &Problem, cap_w: f64) -> (f64, f64) {
+    let l = &problem.lidar.limits;
+    let p_mean = problem.lidar.average_power_w;
+    let hi = l.power_w_max.min(cap_w.max(l.power_w_min));
+    let lo_x = l.power_w_min / p_mean;
+    (lo_x, (hi / p_mean * (1.0 - S.margin)).max(lo_x))
+}
+
+/// The detection objective's segments of every continuous bin, built in
+/// parallel (contiguous runs of bins per thread, so each run's neighbour
+/// guesses stay as in one pass; a segment is the same bits whatever the
+/// guess, `values_near_another_spacing_are_the_values`), or `None` per bin
+/// where [`power_bin`] builds its own: `√` segments (cheap), hardware
+/// levels, a bin whose floor is above its cap (refused there).
+fn bin_shapes(problem: &Problem, g: &Grid, t: &[f64], caps: &[f64]) -> Vec<Option<SqrtSegments>> {
+    use rayon::prelude::*;
+    if problem.objective.kind != super::detection::ObjectiveKind::Detection
+        || !problem.levels.power_w.is_empty()
+    {
+        return vec![None; g.n];
+    }
+    let runs = rayon::current_num_threads().max(1);
+    let per_run = g.n.div_ceil(runs).max(1);
+    let idx: Vec<usize> = (0..g.n).collect();
+    idx.par_chunks(per_run)
+        .flat_map_iter(|run| {
+            run.iter()
+                .map(|&i| {
+                    let (lo_x, hi_x) = bin_box(problem, caps[i]);
+                    Some(super::detection::range_segments(
+                        problem, g.theta[i], t[i], lo_x, hi_x,
+                    ))
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect()
 }
 
 /// The user's box of a continuous bin (as `check` accepts the floor,

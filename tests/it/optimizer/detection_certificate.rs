@@ -354,3 +354,24 @@ fn the_checked_bound_is_above_a_brute_force_enumeration() {
         );
     }
 }
+
+/// The power step builds the detection objective's segments for runs of
+/// contiguous bins on rayon's threads. Each segment is the same bits
+/// whichever neighbour's ranges guessed it, so the answer is the same
+/// profile, bit for bit, on one thread and on three (`smooth`, every bin's
+/// dwell its own: each power step builds all of them).
+#[test]
+fn the_detection_segments_give_the_same_profile_on_any_thread_count() {
+    let (_, problem) = detection_config("smooth");
+    let solve = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let answer = pool.install(|| optimize(&problem, 90.0).unwrap());
+        serde_json::to_string(answer.profile()).unwrap()
+    };
+    let one = solve(1);
+    assert_eq!(one, solve(3));
+    assert_eq!(one, solve(2));
+}
