@@ -445,7 +445,10 @@ mod tests {
     /// surface (`r0` 95–99.5 mm: every turn), among them a ray grazing the
     /// cylinder from 0.5 mm inside it, which is reached 46 mm from its hit
     /// height (the `R + r0` of the whole-turn height is needed there:
-    /// `R − r0` leaves the box 10 mm short).
+    /// `R − r0` leaves the box 10 mm short), and very wide beams steep up
+    /// from within reach (a 600 mm beam 80° up from the axis is reached
+    /// `ρ/cos ε` = 1,744 mm above its hit height: `ρ·cos ε` there leaves
+    /// the box at 1,490).
     #[test]
     fn the_box_holds_every_position_within_reach_of_the_ray() {
         // r0, elevation, offset, exit, divergence, and the least share of
@@ -480,6 +483,8 @@ mod tests {
             (30.0, 60.0, 10.0, 0.1, 0.0, 0.97, 0.92),
             (96.0, 70.0, 180.0, 5.0, 0.0, 0.98, 0.47),
             (99.5, 75.0, 90.0, 5.0, 0.0, 0.06, 0.1),
+            (0.0, 80.0, 0.0, 600.0, 0.0, 0.98, 0.53),
+            (30.0, 70.0, 45.0, 400.0, 0.0, 0.98, 0.42),
         ];
         for (r0, el, az, exit, div, arc_min, height_min) in cases {
             let mut h = head(r0, vec![ch(0, el, az)]);
