@@ -557,8 +557,11 @@ mod tests {
     /// 1.5 times the box), every one within
     /// `(a + w(t))/2` of the ray (3-D distance to the half-line, `w` the
     /// beam at the nearest point) lies in the footprint box, for steep,
-    /// oblique, grazing, diverging and down-pointing rays; and some reached
-    /// position comes near each side of the box (it is not loose).
+    /// oblique, grazing, diverging and down-pointing rays, beams over the
+    /// pole from the axis (every turn: the whole-turn height must reach
+    /// `R + |z|`, `R − |z|` is short), crossing points within reach of the
+    /// sphere (`r0` 96–99.5 mm) and thin steep rays off the axis; and some
+    /// reached position comes near each side of the box (it is not loose).
     #[test]
     fn the_box_holds_every_sphere_position_within_reach_of_the_ray() {
         // r0, elevation, offset, exit, divergence, and the least share of
@@ -579,6 +582,16 @@ mod tests {
             (30.0, 40.0, 20.0, 0.5, 300.0, 0.90, 0.86),
             (58.0, 0.0, 90.0, 0.1, 10.0, 0.97, 0.97),
             (58.0, 10.0, 60.0, 0.2, 5.0, 0.97, 0.94),
+            (0.0, 85.0, 0.0, 12.0, 0.0, 0.98, 0.005),
+            (0.0, -80.0, 30.0, 30.0, 0.0, 0.98, 0.02),
+            (97.0, 20.0, 20.0, 6.0, 0.0, 0.02, 0.06),
+            (99.5, 60.0, 90.0, 5.0, 0.0, 0.04, 0.19),
+            (96.0, -30.0, 180.0, 5.0, 0.0, 0.98, 0.47),
+            (40.0, 60.0, 45.0, 0.5, 0.0, 0.95, 0.89),
+            (20.0, 70.0, 90.0, 1.0, 0.0, 0.93, 0.75),
+            (50.0, 45.0, 30.0, 0.2, 0.0, 0.96, 0.93),
+            (10.0, 80.0, 60.0, 0.5, 0.0, 0.94, 0.86),
+            (60.0, -50.0, 120.0, 2.0, 0.0, 0.91, 0.67),
         ];
         for (r0, el, az, exit, div, arc_min, height_min) in cases {
             let h = head(r0, el, az, exit, div);
