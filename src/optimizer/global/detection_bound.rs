@@ -40,9 +40,11 @@
 //! multipliers are exported as a certificate checked in exact rational
 //! arithmetic ([`super::detection_certificate`]).
 
-use std::cell::RefCell;
 use std::collections::HashMap;
 use std::f64::consts::TAU;
+use std::sync::OnceLock;
+
+use rayon::prelude::*;
 
 use super::super::detection;
 use super::super::lp::Grid;
@@ -78,11 +80,10 @@ pub(super) struct Table<'a> {
     pub(super) discrete: bool,
     pub(super) x: Vec<f64>,
     pub(super) tau: Vec<f64>,
-    /// The proven upper bound of `u` at `(x[k], tau[l])`, row-major (NaN
-    /// until computed).
-    u: RefCell<Vec<f64>>,
-    /// The ranges each computed bound rests on (empty until computed).
-    ranges: RefCell<Vec<Vec<f64>>>,
+    /// The proven upper bound of `u` at `(x[k], tau[l])` and the ranges it
+    /// rests on, row-major, each computed when first asked for (by any
+    /// thread: the value is a function of the node alone).
+    u: Vec<OnceLock<(f64, Vec<f64>)>>,
 }
 
 impl<'a> Table<'a> {
@@ -96,8 +97,7 @@ impl<'a> Table<'a> {
         };
         let (tl, th) = b.tau(theta);
         let tau = nodes(tl, th, DWELL_CELLS, |v| v, |v| v);
-        let u = RefCell::new(vec![f64::NAN; x.len() * tau.len()]);
-        let ranges = RefCell::new(vec![Vec::new(); x.len() * tau.len()]);
+        let u = (0..x.len() * tau.len()).map(|_| OnceLock::new()).collect();
         Table {
             problem,
             theta,
@@ -106,35 +106,44 @@ impl<'a> Table<'a> {
             x,
             tau,
             u,
-            ranges,
         }
     }
 
     fn u(&self, k: usize, l: usize) -> f64 {
-        let i = k * self.tau.len() + l;
-        let v = self.u.borrow()[i];
-        if !v.is_nan() {
-            return v;
-        }
-        let (v, ranges) =
-            detection::value_upper(self.problem, self.theta, self.tau[l] * self.unit, self.x[k]);
-        self.u.borrow_mut()[i] = v;
-        self.ranges.borrow_mut()[i] = ranges;
-        v
+        self.u[k * self.tau.len() + l]
+            .get_or_init(|| {
+                detection::value_upper(self.problem, self.theta, self.tau[l] * self.unit, self.x[k])
+            })
+            .0
+    }
+
+    /// Computes, on all threads, the bounds [`Lagrangian::search_cells`]
+    /// reads at `stride` (each cell's upper node): the values are those
+    /// [`Self::u`] would compute when first asked.
+    fn prefetch(&self, stride: (usize, usize)) {
+        let ks: Vec<usize> = if self.discrete {
+            (0..self.x.len()).collect()
+        } else {
+            cells(self.x.len(), stride.0).iter().map(|c| c.1).collect()
+        };
+        let nodes: Vec<(usize, usize)> = cells(self.tau.len(), stride.1)
+            .iter()
+            .flat_map(|&(_, l)| ks.iter().map(move |&k| (k, l)))
+            .collect();
+        nodes.par_iter().for_each(|&(k, l)| {
+            self.u(k, l);
+        });
     }
 
     /// The nodes whose bound was computed: `(k, l, u, ranges)`.
     pub(super) fn points(&self) -> Vec<(usize, usize, f64, Vec<f64>)> {
-        let (u, ranges) = (self.u.borrow(), self.ranges.borrow());
-        (0..u.len())
-            .filter(|&i| !u[i].is_nan())
-            .map(|i| {
-                (
-                    i / self.tau.len(),
-                    i % self.tau.len(),
-                    u[i],
-                    ranges[i].clone(),
-                )
+        self.u
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| {
+                c.get()
+                    .filter(|(u, _)| !u.is_nan())
+                    .map(|(u, ranges)| (i / self.tau.len(), i % self.tau.len(), *u, ranges.clone()))
             })
             .collect()
     }
@@ -346,19 +355,29 @@ impl Lagrangian<'_, '_> {
         let mut total = mu * self.budget + nu * self.frame;
         let mut magnitude = total.abs();
         let mut seen: HashMap<(u64, u64), usize> = HashMap::new();
-        let mut classes: Vec<(usize, f64, f64, Vec<Cell>)> = Vec::new();
-        let mut of_bin = Vec::with_capacity(self.bins.len());
-        for (i, b) in self.bins.iter().enumerate() {
-            let class = *seen
-                .entry((b.c.to_bits(), b.theta.to_bits()))
-                .or_insert_with(|| {
-                    let (v, m, cells) = self.bin_bound(b, mu, nu, true);
-                    classes.push((i, v, m, cells));
-                    classes.len() - 1
-                });
+        let mut first: Vec<usize> = Vec::new();
+        let of_bin: Vec<usize> = (0..self.bins.len())
+            .map(|i| {
+                let b = &self.bins[i];
+                *seen
+                    .entry((b.c.to_bits(), b.theta.to_bits()))
+                    .or_insert_with(|| {
+                        first.push(i);
+                        first.len() - 1
+                    })
+            })
+            .collect();
+        // Each class's maximum on a thread of its own; summed in bin order.
+        let classes: Vec<(usize, f64, f64, Vec<Cell>)> = first
+            .par_iter()
+            .map(|&i| {
+                let (v, m, cells) = self.bin_bound(&self.bins[i], mu, nu, true);
+                (i, v, m, cells)
+            })
+            .collect();
+        for &class in &of_bin {
             total += classes[class].1;
             magnitude += classes[class].2;
-            of_bin.push(class);
         }
         let terms = (self.bins.len() + 2) as f64;
         Classes {
@@ -474,6 +493,7 @@ pub(super) fn solve<R>(
     let dwell_moves = b.w_lo < b.w_hi;
     // Scales: a unit of budget or frame is worth about the objective per
     // unit of it.
+    tables.par_iter().for_each(|t| t.prefetch(SEARCH_STRIDE));
     let search: Vec<_> = lag
         .bins
         .iter()
@@ -488,6 +508,7 @@ pub(super) fn solve<R>(
         }
     }
     // Then once on the refinement's starting grid, near the coarse optimum.
+    tables.par_iter().for_each(|t| t.prefetch(COARSE));
     let search: Vec<_> = lag
         .bins
         .iter()

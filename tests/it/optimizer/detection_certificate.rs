@@ -368,8 +368,18 @@ fn the_detection_segments_give_the_same_profile_on_any_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap();
-        let answer = pool.install(|| optimize(&problem, 90.0).unwrap());
-        serde_json::to_string(answer.profile()).unwrap()
+        let (answer, bound) = pool.install(|| {
+            (
+                optimize(&problem, 90.0).unwrap(),
+                detection_certificate(&problem, 90.0).unwrap(),
+            )
+        });
+        // The profile, and the global bound's certificate (its nodes are
+        // computed on all threads, its classes' maxima one per thread).
+        (
+            serde_json::to_string(answer.profile()).unwrap(),
+            serde_json::to_string(&bound).unwrap(),
+        )
     };
     let one = solve(1);
     assert_eq!(one, solve(3));

@@ -387,6 +387,28 @@ mod tests {
     /// cylinder's `2·asin(0.085)`; its heights `100·sin(75° ± γ₀)`. Exact on
     /// the axis; the slices, for a crossing point 1 µm off it, hold it
     /// within 3 %.
+    proptest::proptest! {
+        /// The assumption under which `extent`'s special case for the last
+        /// `v_z` edge (`j + 1 == SLICES_V` → `w_max`) is the general
+        /// formula bit for bit (specs/mutants.md, `159:27`): `2·w` and the
+        /// product and quotient by the power of two `SLICES_V` are exact,
+        /// and `2w − w` is exact (Sterbenz), for every width a beam can have
+        /// and beyond (0 to 1e300 mm). The `t` edge has no such identity
+        /// (`t_hi − t_lo` rounds), so its special case is kept.
+        #[test]
+        fn the_last_vz_edge_is_the_general_formula_exactly(
+            w_max in proptest::prop_oneof![
+                0.0f64..1e3,
+                0.0f64..1e300,
+                proptest::num::f64::POSITIVE | proptest::num::f64::SUBNORMAL,
+            ],
+        ) {
+            proptest::prop_assume!(w_max <= 1e300);
+            let general = -w_max + 2.0 * w_max * f64::from(SLICES_V) / f64::from(SLICES_V);
+            proptest::prop_assert_eq!(general.to_bits(), w_max.to_bits());
+        }
+    }
+
     #[test]
     fn steep_beam_turn_by_hand() {
         let exact = (0.085f64 / 75f64.to_radians().cos()).asin();
