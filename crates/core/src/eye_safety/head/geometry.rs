@@ -328,6 +328,206 @@ pub(crate) fn reached_at(
     ((e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() <= 0.5 * (7.0 + width)).then_some(width)
 }
 
+/// Points of the edge of the reached set on the surface (`sphere`: the
+/// 100 mm sphere around the axis point at the crossing point's height, else
+/// the 100 mm cylinder): for `n` directions `v̂` about the ray (the crossing
+/// point `(r0, 0, 0)`, direction `u`), the points `O + t·u + ρ(t)·v̂` on the
+/// surface, `ρ(t) = (a + exit + divergence·t)/2` (a = 7 mm) shrunk by 1e-9
+/// so that [`reached_at`] reaches them. The reached set is the surface
+/// inside the beam's tube; the angle and the height have no extremum inside
+/// it but at a pole (which the caller probes), so its extent is that of
+/// these edge points: the brute force of the boxes over random rays.
+#[cfg(test)]
+pub(crate) fn reach_edge(
+    r0: f64,
+    u: [f64; 3],
+    exit_mm: f64,
+    divergence_mrad: f64,
+    sphere: bool,
+    n: usize,
+) -> Vec<[f64; 3]> {
+    let h = u[0].hypot(u[1]);
+    // e1 horizontal and across the ray, e2 = u × e1.
+    let e1 = if h > 0.0 {
+        [-u[1] / h, u[0] / h, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let e2 = [
+        u[1] * e1[2] - u[2] * e1[1],
+        u[2] * e1[0] - u[0] * e1[2],
+        u[0] * e1[1] - u[1] * e1[0],
+    ];
+    let shrink = 1.0 - 1e-9;
+    let rho0 = 0.5 * (7.0 + exit_mm) * shrink;
+    let kh = 0.5 * divergence_mrad * 1e-3 * shrink;
+    let mut out = Vec::new();
+    for i in 0..n {
+        let (sa, ca) = (core::f64::consts::TAU * i as f64 / n as f64).sin_cos();
+        let v = [
+            ca * e1[0] + sa * e2[0],
+            ca * e1[1] + sa * e2[1],
+            ca * e1[2] + sa * e2[2],
+        ];
+        let a = [r0 + rho0 * v[0], rho0 * v[1], rho0 * v[2]];
+        let b = [u[0] + kh * v[0], u[1] + kh * v[1], u[2] + kh * v[2]];
+        // |a + t·b|² = R² (on the cylinder, of the horizontal part).
+        let m = if sphere { 1.0 } else { 0.0 };
+        let qa = b[0] * b[0] + b[1] * b[1] + m * b[2] * b[2];
+        let qb = 2.0 * (a[0] * b[0] + a[1] * b[1] + m * a[2] * b[2]);
+        let qc = a[0] * a[0] + a[1] * a[1] + m * a[2] * a[2] - 1e4;
+        let disc = qb * qb - 4.0 * qa * qc;
+        if qa <= 0.0 || disc < 0.0 {
+            continue;
+        }
+        for t in [
+            (-qb - disc.sqrt()) / (2.0 * qa),
+            (-qb + disc.sqrt()) / (2.0 * qa),
+        ] {
+            if t >= 0.0 {
+                out.push([a[0] + t * b[0], a[1] + t * b[1], a[2] + t * b[2]]);
+            }
+        }
+    }
+    // Behind the crossing point the reach is the ball of radius ρ(0)
+    // around it: its edge on the surface, where it is behind.
+    let behind = |p: [f64; 3]| (p[0] - r0) * u[0] + p[1] * u[1] + p[2] * u[2] <= 0.0;
+    for i in 0..n {
+        let w = -1.0 + 2.0 * i as f64 / (n - 1).max(1) as f64;
+        if sphere {
+            // Heights over the sphere: cos θ from |P − O| = ρ(0).
+            let z = 100.0 * w;
+            let rz = (1e4 - z * z).max(0.0).sqrt();
+            let c = (1e4 + r0 * r0 - rho0 * rho0) / (2.0 * r0 * rz);
+            if c.abs() <= 1.0 {
+                let th = c.acos();
+                for th in [th, -th] {
+                    let p = [rz * th.cos(), rz * th.sin(), z];
+                    if behind(p) {
+                        out.push(p);
+                    }
+                }
+            }
+        } else {
+            // Angles round the cylinder: the height from |P − O| = ρ(0).
+            let th = core::f64::consts::PI * w;
+            let (x, y) = (100.0 * th.cos(), 100.0 * th.sin());
+            let z2 = rho0 * rho0 - (x - r0) * (x - r0) - y * y;
+            if z2 >= 0.0 {
+                for z in [z2.sqrt(), -z2.sqrt()] {
+                    let p = [x, y, z];
+                    if behind(p) {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Why the surface point `p` (reached, with a beam `width_mm` wide) lies
+/// outside `f`'s box (`z_hit` the hit's height in `p`'s frame), or `None`.
+#[cfg(test)]
+pub(crate) fn outside_box(f: &Footprint, p: [f64; 3], width_mm: f64, z_hit: f64) -> Option<String> {
+    use core::f64::consts::{PI, TAU};
+    let mut dth = (p[1].atan2(p[0]) - f.psi_rad).rem_euclid(TAU);
+    if dth > PI {
+        dth -= TAU;
+    }
+    if width_mm > f.width_mm {
+        Some(format!("beam {width_mm} > {}", f.width_mm))
+    } else if dth.abs() * 100.0 > f.half_arc_mm {
+        Some(format!("arc {} > {}", dth.abs() * 100.0, f.half_arc_mm))
+    } else if dth.abs().to_degrees() > 0.5 * f.pass_angle_deg {
+        Some(format!(
+            "angle {} > half the pass {}",
+            dth.abs().to_degrees(),
+            0.5 * f.pass_angle_deg
+        ))
+    } else if (p[2] - z_hit).abs() > f.half_height_mm {
+        Some(format!(
+            "height {} > {}",
+            (p[2] - z_hit).abs(),
+            f.half_height_mm
+        ))
+    } else {
+        None
+    }
+}
+
+/// The first edge point of one channel's reached set (elevation `el`,
+/// azimuth offset `az`, degrees) outside its box on `surface`, and why; a
+/// reached pole must have the whole turn; `None` when the box holds them
+/// all.
+#[cfg(test)]
+pub(crate) fn edge_outside_box(
+    surface: Surface,
+    r0: f64,
+    el: f64,
+    az: f64,
+    exit_mm: f64,
+    divergence_mrad: f64,
+) -> Option<String> {
+    let head = Head {
+        cycle_s: 1e-4,
+        origin_radius_mm: r0,
+        origin_height_mm: 0.0,
+        exit_diameter_mm: exit_mm,
+        divergence_mrad,
+        aperture_distance_mm: 100.0,
+        channels: vec![crate::eye_safety::head::Channel {
+            id: 0,
+            elevation_deg: el,
+            azimuth_offset_deg: az,
+            slot_s: 0.0,
+            power_scale: 1.0,
+        }],
+    };
+    let f = footprints_on(&head, 7.0, surface)[0];
+    let (phi, eps) = (az.to_radians(), el.to_radians());
+    let u = [eps.cos() * phi.cos(), eps.cos() * phi.sin(), eps.sin()];
+    let sphere = surface == Surface::Sphere;
+    for p in reach_edge(r0, u, exit_mm, divergence_mrad, sphere, 1024) {
+        let Some(width) = reached_at(p, r0, u, exit_mm, divergence_mrad) else {
+            return Some(format!("the edge point {p:?} is not reached"));
+        };
+        if let Some(why) = outside_box(&f, p, width, f.z_mm) {
+            return Some(format!("{p:?}: {why}"));
+        }
+    }
+    // A coarse grid over the surface (a set with no edge covers all of it).
+    for i in 0..72 {
+        let th = core::f64::consts::TAU * f64::from(i) / 72.0;
+        for k in 0..=40 {
+            let z = -100.0 + 5.0 * f64::from(k);
+            let r = if sphere {
+                (1e4 - z * z).max(0.0).sqrt()
+            } else {
+                100.0
+            };
+            let p = [r * th.cos(), r * th.sin(), z];
+            if let Some(width) = reached_at(p, r0, u, exit_mm, divergence_mrad) {
+                if let Some(why) = outside_box(&f, p, width, f.z_mm) {
+                    return Some(format!("{p:?} (grid): {why}"));
+                }
+            }
+        }
+    }
+    for z in [100.0, -100.0] {
+        let pole = [0.0, 0.0, z];
+        if sphere && reached_at(pole, r0, u, exit_mm, divergence_mrad).is_some() {
+            let whole = f.pass_angle_deg >= 360.0 && f.half_arc_mm >= 100.0 * core::f64::consts::PI;
+            if !whole || (z - f.z_mm).abs() > f.half_height_mm {
+                return Some(format!(
+                    "the pole {z} is reached, the box is not the whole turn to it"
+                ));
+            }
+        }
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -430,6 +630,37 @@ mod tests {
         assert!((f.half_arc_mm - 6.0036).abs() < 1e-4, "{}", f.half_arc_mm);
         assert_eq!(f.half_height_mm, 6.0);
         assert_eq!(f.width_mm, 5.0);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(
+            std::env::var("GAZE_LIDAR_EDGE_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(384)
+        ))]
+        /// Random rays over the whole input space (crossing points from the
+        /// axis to 0.1 mm inside the surface, every elevation short of the
+        /// vertical and offset, beams from 10 µm to 600 mm, divergences to
+        /// the validated 1000 mrad): every point of the reached set's edge
+        /// ([`reach_edge`], 1024 directions about the ray) lies in the
+        /// channel's box on both surfaces, and a reached pole makes the
+        /// sphere's box the whole turn.
+        #[test]
+        fn random_rays_stay_in_their_boxes_on_both_surfaces(
+            r0 in proptest::prop_oneof![0.0f64..99.9, 90.0f64..99.9, proptest::strategy::Just(0.0)],
+            el in proptest::prop_oneof![-89.5f64..89.5, 60.0f64..89.5, -89.5f64..-60.0],
+            az in -180.0f64..180.0,
+            exit in proptest::prop_oneof![0.01f64..15.0, 0.01f64..600.0],
+            div in proptest::prop_oneof![proptest::strategy::Just(0.0), 0.0f64..20.0, 0.0f64..999.0],
+        ) {
+            for surface in Surface::ALL {
+                let why = edge_outside_box(surface, r0, el, az, exit, div);
+                proptest::prop_assert!(
+                    why.is_none(),
+                    "{} r0 {r0} el {el} az {az} exit {exit} div {div}: {}",
+                    surface.name(),
+                    why.unwrap_or_default()
+                );
+            }
+        }
     }
 
     /// The 3-D reading by brute force: on a grid of aperture centres on the

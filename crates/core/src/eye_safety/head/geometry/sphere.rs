@@ -378,15 +378,6 @@ mod tests {
         }
     }
 
-    /// By hand, a beam 75° up from the axis (`r0` = 0, 10 mm, no
-    /// divergence, `ρ` = 8.5 mm): the aperture centres within `ρ` of the ray
-    /// on the 100 mm sphere are the cap of angular radius
-    /// `γ₀ = asin(0.085)` = 4.876° around the ray; the widest turn of a
-    /// parallel of that cap is `2·asin(sin γ₀/cos 75°)` = 2·0.33462 rad
-    /// (the parallel where the cap's edge meets a meridian), 3.9× the
-    /// cylinder's `2·asin(0.085)`; its heights `100·sin(75° ± γ₀)`. Exact on
-    /// the axis; the slices, for a crossing point 1 µm off it, hold it
-    /// within 3 %.
     proptest::proptest! {
         /// The assumption under which `extent`'s special case for the last
         /// `v_z` edge (`j + 1 == SLICES_V` → `w_max`) is the general
@@ -409,6 +400,15 @@ mod tests {
         }
     }
 
+    /// By hand, a beam 75° up from the axis (`r0` = 0, 10 mm, no
+    /// divergence, `ρ` = 8.5 mm): the aperture centres within `ρ` of the ray
+    /// on the 100 mm sphere are the cap of angular radius
+    /// `γ₀ = asin(0.085)` = 4.876° around the ray; the widest turn of a
+    /// parallel of that cap is `2·asin(sin γ₀/cos 75°)` = 2·0.33462 rad
+    /// (the parallel where the cap's edge meets a meridian), 3.9× the
+    /// cylinder's `2·asin(0.085)`; its heights `100·sin(75° ± γ₀)`. Exact on
+    /// the axis; the slices, for a crossing point 1 µm off it, hold it
+    /// within 3 %.
     #[test]
     fn steep_beam_turn_by_hand() {
         let exact = (0.085f64 / 75f64.to_radians().cos()).asin();
