@@ -1505,6 +1505,7 @@ fn dwell_step(
             initial: Some(&d.start),
             primal_feasibility_tolerance: S.dwell_feasibility_tol,
             heuristic: choice.as_ref().map(|c| c as &dyn Heuristic),
+            presolve: true,
         },
     )?;
     let view = d.lp.view();

@@ -350,8 +350,10 @@ impl Program {
         // (global bound) faster without it; and on the power steps' MILPs
         // (`multi_level`, one-hot levels and eye-safety column bounds)
         // 1.45× whole process, same answers (the search still closes the
-        // gap to zero).
-        m.set_option("presolve", "off");
+        // gap to zero). The dwell steps' programs (`smooth`: the
+        // acceleration rows between neighbouring bins) are the other way:
+        // 1.3× faster with it, the same answers; they ask for it.
+        m.set_option("presolve", if opts.presolve { "on" } else { "off" });
         m.set_option(
             "primal_feasibility_tolerance",
             opts.primal_feasibility_tolerance,
@@ -805,6 +807,9 @@ pub struct SolveOptions<'a> {
     pub primal_feasibility_tolerance: f64,
     /// A MILP's primal heuristic, run when the relaxation is fractional.
     pub heuristic: Option<&'a dyn Heuristic>,
+    /// HiGHS's presolve (off unless asked: see [`Program::solve_with`]'s
+    /// model).
+    pub presolve: bool,
 }
 
 impl std::fmt::Debug for SolveOptions<'_> {
@@ -816,6 +821,7 @@ impl std::fmt::Debug for SolveOptions<'_> {
                 &self.primal_feasibility_tolerance,
             )
             .field("heuristic", &self.heuristic.is_some())
+            .field("presolve", &self.presolve)
             .finish()
     }
 }
@@ -824,6 +830,7 @@ impl Default for SolveOptions<'_> {
     fn default() -> Self {
         Self {
             initial: None,
+            presolve: false,
             primal_feasibility_tolerance: S.primal_feasibility_tol,
             heuristic: None,
         }
