@@ -247,6 +247,16 @@ impl OptimizerConfig {
         let mut preset = self.preset()?;
         self.apply_lidar(&mut preset.lidar)?;
         self.apply_limits(&mut preset.lidar.limits)?;
+        // A head fires every channel once per cycle: a rate the config sets
+        // against its head is the config's inconsistency, named here.
+        if let Some(params) = &preset.lidar.limits.eye_safety {
+            params
+                .check_pulse_rate(preset.lidar.pulse_rate_hz)
+                .map_err(|e| OptError::Invalid {
+                    field: "lidar.pulse_rate_hz".into(),
+                    reason: e.to_string(),
+                })?;
+        }
         budget_in_scale(&preset.lidar)?;
         let focus = self.focus.clone().unwrap_or(preset.focus);
         focus.validate().map_err(|e| OptError::Invalid {

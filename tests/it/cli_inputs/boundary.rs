@@ -533,3 +533,56 @@ fn check_table_agrees_with_the_integer_restatement() {
     }
     assert!(accepted >= 2 && rejected >= 8, "{accepted} {rejected}");
 }
+
+/// The outside tester's two message findings on heads (round 5): a profile
+/// whose `head.cycle_s` is 0 was refused naming the consequence
+/// (`pulse_rate_hz … must be 1/head.cycle_s = inf`), not the field; a
+/// `--config` setting a `pulse_rate_hz` its head preset cannot fire exited
+/// 1 ("infeasible"), though it is the config's inconsistency. Now the first
+/// names `head.cycle_s` and the second is bad input naming
+/// `lidar.pulse_rate_hz` at its line and column, with no output written.
+#[test]
+fn a_head_s_cycle_and_a_config_rate_against_its_head_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(
+        &[
+            "profile",
+            "--preset",
+            "vlp16",
+            "--mode",
+            "range",
+            "--gaze-deg",
+            "90",
+        ],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let mut p: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    p["limits"]["eye_safety"]["head"]["cycle_s"] = Value::from(0.0);
+    let file = write(dir.path(), "c0.json", p.to_string());
+    let (code, out, err) = check(&[s(&file)]);
+    assert_eq!(code, Some(1), "{out}{err}");
+    assert!(out.contains("head.cycle_s = 0"), "{out}");
+    assert!(!out.contains("= inf"), "{out}");
+
+    let config = write(
+        dir.path(),
+        "c1.toml",
+        "bins = 36\n[lidar]\npreset = \"vlp16\"\npulse_rate_hz = 20000.0\n",
+    );
+    let target = dir.path().join("o.json");
+    let o = run(
+        &[
+            "profile",
+            "--config",
+            s(&config),
+            "--gaze-deg",
+            "90",
+            "--out",
+            s(&target),
+        ],
+        None,
+    );
+    assert_bad_input(&o, "c1.toml:4:17: lidar.pulse_rate_hz");
+    assert!(!target.exists());
+}

@@ -129,6 +129,10 @@ impl EyeSafetyParams {
         let Some(h) = &self.head else {
             return Ok(());
         };
+        if !(h.cycle_s.is_finite() && h.cycle_s > 0.0) {
+            // No rate matches such a cycle: name the cycle, not the rate.
+            h.validate()?;
+        }
         let off = (pulse_rate_hz * h.cycle_s - 1.0).abs();
         if off.is_nan() || off > head::bound::RATE_CYCLE_TOLERANCE {
             return Err(EyeSafetyError::PulseRate {
