@@ -534,12 +534,10 @@ fn check_table_agrees_with_the_integer_restatement() {
     assert!(accepted >= 2 && rejected >= 8, "{accepted} {rejected}");
 }
 
-/// The outside tester's two message findings on heads (round 5): a profile
-/// whose `head.cycle_s` is 0 was refused naming the consequence
-/// (`pulse_rate_hz … must be 1/head.cycle_s = inf`), not the field; a
-/// `--config` setting a `pulse_rate_hz` its head preset cannot fire exited
-/// 1 ("infeasible"), though it is the config's inconsistency. Now the first
-/// names `head.cycle_s` and the second is bad input naming
+/// A profile whose `head.cycle_s` is 0 is refused naming `head.cycle_s`
+/// (not the consequence, an infinite `1/head.cycle_s`); a `--config`
+/// setting a `pulse_rate_hz` its head preset cannot fire is bad input (the
+/// config's inconsistency, not an infeasible problem) naming
 /// `lidar.pulse_rate_hz` at its line and column, with no output written.
 #[test]
 fn a_head_s_cycle_and_a_config_rate_against_its_head_are_named() {
