@@ -634,7 +634,7 @@ mod tests {
 
     proptest::proptest! {
         #![proptest_config(proptest::prelude::ProptestConfig::with_cases(
-            std::env::var("GAZE_LIDAR_EDGE_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(384)
+            std::env::var("GAZE_LIDAR_EDGE_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(4096)
         ))]
         /// Random rays over the whole input space (crossing points from the
         /// axis to 0.1 mm inside the surface, every elevation short of the
