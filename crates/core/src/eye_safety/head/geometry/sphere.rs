@@ -459,6 +459,56 @@ mod tests {
     ///   `(0.5, 1.9)` is 1.965 from the axis, inside the inner circle);
     /// - a box holding the axis, or one holding the whole annulus: the
     ///   whole turn; a box outside the annulus: empty.
+    /// By hand, a box behind the axis that the annulus cuts at its `y`
+    /// edges only: `x ∈ [−200, 10]`, `y ∈ [50, 60]`, `r ∈ [90, 100]`. No
+    /// corner lies in the annulus (`(10, 50)` is 51 from the axis, `(−200,
+    /// 50)` 206) and the `x` edges meet neither circle inside the `y` range,
+    /// so the set's angles are those of the four crossings of the `y` edges
+    /// at negative `x`: `(−√(100² − 50²), 50)` at 150° (the largest),
+    /// `(−√(90² − 50²), 50)` at 146.25°, `(−80, 60)` at 143.13°, `(−√(90² −
+    /// 60²), 60)` at 180° − asin(60/90)·… = 138.19° (the smallest).
+    #[test]
+    fn a_box_behind_the_axis_spans_its_negative_crossings() {
+        let (lo, hi) = angles((-200.0, 10.0), (50.0, 60.0), 90.0, 100.0, (1.0, 0.0))
+            .unwrap()
+            .unwrap();
+        let lo_by_hand = 60.0f64.atan2(-(8100.0f64 - 3600.0).sqrt());
+        assert!(
+            (hi - 150f64.to_radians()).abs() < 1e-12,
+            "{}",
+            hi.to_degrees()
+        );
+        assert!((lo - lo_by_hand).abs() < 1e-12, "{}", lo.to_degrees());
+        assert!(
+            (lo.to_degrees() - 138.1897).abs() < 1e-4,
+            "{}",
+            lo.to_degrees()
+        );
+    }
+
+    /// By hand, the box's beam for a diverging ray off the axis (`r0` = 60
+    /// mm, flat, offset 90°: `p = 0`, `d⊥ = 60`; 1 mm exit, 500 mrad,
+    /// `k = 0.5`, a = 7): the crude radius `ρ₁ = (a + e + k·(R + r0))/2 /
+    /// (1 − k/2)` = 44/0.75 = 58.667 mm, the farthest nearest point `t_hi1 =
+    /// −p + sqrt(R² + 2ρ₁·d⊥ − d⊥²)` = sqrt(10⁴ + 7040 − 3600) = 115.931 mm,
+    /// the beam there `e + k·t_hi1` = 58.966 mm (then `ρ = (a + w)/2` = 33.0
+    /// < `R − r0` = 40: the slices). The width is that bound, not the narrowest sound
+    /// one: a smaller `ρ₁` stays sound on every ray tried (specs/mutants.md),
+    /// and this pins the one the argument in the module docs states.
+    #[test]
+    fn the_widest_beam_of_a_diverging_ray_off_the_axis_by_hand() {
+        let f = footprints(&head(60.0, 0.0, 90.0, 1.0, 500.0), 7.0)[0];
+        let rho1 = 0.5 * (7.0 + 1.0 + 0.5 * 160.0) / 0.75;
+        let t_hi1 = (1e4 + 2.0 * rho1 * 60.0 - 3600.0f64).sqrt();
+        let by_hand = 1.0 + 0.5 * t_hi1;
+        assert!(
+            (f.width_mm - by_hand).abs() <= 1e-9 * by_hand,
+            "{} {by_hand}",
+            f.width_mm
+        );
+        assert!((by_hand - 58.9655).abs() < 1e-3, "{by_hand}");
+    }
+
     #[test]
     fn box_and_annulus_angles_by_hand() {
         let d = (1.0, 0.0);
