@@ -448,25 +448,15 @@ mod tests {
         );
     }
 
-    /// The angles of a box cut by an annulus, by hand, each extreme at
-    /// another kind of point (relative to +x):
-    /// - `x ∈ [1, 3]`, `y ∈ [−5, 5]`, radii `[0, 2]`: the disc right of
-    ///   `x = 1`, its ends where the edge meets the outer circle,
-    ///   `(1, ±√3)`: ±60°;
-    /// - `x ∈ [0.5, 3]`, `y ∈ [1, 1.9]`, radii `[2, 10]`: from the corner
-    ///   `(3, 1)` (18.435°) to where the top edge meets the inner circle,
-    ///   `(sqrt(4 − 1.9²), 1.9)` = `(0.6245, 1.9)`: 71.805° (the corner
-    ///   `(0.5, 1.9)` is 1.965 from the axis, inside the inner circle);
-    /// - a box holding the axis, or one holding the whole annulus: the
-    ///   whole turn; a box outside the annulus: empty.
     /// By hand, a box behind the axis that the annulus cuts at its `y`
-    /// edges only: `x ∈ [−200, 10]`, `y ∈ [50, 60]`, `r ∈ [90, 100]`. No
-    /// corner lies in the annulus (`(10, 50)` is 51 from the axis, `(−200,
-    /// 50)` 206) and the `x` edges meet neither circle inside the `y` range,
-    /// so the set's angles are those of the four crossings of the `y` edges
-    /// at negative `x`: `(−√(100² − 50²), 50)` at 150° (the largest),
-    /// `(−√(90² − 50²), 50)` at 146.25°, `(−80, 60)` at 143.13°, `(−√(90² −
-    /// 60²), 60)` at 180° − asin(60/90)·… = 138.19° (the smallest).
+    /// edges only: x from −200 to 10, y from 50 to 60, radii 90 to 100. No
+    /// corner lies in the annulus (the corner at x = 10, y = 50 is 51 mm
+    /// from the axis, the one at x = −200 is 206 mm), and the `x` edges meet
+    /// neither circle inside the `y` range. So the set's angles are those of
+    /// the four crossings of the `y` edges at negative `x`: radius 100 at
+    /// y = 50 gives 150° (the largest); radius 90 at y = 50 gives 146.25°;
+    /// radius 100 at y = 60 gives 143.13°; radius 90 at y = 60 gives
+    /// 180° − asin(60/90) = 138.19° (the smallest).
     #[test]
     fn a_box_behind_the_axis_spans_its_negative_crossings() {
         let (lo, hi) = angles((-200.0, 10.0), (50.0, 60.0), 90.0, 100.0, (1.0, 0.0))
@@ -509,6 +499,17 @@ mod tests {
         assert!((by_hand - 58.9655).abs() < 1e-3, "{by_hand}");
     }
 
+    /// The angles of a box cut by an annulus, by hand, each extreme at
+    /// another kind of point (relative to +x):
+    /// - `x ∈ [1, 3]`, `y ∈ [−5, 5]`, radii `[0, 2]`: the disc right of
+    ///   `x = 1`, its ends where the edge meets the outer circle,
+    ///   `(1, ±√3)`: ±60°;
+    /// - `x ∈ [0.5, 3]`, `y ∈ [1, 1.9]`, radii `[2, 10]`: from the corner
+    ///   `(3, 1)` (18.435°) to where the top edge meets the inner circle,
+    ///   `(sqrt(4 − 1.9²), 1.9)` = `(0.6245, 1.9)`: 71.805° (the corner
+    ///   `(0.5, 1.9)` is 1.965 from the axis, inside the inner circle);
+    /// - a box holding the axis, or one holding the whole annulus: the
+    ///   whole turn; a box outside the annulus: empty.
     #[test]
     fn box_and_annulus_angles_by_hand() {
         let d = (1.0, 0.0);
