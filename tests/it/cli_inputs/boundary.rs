@@ -30,12 +30,13 @@ fn check(args: &[&str]) -> (Option<i32>, String, String) {
     (o.status.code(), stdout(&o), stderr(&o))
 }
 
-fn paper_range_profile() -> String {
+/// `profile --preset PRESET --mode range --gaze-deg 90`'s JSON.
+fn range_profile(preset: &str) -> String {
     let o = run(
         &[
             "profile",
             "--preset",
-            "paper",
+            preset,
             "--mode",
             "range",
             "--gaze-deg",
@@ -45,6 +46,10 @@ fn paper_range_profile() -> String {
     );
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     stdout(&o)
+}
+
+fn paper_range_profile() -> String {
+    range_profile("paper")
 }
 
 fn sensor_file(preset: &str) -> String {
@@ -542,20 +547,7 @@ fn check_table_agrees_with_the_integer_restatement() {
 #[test]
 fn a_head_s_cycle_and_a_config_rate_against_its_head_are_named() {
     let dir = tempfile::tempdir().unwrap();
-    let o = run(
-        &[
-            "profile",
-            "--preset",
-            "vlp16",
-            "--mode",
-            "range",
-            "--gaze-deg",
-            "90",
-        ],
-        None,
-    );
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let mut p: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let mut p: Value = serde_json::from_str(&range_profile("vlp16")).unwrap();
     p["limits"]["eye_safety"]["head"]["cycle_s"] = Value::from(0.0);
     let file = write(dir.path(), "c0.json", p.to_string());
     let (code, out, err) = check(&[s(&file)]);
