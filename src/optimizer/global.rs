@@ -374,13 +374,15 @@ fn objective_of(problem: &Problem, g: &Grid, profile: &Profile) -> f64 {
         .sum()
 }
 
-/// The global figures for `profile` (the optimizer's answer for `gaze_deg`).
+/// The global figures for `profile` (the optimizer's answer for `gaze_deg`)
+/// against `upper_bound`, the problem's [`upper_bound`] (which does not
+/// depend on the profile, so the caller may compute it alongside the solve).
 pub(super) fn bound(
     problem: &Problem,
     gaze_deg: f64,
     profile: &Profile,
+    upper_bound: f64,
 ) -> Result<GlobalOptimality, OptError> {
-    let upper_bound = upper_bound(problem, gaze_deg)?;
     let j = model_objective(problem, gaze_deg, profile)?;
     let objective = j - S.objective_margin * j.abs();
     Ok(GlobalOptimality {

@@ -22,6 +22,7 @@ use super::settings::S;
 use super::{OptError, Problem};
 use crate::eye_safety::bound::{Laser, Rule, Seg, RATIO_MARGIN};
 use crate::eye_safety::cuts::{cuts_for, Cut};
+use crate::eye_safety::head::bound::head_figures_on;
 use crate::eye_safety::{exposure, EyeSafetyParams};
 use crate::model::angle::{next_index, wrap_deg, Arc, Binning};
 use crate::model::lidar::PowerAccounting;
@@ -150,11 +151,30 @@ fn eye(problem: &Problem) -> Result<Option<Eye>, OptError> {
             field: "limits.eye_safety".into(),
             reason: e.to_string(),
         })?;
+    warm_head(params, &laser);
     Ok(Some(Eye {
         params: params.clone(),
         laser,
         pulse_rate_hz: problem.lidar.pulse_rate_hz,
     }))
+}
+
+/// Computes the head's figures on every surface its verdict covers, one
+/// surface per thread, before the first verdict asks for them one after
+/// another: what depends on the head alone is kept
+/// (`head::bound::HeadOverlaps`, shared by all threads), so the verdicts
+/// find it computed. An error is left for the verdict to report.
+fn warm_head(params: &EyeSafetyParams, laser: &Laser) {
+    use rayon::prelude::*;
+    let Some(head) = &params.head else {
+        return;
+    };
+    if let Ok(surfaces) = exposure::surfaces(head) {
+        surfaces.par_iter().for_each(|(h, surface)| {
+            // The figures that do not depend on the spin (no widening).
+            let _ = head_figures_on(h, *surface, params, laser, 0.0);
+        });
+    }
 }
 
 /// The bins as the eye-safety model sees them.

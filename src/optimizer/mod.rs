@@ -282,11 +282,18 @@ pub fn optimize_with_certificate(
         field: "gaze-deg".into(),
         reason: e.to_string(),
     })?;
+    // The global bound does not depend on the answer: it is computed
+    // alongside the solve (its threads fill the solve's serial HiGHS
+    // phases); both are deterministic, so the output is the same bits.
+    let (solved, upper_bound) = rayon::join(
+        || lp::solve(problem, gaze_deg),
+        || global::upper_bound(problem, gaze_deg),
+    );
     let lp::Solution {
         mut profile,
         power,
         dwell,
-    } = lp::solve(problem, gaze_deg)?;
+    } = solved?;
     let dwell_figures = dwell
         .as_ref()
         .and_then(|d| d.last.as_ref().ok().map(|c| c.step_figures(d.programs)));
@@ -320,7 +327,9 @@ pub fn optimize_with_certificate(
         o.dwell_step = dwell_figures;
     }
     if profile.optimality.is_some() {
-        let global = global::bound(problem, gaze_deg, &profile).ok();
+        let global = upper_bound
+            .and_then(|ub| global::bound(problem, gaze_deg, &profile, ub))
+            .ok();
         if let Some(opt) = profile.optimality.as_mut() {
             opt.global = global;
         }

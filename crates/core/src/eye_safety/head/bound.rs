@@ -36,8 +36,7 @@
 //! A 1-channel head is the single-channel bound times 1.0: the same bits.
 
 use serde::Serialize;
-use std::cell::RefCell;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use super::geometry::{footprints_on, Footprint, Surface};
 use super::overlap;
@@ -471,7 +470,7 @@ pub fn energy_ratios(
 /// Everything but the two enumerations whose boxes widen with the fastest
 /// spin (`W_g` and `W_inst`) depends on the head, the band's aperture and
 /// the grouping window alone: it is computed once per head
-/// ([`HeadOverlaps`], kept per thread for the last [`MEMO_HEADS`] heads)
+/// ([`HeadOverlaps`], kept for the last [`MEMO_HEADS`] heads, shared by all threads)
 /// and the same for every profile.
 pub fn head_figures(
     head: &Head,
@@ -617,8 +616,7 @@ impl HeadOverlaps {
     }
 }
 
-/// Heads whose [`HeadOverlaps`] each thread keeps (the most recently
-/// computed ones).
+/// Heads whose [`HeadOverlaps`] are kept (the most recently asked for).
 pub const MEMO_HEADS: usize = 8;
 
 /// A kept head: its inputs, compared bit for bit, and its figures.
@@ -627,12 +625,15 @@ struct Memo {
     surface: Surface,
     aperture_bits: u64,
     group_window_bits: u64,
-    overlaps: Rc<HeadOverlaps>,
+    overlaps: Arc<OnceLock<Arc<HeadOverlaps>>>,
 }
 
-std::thread_local! {
-    static MEMO: RefCell<Vec<Memo>> = const { RefCell::new(Vec::new()) };
-}
+/// The kept heads, shared by every thread. The list's lock is held only to
+/// find or add an entry; the entry's figures are computed once, outside
+/// it, by the first thread that asks (a thread asking for a head another
+/// is computing waits for that one, not for other heads): the optimizer
+/// certifies profiles and bounds the problem on two threads at once.
+static MEMO: Mutex<Vec<Memo>> = Mutex::new(Vec::new());
 
 /// Whether two heads are the same bits (`==` would take `-0.0` for `0.0`).
 fn same_bits(a: &Head, b: &Head) -> bool {
@@ -653,44 +654,54 @@ fn same_bits(a: &Head, b: &Head) -> bool {
         })
 }
 
-/// [`HeadOverlaps::new`], kept per thread: a head evaluated again (every
-/// frame of a stream, every profile of an optimizer run) reuses its figures,
-/// the same values as computing them again.
+/// [`HeadOverlaps::new`], kept: a head evaluated again (every frame of a
+/// stream, every profile of an optimizer run, on any thread) reuses its
+/// figures, the same values as computing them again.
 fn head_overlaps(
     head: &Head,
     surface: Surface,
     aperture_mm: f64,
     group_window_s: f64,
-) -> Rc<HeadOverlaps> {
+) -> Arc<HeadOverlaps> {
     let (aperture_bits, group_window_bits) = (aperture_mm.to_bits(), group_window_s.to_bits());
-    MEMO.with(|memo| {
-        let mut memo = memo.borrow_mut();
-        if let Some(m) = memo.iter().find(|m| {
+    let entry = {
+        // The list is whole between statements, so a lock poisoned by a
+        // panic elsewhere is taken over.
+        let mut memo = MEMO
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let found = memo.iter().find(|m| {
             m.aperture_bits == aperture_bits
                 && m.surface == surface
                 && m.group_window_bits == group_window_bits
                 && same_bits(&m.head, head)
-        }) {
-            return Rc::clone(&m.overlaps);
+        });
+        match found {
+            Some(m) => Arc::clone(&m.overlaps),
+            None => {
+                if memo.len() >= MEMO_HEADS {
+                    memo.remove(0);
+                }
+                let overlaps = Arc::new(OnceLock::new());
+                memo.push(Memo {
+                    head: head.clone(),
+                    surface,
+                    aperture_bits,
+                    group_window_bits,
+                    overlaps: Arc::clone(&overlaps),
+                });
+                overlaps
+            }
         }
-        let overlaps = Rc::new(HeadOverlaps::new(
+    };
+    Arc::clone(entry.get_or_init(|| {
+        Arc::new(HeadOverlaps::new(
             head,
             surface,
             aperture_mm,
             group_window_s,
-        ));
-        if memo.len() >= MEMO_HEADS {
-            memo.remove(0);
-        }
-        memo.push(Memo {
-            head: head.clone(),
-            surface,
-            aperture_bits,
-            group_window_bits,
-            overlaps: Rc::clone(&overlaps),
-        });
-        overlaps
-    })
+        ))
+    }))
 }
 
 /// `k` of [`HeadFigures::union_passes`]: channel `c` meets an aperture at
@@ -1032,6 +1043,48 @@ mod tests {
         assert_eq!(signed, heads[0]);
         assert!(!same_bits(&signed, &heads[0]));
         assert!(same_bits(&heads[0].clone(), &heads[0]));
+    }
+
+    /// A head is kept for every thread: two threads asking for it at once
+    /// get one computation (the same figures, not two equal copies), and a
+    /// thread asking later gets that one too. (Kept per thread, each would
+    /// compute its own.) Other tests running at the same time add heads and
+    /// may push this one out between two calls, so the check may take a few
+    /// tries; kept per thread, no try passes.
+    #[test]
+    fn two_threads_share_one_kept_head() {
+        // Offsets no other test uses, so the head is this test's own.
+        let head = column(&[0.0, 2e-5, 4e-5], &[0.31, 1.77, 2.93]);
+        let t_g = 1e-3;
+        let shared = |surface: Surface| {
+            let barrier = std::sync::Barrier::new(2);
+            let ask = || {
+                barrier.wait();
+                head_overlaps(&head, surface, 7.0, t_g)
+            };
+            let (a, b) = std::thread::scope(|s| {
+                let (one, two) = (s.spawn(ask), s.spawn(ask));
+                (one.join().unwrap(), two.join().unwrap())
+            });
+            let later = std::thread::scope(|s| {
+                s.spawn(|| head_overlaps(&head, surface, 7.0, t_g))
+                    .join()
+                    .unwrap()
+            });
+            Arc::ptr_eq(&a, &b) && Arc::ptr_eq(&a, &later)
+        };
+        for surface in [Surface::Cylinder, Surface::Sphere] {
+            assert!(
+                (0..8).any(|_| shared(surface)),
+                "{surface:?}: every try computed the head more than once"
+            );
+        }
+        // Another surface is another entry.
+        let (c, s) = (
+            head_overlaps(&head, Surface::Cylinder, 7.0, t_g),
+            head_overlaps(&head, Surface::Sphere, 7.0, t_g),
+        );
+        assert!(!Arc::ptr_eq(&c, &s));
     }
 
     fn figures(count_vertical: u32, slots_vertical: u32, union_passes: u32) -> HeadFigures {
