@@ -19,6 +19,18 @@ pub struct OptimizerSettings {
     /// relative (`optimality.global.objective` 8.864885452179 either way).
     /// Columns without a trust region keep `utility_segments`.
     pub trust_region_segments: usize,
+    /// Widest `√`-span of a utility's box spread evenly over its chords
+    /// (default 2, a box from 0 to 4 times the mean). A wider box (a
+    /// `power_w_max` far above the budget) keeps `utility_segments −
+    /// utility_tail_segments` chords evenly on the first 2 of `√` and the
+    /// rest geometric in `√` up to the box's end: evenly over a box to
+    /// 12,500 × the mean, the first chord alone ran to 48.8 × (linear
+    /// there), and the power step put a 36-bin budget into one bin, 5 ×
+    /// below the uniform profile's objective. Every shipped config's boxes
+    /// are narrower (chords unchanged).
+    pub utility_dense_sqrt_span: f64,
+    /// Chords of a wide box's geometric tail (default 4).
+    pub utility_tail_segments: usize,
     /// Tie-break added to the weights, growing with signed eccentricity
     /// (default 1e-3): makes the optimum unique where the acuity is
     /// symmetric about the gaze, and is itself rotation-equivariant (a
@@ -207,6 +219,8 @@ impl OptimizerSettings {
     pub const DEFAULT: Self = Self {
         utility_segments: 16,
         trust_region_segments: 4,
+        utility_dense_sqrt_span: 2.0,
+        utility_tail_segments: 4,
         tie_break: 1e-3,
         max_bins: 1440,
         margin: 1e-6,

@@ -1,8 +1,9 @@
 //! The concave piecewise-linear utilities of the steps, as *segments*.
 //!
 //! `√v` on `[lo, hi]` is approximated from below by its chords between
-//! [`super::UTILITY_SEGMENTS`] + 1 nodes spread evenly in `√` (`sqrt_chords`
-//! in `lp.rs` lists the same chords as lines). A concave piecewise-linear
+//! [`super::UTILITY_SEGMENTS`] + 1 nodes spread evenly in `√` ([`nodes`];
+//! a box wider than [`super::OptimizerSettings::utility_dense_sqrt_span`]
+//! in `√` keeps its geometric tail for the far end). A concave piecewise-linear
 //! function `h` with nodes `v_0 = lo < v_1 < … < v_K = hi` and decreasing
 //! slopes `a_k` is, for every `v ∈ [lo, hi]`,
 //!
@@ -38,15 +39,47 @@ pub(super) fn sqrt_segments(lo: f64, hi: f64) -> SqrtSegments {
 
 /// [`sqrt_segments`] with `k` chords.
 pub(super) fn sqrt_segments_n(lo: f64, hi: f64, k: usize) -> SqrtSegments {
-    let (a, b) = (lo.max(0.0).sqrt(), hi.max(lo).sqrt());
-    let node = |j: usize| (a + (b - a) * j as f64 / k as f64).powi(2);
-    let segments = (0..k)
-        .filter_map(|j| {
-            let (x0, x1) = (node(j), node(j + 1));
+    let v = nodes(lo, hi, k);
+    let segments = v
+        .windows(2)
+        .filter_map(|w| {
+            let (x0, x1) = (w[0], w[1]);
             (x1 > x0).then(|| ((x1.sqrt() - x0.sqrt()) / (x1 - x0), x1 - x0))
         })
         .collect();
-    SqrtSegments { base: a, segments }
+    SqrtSegments {
+        base: lo.max(0.0).sqrt(),
+        segments,
+    }
+}
+
+/// The `k + 1` chord nodes of `[lo, hi]`, ascending from `lo` to
+/// `max(lo, hi)`: evenly spaced in `√`, or, when the box spans more than
+/// `utility_dense_sqrt_span` in `√` (and `k` leaves room), `k − tail`
+/// chords evenly on that first span and `tail` geometric in `√` from its
+/// end to `√hi` (every chord of `√` lies below it, wherever its nodes).
+pub(super) fn nodes(lo: f64, hi: f64, k: usize) -> Vec<f64> {
+    let s = &super::OptimizerSettings::DEFAULT;
+    let (a, b) = (lo.max(0.0).sqrt(), hi.max(lo).sqrt());
+    let tail = s.utility_tail_segments;
+    let dense_end = a + s.utility_dense_sqrt_span;
+    let roots: Vec<f64> = if b <= dense_end || k <= tail + 1 || dense_end <= 0.0 {
+        (0..=k).map(|j| a + (b - a) * j as f64 / k as f64).collect()
+    } else {
+        let dense = k - tail;
+        let ratio = (b / dense_end).powf(1.0 / tail as f64);
+        (0..=dense)
+            .map(|j| a + (dense_end - a) * j as f64 / dense as f64)
+            .chain((1..=tail).map(|j| {
+                if j == tail {
+                    b
+                } else {
+                    dense_end * ratio.powi(j as i32)
+                }
+            }))
+            .collect()
+    };
+    roots.iter().map(|r| r.powi(2)).collect()
 }
 
 /// Relative shortfall left when a fill is computed in floating point, so
@@ -114,14 +147,12 @@ mod tests {
     /// The chords as lines, written independently of the segments: the
     /// minimum of the lines through consecutive nodes.
     fn chord_min(lo: f64, hi: f64, v: f64) -> f64 {
-        let (a, b) = (lo.sqrt(), hi.sqrt());
-        let k = crate::optimizer::UTILITY_SEGMENTS;
-        (0..k)
-            .map(|j| {
-                let x0 = (a + (b - a) * j as f64 / k as f64).powi(2);
-                let x1 = (a + (b - a) * (j + 1) as f64 / k as f64).powi(2);
-                let s = (x1.sqrt() - x0.sqrt()) / (x1 - x0);
-                x0.sqrt() + s * (v - x0)
+        let x = nodes(lo, hi, crate::optimizer::UTILITY_SEGMENTS);
+        x.windows(2)
+            .filter(|w| w[1] > w[0])
+            .map(|w| {
+                let s = (w[1].sqrt() - w[0].sqrt()) / (w[1] - w[0]);
+                w[0].sqrt() + s * (v - w[0])
             })
             .fold(f64::INFINITY, f64::min)
     }
@@ -134,6 +165,9 @@ mod tests {
             (0.05, 1.3),
             (0.4, 0.400001),
             (3.0, 3.0),
+            (0.0, 12_500.0),
+            (0.3, 125.0),
+            (2.0, 9.5),
         ] {
             let s = sqrt_segments(lo, hi);
             for w in s.segments.windows(2) {
@@ -147,10 +181,42 @@ mod tests {
                 assert!(h <= v.sqrt() + 1e-12, "{lo} {hi} {v}: {h} above √");
                 if hi > lo {
                     let c = chord_min(lo, hi, v);
-                    assert!((h - c).abs() <= 1e-12, "{lo} {hi} {v}: {h} vs chords {c}");
+                    assert!(
+                        (h - c).abs() <= 1e-12 * c.abs().max(1.0),
+                        "{lo} {hi} {v}: {h} vs chords {c}"
+                    );
                 }
             }
         }
+    }
+
+    /// A box far wider than the budget's mean (`power_w_max` 12,500 ×
+    /// the mean) keeps chords near the mean: the utility at 0.25–4 × the
+    /// mean within 1.2 % of `√` (evenly over the box, the first chord ran
+    /// to 48.8 and gave 0.14 at the mean). Its nodes rise and end at `hi`;
+    /// a box up to 4 × the mean keeps the even nodes.
+    #[test]
+    fn a_wide_box_keeps_its_chords_near_the_mean() {
+        let s = sqrt_segments(0.0, 12_500.0);
+        for v in [0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0] {
+            let h = s.value(0.0, v);
+            assert!(h >= 0.988 * v.sqrt(), "{v}: {h}");
+        }
+        let x = nodes(0.0, 12_500.0, 16);
+        assert_eq!(x.len(), 17);
+        assert!(x.windows(2).all(|w| w[1] > w[0]));
+        assert!((x[16] - 12_500.0).abs() <= 1e-9 * 12_500.0);
+        assert_eq!(x[12], 4.0);
+        let even = |lo: f64, hi: f64| -> Vec<f64> {
+            let (a, b) = (lo.sqrt(), hi.sqrt());
+            (0..=16)
+                .map(|j| (a + (b - a) * f64::from(j) / 16.0).powi(2))
+                .collect()
+        };
+        for (lo, hi) in [(0.0, 4.0), (0.2, 1.25), (0.5, 3.0), (1.0, 9.0)] {
+            assert_eq!(nodes(lo, hi, 16), even(lo, hi), "[{lo}, {hi}]");
+        }
+        assert_ne!(nodes(0.0, 4.01, 16), even(0.0, 4.01));
     }
 
     #[test]
