@@ -1518,7 +1518,13 @@ fn dwell_step(
     current: &[f64],
 ) -> Result<DwellStep, OptError> {
     let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, false)?;
-    let choice = SetPointChoice::new(&d, g);
+    // Under time accounting the `budget` row `Σ τ_i·p_i/P̄ ≤ N` holds
+    // whenever `Σ τ_i ≤ N / max_i(p_i/P̄)`: the heuristic's band ends there
+    // too (the frame band alone reaches above `N`).
+    let spend = (problem.lidar.power_accounting == PowerAccounting::Time).then(|| {
+        p.iter().fold(0.0_f64, |m, &pi| m.max(pi)) / problem.lidar.average_power_w
+    });
+    let choice = SetPointChoice::new(&d, g, spend);
     let solved = d.lp.solve_with(
         "dwell",
         &SolveOptions {
@@ -1800,8 +1806,12 @@ struct SetPointChoice {
 
 impl SetPointChoice {
     /// `None` unless every bin has the same set-points' `τ` (equal bins)
-    /// and the program's columns are the set-points' binaries.
-    fn new(d: &DwellProgram, g: &Grid) -> Option<Self> {
+    /// and the program's columns are the set-points' binaries. With
+    /// `spend` (the largest `p_i/P̄` of a time-accounted budget row), the
+    /// band's top is also `N/spend`, lowered by a relative 10⁻¹² (the float
+    /// sums' rounding and the row coefficients' `r_k·p_i/P̄` products, some
+    /// 10⁻¹³, stay inside it), so the point meets the budget row exactly.
+    fn new(d: &DwellProgram, g: &Grid, spend: Option<f64>) -> Option<Self> {
         let n = g.n;
         if d.sp_cols.len() != n || n == 0 || !equal_bins(g) {
             return None;
@@ -1828,7 +1838,13 @@ impl SetPointChoice {
             cols,
             cost,
             r,
-            band: (nf * (1.0 - tol * 0.5), nf * (1.0 + tol * 0.5)),
+            band: (
+                nf * (1.0 - tol * 0.5),
+                match spend {
+                    Some(q) if q > 0.0 => (nf * (1.0 + tol * 0.5)).min(nf / q * (1.0 - 1e-12)),
+                    _ => nf * (1.0 + tol * 0.5),
+                },
+            ),
             columns: d.lp.len(),
         })
     }
