@@ -2048,6 +2048,19 @@ fn spins_of(g: &Grid, t: &[f64], smooth: bool, frame_rate_hz: f64) -> Vec<(f64, 
         .collect()
 }
 
+/// Whether every bin of `spins` ramps within the acceleration limit
+/// (`a = (ω_end² − ω_start²)/(2θ)`, the profile's constant acceleration),
+/// with no tolerance: the checker allows a relative 10⁻⁹ more.
+fn meets_accel(g: &Grid, spins: &[(f64, f64)], limit: Option<f64>) -> bool {
+    let Some(a_max) = limit else {
+        return true;
+    };
+    spins
+        .iter()
+        .zip(&g.theta)
+        .all(|(&(w0, w1), th)| ((w1 * w1 - w0 * w0) / (2.0 * th)).abs() <= a_max)
+}
+
 /// What [`solve`] hands out: the (uncertified) profile, the final power
 /// step's program (none when the power does not move) and the dwell
 /// steps' certificates.
@@ -2119,6 +2132,14 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
     }
     let smooth = lid.limits.spin_accel_rad_s2_max.is_some() && mode.controls_resolution();
     let mut spins = spins_of(&g, &it.t, smooth, lid.frame_rate_hz);
+    if smooth && !meets_accel(&g, &spins, lid.limits.spin_accel_rad_s2_max) {
+        // The sequential LP's rows are linearised (and the rebuilt spin is
+        // rescaled to the frame period): under a limit too small for any
+        // modulation the ramps it leaves can exceed it. The uniform spin
+        // meets every limit the rounds started from.
+        spins = vec![(w_mean, w_mean); g.n];
+        it.t = dwell_of(&g, &spins);
+    }
     if smooth && mode.controls_range() {
         // Final power step on the exact spin of the rebuilt profile.
         let mut pool = ctx.warm(&spins, &it.p);

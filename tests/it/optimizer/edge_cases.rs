@@ -741,3 +741,30 @@ fn an_unreadable_optimality_block_is_named_not_refused() {
         "{e}"
     );
 }
+
+/// An acceleration limit too small for any modulation in a turn (the
+/// uniform spin meets it, a limit of 0 included): the sequential LP's
+/// linearised rows left ramps of 0.049 rad/s² against 10⁻³, and a limit of
+/// 0 a ramp of 2·10⁻¹¹, so the optimizer's own profile failed the checker.
+/// Every such request is answered and certified, within the limit.
+#[test]
+fn an_acceleration_limit_too_small_to_modulate_keeps_the_uniform_spin() {
+    for (a, bins) in [(0.0, 36), (1e-5, 36), (1e-3, 36), (3e-2, 36), (1e-3, 360)] {
+        for mode in ["joint", "resolution"] {
+            let toml = format!(
+                "bins = {bins}\n[limits]\nspin_accel_rad_s2_max = {a:?}\n[objective]\nmode = \"{mode}\"\n"
+            );
+            let problem = OptimizerConfig::from_toml(&toml, "accel.toml")
+                .unwrap()
+                .problem()
+                .unwrap();
+            let certified = optimize(&problem, 90.0)
+                .unwrap_or_else(|e| panic!("{a} {mode} {bins}: {e}"));
+            for b in &certified.profile().bins {
+                let accel = (b.spin_end_rad_s.powi(2) - b.spin_start_rad_s.powi(2))
+                    / (2.0 * b.width_deg.to_radians());
+                assert!(accel.abs() <= a, "{a} {mode} {bins}: {accel}");
+            }
+        }
+    }
+}
