@@ -50,6 +50,15 @@ pub enum Infeasible {
         /// The average power budget, W.
         average_power_w: f64,
     },
+    /// Every hardware power level within the limits is above the average
+    /// power budget: any profile of them spends more.
+    #[error("every power level within [power_w_min, power_w_max] (levels.power_w; the lowest {level_w:.4e} W) exceeds the average power budget {average_power_w:.4e} W")]
+    LevelsOverBudget {
+        /// The lowest level within the limits, W.
+        level_w: f64,
+        /// The average power budget, W.
+        average_power_w: f64,
+    },
     /// A bin's single-pulse eye-safety cap (at its spin) is below the power floor.
     #[error("eye-safety cap {cap_w:.4e} W at {wavelength_nm} nm in bin {bin} (the single-pulse limit at this spin) is below power_w_min {power_w_min:.4e} W")]
     EyeCapBelowFloor {

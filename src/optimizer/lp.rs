@@ -243,6 +243,25 @@ fn prechecks(problem: &Problem, eye: Option<&Eye>) -> Result<(), OptError> {
         }
         .into());
     }
+    // Every bin at a level at or above the lowest (either accounting:
+    // the mean over angle or over time is at least the lowest level).
+    let lowest_level = problem
+        .levels
+        .power_w
+        .iter()
+        .copied()
+        .filter(|&v| v >= l.power_w_min && v <= l.power_w_max)
+        .fold(f64::INFINITY, f64::min);
+    if problem.objective.mode.controls_range()
+        && lowest_level.is_finite()
+        && lowest_level > lid.average_power_w * (1.0 + crate::checker::REL_TOL)
+    {
+        return Err(Infeasible::LevelsOverBudget {
+            level_w: lowest_level,
+            average_power_w: lid.average_power_w,
+        }
+        .into());
+    }
     if l.power_w_min > l.power_w_max {
         return Err(OptError::Invalid {
             field: "limits.power_w_min".into(),
@@ -1521,9 +1540,8 @@ fn dwell_step(
     // Under time accounting the `budget` row `Σ τ_i·p_i/P̄ ≤ N` holds
     // whenever `Σ τ_i ≤ N / max_i(p_i/P̄)`: the heuristic's band ends there
     // too (the frame band alone reaches above `N`).
-    let spend = (problem.lidar.power_accounting == PowerAccounting::Time).then(|| {
-        p.iter().fold(0.0_f64, |m, &pi| m.max(pi)) / problem.lidar.average_power_w
-    });
+    let spend = (problem.lidar.power_accounting == PowerAccounting::Time)
+        .then(|| p.iter().fold(0.0_f64, |m, &pi| m.max(pi)) / problem.lidar.average_power_w);
     let choice = SetPointChoice::new(&d, g, spend);
     let solved = d.lp.solve_with(
         "dwell",

@@ -758,8 +758,8 @@ fn an_acceleration_limit_too_small_to_modulate_keeps_the_uniform_spin() {
                 .unwrap()
                 .problem()
                 .unwrap();
-            let certified = optimize(&problem, 90.0)
-                .unwrap_or_else(|e| panic!("{a} {mode} {bins}: {e}"));
+            let certified =
+                optimize(&problem, 90.0).unwrap_or_else(|e| panic!("{a} {mode} {bins}: {e}"));
             for b in &certified.profile().bins {
                 let accel = (b.spin_end_rad_s.powi(2) - b.spin_start_rad_s.powi(2))
                     / (2.0 * b.width_deg.to_radians());
@@ -767,4 +767,34 @@ fn an_acceleration_limit_too_small_to_modulate_keeps_the_uniform_spin() {
             }
         }
     }
+}
+
+/// Every hardware power level above the budget: refused naming the levels
+/// and the budget (it blamed "36 eye-safety cuts"), with the lowest level;
+/// the same request with one level at the budget is solved.
+#[test]
+fn levels_all_above_the_budget_are_named() {
+    let config = |levels: &str| {
+        format!("bins = 36\n[lidar]\naverage_power_w = 1e-3\n[limits]\npower_w_max = 2e-3\n[levels]\npower_w = [{levels}]\n[objective]\nmode = \"range\"\n")
+    };
+    let problem = |levels: &str| {
+        OptimizerConfig::from_toml(&config(levels), "levels.toml")
+            .unwrap()
+            .problem()
+            .unwrap()
+    };
+    match optimize(&problem("1.1e-3, 1.2e-3"), 90.0) {
+        Err(OptError::Infeasible(
+            e @ gaze_lidar::optimizer::Infeasible::LevelsOverBudget { .. },
+        )) => {
+            let msg = e.to_string();
+            assert!(
+                msg.contains("levels.power_w") && msg.contains("1.1000e-3 W"),
+                "{msg}"
+            );
+            assert!(msg.contains("budget 1.0000e-3 W"), "{msg}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(optimize(&problem("1.0e-3, 1.2e-3"), 90.0).is_ok());
 }
