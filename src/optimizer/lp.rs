@@ -2067,16 +2067,19 @@ fn spins_of(g: &Grid, t: &[f64], smooth: bool, frame_rate_hz: f64) -> Vec<(f64, 
 }
 
 /// Whether every bin of `spins` ramps within the acceleration limit
-/// (`a = (ω_end² − ω_start²)/(2θ)`, the profile's constant acceleration),
-/// with no tolerance: the checker allows a relative 10⁻⁹ more.
+/// (`a = (ω_end² − ω_start²)/(2θ)`, the profile's constant acceleration)
+/// to half the checker's relative tolerance: what passes here the checker
+/// accepts (its own rounding of `a` is ulps), and a ramp the checker would
+/// accept is not thrown away for being a hair above the limit.
 fn meets_accel(g: &Grid, spins: &[(f64, f64)], limit: Option<f64>) -> bool {
     let Some(a_max) = limit else {
         return true;
     };
+    let top = a_max + 0.5 * crate::checker::REL_TOL * a_max.abs().max(f64::MIN_POSITIVE);
     spins
         .iter()
         .zip(&g.theta)
-        .all(|(&(w0, w1), th)| ((w1 * w1 - w0 * w0) / (2.0 * th)).abs() <= a_max)
+        .all(|(&(w0, w1), th)| ((w1 * w1 - w0 * w0) / (2.0 * th)).abs() <= top)
 }
 
 /// What [`solve`] hands out: the (uncertified) profile, the final power
