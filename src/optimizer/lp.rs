@@ -435,6 +435,13 @@ fn power_step(
         match checkpoint {
             Checkpoint::Certified => {
                 let top = factor[0].max(factor[1]);
+                let budget_price = program
+                    .lp
+                    .names()
+                    .iter()
+                    .position(|n| *n == "budget")
+                    .and_then(|r| solved.y.get(r))
+                    .map_or(0.0, |y| y.abs());
                 return Ok((
                     p,
                     PowerLp {
@@ -447,6 +454,7 @@ fn power_step(
                         floor_w: problem.lidar.limits.power_w_min,
                         y: solved.y,
                         solver_dual_bound: solved.solver_dual_bound,
+                        budget_price,
                     },
                 ));
             }
@@ -1414,6 +1422,10 @@ pub(super) struct PowerLp {
     floor_w: f64,
     y: Vec<f64>,
     solver_dual_bound: Option<f64>,
+    /// The `budget` row's multiplier (objective per unit of `Σ w_i x_i`,
+    /// `w_i` the bin's share of the frame under time accounting), 0 when
+    /// the row does not bind or there is none.
+    budget_price: f64,
 }
 
 impl PowerLp {
@@ -1535,8 +1547,12 @@ fn dwell_step(
     pulse_rate_hz: f64,
     p: &[f64],
     current: &[f64],
+    energy_price: f64,
 ) -> Result<DwellStep, OptError> {
-    let d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, false)?;
+    let mut d = dwell_program(problem, g, binding, pulse_rate_hz, p, current, false)?;
+    if energy_price > 0.0 {
+        price_energy(&mut d, p, problem.lidar.average_power_w, energy_price);
+    }
     // Under time accounting the `budget` row `Σ τ_i·p_i/P̄ ≤ N` holds
     // whenever `Σ τ_i ≤ N / max_i(p_i/P̄)`: the heuristic's band ends there
     // too (the frame band alone reaches above `N`).
@@ -1954,6 +1970,19 @@ fn bit_reversed(i: usize, n: usize) -> usize {
     }
 }
 
+/// The energy a dwell spends, priced into the dwell step's objective:
+/// `− price·Σ τ_i·p_i/P̄` (the `budget` row's form). At the power step's
+/// `budget` multiplier, the dwell step weighs the density it buys against
+/// the range the next power step would buy with the energy it frees.
+fn price_energy(d: &mut DwellProgram, p: &[f64], p_mean: f64, price: f64) {
+    for (form, &pi) in d.tau.iter().zip(p) {
+        for (v, a) in form.linear_coefficients() {
+            let j = d.lp.col(v);
+            d.lp.add_cost(j, -price * a * pi / p_mean);
+        }
+    }
+}
+
 /// `budget` under time accounting at the fixed powers `p`:
 /// `Σ τ_i·p_i/P̄ ≤ N`. No margin here: with uniform P̄ the budget is exactly
 /// tight. The power step that ends every joint solve trims the budget
@@ -2143,6 +2172,7 @@ pub(super) fn solve(problem: &Problem, gaze_deg: f64) -> Result<Solution, OptErr
         problem,
         g: &g,
         eye: eye.as_ref(),
+        gaze_deg,
     };
     let mode = problem.objective.mode;
     match mode {
@@ -2204,6 +2234,7 @@ struct Ctx<'a> {
     problem: &'a Problem,
     g: &'a Grid,
     eye: Option<&'a Eye>,
+    gaze_deg: f64,
 }
 
 impl Ctx<'_> {
@@ -2213,6 +2244,16 @@ impl Ctx<'_> {
         self.eye.map_or_else(Vec::new, |e| {
             e.cuts(&segs(self.g, spins, p), &[], S.binding)
         })
+    }
+
+    /// The binding cuts of an iterate, found afresh (a function of the
+    /// iterate alone, not of the loop's path).
+    fn binding(&self, spins: &[(f64, f64)], p: &[f64]) -> Vec<Cut> {
+        let f_p = self.problem.lidar.pulse_rate_hz;
+        self.warm(spins, p)
+            .into_iter()
+            .filter(|c| c.ratio(p, f_p) >= S.binding)
+            .collect()
     }
 
     /// Step spins of dwell `t` (one spin per bin).
@@ -2259,7 +2300,7 @@ fn range_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
 fn resolution_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
     let f_p = ctx.problem.lidar.pulse_rate_hz;
     for round in 0..ctx.spin_rounds() {
-        let step = match dwell_step(ctx.problem, ctx.g, &[], f_p, &it.p, &it.t) {
+        let step = match dwell_step(ctx.problem, ctx.g, &[], f_p, &it.p, &it.t, 0.0) {
             // See `joint_rounds`.
             Err(OptError::Infeasible(_)) if round > 0 => break,
             r => r?,
@@ -2282,7 +2323,7 @@ fn joint_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
     let rounds = ctx.spin_rounds().max(2);
     let mut binding: Vec<Cut> = Vec::new();
     for round in 0..rounds {
-        let step = match dwell_step(ctx.problem, ctx.g, &binding, f_p, &it.p, &it.t) {
+        let step = match dwell_step(ctx.problem, ctx.g, &binding, f_p, &it.p, &it.t, 0.0) {
             // A later round's program (re-linearised acceleration rows,
             // trust region, the budget at the new powers) can have no point
             // even though the iterate is a certified profile's (seen at
@@ -2308,13 +2349,56 @@ fn joint_rounds(ctx: &Ctx<'_>, it: &mut Iterate) -> Result<(), OptError> {
         }
         let sp = ctx.steps(&it.t);
         ctx.power(it, &sp)?;
-        // The binding cuts of the new iterate, found afresh (a function of
-        // the iterate alone, not of the loop's path).
-        binding = ctx
-            .warm(&sp, &it.p)
-            .into_iter()
-            .filter(|c| c.ratio(&it.p, f_p) >= S.binding)
-            .collect();
+        binding = ctx.binding(&sp, &it.p);
+    }
+    if !smooth_spin && ctx.problem.lidar.power_accounting == PowerAccounting::Time {
+        priced_rounds(ctx, it, binding)?;
+    }
+    Ok(())
+}
+
+/// Under time accounting the budget couples the steps (a bin's energy is
+/// its power times its dwell), and the loop above stops where neither
+/// step moves: the dwell step, the power fixed, has no reason to free
+/// energy. From there each round prices the energy in the dwell step at
+/// the last power step's `budget` multiplier ([`price_energy`]; the power
+/// step's row `Σ (t_i/T)·x_i ≤ 1` is the dwell step's `Σ τ_i·x_i ≤ N`
+/// over `N`), then runs the power step at the new dwell; a round is kept
+/// only if it raises the model objective (the exact utilities), and the
+/// first that does not ends the search. Every kept round is a dwell step
+/// and a power step like any other, with their certificates.
+fn priced_rounds(ctx: &Ctx<'_>, it: &mut Iterate, mut binding: Vec<Cut>) -> Result<(), OptError> {
+    let f_p = ctx.problem.lidar.pulse_rate_hz;
+    let n = ctx.g.n as f64;
+    let score = |p: &[f64], t: &[f64]| -> Result<f64, OptError> {
+        let sp = ctx.steps(t);
+        let profile = build_profile(ctx.problem, ctx.g, ctx.gaze_deg, p, &sp);
+        super::exact_objective(ctx.problem, ctx.gaze_deg, &profile)
+    };
+    let mut best = score(&it.p, &it.t)?;
+    for _ in 0..S.priced_rounds {
+        let price = it.last.as_ref().map_or(0.0, |l| l.budget_price) / n;
+        if !(price > 0.0 && price.is_finite()) {
+            break;
+        }
+        let Ok(step) = dwell_step(ctx.problem, ctx.g, &binding, f_p, &it.p, &it.t, price) else {
+            break;
+        };
+        let sp = ctx.steps(&step.t);
+        let mut pool = ctx.warm(&sp, &it.p);
+        let Ok((p, plp)) = power_step(ctx.problem, ctx.g, ctx.eye, &sp, &mut pool) else {
+            break;
+        };
+        let j = score(&p, &step.t)?;
+        if j.is_nan() || j <= best * (1.0 + S.priced_gain) {
+            break;
+        }
+        best = j;
+        let t = DwellCertificates::push(&mut it.dwell, step);
+        it.t = t;
+        it.p = p;
+        it.last = Some(plp);
+        binding = ctx.binding(&sp, &it.p);
     }
     Ok(())
 }

@@ -110,6 +110,11 @@ impl Program {
         self.columns[j].cost
     }
 
+    /// Adds `c` to the objective coefficient of column `j`.
+    pub fn add_cost(&mut self, j: usize, c: f64) {
+        self.columns[j].cost += c;
+    }
+
     /// Number of constraints (rows) so far: the next one's index.
     #[must_use]
     pub fn rows(&self) -> usize {

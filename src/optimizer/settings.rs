@@ -89,6 +89,12 @@ pub struct OptimizerSettings {
     /// Dwell-step iterations when the acceleration limit is finite (at
     /// most; default 5).
     pub slp_rounds: usize,
+    /// Priced block-coordinate rounds under time accounting without an
+    /// acceleration limit, at most (default 30; `lp::priced_rounds`).
+    pub priced_rounds: usize,
+    /// Relative rise of the model objective a priced round must bring to
+    /// be kept (default 1e-9; the first that brings less ends them).
+    pub priced_gain: f64,
     /// The sequential LP stops once a dwell step moves no bin's dwell by
     /// more than this (relative; default 1e-3). On `smooth` (360 bins,
     /// joint) the five rounds' moves were 2.7e-2, 7.6e-4, 2.4e-5, 3.2e-6,
@@ -233,6 +239,8 @@ impl OptimizerSettings {
         trust: 0.3,
         accel_share: 0.8,
         slp_rounds: 5,
+        priced_rounds: 30,
+        priced_gain: 1e-9,
         slp_settled: 1e-3,
         repair_tries: 40,
         primal_feasibility_tol: 1e-7,
