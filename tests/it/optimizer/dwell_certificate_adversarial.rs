@@ -59,12 +59,7 @@ fn explore_resolve_exported_programs() {
 
 use gaze_lidar::optimizer::{optimize_with_certificate, OptError, OptimizerConfig};
 
-fn problem_from_toml(text: &str) -> gaze_lidar::optimizer::Problem {
-    OptimizerConfig::from_toml(text, "attack")
-        .unwrap()
-        .problem()
-        .unwrap()
-}
+use super::problem_from_toml;
 
 /// Three spin set-points of the paper preset (20 Hz, mean spin 40π rad/s)
 /// chosen so that 100 bins at the first, 130 at the second and 130 at the

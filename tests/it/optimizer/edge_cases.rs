@@ -754,10 +754,7 @@ fn an_acceleration_limit_too_small_to_modulate_keeps_the_uniform_spin() {
             let toml = format!(
                 "bins = {bins}\n[limits]\nspin_accel_rad_s2_max = {a:?}\n[objective]\nmode = \"{mode}\"\n"
             );
-            let problem = OptimizerConfig::from_toml(&toml, "accel.toml")
-                .unwrap()
-                .problem()
-                .unwrap();
+            let problem = super::problem_from_toml(&toml);
             let certified =
                 optimize(&problem, 90.0).unwrap_or_else(|e| panic!("{a} {mode} {bins}: {e}"));
             for b in &certified.profile().bins {
@@ -777,12 +774,7 @@ fn levels_all_above_the_budget_are_named() {
     let config = |levels: &str| {
         format!("bins = 36\n[lidar]\naverage_power_w = 1e-3\n[limits]\npower_w_max = 2e-3\n[levels]\npower_w = [{levels}]\n[objective]\nmode = \"range\"\n")
     };
-    let problem = |levels: &str| {
-        OptimizerConfig::from_toml(&config(levels), "levels.toml")
-            .unwrap()
-            .problem()
-            .unwrap()
-    };
+    let problem = |levels: &str| super::problem_from_toml(&config(levels));
     match optimize(&problem("1.1e-3, 1.2e-3"), 90.0) {
         Err(OptError::Infeasible(
             e @ gaze_lidar::optimizer::Infeasible::LevelsOverBudget { .. },
@@ -812,10 +804,7 @@ fn a_time_accounted_joint_answer_is_near_its_global_bound() {
             .join("breakers/optimizer/repro/f2_time_joint.toml"),
     )
     .unwrap();
-    let problem = OptimizerConfig::from_toml(&text, "f2_time_joint.toml")
-        .unwrap()
-        .problem()
-        .unwrap();
+    let problem = super::problem_from_toml(&text);
     for gaze in [0.0, 90.0, 200.0, 323.89] {
         let certified = optimize(&problem, gaze).unwrap();
         let global = certified

@@ -16,3 +16,12 @@ mod perturb;
 mod setpoints;
 mod solve;
 mod units;
+
+/// The problem of an optimizer config's text (a test's own config, so any
+/// error is the test's: unwrapped).
+pub(super) fn problem_from_toml(text: &str) -> gaze_lidar::optimizer::Problem {
+    gaze_lidar::optimizer::OptimizerConfig::from_toml(text, "test.toml")
+        .unwrap()
+        .problem()
+        .unwrap()
+}

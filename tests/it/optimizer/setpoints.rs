@@ -125,10 +125,7 @@ fn setpoints_that_miss_the_frame_name_the_frame_period() {
 #[test]
 fn a_time_accounted_budget_caps_the_set_point_heuristic() {
     let text = "bins = 720\n[lidar]\npreset = \"vlp16\"\npower_accounting = \"time\"\n[limits]\nspin_accel_rad_s2_max = \"unlimited\"\n[levels]\nspin_rad_s = [60.645036, 62.83185307179586, 64.823745, 80.599347]\n[objective]\nmode = \"resolution\"\n";
-    let problem = OptimizerConfig::from_toml(text, "time.toml")
-        .unwrap()
-        .problem()
-        .unwrap();
+    let problem = super::problem_from_toml(text);
     let (profile, cert) = optimize_with_certificate(&problem, 145.16).unwrap();
     assert!(cert.is_ok(), "{:?}", cert.err());
     assert_eq!(profile.profile().bins.len(), 720);
