@@ -2096,19 +2096,20 @@ fn spins_of(g: &Grid, t: &[f64], smooth: bool, frame_rate_hz: f64) -> Vec<(f64, 
 }
 
 /// Whether every bin of `spins` ramps within the acceleration limit
-/// (`a = (ω_end² − ω_start²)/(2θ)`, the profile's constant acceleration)
-/// to half the checker's relative tolerance: what passes here the checker
-/// accepts (its own rounding of `a` is ulps), and a ramp the checker would
-/// accept is not thrown away for being a hair above the limit.
+/// (the profile's constant acceleration, [`BinMotion::accel_rad_s2`]) to
+/// half the checker's relative tolerance: what passes here the checker
+/// accepts, and a ramp the checker would accept is not thrown away for
+/// being a hair above the limit.
 fn meets_accel(g: &Grid, spins: &[(f64, f64)], limit: Option<f64>) -> bool {
+    use crate::profile::kinematics::BinMotion;
     let Some(a_max) = limit else {
         return true;
     };
     let top = a_max + 0.5 * crate::checker::REL_TOL * a_max.abs().max(f64::MIN_POSITIVE);
-    spins
+    // The power does not move the acceleration.
+    segs(g, spins, &vec![0.0; g.n])
         .iter()
-        .zip(&g.theta)
-        .all(|(&(w0, w1), th)| ((w1 * w1 - w0 * w0) / (2.0 * th)).abs() <= top)
+        .all(|s| s.accel_rad_s2().abs() <= top)
 }
 
 /// What [`solve`] hands out: the (uncertified) profile, the final power
